@@ -1,0 +1,59 @@
+//! The one error type of voxelkit. Every variant carries enough context (file, line, face)
+//! for a user to find the problem without a debugger.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in voxelkit.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path}:{line}: {message}")]
+    Parse {
+        path: PathBuf,
+        /// 1-based line number; 0 when the format has no lines (binary STL: see message).
+        line: usize,
+        message: String,
+    },
+    #[error("{path}: face {face}: {message}")]
+    BadFace {
+        path: PathBuf,
+        /// 0-based face index in file order.
+        face: usize,
+        message: String,
+    },
+    #[error("{path}: the mesh is empty ({message})")]
+    EmptyMesh { path: PathBuf, message: String },
+    #[error("{path}: unsupported file type (expected .obj or .stl)")]
+    UnsupportedFormat { path: PathBuf },
+    #[error("invalid argument: {0}")]
+    InvalidArgument(String),
+    #[error(
+        "resolution too large: an estimated {estimated_mib} MiB is needed but only {available_mib} MiB is available ({detail})"
+    )]
+    TooLarge {
+        estimated_mib: u64,
+        available_mib: u64,
+        detail: String,
+    },
+    #[error("{path}: OpenVDB: {message}")]
+    Vdb { path: PathBuf, message: String },
+    #[error("{0}")]
+    Unsupported(String),
+}
+
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    pub(crate) fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+}

@@ -1,0 +1,142 @@
+//! A dense bit volume over a box of voxel indices, for whole-volume passes (flooding,
+//! inside classification, neighbourhood tests) where hashing per voxel would dominate.
+
+use super::coord::{Coord, CoordBox};
+use super::sparse::SparseGrid;
+use crate::error::{Error, Result};
+
+#[derive(Clone, Debug)]
+pub struct DenseMask {
+    pub bbox: CoordBox,
+    dims: [usize; 3],
+    bits: Vec<u64>,
+}
+
+impl DenseMask {
+    /// An all-clear volume over `bbox`; refuses boxes over `2^34` voxels (2 GiB of bits).
+    pub fn new(bbox: CoordBox) -> Result<Self> {
+        let d = bbox.dim();
+        let total = d[0].checked_mul(d[1]).and_then(|v| v.checked_mul(d[2]));
+        match total {
+            Some(n) if n <= 1 << 34 => Ok(DenseMask {
+                bbox,
+                dims: d.map(|v| v as usize),
+                bits: vec![0; (n as usize).div_ceil(64)],
+            }),
+            _ => Err(Error::TooLarge {
+                estimated_mib: total.map_or(u64::MAX, |n| n / 8 / (1 << 20)),
+                available_mib: 2048,
+                detail: format!("a dense volume of {}x{}x{} voxels", d[0], d[1], d[2]),
+            }),
+        }
+    }
+
+    /// The active voxels of `grid` inside `bbox`.
+    pub fn from_grid(grid: &SparseGrid, bbox: CoordBox) -> Result<Self> {
+        let mut m = DenseMask::new(bbox)?;
+        for c in grid.voxels().filter(|&c| bbox.contains(c)) {
+            m.set(c);
+        }
+        Ok(m)
+    }
+
+    pub fn dims(&self) -> [usize; 3] {
+        self.dims
+    }
+
+    pub fn len(&self) -> usize {
+        self.dims[0] * self.dims[1] * self.dims[2]
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Linear index of `c`, which must lie in the box.
+    #[inline]
+    pub fn index(&self, c: Coord) -> usize {
+        let x = (c[0] - self.bbox.min[0]) as usize;
+        let y = (c[1] - self.bbox.min[1]) as usize;
+        let z = (c[2] - self.bbox.min[2]) as usize;
+        (x * self.dims[1] + y) * self.dims[2] + z
+    }
+
+    /// The coordinate of linear index `i`.
+    pub fn coord(&self, i: usize) -> Coord {
+        let z = i % self.dims[2];
+        let y = (i / self.dims[2]) % self.dims[1];
+        let x = i / (self.dims[1] * self.dims[2]);
+        [
+            self.bbox.min[0] + x as i64,
+            self.bbox.min[1] + y as i64,
+            self.bbox.min[2] + z as i64,
+        ]
+    }
+
+    #[inline]
+    pub fn get_index(&self, i: usize) -> bool {
+        self.bits[i >> 6] >> (i & 63) & 1 == 1
+    }
+
+    #[inline]
+    pub fn set_index(&mut self, i: usize) {
+        self.bits[i >> 6] |= 1 << (i & 63);
+    }
+
+    #[inline]
+    pub fn clear_index(&mut self, i: usize) {
+        self.bits[i >> 6] &= !(1 << (i & 63));
+    }
+
+    /// False outside the box.
+    pub fn get(&self, c: Coord) -> bool {
+        self.bbox.contains(c) && self.get_index(self.index(c))
+    }
+
+    pub fn set(&mut self, c: Coord) {
+        let i = self.index(c);
+        self.set_index(i);
+    }
+
+    pub fn count(&self) -> u64 {
+        self.bits.iter().map(|w| w.count_ones() as u64).sum()
+    }
+
+    /// Linear indices of the set voxels.
+    pub fn ones(&self) -> impl Iterator<Item = usize> + '_ {
+        self.bits.iter().enumerate().flat_map(|(w, &bits)| {
+            let mut b = bits;
+            std::iter::from_fn(move || {
+                if b == 0 {
+                    return None;
+                }
+                let t = b.trailing_zeros() as usize;
+                b &= b - 1;
+                Some(w * 64 + t)
+            })
+        })
+    }
+
+    /// Voxels set in both.
+    pub fn and_count(&self, other: &DenseMask) -> u64 {
+        assert_eq!(self.bbox, other.bbox, "masks over different boxes");
+        self.bits
+            .iter()
+            .zip(&other.bits)
+            .map(|(a, b)| (a & b).count_ones() as u64)
+            .sum()
+    }
+
+    /// First voxel set in both.
+    pub fn first_common(&self, other: &DenseMask) -> Option<Coord> {
+        assert_eq!(self.bbox, other.bbox, "masks over different boxes");
+        self.bits
+            .iter()
+            .zip(&other.bits)
+            .position(|(a, b)| a & b != 0)
+            .map(|w| {
+                let bit = (self.bits[w] & other.bits[w]).trailing_zeros() as usize;
+                self.coord(w * 64 + bit)
+            })
+    }
+}

@@ -1,0 +1,104 @@
+//! One 8x8x8 leaf: a 512-bit occupancy mask plus optional per-voxel channels, laid out
+//! exactly like an OpenVDB LeafNode (`n = x*64 + y*8 + z`; mask word `x`, bit `y*8+z`) so
+//! leaves cross the bridge as plain arrays.
+
+use super::coord::{Coord, LEAF_VOXELS, offset_coord};
+
+/// Which optional per-voxel channels a grid carries.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Channels {
+    /// One `f32` per voxel (the separating voxelizer stores the distance to the surface).
+    pub value: bool,
+    /// A unit normal per voxel.
+    pub normal: bool,
+    /// An RGB colour per voxel.
+    pub color: bool,
+}
+
+impl Channels {
+    pub const NONE: Channels = Channels {
+        value: false,
+        normal: false,
+        color: false,
+    };
+}
+
+#[derive(Clone, Debug)]
+pub struct Leaf {
+    /// Index of the leaf's (0,0,0) voxel; every component a multiple of 8.
+    pub origin: Coord,
+    pub mask: [u64; 8],
+    pub value: Option<Box<[f32; LEAF_VOXELS]>>,
+    pub normal: Option<Box<[[f32; 3]; LEAF_VOXELS]>>,
+    pub color: Option<Box<[[u8; 3]; LEAF_VOXELS]>>,
+}
+
+impl Leaf {
+    /// An empty leaf with storage for `channels`.
+    pub fn new(origin: Coord, channels: Channels) -> Self {
+        Leaf {
+            origin,
+            mask: [0; 8],
+            value: channels.value.then(|| Box::new([0.0; LEAF_VOXELS])),
+            normal: channels.normal.then(|| Box::new([[0.0; 3]; LEAF_VOXELS])),
+            color: channels.color.then(|| Box::new([[0; 3]; LEAF_VOXELS])),
+        }
+    }
+
+    #[inline]
+    pub fn is_on(&self, n: usize) -> bool {
+        self.mask[n >> 6] >> (n & 63) & 1 == 1
+    }
+
+    #[inline]
+    pub fn set_on(&mut self, n: usize) {
+        self.mask[n >> 6] |= 1 << (n & 63);
+    }
+
+    #[inline]
+    pub fn set_off(&mut self, n: usize) {
+        self.mask[n >> 6] &= !(1 << (n & 63));
+    }
+
+    /// Number of active voxels.
+    pub fn count(&self) -> u32 {
+        self.mask.iter().map(|w| w.count_ones()).sum()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.mask.iter().all(|&w| w == 0)
+    }
+
+    /// In-leaf offsets of the active voxels, ascending.
+    pub fn offsets(&self) -> impl Iterator<Item = usize> + '_ {
+        self.mask.iter().enumerate().flat_map(|(w, &bits)| {
+            let mut b = bits;
+            std::iter::from_fn(move || {
+                if b == 0 {
+                    return None;
+                }
+                let t = b.trailing_zeros() as usize;
+                b &= b - 1;
+                Some(w * 64 + t)
+            })
+        })
+    }
+
+    /// Coordinates of the active voxels.
+    pub fn coords(&self) -> impl Iterator<Item = Coord> + '_ {
+        self.offsets().map(|n| offset_coord(self.origin, n))
+    }
+
+    /// Copies the channels of voxel `n` from `other` (same channel set or a subset).
+    pub fn copy_channels_from(&mut self, other: &Leaf, n: usize) {
+        if let (Some(d), Some(s)) = (self.value.as_mut(), other.value.as_ref()) {
+            d[n] = s[n];
+        }
+        if let (Some(d), Some(s)) = (self.normal.as_mut(), other.normal.as_ref()) {
+            d[n] = s[n];
+        }
+        if let (Some(d), Some(s)) = (self.color.as_mut(), other.color.as_ref()) {
+            d[n] = s[n];
+        }
+    }
+}

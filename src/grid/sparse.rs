@@ -1,0 +1,265 @@
+//! The sparse voxel grid: leaves in a vector (cheap iteration, bulk transfer to OpenVDB)
+//! indexed by origin through a hash map.
+
+use super::coord::{Coord, CoordBox, leaf_offset, leaf_origin};
+use super::leaf::{Channels, Leaf};
+use super::transform::Transform;
+use rustc_hash::FxHashMap;
+
+#[derive(Clone, Debug, Default)]
+pub struct SparseGrid {
+    pub transform: Transform,
+    channels: Channels,
+    leaves: Vec<Leaf>,
+    index: FxHashMap<Coord, u32>,
+}
+
+impl SparseGrid {
+    pub fn new(transform: Transform, channels: Channels) -> Self {
+        SparseGrid {
+            transform,
+            channels,
+            leaves: Vec::new(),
+            index: FxHashMap::default(),
+        }
+    }
+
+    pub fn channels(&self) -> Channels {
+        self.channels
+    }
+
+    /// Builds a grid from leaves; leaves with the same origin are OR-ed together.
+    pub fn from_leaves(transform: Transform, channels: Channels, leaves: Vec<Leaf>) -> Self {
+        let mut g = SparseGrid::new(transform, channels);
+        for leaf in leaves {
+            g.merge_leaf(leaf, |dst, src| union_leaf(dst, src));
+        }
+        g
+    }
+
+    pub fn leaves(&self) -> &[Leaf] {
+        &self.leaves
+    }
+
+    pub fn leaf(&self, origin: Coord) -> Option<&Leaf> {
+        self.index.get(&origin).map(|&i| &self.leaves[i as usize])
+    }
+
+    /// Index of the leaf at `origin`, created empty when missing.
+    fn leaf_index_or_insert(&mut self, origin: Coord) -> usize {
+        if let Some(&i) = self.index.get(&origin) {
+            return i as usize;
+        }
+        let i = self.leaves.len();
+        self.leaves.push(Leaf::new(origin, self.channels));
+        self.index.insert(origin, i as u32);
+        i
+    }
+
+    pub fn leaf_mut_or_insert(&mut self, origin: Coord) -> &mut Leaf {
+        let i = self.leaf_index_or_insert(origin);
+        &mut self.leaves[i]
+    }
+
+    pub fn insert(&mut self, c: Coord) {
+        self.leaf_mut_or_insert(leaf_origin(c))
+            .set_on(leaf_offset(c));
+    }
+
+    pub fn contains(&self, c: Coord) -> bool {
+        self.leaf(leaf_origin(c))
+            .is_some_and(|l| l.is_on(leaf_offset(c)))
+    }
+
+    /// A write accessor that remembers the last leaf it touched.
+    pub fn accessor(&mut self) -> Accessor<'_> {
+        Accessor {
+            grid: self,
+            cached_origin: [i64::MIN; 3],
+            cached_index: 0,
+        }
+    }
+
+    pub fn voxel_count(&self) -> u64 {
+        self.leaves.iter().map(|l| l.count() as u64).sum()
+    }
+
+    /// Number of leaves holding at least one active voxel.
+    pub fn leaf_count(&self) -> usize {
+        self.leaves.iter().filter(|l| !l.is_empty()).count()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.leaves.iter().all(|l| l.is_empty())
+    }
+
+    /// Bounding box of the active voxels, `None` for an empty grid.
+    pub fn bbox(&self) -> Option<CoordBox> {
+        let mut b: Option<CoordBox> = None;
+        for leaf in self.leaves.iter().filter(|l| !l.is_empty()) {
+            // Only leaves on the current hull can move it; cheap enough to scan all voxels.
+            for c in leaf.coords() {
+                match b.as_mut() {
+                    Some(b) => b.expand(c),
+                    None => b = Some(CoordBox::point(c)),
+                }
+            }
+        }
+        b
+    }
+
+    /// Every active voxel.
+    pub fn voxels(&self) -> impl Iterator<Item = Coord> + '_ {
+        self.leaves.iter().flat_map(|l| l.coords())
+    }
+
+    /// Merges `leaf` into the leaf of the same origin with `combine(existing, incoming)`.
+    pub fn merge_leaf(&mut self, leaf: Leaf, combine: impl FnOnce(&mut Leaf, &Leaf)) {
+        match self.index.get(&leaf.origin) {
+            Some(&i) => combine(&mut self.leaves[i as usize], &leaf),
+            None => {
+                self.index.insert(leaf.origin, self.leaves.len() as u32);
+                self.leaves.push(leaf);
+            }
+        }
+    }
+
+    /// Merges every leaf of `other` into `self` with `combine(existing, incoming)`.
+    pub fn merge_with(&mut self, other: SparseGrid, mut combine: impl FnMut(&mut Leaf, &Leaf)) {
+        for leaf in other.leaves {
+            self.merge_leaf(leaf, &mut combine);
+        }
+    }
+
+    /// Voxels active in `self` or `other`; where both are, `self`'s channels are kept.
+    pub fn union(&mut self, other: &SparseGrid) {
+        for leaf in &other.leaves {
+            let i = self.leaf_index_or_insert(leaf.origin);
+            union_leaf(&mut self.leaves[i], leaf);
+        }
+    }
+
+    /// Voxels active in both grids.
+    pub fn intersection(&mut self, other: &SparseGrid) {
+        for leaf in &mut self.leaves {
+            match other.leaf(leaf.origin) {
+                Some(o) => (0..8).for_each(|w| leaf.mask[w] &= o.mask[w]),
+                None => leaf.mask = [0; 8],
+            }
+        }
+        self.prune();
+    }
+
+    /// Voxels active in `self` and not in `other`.
+    pub fn difference(&mut self, other: &SparseGrid) {
+        for leaf in &mut self.leaves {
+            if let Some(o) = other.leaf(leaf.origin) {
+                (0..8).for_each(|w| leaf.mask[w] &= !o.mask[w]);
+            }
+        }
+        self.prune();
+    }
+
+    /// Drops empty leaves.
+    pub fn prune(&mut self) {
+        self.leaves.retain(|l| !l.is_empty());
+        self.index = self
+            .leaves
+            .iter()
+            .enumerate()
+            .map(|(i, l)| (l.origin, i as u32))
+            .collect();
+    }
+}
+
+/// ORs `src` into `dst`, taking `src`'s channels only where `dst` was empty.
+fn union_leaf(dst: &mut Leaf, src: &Leaf) {
+    for w in 0..8 {
+        let new = src.mask[w] & !dst.mask[w];
+        let mut b = new;
+        while b != 0 {
+            let n = w * 64 + b.trailing_zeros() as usize;
+            dst.copy_channels_from(src, n);
+            b &= b - 1;
+        }
+        dst.mask[w] |= src.mask[w];
+    }
+}
+
+/// Write access with a one-leaf cache: consecutive writes into the same leaf skip the hash.
+pub struct Accessor<'g> {
+    grid: &'g mut SparseGrid,
+    cached_origin: Coord,
+    cached_index: usize,
+}
+
+impl Accessor<'_> {
+    /// The leaf holding `c` (created when missing) and the offset of `c` in it.
+    #[inline]
+    pub fn leaf_mut(&mut self, c: Coord) -> (&mut Leaf, usize) {
+        let origin = leaf_origin(c);
+        if origin != self.cached_origin {
+            self.cached_index = self.grid.leaf_index_or_insert(origin);
+            self.cached_origin = origin;
+        }
+        (&mut self.grid.leaves[self.cached_index], leaf_offset(c))
+    }
+
+    #[inline]
+    pub fn insert(&mut self, c: Coord) {
+        let (leaf, n) = self.leaf_mut(c);
+        leaf.set_on(n);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(coords: &[Coord]) -> SparseGrid {
+        let mut g = SparseGrid::default();
+        let mut acc = g.accessor();
+        coords.iter().for_each(|&c| acc.insert(c));
+        g
+    }
+
+    #[test]
+    fn counts_bbox_and_membership() {
+        let g = grid(&[[0, 0, 0], [9, -3, 2], [9, -3, 2], [-100, 5, 3000]]);
+        assert_eq!(g.voxel_count(), 3);
+        assert_eq!(g.leaf_count(), 3);
+        assert!(g.contains([9, -3, 2]) && !g.contains([9, -3, 3]));
+        let b = g.bbox().unwrap();
+        assert_eq!(b.min, [-100, -3, 0]);
+        assert_eq!(b.max, [9, 5, 3000]);
+        let mut all: Vec<_> = g.voxels().collect();
+        all.sort();
+        assert_eq!(all, vec![[-100, 5, 3000], [0, 0, 0], [9, -3, 2]]);
+    }
+
+    #[test]
+    fn boolean_operations_match_set_algebra() {
+        let a_pts: Vec<Coord> = (0..40).map(|i| [i, i % 7, -i]).collect();
+        let b_pts: Vec<Coord> = (20..60).map(|i| [i, i % 7, -i]).collect();
+        let (a, b) = (grid(&a_pts), grid(&b_pts));
+        let mut u = a.clone();
+        u.union(&b);
+        let mut i = a.clone();
+        i.intersection(&b);
+        let mut d = a.clone();
+        d.difference(&b);
+        assert_eq!(u.voxel_count(), 60);
+        assert_eq!(i.voxel_count(), 20);
+        assert_eq!(d.voxel_count(), 20);
+        assert!(i.voxels().all(|c| c[0] >= 20 && c[0] < 40));
+        assert!(d.voxels().all(|c| c[0] < 20));
+    }
+
+    #[test]
+    fn coordinates_beyond_2048_cubed_do_not_overflow() {
+        let big = 1i64 << 33;
+        let g = grid(&[[big, -big, big + 7], [-big, big, 0]]);
+        assert!(g.contains([big, -big, big + 7]));
+        assert_eq!(g.bbox().unwrap().max[0], big);
+    }
+}

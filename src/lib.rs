@@ -1,0 +1,13 @@
+//! voxelkit: voxelization with guaranteed topology.
+//!
+//! Meshes and analytic surfaces become sparse voxel grids whose separability is proven
+//! (Huang et al.), checked by flooding, and written as OpenVDB files.
+
+pub mod error;
+pub mod grid;
+pub mod io;
+pub mod mesh;
+pub mod ops;
+pub mod voxelize;
+
+pub use error::{Error, Result};

@@ -1,0 +1,65 @@
+//! Placing a mesh in index space.
+//!
+//! With `Resolution(R)` the voxel size is `longest bbox axis / R` and the bbox minimum lies
+//! on the lower face of voxel 0, so the bbox spans voxels `0..R` along its longest axis (and
+//! proportionally fewer on the others). No padding is stored in the sparse grid: surfaces
+//! reach at most one voxel beyond the bbox (index -1 and R), and dense consumers such as the
+//! flood fill add their own two-voxel border. `VoxelSize(h)` uses `h` with the same placement.
+
+use super::Aabb;
+use crate::error::{Error, Result};
+use crate::grid::Transform;
+
+/// How to choose the voxel size for a mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GridFit {
+    /// Voxels along the longest bbox axis.
+    Resolution(u32),
+    /// Voxel edge length in world units.
+    VoxelSize(f64),
+}
+
+/// The transform that places `bbox` in index space as described in the module docs.
+pub fn fit_transform(bbox: &Aabb, fit: GridFit) -> Result<Transform> {
+    let longest = bbox.extent().max_element();
+    let voxel_size = match fit {
+        GridFit::Resolution(0) => {
+            return Err(Error::InvalidArgument(
+                "resolution must be at least 1".into(),
+            ));
+        }
+        GridFit::Resolution(r) if longest > 0.0 => longest / r as f64,
+        GridFit::Resolution(_) => {
+            return Err(Error::InvalidArgument(
+                "the mesh has zero extent; give --voxel-size instead of --resolution".into(),
+            ));
+        }
+        GridFit::VoxelSize(h) if h.is_finite() && h > 0.0 => h,
+        GridFit::VoxelSize(h) => {
+            return Err(Error::InvalidArgument(format!(
+                "voxel size must be a positive number, got {h}"
+            )));
+        }
+    };
+    Ok(Transform::new(bbox.min + 0.5 * voxel_size, voxel_size))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn resolution_spans_the_longest_axis() {
+        let b = Aabb {
+            min: DVec3::new(-1.0, 0.0, 2.0),
+            max: DVec3::new(3.0, 1.0, 2.5),
+        };
+        let t = fit_transform(&b, GridFit::Resolution(8)).unwrap();
+        assert_eq!(t.voxel_size, 0.5);
+        assert_eq!(t.world_to_voxel(b.min + 1e-9), [0, 0, 0]);
+        assert_eq!(t.world_to_voxel(b.max - 1e-9), [7, 1, 0]);
+        assert!(fit_transform(&b, GridFit::Resolution(0)).is_err());
+        assert!(fit_transform(&b, GridFit::VoxelSize(f64::NAN)).is_err());
+    }
+}

@@ -1,0 +1,226 @@
+//! Polygon meshes: loading (OBJ with n-gons kept, binary and ASCII STL), validation,
+//! measurement, fitting to a grid, and the project's own generated fixtures.
+
+mod fit;
+pub mod generate;
+mod obj;
+mod stl;
+
+pub use fit::{GridFit, fit_transform};
+
+use crate::error::{Error, Result};
+use glam::DVec3;
+use std::path::{Path, PathBuf};
+
+/// A polygon mesh: shared positions and faces of any size (kept as in the file).
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub positions: Vec<DVec3>,
+    /// Vertex indices of all faces, back to back.
+    pub indices: Vec<u32>,
+    /// `face_starts[f]..face_starts[f+1]` is face `f` in `indices`; `len = faces + 1`.
+    pub face_starts: Vec<u32>,
+    /// Where the mesh came from (a file, or a generator name), for error messages and metadata.
+    pub source: PathBuf,
+}
+
+/// Axis-aligned bounding box in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: DVec3,
+    pub max: DVec3,
+}
+
+impl Aabb {
+    pub fn extent(&self) -> DVec3 {
+        self.max - self.min
+    }
+}
+
+impl Mesh {
+    /// Builds a mesh from positions and polygons; `source` names it in errors.
+    pub fn from_polygons(
+        source: impl Into<PathBuf>,
+        positions: Vec<DVec3>,
+        polygons: &[Vec<u32>],
+    ) -> Self {
+        let mut face_starts = vec![0u32];
+        let mut indices = Vec::new();
+        for p in polygons {
+            indices.extend_from_slice(p);
+            face_starts.push(indices.len() as u32);
+        }
+        Mesh {
+            positions,
+            indices,
+            face_starts,
+            source: source.into(),
+        }
+    }
+
+    /// Loads an `.obj` or `.stl` file (chosen by extension) and validates it.
+    pub fn load(path: &Path) -> Result<Mesh> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase());
+        let mesh = match ext.as_deref() {
+            Some("obj") => obj::load_obj(path)?,
+            Some("stl") => stl::load_stl(path)?,
+            _ => {
+                return Err(Error::UnsupportedFormat {
+                    path: path.to_path_buf(),
+                });
+            }
+        };
+        mesh.validate()?;
+        Ok(mesh)
+    }
+
+    pub fn face_count(&self) -> usize {
+        self.face_starts.len() - 1
+    }
+
+    pub fn face(&self, f: usize) -> &[u32] {
+        &self.indices[self.face_starts[f] as usize..self.face_starts[f + 1] as usize]
+    }
+
+    /// Checks what every algorithm relies on: a face, finite positions, indices in range,
+    /// at least three corners per face.
+    pub fn validate(&self) -> Result<()> {
+        if self.face_count() == 0 || self.positions.is_empty() {
+            return Err(Error::EmptyMesh {
+                path: self.source.clone(),
+                message: format!(
+                    "{} vertices, {} faces",
+                    self.positions.len(),
+                    self.face_count()
+                ),
+            });
+        }
+        if let Some(v) = self.positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::InvalidArgument(format!(
+                "{}: vertex {} has a non-finite coordinate {:?}",
+                self.source.display(),
+                v + 1,
+                self.positions[v]
+            )));
+        }
+        let n = self.positions.len() as u32;
+        for f in 0..self.face_count() {
+            let face = self.face(f);
+            if face.len() < 3 {
+                return Err(
+                    self.bad_face(f, format!("has {} corners; 3 or more needed", face.len()))
+                );
+            }
+            if let Some(&i) = face.iter().find(|&&i| i >= n) {
+                return Err(self.bad_face(
+                    f,
+                    format!(
+                        "vertex index {} is out of range (the mesh has {n} vertices)",
+                        i + 1
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn bad_face(&self, face: usize, message: String) -> Error {
+        Error::BadFace {
+            path: self.source.clone(),
+            face,
+            message,
+        }
+    }
+
+    pub fn bbox(&self) -> Aabb {
+        let mut b = Aabb {
+            min: DVec3::splat(f64::INFINITY),
+            max: DVec3::splat(f64::NEG_INFINITY),
+        };
+        for &i in &self.indices {
+            let p = self.positions[i as usize];
+            b.min = b.min.min(p);
+            b.max = b.max.max(p);
+        }
+        b
+    }
+
+    /// Fan triangulation of every face: `(face, [a, b, c])`.
+    pub fn triangles(&self) -> impl Iterator<Item = (usize, [u32; 3])> + '_ {
+        (0..self.face_count()).flat_map(move |f| {
+            let face = self.face(f);
+            (1..face.len() - 1).map(move |k| (f, [face[0], face[k], face[k + 1]]))
+        })
+    }
+
+    /// Faces whose fan triangles all have (near) zero area, or that repeat a vertex.
+    pub fn degenerate_face_count(&self) -> usize {
+        let scale = self.bbox().extent().length().max(f64::MIN_POSITIVE);
+        (0..self.face_count())
+            .filter(|&f| {
+                let face = self.face(f);
+                let repeats = (0..face.len()).any(|k| face[k] == face[(k + 1) % face.len()]);
+                let area = self.polygon_vector_area(face).length();
+                repeats || area <= 1e-14 * scale * scale
+            })
+            .count()
+    }
+
+    /// Half the sum of the fan's cross products: its length is the area of a planar polygon.
+    fn polygon_vector_area(&self, face: &[u32]) -> DVec3 {
+        let p0 = self.positions[face[0] as usize];
+        (1..face.len() - 1)
+            .map(|k| {
+                let a = self.positions[face[k] as usize] - p0;
+                let b = self.positions[face[k + 1] as usize] - p0;
+                a.cross(b)
+            })
+            .sum::<DVec3>()
+            * 0.5
+    }
+
+    /// Surface area of the fan triangulation.
+    pub fn area(&self) -> f64 {
+        self.triangles()
+            .map(|(_, [a, b, c])| {
+                let (a, b, c) = (self.p(a), self.p(b), self.p(c));
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum()
+    }
+
+    /// Signed volume by the divergence theorem (positive for outward-facing normals).
+    pub fn signed_volume(&self) -> f64 {
+        self.triangles()
+            .map(|(_, [a, b, c])| self.p(a).dot(self.p(b).cross(self.p(c))) / 6.0)
+            .sum()
+    }
+
+    #[inline]
+    pub fn p(&self, i: u32) -> DVec3 {
+        self.positions[i as usize]
+    }
+
+    /// Writes the mesh as OBJ text (used by `voxelkit demo` to ship the model it voxelizes).
+    pub fn write_obj(&self, path: &Path) -> Result<()> {
+        use std::fmt::Write as _;
+        let mut s = String::new();
+        let _ = writeln!(s, "# written by voxelkit {}", env!("CARGO_PKG_VERSION"));
+        for p in &self.positions {
+            let _ = writeln!(s, "v {} {} {}", p.x, p.y, p.z);
+        }
+        for f in 0..self.face_count() {
+            s.push('f');
+            for &i in self.face(f) {
+                let _ = write!(s, " {}", i + 1);
+            }
+            s.push('\n');
+        }
+        crate::io::atomic::write_atomic(path, |tmp| {
+            std::fs::write(tmp, s.as_bytes()).map_err(|e| Error::io(tmp, e))
+        })
+    }
+}

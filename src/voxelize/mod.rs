@@ -1,0 +1,56 @@
+//! Voxelization methods, one file each, named for what they do.
+
+pub mod separating;
+pub mod separating_analytic;
+mod sink;
+
+pub use sink::Progress;
+
+use glam::DVec3;
+
+/// Which paths of empty voxels a surface must block (Huang et al. §4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Separability {
+    /// Blocks paths through voxel faces: the thin surface, `t6 = (L/2) max|n_i|`.
+    Six,
+    /// Blocks paths through faces, edges and corners: `t26 = (L/2) sum|n_i|`.
+    TwentySix,
+}
+
+impl Separability {
+    /// The adjacency number N of an N-separating surface.
+    pub fn adjacency(self) -> u32 {
+        match self {
+            Separability::Six => 6,
+            Separability::TwentySix => 26,
+        }
+    }
+
+    /// Half thickness `t` of the slab around a plane with unit normal `n`, in voxels.
+    pub fn slab_half_thickness(self, n: DVec3) -> f64 {
+        let a = n.abs();
+        match self {
+            Separability::Six => 0.5 * a.max_element(),
+            Separability::TwentySix => 0.5 * (a.x + a.y + a.z),
+        }
+    }
+
+    /// Radius `Rc` of the vertex spheres and edge cylinders, in voxels.
+    pub fn vertex_edge_radius(self) -> f64 {
+        match self {
+            Separability::Six => 0.5,
+            Separability::TwentySix => 0.5 * 3f64.sqrt(),
+        }
+    }
+}
+
+impl std::str::FromStr for Separability {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "6" => Ok(Separability::Six),
+            "26" => Ok(Separability::TwentySix),
+            _ => Err(format!("separability must be 6 or 26, not `{s}`")),
+        }
+    }
+}

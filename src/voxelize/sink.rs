@@ -1,0 +1,108 @@
+//! Where distance-criterion voxelizers put their voxels: a thread-local grid that keeps,
+//! per voxel, the distance to and normal of the nearest primitive, and the parallel
+//! fold/merge that turns many such grids into one.
+
+use crate::grid::{Channels, Coord, Leaf, SparseGrid, Transform};
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Called with the number of work items just finished (for progress bars).
+pub type Progress<'a> = &'a (dyn Fn(u64) + Sync);
+
+/// Channels a distance-criterion voxelizer produces: distance as value, plus the normal.
+pub(crate) fn nearest_channels(normals: bool) -> Channels {
+    Channels {
+        value: normals,
+        normal: normals,
+        color: false,
+    }
+}
+
+pub(crate) struct Sink<'g> {
+    acc: crate::grid::Accessor<'g>,
+    nearest: bool,
+}
+
+impl<'g> Sink<'g> {
+    pub fn new(grid: &'g mut SparseGrid) -> Self {
+        let nearest = grid.channels().normal;
+        Sink {
+            acc: grid.accessor(),
+            nearest,
+        }
+    }
+
+    /// Marks voxel `c`; with channels, keeps the nearest primitive's distance and normal.
+    #[inline]
+    pub fn add(&mut self, c: Coord, distance: f64, normal: DVec3) {
+        let (leaf, n) = self.acc.leaf_mut(c);
+        if self.nearest {
+            let d = distance as f32;
+            let values = leaf.value.as_mut().expect("nearest sink has values");
+            if !leaf.mask[n >> 6] >> (n & 63) & 1 == 1 || d < values[n] {
+                values[n] = d;
+                leaf.normal.as_mut().expect("nearest sink has normals")[n] =
+                    normal.as_vec3().into();
+            }
+        }
+        leaf.set_on(n);
+    }
+}
+
+/// ORs `src` into `dst`; where both hold a voxel, keeps the smaller distance and its normal.
+pub(crate) fn merge_nearest(dst: &mut Leaf, src: &Leaf) {
+    if let (Some(dv), Some(sv)) = (dst.value.as_mut(), src.value.as_ref()) {
+        let (dn, sn) = (dst.normal.as_mut().unwrap(), src.normal.as_ref().unwrap());
+        for w in 0..8 {
+            let mut b = src.mask[w];
+            while b != 0 {
+                let n = w * 64 + b.trailing_zeros() as usize;
+                if dst.mask[w] >> (n & 63) & 1 == 0 || sv[n] < dv[n] {
+                    dv[n] = sv[n];
+                    dn[n] = sn[n];
+                }
+                b &= b - 1;
+            }
+        }
+    }
+    for w in 0..8 {
+        dst.mask[w] |= src.mask[w];
+    }
+}
+
+/// Merges two grids of the same channels, the smaller into the larger.
+pub(crate) fn merge_grids(a: SparseGrid, b: SparseGrid) -> SparseGrid {
+    let (mut big, small) = if a.leaves().len() >= b.leaves().len() {
+        (a, b)
+    } else {
+        (b, a)
+    };
+    big.merge_with(small, merge_nearest);
+    big
+}
+
+/// Runs `emit` on every item in parallel chunks, each chunk into a thread-local grid, and
+/// merges the grids leaf by leaf.
+pub(crate) fn voxelize_parallel<T: Sync>(
+    items: &[T],
+    transform: Transform,
+    channels: Channels,
+    progress: Progress,
+    emit: impl Fn(&T, &mut Sink) + Sync,
+) -> SparseGrid {
+    const CHUNK: usize = 1024;
+    items
+        .par_chunks(CHUNK)
+        .fold(
+            || SparseGrid::new(transform, channels),
+            |mut grid, chunk| {
+                let mut sink = Sink::new(&mut grid);
+                for item in chunk {
+                    emit(item, &mut sink);
+                }
+                progress(chunk.len() as u64);
+                grid
+            },
+        )
+        .reduce(|| SparseGrid::new(transform, channels), merge_grids)
+}

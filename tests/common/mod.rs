@@ -1,0 +1,37 @@
+//! Shared helpers for the integration tests.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+/// The shared test data folder: `$VOXELKIT_DATA`, or `../shared/data` beside the crate.
+/// `None` (with a loud warning) when it is missing, so a clean clone still passes; CI
+/// (`.ci/run`) refuses to run without it.
+pub fn data_dir() -> Option<PathBuf> {
+    let dir = std::env::var_os("VOXELKIT_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
+    if dir.join("meshes").is_dir() {
+        Some(dir)
+    } else {
+        eprintln!(
+            "\n!!! VOXELKIT_DATA: test data not found at {} — tests on the real meshes are SKIPPED.\n\
+             !!! Set VOXELKIT_DATA to the shared data folder to run them.\n",
+            dir.display()
+        );
+        None
+    }
+}
+
+/// The closed meshes of the data folder used for separability tests.
+pub const CLOSED_MESHES: [&str; 10] = [
+    "bunny-closed",
+    "rocker-arm",
+    "spot_triangulated",
+    "armadillo",
+    "fandisk",
+    "torus",
+    "sphere",
+    "skull",
+    "scorpion",
+    "horse",
+];
