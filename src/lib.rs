@@ -8,6 +8,8 @@ pub mod grid;
 pub mod io;
 pub mod mesh;
 pub mod ops;
+pub mod system;
 pub mod voxelize;
 
 pub use error::{Error, Result};
+pub mod ffi;

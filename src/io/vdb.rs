@@ -1,1 +1,180 @@
+//! OpenVDB files through the bridge: one `.vdb` holding `surface` (BoolGrid), `density`
+//! (fog volume: 1 on every voxel of the set, what Blender's volume object reads) and
+//! `normal` (Vec3s, covariant-normalize) when the grid carries normals; and reading any
+//! Bool, Mask or Float grid back. Writes are atomic (temporary file, then rename).
 
+use super::atomic::write_atomic;
+use crate::error::{Error, Result};
+use crate::ffi::vdb::bridge::{self, MetaEntry};
+use crate::grid::{Channels, LEAF_VOXELS, Leaf, SparseGrid, Transform};
+use glam::DVec3;
+use std::path::Path;
+
+pub use crate::ffi::vdb::bridge::GridInfo;
+
+/// Leaves of `grid` as the bridge's flat arrays: origins (i32 x 3) and masks (u64 x 8).
+fn flatten<'g>(path: &Path, grid: &'g SparseGrid) -> Result<(Vec<i32>, Vec<u64>, Vec<&'g Leaf>)> {
+    let leaves: Vec<&Leaf> = grid.leaves().iter().filter(|l| !l.is_empty()).collect();
+    let mut origins = Vec::with_capacity(leaves.len() * 3);
+    let mut masks = Vec::with_capacity(leaves.len() * 8);
+    for leaf in &leaves {
+        for &c in &leaf.origin {
+            let v = i32::try_from(c).ok().filter(|v| v.checked_add(7).is_some());
+            origins.push(v.ok_or_else(|| Error::Vdb {
+                path: path.to_path_buf(),
+                message: format!(
+                    "leaf origin {:?} is outside OpenVDB's 32-bit index range",
+                    leaf.origin
+                ),
+            })?);
+        }
+        masks.extend_from_slice(&leaf.mask);
+    }
+    Ok((origins, masks, leaves))
+}
+
+fn vdb_error(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::Vdb {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+/// Writes `grid` to `path` as `surface`, `density` and (when present) `normal` grids, each
+/// with `grid.transform` and `metadata` plus `voxelkit_version`.
+pub fn write_vdb(path: &Path, grid: &SparseGrid, metadata: &[(&str, String)]) -> Result<()> {
+    let (origins, masks, leaves) = flatten(path, grid)?;
+    let mut meta: Vec<MetaEntry> = metadata
+        .iter()
+        .map(|(k, v)| MetaEntry {
+            key: k.to_string(),
+            value: v.clone(),
+        })
+        .collect();
+    meta.push(MetaEntry {
+        key: "voxelkit_version".into(),
+        value: env!("CARGO_PKG_VERSION").into(),
+    });
+    let t = grid.transform;
+    let origin = t.origin.to_array();
+    let mut writer = bridge::new_vdb_writer();
+    let mut add = |kind: &str, name: &str, values: &[f32]| {
+        writer
+            .pin_mut()
+            .add_grid(
+                kind,
+                name,
+                t.voxel_size,
+                origin,
+                &origins,
+                &masks,
+                values,
+                &meta,
+            )
+            .map_err(|e| vdb_error(path, e))
+    };
+    add("bool", "surface", &[])?;
+    add("fog", "density", &[])?;
+    if grid.channels().normal {
+        let mut normals = Vec::with_capacity(leaves.len() * LEAF_VOXELS * 3);
+        for leaf in &leaves {
+            let n = leaf.normal.as_ref().expect("grid with normal channel");
+            normals.extend(n.iter().flatten());
+        }
+        add("normal", "normal", &normals)?;
+    }
+    write_atomic(path, |tmp| {
+        let tmp_str = tmp
+            .to_str()
+            .ok_or_else(|| vdb_error(path, "path is not UTF-8"))?;
+        writer.write(tmp_str).map_err(|e| vdb_error(path, e))
+    })
+}
+
+fn open(path: &Path) -> Result<cxx::UniquePtr<bridge::VdbFile>> {
+    if !path.exists() {
+        return Err(Error::io(
+            path,
+            std::io::Error::from(std::io::ErrorKind::NotFound),
+        ));
+    }
+    let p = path
+        .to_str()
+        .ok_or_else(|| vdb_error(path, "path is not UTF-8"))?;
+    bridge::open_vdb(p).map_err(|e| vdb_error(path, e))
+}
+
+/// Describes every grid in the file.
+pub fn read_vdb_info(path: &Path) -> Result<Vec<GridInfo>> {
+    let file = open(path)?;
+    (0..file.grid_count())
+        .map(|i| file.grid_info(i).map_err(|e| vdb_error(path, e)))
+        .collect()
+}
+
+/// Reads the Bool, Mask or Float grid `name` (or the first such grid) into a grid; Float
+/// values land in the value channel.
+pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
+    let file = open(path)?;
+    let infos: Vec<GridInfo> = (0..file.grid_count())
+        .map(|i| file.grid_info(i).map_err(|e| vdb_error(path, e)))
+        .collect::<Result<_>>()?;
+    let readable = |i: &GridInfo| matches!(i.value_type.as_str(), "bool" | "mask" | "float");
+    let index = infos
+        .iter()
+        .position(|i| name.map_or(readable(i), |n| i.name == n))
+        .ok_or_else(|| match name {
+            Some(n) => vdb_error(path, format!("no grid named `{n}`")),
+            None => vdb_error(path, "no bool, mask or float grid in the file"),
+        })?;
+    let info = &infos[index];
+    if !info.uniform_linear {
+        return Err(vdb_error(
+            path,
+            format!(
+                "grid `{}` has a non-uniform or non-linear transform",
+                info.name
+            ),
+        ));
+    }
+    let (mut origins, mut masks, mut values) = (Vec::new(), Vec::new(), Vec::new());
+    file.read_leaves(index, &mut origins, &mut masks, &mut values)
+        .map_err(|e| vdb_error(path, e))?;
+    let has_values = !values.is_empty();
+    let channels = Channels {
+        value: has_values,
+        ..Channels::NONE
+    };
+    let leaves = origins
+        .chunks_exact(3)
+        .zip(masks.chunks_exact(8))
+        .enumerate()
+        .map(|(i, (o, m))| {
+            let mut leaf = Leaf::new([o[0] as i64, o[1] as i64, o[2] as i64], channels);
+            leaf.mask.copy_from_slice(m);
+            if let Some(v) = leaf.value.as_mut() {
+                v.copy_from_slice(&values[i * LEAF_VOXELS..(i + 1) * LEAF_VOXELS]);
+            }
+            leaf
+        })
+        .collect();
+    let transform = Transform::new(DVec3::from_array(info.origin), info.voxel_size[0]);
+    Ok(SparseGrid::from_leaves(transform, channels, leaves))
+}
+
+/// OpenVDB's `meshToVolume` on a triangle mesh in index space (benchmark reference):
+/// returns its active voxel count.
+pub fn openvdb_mesh_to_volume(
+    index_points: &[f32],
+    triangles: &[u32],
+    voxel_size: f64,
+    band: f32,
+    threads: usize,
+) -> Result<u64> {
+    bridge::openvdb_mesh_to_volume(index_points, triangles, voxel_size, band, threads).map_err(
+        |e| Error::Vdb {
+            path: "<meshToVolume>".into(),
+            message: e.to_string(),
+        },
+    )
+}

@@ -1,0 +1,106 @@
+//! Builds the C++ side of the bridges. With feature `vdb` it compiles cpp/vdb_bridge.cc
+//! against OpenVDB (C++17, TBB, Imath); with `osd` it links OpenSubdiv. When a library is
+//! missing the build stops with one line naming the Debian packages to install.
+
+use std::path::Path;
+use std::process::Command;
+
+fn main() {
+    println!("cargo:rerun-if-changed=build.rs");
+    let vdb = std::env::var_os("CARGO_FEATURE_VDB").is_some();
+    let osd = std::env::var_os("CARGO_FEATURE_OSD").is_some();
+    if vdb {
+        require(
+            &[
+                "openvdb/openvdb.h",
+                "boost/version.hpp",
+                "tbb/tbb.h",
+                "Imath/ImathVec.h",
+            ],
+            &["openvdb"],
+            "OpenVDB is missing: install it with `apt-get install libopenvdb-dev libboost-dev libtbb-dev pkg-config`, or build with --no-default-features",
+        );
+        build_vdb_bridge();
+    }
+    if osd {
+        require(
+            &["opensubdiv/version.h"],
+            &["osdCPU"],
+            "OpenSubdiv is missing: install it with `apt-get install libosd-dev`, or build with --no-default-features",
+        );
+        println!("cargo:rustc-link-lib=osdCPU");
+    }
+}
+
+/// Stops the build with `message` unless every header and library is found.
+fn require(headers: &[&str], libs: &[&str], message: &str) {
+    let include_dirs = ["/usr/include", "/usr/local/include"];
+    let lib_dirs = lib_search_dirs();
+    let header_ok = headers
+        .iter()
+        .all(|h| include_dirs.iter().any(|d| Path::new(d).join(h).exists()));
+    let lib_ok = libs.iter().all(|l| {
+        lib_dirs
+            .iter()
+            .any(|d| Path::new(d).join(format!("lib{l}.so")).exists())
+    });
+    if !(header_ok && lib_ok) {
+        eprintln!("voxelkit: {message}");
+        std::process::exit(1);
+    }
+}
+
+fn lib_search_dirs() -> Vec<String> {
+    let mut dirs: Vec<String> = ["/usr/lib", "/usr/local/lib", "/usr/lib64"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    if let Ok(out) = Command::new("gcc").arg("-print-multiarch").output() {
+        let triple = String::from_utf8_lossy(&out.stdout).trim().to_string();
+        if !triple.is_empty() {
+            dirs.push(format!("/usr/lib/{triple}"));
+        }
+    }
+    dirs
+}
+
+/// `pkg-config` output split into words (empty when pkg-config or the package is missing).
+fn pkg_config(args: &[&str]) -> Vec<String> {
+    Command::new("pkg-config")
+        .args(args)
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| {
+            String::from_utf8_lossy(&o.stdout)
+                .split_whitespace()
+                .map(String::from)
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+fn build_vdb_bridge() {
+    let mut build = cxx_build::bridge("src/ffi/vdb.rs");
+    build
+        .file("cpp/vdb_bridge.cc")
+        .std("c++17")
+        .flag_if_supported("-Wno-deprecated-declarations")
+        .opt_level(2);
+    for flag in pkg_config(&["--cflags", "tbb", "Imath"]) {
+        build.flag(&flag);
+    }
+    build.compile("voxelkit_vdb_bridge");
+    for flag in pkg_config(&["--libs", "tbb", "Imath"]) {
+        if let Some(lib) = flag.strip_prefix("-l") {
+            println!("cargo:rustc-link-lib={lib}");
+        } else if let Some(dir) = flag.strip_prefix("-L") {
+            println!("cargo:rustc-link-search=native={dir}");
+        }
+    }
+    println!("cargo:rustc-link-lib=openvdb");
+    println!("cargo:rustc-link-lib=tbb");
+    for f in ["cpp/vdb_bridge.cc", "cpp/vdb_bridge.h", "src/ffi/vdb.rs"] {
+        println!("cargo:rerun-if-changed={f}");
+    }
+}

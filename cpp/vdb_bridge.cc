@@ -1,0 +1,200 @@
+// OpenVDB side of the bridge: builds LeafNodes from bulk leaf arrays in parallel, writes and
+// reads .vdb files, and runs tools::meshToVolume for benchmarks. Every exception becomes a
+// Rust Err through cxx (see the trycatch override in vdb_bridge.h).
+#include "voxelkit/cpp/vdb_bridge.h"
+#include "voxelkit/src/ffi/vdb.rs.h"
+
+#include <openvdb/tools/MeshToVolume.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <mutex>
+#include <stdexcept>
+
+namespace voxelkit {
+
+namespace {
+
+std::once_flag init_flag;
+
+void ensure_initialized() { std::call_once(init_flag, [] { openvdb::initialize(); }); }
+
+openvdb::math::Transform::Ptr make_transform(double voxel_size, const std::array<double, 3>& origin) {
+    auto xform = openvdb::math::Transform::createLinearTransform(voxel_size);
+    xform->postTranslate(openvdb::Vec3d(origin[0], origin[1], origin[2]));
+    return xform;
+}
+
+// Builds one LeafNode per input leaf in parallel, then inserts them serially.
+template <typename GridT, typename SetFn>
+typename GridT::Ptr build_grid(rust::Slice<const int32_t> origins, rust::Slice<const uint64_t> masks,
+                               typename GridT::ValueType background, SetFn set_value) {
+    using LeafT = typename GridT::TreeType::LeafNodeType;
+    const size_t count = origins.size() / 3;
+    if (origins.size() != 3 * count || masks.size() != 8 * count)
+        throw std::invalid_argument("leaf arrays of inconsistent length");
+    std::vector<LeafT*> leaves(count, nullptr);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, count), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            openvdb::Coord c(origins[3 * i], origins[3 * i + 1], origins[3 * i + 2]);
+            auto* leaf = new LeafT(c, background);
+            for (openvdb::Index w = 0; w < 8; ++w) {
+                uint64_t bits = masks[8 * i + w];
+                while (bits) {
+                    const openvdb::Index n = w * 64 + openvdb::Index(__builtin_ctzll(bits));
+                    set_value(*leaf, i, n);
+                    bits &= bits - 1;
+                }
+            }
+            leaves[i] = leaf;
+        }
+    });
+    auto grid = GridT::create(background);
+    typename GridT::Accessor acc = grid->getAccessor();
+    for (auto* leaf : leaves) acc.addLeaf(leaf);
+    return grid;
+}
+
+}  // namespace
+
+std::unique_ptr<VdbWriter> new_vdb_writer() {
+    ensure_initialized();
+    return std::make_unique<VdbWriter>();
+}
+
+void VdbWriter::add_grid(rust::Str kind, rust::Str name, double voxel_size, std::array<double, 3> origin,
+                         rust::Slice<const int32_t> leaf_origins, rust::Slice<const uint64_t> masks,
+                         rust::Slice<const float> values, rust::Slice<const MetaEntry> metadata) {
+    const std::string k(kind);
+    const size_t count = leaf_origins.size() / 3;
+    openvdb::GridBase::Ptr grid;
+    if (k == "bool") {
+        grid = build_grid<openvdb::BoolGrid>(leaf_origins, masks, false,
+                                             [](auto& leaf, size_t, openvdb::Index n) { leaf.setValueOn(n, true); });
+    } else if (k == "fog") {
+        if (!values.empty() && values.size() != 512 * count)
+            throw std::invalid_argument("fog grid: expected 512 values per leaf");
+        auto g = build_grid<openvdb::FloatGrid>(leaf_origins, masks, 0.0f, [&](auto& leaf, size_t i, openvdb::Index n) {
+            leaf.setValueOn(n, values.empty() ? 1.0f : values[512 * i + n]);
+        });
+        g->setGridClass(openvdb::GRID_FOG_VOLUME);
+        grid = g;
+    } else if (k == "normal") {
+        if (values.size() != 3 * 512 * count)
+            throw std::invalid_argument("normal grid: expected 3 x 512 values per leaf");
+        auto g = build_grid<openvdb::Vec3SGrid>(
+            leaf_origins, masks, openvdb::Vec3s(0.0f), [&](auto& leaf, size_t i, openvdb::Index n) {
+                const float* v = &values[3 * (512 * i + n)];
+                leaf.setValueOn(n, openvdb::Vec3s(v[0], v[1], v[2]));
+            });
+        g->setVectorType(openvdb::VEC_COVARIANT_NORMALIZE);
+        grid = g;
+    } else {
+        throw std::invalid_argument("unknown grid kind " + k);
+    }
+    grid->setName(std::string(name));
+    grid->setTransform(make_transform(voxel_size, origin));
+    for (const auto& m : metadata)
+        grid->insertMeta(std::string(m.key), openvdb::StringMetadata(std::string(m.value)));
+    grids_.push_back(grid);
+}
+
+void VdbWriter::write(rust::Str path) const {
+    openvdb::io::File file{std::string(path)};
+    file.write(grids_);
+    file.close();
+}
+
+std::unique_ptr<VdbFile> open_vdb(rust::Str path) {
+    ensure_initialized();
+    openvdb::io::File file{std::string(path)};
+    file.open();
+    auto grids = file.getGrids();
+    file.close();
+    return std::make_unique<VdbFile>(grids);
+}
+
+size_t VdbFile::grid_count() const { return grids_->size(); }
+
+openvdb::GridBase::ConstPtr VdbFile::grid(size_t index) const {
+    if (index >= grids_->size()) throw std::out_of_range("grid index out of range");
+    return (*grids_)[index];
+}
+
+GridInfo VdbFile::grid_info(size_t index) const {
+    auto g = grid(index);
+    GridInfo info;
+    info.name = g->getName();
+    info.value_type = g->valueType();
+    info.grid_class = openvdb::GridBase::gridClassToString(g->getGridClass());
+    const auto& xform = g->transform();
+    const auto vs = xform.voxelSize();
+    info.voxel_size = {vs[0], vs[1], vs[2]};
+    const auto o = xform.indexToWorld(openvdb::Vec3d(0.0));
+    info.origin = {o[0], o[1], o[2]};
+    info.uniform_linear = xform.isLinear() && vs[0] == vs[1] && vs[1] == vs[2] &&
+                          xform.indexToWorld(openvdb::Vec3d(1, 0, 0)) - o == openvdb::Vec3d(vs[0], 0, 0) &&
+                          xform.indexToWorld(openvdb::Vec3d(0, 1, 0)) - o == openvdb::Vec3d(0, vs[0], 0);
+    info.active_voxels = g->activeVoxelCount();
+    info.leaf_count = 0;
+    const auto bbox = g->evalActiveVoxelBoundingBox();
+    info.bbox_min = {bbox.min().x(), bbox.min().y(), bbox.min().z()};
+    info.bbox_max = {bbox.max().x(), bbox.max().y(), bbox.max().z()};
+    for (auto it = g->beginMeta(); it != g->endMeta(); ++it) {
+        if (it->first.rfind("file_", 0) == 0) continue;  // OpenVDB's own bookkeeping
+        info.metadata.push_back(MetaEntry{rust::String(it->first), rust::String(it->second->str())});
+    }
+    auto count_leaves = [&](auto typed) { info.leaf_count = typed->tree().leafCount(); };
+    if (auto b = openvdb::gridConstPtrCast<openvdb::BoolGrid>(g)) count_leaves(b);
+    else if (auto m = openvdb::gridConstPtrCast<openvdb::MaskGrid>(g)) count_leaves(m);
+    else if (auto f = openvdb::gridConstPtrCast<openvdb::FloatGrid>(g)) count_leaves(f);
+    else if (auto v = openvdb::gridConstPtrCast<openvdb::Vec3SGrid>(g)) count_leaves(v);
+    return info;
+}
+
+namespace {
+template <typename GridT>
+void copy_leaves(const GridT& src, rust::Vec<int32_t>& origins, rust::Vec<uint64_t>& masks,
+                 rust::Vec<float>* values) {
+    typename GridT::TreeType tree(src.tree());  // tiles become leaves on a copy, never on the file's grid
+    tree.voxelizeActiveTiles();
+    for (auto it = tree.cbeginLeaf(); it; ++it) {
+        const auto& mask = it->getValueMask();
+        if (mask.isOff()) continue;
+        const auto o = it->origin();
+        origins.push_back(o.x());
+        origins.push_back(o.y());
+        origins.push_back(o.z());
+        for (openvdb::Index w = 0; w < 8; ++w) masks.push_back(mask.template getWord<openvdb::Index64>(w));
+        if (values) {
+            for (openvdb::Index n = 0; n < 512; ++n) values->push_back(float(it->getValue(n)));
+        }
+    }
+}
+}  // namespace
+
+void VdbFile::read_leaves(size_t index, rust::Vec<int32_t>& leaf_origins, rust::Vec<uint64_t>& masks,
+                          rust::Vec<float>& values) const {
+    auto g = grid(index);
+    if (auto b = openvdb::gridConstPtrCast<openvdb::BoolGrid>(g)) copy_leaves(*b, leaf_origins, masks, nullptr);
+    else if (auto m = openvdb::gridConstPtrCast<openvdb::MaskGrid>(g)) copy_leaves(*m, leaf_origins, masks, nullptr);
+    else if (auto f = openvdb::gridConstPtrCast<openvdb::FloatGrid>(g)) copy_leaves(*f, leaf_origins, masks, &values);
+    else throw std::invalid_argument("grid '" + g->getName() + "' has value type " + g->valueType() +
+                                     "; only bool, mask and float grids can be read");
+}
+
+uint64_t openvdb_mesh_to_volume(rust::Slice<const float> points, rust::Slice<const uint32_t> triangles,
+                                double voxel_size, float band, size_t threads) {
+    ensure_initialized();
+    std::vector<openvdb::Vec3s> pts(points.size() / 3);
+    for (size_t i = 0; i < pts.size(); ++i) pts[i] = openvdb::Vec3s(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
+    std::vector<openvdb::Vec3I> tris(triangles.size() / 3);
+    for (size_t i = 0; i < tris.size(); ++i)
+        tris[i] = openvdb::Vec3I(triangles[3 * i], triangles[3 * i + 1], triangles[3 * i + 2]);
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    auto xform = openvdb::math::Transform::createLinearTransform(voxel_size);
+    openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> mesh(pts, tris);
+    auto grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(mesh, *xform, band, band);
+    return grid->activeVoxelCount();
+}
+
+}  // namespace voxelkit

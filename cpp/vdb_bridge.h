@@ -1,0 +1,55 @@
+// The C++ half of src/ffi/vdb.rs: OpenVDB file I/O and meshToVolume for benchmarks.
+#pragma once
+#include "rust/cxx.h"
+#include <memory>
+#include <openvdb/openvdb.h>
+
+namespace voxelkit {
+
+struct MetaEntry;
+struct GridInfo;
+
+class VdbWriter {
+public:
+    void add_grid(rust::Str kind, rust::Str name, double voxel_size, std::array<double, 3> origin,
+                  rust::Slice<const int32_t> leaf_origins, rust::Slice<const uint64_t> masks,
+                  rust::Slice<const float> values, rust::Slice<const MetaEntry> metadata);
+    void write(rust::Str path) const;
+
+private:
+    openvdb::GridPtrVec grids_;
+};
+
+class VdbFile {
+public:
+    explicit VdbFile(openvdb::GridPtrVecPtr grids) : grids_(std::move(grids)) {}
+    size_t grid_count() const;
+    GridInfo grid_info(size_t index) const;
+    void read_leaves(size_t index, rust::Vec<int32_t>& leaf_origins, rust::Vec<uint64_t>& masks,
+                     rust::Vec<float>& values) const;
+
+private:
+    openvdb::GridBase::ConstPtr grid(size_t index) const;
+    openvdb::GridPtrVecPtr grids_;
+};
+
+std::unique_ptr<VdbWriter> new_vdb_writer();
+std::unique_ptr<VdbFile> open_vdb(rust::Str path);
+uint64_t openvdb_mesh_to_volume(rust::Slice<const float> points, rust::Slice<const uint32_t> triangles,
+                                double voxel_size, float band, size_t threads);
+
+}  // namespace voxelkit
+
+// cxx turns std::exception into Err; anything else thrown must not cross into Rust either.
+namespace rust {
+namespace behavior {
+template <typename Try, typename Fail>
+static void trycatch(Try&& func, Fail&& fail) noexcept try {
+    func();
+} catch (const std::exception& e) {
+    fail(e.what());
+} catch (...) {
+    fail("unknown C++ exception");
+}
+}  // namespace behavior
+}  // namespace rust

@@ -1,0 +1,150 @@
+//! `voxelkit bench`: our separating voxelizer against OpenVDB's `tools::meshToVolume` with a
+//! one-voxel band, on the same mesh, voxel size and thread count, in the same process.
+
+use crate::report::Json;
+use clap::Args;
+use std::path::PathBuf;
+use std::time::Instant;
+use voxelkit::io::vdb::openvdb_mesh_to_volume;
+use voxelkit::mesh::{GridFit, Mesh, fit_transform};
+use voxelkit::voxelize::Separability;
+use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
+use voxelkit::{Error, Result};
+
+#[derive(Args)]
+pub struct BenchArgs {
+    /// Meshes to run: names in DATA/meshes (without .obj) or paths to .obj/.stl files.
+    #[arg(long, value_delimiter = ',', default_value = "igea,skull,bunny-closed")]
+    meshes: Vec<String>,
+    /// Data folder holding meshes/ [default: $VOXELKIT_DATA or ../shared/data].
+    #[arg(long)]
+    data: Option<PathBuf>,
+    #[arg(long, value_delimiter = ',', default_value = "256,512,1024")]
+    resolutions: Vec<u32>,
+    #[arg(long, value_delimiter = ',', default_value = "6,26")]
+    separability: Vec<String>,
+    /// Thread counts to compare.
+    #[arg(long = "thread-counts", value_delimiter = ',', default_value = "1,2")]
+    thread_counts: Vec<usize>,
+    /// Runs per measurement; the fastest is reported.
+    #[arg(long, default_value_t = 3)]
+    repeat: usize,
+}
+
+fn resolve(name: &str, data: &std::path::Path) -> PathBuf {
+    let p = PathBuf::from(name);
+    if p.extension().is_some() {
+        p
+    } else {
+        data.join("meshes").join(format!("{name}.obj"))
+    }
+}
+
+/// Fastest of `repeat` runs of `f`, in seconds, with its last result.
+fn best_of<T>(repeat: usize, mut f: impl FnMut() -> Result<T>) -> Result<(f64, T)> {
+    let mut best = f64::INFINITY;
+    let mut last = None;
+    for _ in 0..repeat.max(1) {
+        let start = Instant::now();
+        let r = f()?;
+        best = best.min(start.elapsed().as_secs_f64());
+        last = Some(r);
+    }
+    Ok((best, last.expect("at least one run")))
+}
+
+pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
+    let data = args
+        .data
+        .clone()
+        .or_else(|| std::env::var_os("VOXELKIT_DATA").map(PathBuf::from))
+        .unwrap_or_else(|| PathBuf::from("../shared/data"));
+    let seps: Vec<Separability> = args
+        .separability
+        .iter()
+        .map(|s| s.parse().map_err(Error::InvalidArgument))
+        .collect::<Result<_>>()?;
+    let mut rows = Vec::new();
+    if !json {
+        println!(
+            "{:<14} {:>5} {:>3} {:>3} {:>10} {:>11} {:>12} {:>11} {:>8}",
+            "mesh",
+            "res",
+            "sep",
+            "thr",
+            "ours s",
+            "ours voxels",
+            "openvdb s",
+            "vdb voxels",
+            "speedup"
+        );
+    }
+    for name in &args.meshes {
+        let path = resolve(name, &data);
+        let mesh = Mesh::load(&path)?;
+        let tris: Vec<u32> = mesh.triangles().flat_map(|(_, t)| t).collect();
+        for &res in &args.resolutions {
+            let transform = fit_transform(&mesh.bbox(), GridFit::Resolution(res))?;
+            let index_points: Vec<f32> = mesh
+                .positions
+                .iter()
+                .flat_map(|&p| transform.world_to_index(p).as_vec3().to_array())
+                .collect();
+            for &threads in &args.thread_counts {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .map_err(|e| {
+                        Error::InvalidArgument(format!("cannot start {threads} threads: {e}"))
+                    })?;
+                let (vdb_s, vdb_voxels) = best_of(args.repeat, || {
+                    openvdb_mesh_to_volume(&index_points, &tris, transform.voxel_size, 1.0, threads)
+                })?;
+                for &sep in &seps {
+                    let opts = SeparatingOptions {
+                        separability: sep,
+                        normals: false,
+                    };
+                    let (ours_s, voxels) = pool.install(|| {
+                        best_of(args.repeat, || {
+                            voxelize_mesh(&mesh, transform, &opts, &|_| {})
+                                .map(|(g, _)| g.voxel_count())
+                        })
+                    })?;
+                    let speedup = vdb_s / ours_s;
+                    if json {
+                        rows.push(
+                            Json::default()
+                                .str("mesh", name.clone())
+                                .int("resolution", res as u64)
+                                .int("separability", sep.adjacency() as u64)
+                                .int("threads", threads as u64)
+                                .num("ours_seconds", ours_s)
+                                .int("ours_voxels", voxels)
+                                .num("openvdb_seconds", vdb_s)
+                                .int("openvdb_voxels", vdb_voxels)
+                                .num("speedup", speedup),
+                        );
+                    } else {
+                        println!(
+                            "{:<14} {:>5} {:>3} {:>3} {:>10.4} {:>11} {:>12.4} {:>11} {:>7.2}x",
+                            name,
+                            res,
+                            sep.adjacency(),
+                            threads,
+                            ours_s,
+                            voxels,
+                            vdb_s,
+                            vdb_voxels,
+                            speedup
+                        );
+                    }
+                }
+            }
+        }
+    }
+    if json {
+        println!("{}", Json::default().arr("runs", rows).render());
+    }
+    Ok(())
+}

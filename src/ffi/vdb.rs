@@ -1,0 +1,78 @@
+//! The cxx bridge to OpenVDB (`cpp/vdb_bridge.cc`). Leaves cross in bulk: per grid one call
+//! with, for every 8^3 leaf, its origin (3 x i32), its mask (8 x u64, OpenVDB's word order)
+//! and, for value grids, its 512 values (or 3 x 512 for vectors) in OpenVDB's voxel order.
+//! Every C++ function catches its exceptions and turns them into `Result` errors.
+
+#[cxx::bridge(namespace = "voxelkit")]
+pub mod bridge {
+    /// One string metadata item of a grid.
+    struct MetaEntry {
+        key: String,
+        value: String,
+    }
+
+    /// What a grid in a .vdb file is.
+    struct GridInfo {
+        name: String,
+        value_type: String,
+        grid_class: String,
+        voxel_size: [f64; 3],
+        /// World position of the centre of voxel (0,0,0).
+        origin: [f64; 3],
+        /// Whether the transform is a uniform scale plus translation (our Transform).
+        uniform_linear: bool,
+        active_voxels: u64,
+        leaf_count: u64,
+        bbox_min: [i32; 3],
+        bbox_max: [i32; 3],
+        metadata: Vec<MetaEntry>,
+    }
+
+    unsafe extern "C++" {
+        include!("voxelkit/cpp/vdb_bridge.h");
+
+        type VdbWriter;
+        type VdbFile;
+
+        fn new_vdb_writer() -> UniquePtr<VdbWriter>;
+        /// Adds a BoolGrid (`kind` = "bool"), fog-volume FloatGrid ("fog": `values` per voxel,
+        /// or 1 where empty) or Vec3SGrid of normals ("normal": 3 values per voxel).
+        fn add_grid(
+            self: Pin<&mut VdbWriter>,
+            kind: &str,
+            name: &str,
+            voxel_size: f64,
+            origin: [f64; 3],
+            leaf_origins: &[i32],
+            masks: &[u64],
+            values: &[f32],
+            metadata: &[MetaEntry],
+        ) -> Result<()>;
+        /// Writes all grids to `path` (the caller renames it into place).
+        fn write(self: &VdbWriter, path: &str) -> Result<()>;
+
+        fn open_vdb(path: &str) -> Result<UniquePtr<VdbFile>>;
+        fn grid_count(self: &VdbFile) -> usize;
+        fn grid_info(self: &VdbFile, index: usize) -> Result<GridInfo>;
+        /// Active voxels of a Bool, Mask or Float grid (tiles expanded), leaf by leaf;
+        /// `values` gets 512 floats per leaf for Float grids and stays empty otherwise.
+        fn read_leaves(
+            self: &VdbFile,
+            index: usize,
+            leaf_origins: &mut Vec<i32>,
+            masks: &mut Vec<u64>,
+            values: &mut Vec<f32>,
+        ) -> Result<()>;
+
+        /// OpenVDB's own narrow-band conversion (`tools::meshToVolume`) of a triangle mesh
+        /// given in index space, with `band` voxels outside and inside, on at most `threads`
+        /// threads. Returns the number of active voxels (for benchmarks).
+        fn openvdb_mesh_to_volume(
+            points: &[f32],
+            triangles: &[u32],
+            voxel_size: f64,
+            band: f32,
+            threads: usize,
+        ) -> Result<u64>;
+    }
+}
