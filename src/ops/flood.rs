@@ -6,32 +6,26 @@ use crate::grid::{Adjacency, CoordBox, DenseMask};
 /// Empty voxels (not in `blocked`) reachable from the border of `blocked.bbox` through
 /// `adjacency`-paths of empty voxels.
 pub fn flood_from_border(blocked: &DenseMask, adjacency: Adjacency) -> Result<DenseMask> {
-    let bbox = blocked.bbox;
-    let mut reached = DenseMask::new(bbox)?;
+    let mut seeds = DenseMask::new(blocked.bbox)?;
     let [nx, ny, nz] = blocked.dims();
-    if nx == 0 || ny == 0 || nz == 0 {
-        return Ok(reached);
-    }
-    let deltas: Vec<[i64; 3]> = adjacency.offsets();
-    let mut stack: Vec<usize> = Vec::new();
-    let on_border = |x: usize, y: usize, z: usize| {
-        x == 0 || y == 0 || z == 0 || x == nx - 1 || y == ny - 1 || z == nz - 1
-    };
-    let visit = |i: usize, reached: &mut DenseMask, stack: &mut Vec<usize>| {
-        if !blocked.get_index(i) && !reached.get_index(i) {
-            reached.set_index(i);
-            stack.push(i);
-        }
-    };
     for x in 0..nx {
         for y in 0..ny {
             for z in 0..nz {
-                if on_border(x, y, z) {
-                    visit((x * ny + y) * nz + z, &mut reached, &mut stack);
+                if x == 0 || y == 0 || z == 0 || x == nx - 1 || y == ny - 1 || z == nz - 1 {
+                    seeds.set_index((x * ny + y) * nz + z);
                 }
             }
         }
     }
+    flood(blocked, &seeds, adjacency)
+}
+
+/// Empty voxels reachable from the empty voxels of `seeds` through `adjacency`-paths of
+/// empty voxels, without leaving the box.
+pub fn flood(blocked: &DenseMask, seeds: &DenseMask, adjacency: Adjacency) -> Result<DenseMask> {
+    let mut reached = DenseMask::new(blocked.bbox)?;
+    let [nx, ny, nz] = blocked.dims();
+    let deltas: Vec<[i64; 3]> = adjacency.offsets();
     let strides = [(ny * nz) as isize, nz as isize, 1isize];
     let linear: Vec<isize> = deltas
         .iter()
@@ -39,29 +33,34 @@ pub fn flood_from_border(blocked: &DenseMask, adjacency: Adjacency) -> Result<De
             d[0] as isize * strides[0] + d[1] as isize * strides[1] + d[2] as isize * strides[2]
         })
         .collect();
+    let mut stack: Vec<usize> = Vec::new();
+    for i in seeds.ones() {
+        if !blocked.get_index(i) && !reached.get_index(i) {
+            reached.set_index(i);
+            stack.push(i);
+        }
+    }
     while let Some(i) = stack.pop() {
         let (x, y, z) = (i / (ny * nz), (i / nz) % ny, i % nz);
-        if on_border(x, y, z) {
-            // Border voxels: check each neighbour against the box.
-            for d in &deltas {
+        let interior = x > 0 && y > 0 && z > 0 && x + 1 < nx && y + 1 < ny && z + 1 < nz;
+        for (d, &l) in deltas.iter().zip(&linear) {
+            if !interior {
+                // Next to the border: keep the neighbour inside the box.
                 let (a, b, c) = (x as i64 + d[0], y as i64 + d[1], z as i64 + d[2]);
-                if a >= 0
-                    && b >= 0
-                    && c >= 0
-                    && (a as usize) < nx
-                    && (b as usize) < ny
-                    && (c as usize) < nz
+                if a < 0
+                    || b < 0
+                    || c < 0
+                    || a as usize >= nx
+                    || b as usize >= ny
+                    || c as usize >= nz
                 {
-                    visit(
-                        (a as usize * ny + b as usize) * nz + c as usize,
-                        &mut reached,
-                        &mut stack,
-                    );
+                    continue;
                 }
             }
-        } else {
-            for &l in &linear {
-                visit((i as isize + l) as usize, &mut reached, &mut stack);
+            let j = (i as isize + l) as usize;
+            if !blocked.get_index(j) && !reached.get_index(j) {
+                reached.set_index(j);
+                stack.push(j);
             }
         }
     }

@@ -1,7 +1,7 @@
 //! Checking that a voxel surface separates the inside of a closed mesh from the outside:
 //! flood the empty voxels from outside and look for an inside centre the flood reached.
 
-use super::flood::{flood_from_border, padded};
+use super::flood::{flood, flood_from_border, padded};
 use super::inside::inside_centres;
 use crate::error::Result;
 use crate::grid::{Adjacency, CoordBox, DenseMask, SparseGrid};
@@ -49,12 +49,45 @@ pub fn check_mesh_separation(
     let blocked = DenseMask::from_grid(surface, bbox)?;
     let inside = inside_centres(mesh, &t, bbox)?;
     let reached = flood_from_border(&blocked, adjacency)?;
-    Ok(SeparationReport {
+    Ok(report(adjacency, &blocked, &inside, &reached))
+}
+
+/// Floods the complement of `surface` inside `bbox` from the voxels `side` puts on the
+/// positive side, and counts the voxels of the negative side it reaches: for surfaces that
+/// cross the box (an open analytic surface) as well as closed ones.
+pub fn check_side_separation(
+    surface: &SparseGrid,
+    bbox: CoordBox,
+    side: impl Fn([i64; 3]) -> f64,
+    adjacency: Adjacency,
+) -> Result<SeparationReport> {
+    let blocked = DenseMask::from_grid(surface, bbox)?;
+    let mut inside = DenseMask::new(bbox)?;
+    let mut outside = DenseMask::new(bbox)?;
+    for i in 0..blocked.len() {
+        let s = side(blocked.coord(i));
+        if s < 0.0 {
+            inside.set_index(i);
+        } else if s > 0.0 {
+            outside.set_index(i);
+        }
+    }
+    let reached = flood(&blocked, &outside, adjacency)?;
+    Ok(report(adjacency, &blocked, &inside, &reached))
+}
+
+fn report(
+    adjacency: Adjacency,
+    blocked: &DenseMask,
+    inside: &DenseMask,
+    reached: &DenseMask,
+) -> SeparationReport {
+    SeparationReport {
         adjacency,
         inside_centres: inside.count(),
-        inside_empty: inside.count() - inside.and_count(&blocked),
+        inside_empty: inside.count() - inside.and_count(blocked),
         exterior: reached.count(),
-        leaked: reached.and_count(&inside),
-        first_leak: reached.first_common(&inside),
-    })
+        leaked: reached.and_count(inside),
+        first_leak: reached.first_common(inside),
+    }
 }
