@@ -131,9 +131,13 @@ GridInfo VdbFile::grid_info(size_t index) const {
     info.voxel_size = {vs[0], vs[1], vs[2]};
     const auto o = xform.indexToWorld(openvdb::Vec3d(0.0));
     info.origin = {o[0], o[1], o[2]};
-    info.uniform_linear = xform.isLinear() && vs[0] == vs[1] && vs[1] == vs[2] &&
-                          xform.indexToWorld(openvdb::Vec3d(1, 0, 0)) - o == openvdb::Vec3d(vs[0], 0, 0) &&
-                          xform.indexToWorld(openvdb::Vec3d(0, 1, 0)) - o == openvdb::Vec3d(0, vs[0], 0);
+    // A uniform scale plus translation, up to rounding in the stored matrix.
+    const double h = vs[0];
+    auto close = [h](const openvdb::Vec3d& a, const openvdb::Vec3d& b) { return (a - b).length() <= 1e-9 * h; };
+    info.uniform_linear = xform.isLinear() && close(vs, openvdb::Vec3d(h)) &&
+                          close(xform.indexToWorld(openvdb::Vec3d(1, 0, 0)) - o, openvdb::Vec3d(h, 0, 0)) &&
+                          close(xform.indexToWorld(openvdb::Vec3d(0, 1, 0)) - o, openvdb::Vec3d(0, h, 0)) &&
+                          close(xform.indexToWorld(openvdb::Vec3d(0, 0, 1)) - o, openvdb::Vec3d(0, 0, h));
     info.active_voxels = g->activeVoxelCount();
     info.leaf_count = 0;
     const auto bbox = g->evalActiveVoxelBoundingBox();

@@ -68,7 +68,7 @@ pub enum ShapeKind {
     Sphere {
         #[arg(long, default_value_t = 1.0)]
         radius: f64,
-        #[arg(long, value_parser = parse_vec3, default_value = "0,0,0")]
+        #[arg(long, value_parser = parse_vec3, default_value = "0,0,0", allow_hyphen_values = true)]
         center: DVec3,
         #[command(flatten)]
         common: ShapeCommon,
@@ -79,10 +79,10 @@ pub enum ShapeKind {
         radius: f64,
         #[arg(long, default_value_t = 2.0)]
         height: f64,
-        #[arg(long, value_parser = parse_vec3, default_value = "0,0,0")]
+        #[arg(long, value_parser = parse_vec3, default_value = "0,0,0", allow_hyphen_values = true)]
         center: DVec3,
         /// Axis direction (normalized for you).
-        #[arg(long, value_parser = parse_vec3, default_value = "0,0,1")]
+        #[arg(long, value_parser = parse_vec3, default_value = "0,0,1", allow_hyphen_values = true)]
         axis: DVec3,
         #[command(flatten)]
         common: ShapeCommon,
