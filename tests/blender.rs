@@ -1,0 +1,75 @@
+//! Blender opens what voxelkit writes: a headless Blender imports the .vdb as a volume
+//! object and sees the `density`, `surface` and `normal` grids at the right place.
+//! Skipped (loudly) where Blender is not installed; CI does not install it.
+#![cfg(feature = "vdb")]
+
+use std::process::Command;
+use voxelkit::io::vdb::write_vdb;
+use voxelkit::mesh::{GridFit, fit_transform, generate};
+use voxelkit::voxelize::Separability;
+use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
+
+#[test]
+fn blender_imports_the_volume() {
+    if Command::new("blender").arg("--version").output().is_err() {
+        eprintln!("\n!!! blender is not installed: the Blender import test is SKIPPED\n");
+        return;
+    }
+    let mesh = generate::torus(glam::DVec3::new(2.0, -1.0, 0.5), 1.0, 0.3, 64, 16);
+    let t = fit_transform(&mesh.bbox(), GridFit::Resolution(64)).unwrap();
+    let opts = SeparatingOptions {
+        separability: Separability::TwentySix,
+        normals: true,
+    };
+    let (grid, _) = voxelize_mesh(&mesh, t, &opts, &|_| {}).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("torus.vdb");
+    write_vdb(&path, &grid, &[]).unwrap();
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/blender/inspect_volume.py"
+    );
+    let out = Command::new("blender")
+        .args([
+            "-b",
+            "--factory-startup",
+            "--python",
+            script,
+            "--",
+            path.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    for g in [
+        "GRID density FLOAT",
+        "GRID surface BOOLEAN",
+        "GRID normal VECTOR_FLOAT",
+    ] {
+        assert!(text.contains(g), "`{g}` missing: {text}");
+    }
+    // BOUNDS (x0, y0, z0) (x1, y1, z1): Blender bounds a volume by the voxel centres of whole
+    // 8^3 leaves, so the box holds the active centres and reaches at most a leaf beyond.
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("BOUNDS"))
+        .expect("bounds line");
+    let nums: Vec<f64> = line
+        .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let b = grid.bbox().unwrap();
+    let lo = grid.transform.index_to_world(b.min);
+    let hi = grid.transform.index_to_world(b.max);
+    let h = grid.transform.voxel_size;
+    for a in 0..3 {
+        assert!(
+            nums[a] <= lo[a] + 1e-3 && nums[a] >= lo[a] - 8.0 * h,
+            "{line} vs {lo}"
+        );
+        assert!(
+            nums[3 + a] >= hi[a] - 1e-3 && nums[3 + a] <= hi[a] + 8.0 * h,
+            "{line} vs {hi}"
+        );
+    }
+}
