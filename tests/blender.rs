@@ -20,6 +20,7 @@ fn blender_imports_the_volume() {
     let opts = SeparatingOptions {
         separability: Separability::TwentySix,
         normals: true,
+        ..Default::default()
     };
     let (grid, _) = voxelize_mesh(&mesh, t, &opts, &|_| {}).unwrap();
     let dir = tempfile::tempdir().unwrap();

@@ -10,7 +10,7 @@ use voxelkit::grid::Adjacency;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
 use voxelkit::ops::separability::check_mesh_separation;
 use voxelkit::voxelize::Separability;
-use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
+use voxelkit::voxelize::separating::{Criterion, SeparatingOptions, voxelize_mesh};
 
 fn flood_adjacency(sep: Separability) -> Adjacency {
     match sep {
@@ -21,9 +21,16 @@ fn flood_adjacency(sep: Separability) -> Adjacency {
 
 /// Voxelizes and floods; panics with a diagnosis when the flood leaks.
 fn assert_separates(mesh: &Mesh, resolution: u32, sep: Separability) {
+    for criterion in [Criterion::Huang, Criterion::Clipped] {
+        assert_separates_with(mesh, resolution, sep, criterion);
+    }
+}
+
+fn assert_separates_with(mesh: &Mesh, resolution: u32, sep: Separability, criterion: Criterion) {
     let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
     let opts = SeparatingOptions {
         separability: sep,
+        criterion,
         normals: false,
     };
     let (grid, stats) = voxelize_mesh(mesh, t, &opts, &|_| {}).unwrap();
@@ -36,7 +43,7 @@ fn assert_separates(mesh: &Mesh, resolution: u32, sep: Separability) {
     assert!(report.exterior > 0);
     assert!(
         report.separates(),
-        "{} at {resolution}, {}-separating: flood leaked into {} inside voxels, e.g. {:?} ({} voxels, {:?})",
+        "{} at {resolution}, {}-separating ({criterion:?}): flood leaked into {} inside voxels, e.g. {:?} ({} voxels, {:?})",
         mesh.source.display(),
         sep.adjacency(),
         report.leaked,

@@ -26,6 +26,7 @@ fn written_example(dir: &std::path::Path) -> (SparseGrid, std::path::PathBuf) {
     let opts = SeparatingOptions {
         separability: Separability::TwentySix,
         normals: true,
+        ..Default::default()
     };
     let (grid, _) = voxelize_mesh(&mesh, t, &opts, &|_| {}).unwrap();
     let path = dir.join("knot.vdb");

@@ -34,6 +34,7 @@ fn run(mesh: &Mesh, res: u32, sep: Separability, normals: bool) -> voxelkit::gri
         &SeparatingOptions {
             separability: sep,
             normals,
+            ..Default::default()
         },
         &|_| {},
     )
@@ -85,6 +86,7 @@ fn class_counts_of_a_box_on_voxel_centres_are_exact() {
     let opts = SeparatingOptions {
         separability: Separability::Six,
         normals: false,
+        ..Default::default()
     };
     let (g, stats) = voxelize_mesh(&mesh, t, &opts, &|_| {}).unwrap();
     assert_eq!((stats.vertices, stats.edges, stats.triangles), (8, 12, 12));

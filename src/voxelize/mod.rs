@@ -9,11 +9,12 @@ pub use sink::Progress;
 use glam::DVec3;
 
 /// Which paths of empty voxels a surface must block (Huang et al. §4).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Separability {
     /// Blocks paths through voxel faces: the thin surface, `t6 = (L/2) max|n_i|`.
     Six,
     /// Blocks paths through faces, edges and corners: `t26 = (L/2) sum|n_i|`.
+    #[default]
     TwentySix,
 }
 

@@ -16,6 +16,10 @@
 //! otherwise the segment from A to P leaves F through its boundary, so A lies within
 //! `|A-P| <= Rc` of an edge or vertex. Every inside-to-outside path makes such a step.
 //!
+//! The same argument shows that A needs the sphere or cylinder only where it is also within
+//! `t` of the plane of a face around that edge or vertex: `Criterion::Clipped` keeps just
+//! those voxels, which removes most simple voxels the paper's full spheres and cylinders add.
+//!
 //! Deviations from the paper:
 //! - Polygons are fanned into triangles for the body test. The fan's inner diagonals get
 //!   no cylinder when the polygon is planar (a centre projecting inside the polygon projects
@@ -31,24 +35,30 @@ use crate::error::{Error, Result};
 use crate::grid::{SparseGrid, Transform};
 use crate::mesh::Mesh;
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// Tolerance, in voxels, added to every inclusion test.
 const MARGIN: f64 = 1e-9;
+/// Extra room when clipping candidate rows (the exact tests run on every candidate).
+const ROW_SLACK: f64 = 1e-6;
 
-#[derive(Clone, Copy, Debug)]
-pub struct SeparatingOptions {
-    pub separability: Separability,
-    /// Keep the nearest face, edge or vertex normal (and its distance) per voxel.
-    pub normals: bool,
+/// Which voxels around edges and vertices are kept.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Criterion {
+    /// The paper's: whole vertex spheres and edge cylinders of radius `Rc`.
+    #[default]
+    Huang,
+    /// Spheres and cylinders clipped to the slabs (half thickness `t`) of the faces around
+    /// them. Still separating (see the module docs) with far fewer simple voxels.
+    Clipped,
 }
 
-impl Default for SeparatingOptions {
-    fn default() -> Self {
-        SeparatingOptions {
-            separability: Separability::TwentySix,
-            normals: false,
-        }
-    }
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SeparatingOptions {
+    pub separability: Separability,
+    pub criterion: Criterion,
+    /// Keep the nearest face, edge or vertex normal (and its distance) per voxel.
+    pub normals: bool,
 }
 
 /// What the voxelizer did, like Tables 2–3 of the paper.
@@ -78,10 +88,39 @@ struct Triangle {
     normal: DVec3,
 }
 
+/// A vertex (`a == b`) or an edge, with the faces around it.
 struct Primitive {
     a: DVec3,
     b: DVec3,
     normal: DVec3,
+    /// Range of `Adjacency::faces` holding the faces around it.
+    faces: std::ops::Range<usize>,
+}
+
+/// Faces around edges and vertices, and each face's fan triangles.
+struct Adjacency {
+    faces: Vec<u32>,
+    /// `triangle_starts[f]..triangle_starts[f+1]`: the kept triangles of face `f`.
+    triangle_starts: Vec<usize>,
+}
+
+impl Adjacency {
+    /// Whether `x` lies in the slab (half thickness `t`) of a triangle of a face of `p`.
+    fn in_face_slab(
+        &self,
+        p: &Primitive,
+        triangles: &[Triangle],
+        sep: Separability,
+        x: DVec3,
+    ) -> bool {
+        self.faces[p.faces.clone()].iter().any(|&f| {
+            let range = self.triangle_starts[f as usize]..self.triangle_starts[f as usize + 1];
+            triangles[range].iter().any(|tri| {
+                tri.normal.dot(x - tri.corners[0]).abs()
+                    <= sep.slab_half_thickness(tri.normal) + MARGIN
+            })
+        })
+    }
 }
 
 /// Work items: number of vertices, edges and triangles the voxelizer will process.
@@ -116,20 +155,34 @@ pub fn voxelize_mesh(
     }
     let pos: Vec<DVec3> = mesh
         .positions
-        .iter()
+        .par_iter()
         .map(|&p| transform.world_to_index(p))
         .collect();
     let sep = opts.separability;
     let channels = nearest_channels(opts.normals);
 
-    let (triangles, degenerate_faces, face_normals) = triangles_of(mesh, &pos);
-    let (edges, vertices) = edges_and_vertices(mesh, &pos, &face_normals, opts.normals);
+    let face_normals: Vec<DVec3> = (0..mesh.face_count())
+        .into_par_iter()
+        .map(|f| fan_area_normal(mesh.face(f), &pos))
+        .collect();
+    let ((triangles, triangle_starts, degenerate_faces), (edges, vertices, faces)) = rayon::join(
+        || triangles_of(mesh, &pos),
+        || edges_and_vertices(mesh, &pos, &face_normals, opts.normals),
+    );
+    let adjacency = Adjacency {
+        faces,
+        triangle_starts,
+    };
+    let keep = |p: &Primitive, x: DVec3| match opts.criterion {
+        Criterion::Huang => true,
+        Criterion::Clipped => adjacency.in_face_slab(p, &triangles, sep, x),
+    };
 
     let vertex_grid = voxelize_parallel(&vertices, transform, channels, progress, |v, s| {
-        vertex_sphere(v, sep.vertex_edge_radius(), s)
+        vertex_sphere(v, sep.vertex_edge_radius(), &keep, s)
     });
     let edge_grid = voxelize_parallel(&edges, transform, channels, progress, |e, s| {
-        edge_cylinder(e, sep.vertex_edge_radius(), s)
+        edge_cylinder(e, sep.vertex_edge_radius(), &keep, s)
     });
     let body_grid = voxelize_parallel(&triangles, transform, channels, progress, |t, s| {
         face_body(t, sep, s)
@@ -167,15 +220,23 @@ fn count_outside(grid: &SparseGrid, others: &[&SparseGrid]) -> u64 {
         .sum()
 }
 
-/// Fan triangles with unit normals (degenerate ones dropped), the number of degenerate
-/// faces, and each face's area-weighted normal.
-fn triangles_of(mesh: &Mesh, pos: &[DVec3]) -> (Vec<Triangle>, usize, Vec<DVec3>) {
+/// Twice the vector area of a polygon's fan (its normal, weighted by area).
+fn fan_area_normal(face: &[u32], pos: &[DVec3]) -> DVec3 {
+    let p0 = pos[face[0] as usize];
+    (1..face.len() - 1)
+        .map(|k| (pos[face[k] as usize] - p0).cross(pos[face[k + 1] as usize] - p0))
+        .sum()
+}
+
+/// Fan triangles with unit normals (degenerate ones dropped), where each face's triangles
+/// start, and the number of degenerate faces.
+fn triangles_of(mesh: &Mesh, pos: &[DVec3]) -> (Vec<Triangle>, Vec<usize>, usize) {
     let mut triangles = Vec::with_capacity(mesh.indices.len());
+    let mut starts = Vec::with_capacity(mesh.face_count() + 1);
     let mut degenerate = 0;
-    let mut face_normals = Vec::with_capacity(mesh.face_count());
     for f in 0..mesh.face_count() {
+        starts.push(triangles.len());
         let face = mesh.face(f);
-        let mut area_normal = DVec3::ZERO;
         let mut kept = 0;
         for k in 1..face.len() - 1 {
             let corners = [
@@ -184,7 +245,6 @@ fn triangles_of(mesh: &Mesh, pos: &[DVec3]) -> (Vec<Triangle>, usize, Vec<DVec3>
                 pos[face[k + 1] as usize],
             ];
             let cross = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
-            area_normal += cross;
             let len = cross.length();
             // Relative to the longest edge squared: slivers thinner than 1e-12 have no stable plane.
             let scale = (corners[1] - corners[0])
@@ -201,78 +261,149 @@ fn triangles_of(mesh: &Mesh, pos: &[DVec3]) -> (Vec<Triangle>, usize, Vec<DVec3>
         if kept == 0 {
             degenerate += 1;
         }
-        face_normals.push(area_normal);
     }
-    (triangles, degenerate, face_normals)
+    starts.push(triangles.len());
+    (triangles, starts, degenerate)
 }
 
 /// Deduplicated edges (polygon sides, plus fan diagonals of non-planar polygons) and the
-/// used vertices, each with the normal of the faces around it when `normals` is set.
+/// used vertices, each with the faces around it (a range of the returned list) and, when
+/// `normals` is set, the normalized sum of their area-weighted normals. Linear time:
+/// edges are bucketed by their lower vertex, corners by their vertex (counting sorts).
 fn edges_and_vertices(
     mesh: &Mesh,
     pos: &[DVec3],
     face_normals: &[DVec3],
     normals: bool,
-) -> (Vec<Primitive>, Vec<Primitive>) {
-    let mut keyed: Vec<(u64, DVec3)> = Vec::with_capacity(mesh.indices.len() * 2);
-    let mut vertex_normal = vec![DVec3::ZERO; pos.len()];
-    let mut used = vec![false; pos.len()];
-    let key = |a: u32, b: u32| ((a.min(b) as u64) << 32) | a.max(b) as u64;
+) -> (Vec<Primitive>, Vec<Primitive>, Vec<u32>) {
+    let planar: Vec<bool> = (0..mesh.face_count())
+        .map(|f| mesh.face(f).len() == 3 || is_planar(mesh.face(f), pos, face_normals[f]))
+        .collect();
+    let for_each_edge = |visit: &mut dyn FnMut(u32, u32, u32)| {
+        for f in 0..mesh.face_count() {
+            let face = mesh.face(f);
+            for k in 0..face.len() {
+                let (a, b) = (face[k], face[(k + 1) % face.len()]);
+                if a != b {
+                    visit(a.min(b), a.max(b), f as u32);
+                }
+            }
+            if !planar[f] {
+                for k in 2..face.len() - 1 {
+                    visit(face[0].min(face[k]), face[0].max(face[k]), f as u32);
+                }
+            }
+        }
+    };
+    // Bucket (upper vertex, face) by lower vertex.
+    let mut start = vec![0usize; pos.len() + 1];
+    for_each_edge(&mut |lo, _, _| start[lo as usize + 1] += 1);
+    for i in 0..pos.len() {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut buckets = vec![(0u32, 0u32); start[pos.len()]];
+    for_each_edge(&mut |lo, hi, f| {
+        buckets[fill[lo as usize]] = (hi, f);
+        fill[lo as usize] += 1;
+    });
+    let normal_of = |fs: &[u32]| {
+        if normals {
+            fs.iter()
+                .map(|&f| face_normals[f as usize])
+                .sum::<DVec3>()
+                .normalize_or_zero()
+        } else {
+            DVec3::ZERO
+        }
+    };
+    let (edges_part, vertices_part) = rayon::join(
+        || edges_from_buckets(pos, &start, buckets, &normal_of),
+        || vertices_of(mesh, pos, &normal_of),
+    );
+    let ((edges, mut faces), (mut vertices, vertex_faces)) = (edges_part, vertices_part);
+    let shift = faces.len();
+    for v in &mut vertices {
+        v.faces = v.faces.start + shift..v.faces.end + shift;
+    }
+    faces.extend(vertex_faces);
+    (edges, vertices, faces)
+}
+
+/// One edge per distinct (lower, upper) vertex pair of the buckets, with its faces.
+fn edges_from_buckets(
+    pos: &[DVec3],
+    start: &[usize],
+    mut buckets: Vec<(u32, u32)>,
+    normal_of: &(dyn Fn(&[u32]) -> DVec3 + Sync),
+) -> (Vec<Primitive>, Vec<u32>) {
+    let mut faces: Vec<u32> = Vec::with_capacity(buckets.len());
+    let mut edges = Vec::with_capacity(buckets.len() / 2);
+    for lo in 0..pos.len() {
+        let bucket = &mut buckets[start[lo]..start[lo + 1]];
+        bucket.sort_unstable();
+        for group in bucket.chunk_by(|x, y| x.0 == y.0) {
+            let first = faces.len();
+            for g in group {
+                // Sorted within the group: a face listing the edge twice appears once.
+                if faces.len() == first || faces[faces.len() - 1] != g.1 {
+                    faces.push(g.1);
+                }
+            }
+            edges.push(Primitive {
+                a: pos[lo],
+                b: pos[group[0].0 as usize],
+                normal: normal_of(&faces[first..]),
+                faces: first..faces.len(),
+            });
+        }
+    }
+    (edges, faces)
+}
+
+/// The used vertices with the faces around each, by a counting sort of the corners.
+fn vertices_of(
+    mesh: &Mesh,
+    pos: &[DVec3],
+    normal_of: &(dyn Fn(&[u32]) -> DVec3 + Sync),
+) -> (Vec<Primitive>, Vec<u32>) {
+    let mut faces: Vec<u32> = Vec::with_capacity(mesh.indices.len());
+    let mut vstart = vec![0usize; pos.len() + 1];
+    for &v in &mesh.indices {
+        vstart[v as usize + 1] += 1;
+    }
+    for i in 0..pos.len() {
+        vstart[i + 1] += vstart[i];
+    }
+    let mut vfill = vstart.clone();
+    let mut around = vec![0u32; mesh.indices.len()];
     for f in 0..mesh.face_count() {
-        let face = mesh.face(f);
-        let nf = face_normals[f];
-        for k in 0..face.len() {
-            let (a, b) = (face[k], face[(k + 1) % face.len()]);
-            if a != b {
-                keyed.push((key(a, b), nf));
-            }
-            used[a as usize] = true;
-            vertex_normal[a as usize] += nf;
-        }
-        if face.len() > 3 && !is_planar(face, pos, nf) {
-            for k in 2..face.len() - 1 {
-                keyed.push((key(face[0], face[k]), nf));
-            }
+        for &v in mesh.face(f) {
+            around[vfill[v as usize]] = f as u32;
+            vfill[v as usize] += 1;
         }
     }
-    keyed.sort_unstable_by_key(|e| e.0);
-    let mut edges = Vec::with_capacity(keyed.len() / 2);
-    let mut i = 0;
-    while i < keyed.len() {
-        let mut j = i;
-        let mut n = DVec3::ZERO;
-        while j < keyed.len() && keyed[j].0 == keyed[i].0 {
-            n += keyed[j].1;
-            j += 1;
+    let mut vertices = Vec::with_capacity(pos.len());
+    for v in 0..pos.len() {
+        let list = &mut around[vstart[v]..vstart[v + 1]];
+        if list.is_empty() {
+            continue; // not used by any face
         }
-        let (a, b) = (
-            (keyed[i].0 >> 32) as usize,
-            (keyed[i].0 & 0xffff_ffff) as usize,
-        );
-        edges.push(Primitive {
-            a: pos[a],
-            b: pos[b],
-            normal: if normals {
-                n.normalize_or_zero()
-            } else {
-                DVec3::ZERO
-            },
-        });
-        i = j;
-    }
-    let vertices = (0..pos.len())
-        .filter(|&v| used[v])
-        .map(|v| Primitive {
+        list.sort_unstable();
+        let first = faces.len();
+        for &f in list.iter() {
+            if faces.len() == first || faces[faces.len() - 1] != f {
+                faces.push(f);
+            }
+        }
+        vertices.push(Primitive {
             a: pos[v],
             b: pos[v],
-            normal: if normals {
-                vertex_normal[v].normalize_or_zero()
-            } else {
-                DVec3::ZERO
-            },
-        })
-        .collect();
-    (edges, vertices)
+            normal: normal_of(&faces[first..]),
+            faces: first..faces.len(),
+        });
+    }
+    (vertices, faces)
 }
 
 /// All corners within 1e-6 voxels of the plane through the first corner with normal `n`.
@@ -289,18 +420,41 @@ fn is_planar(face: &[u32], pos: &[DVec3], n: DVec3) -> bool {
 /// Integer range `ceil(lo)..=floor(hi)`.
 #[inline]
 fn int_range(lo: f64, hi: f64) -> std::ops::RangeInclusive<i64> {
-    (lo.ceil() as i64)..=(hi.floor() as i64)
+    // Truncation plus a fix-up: `f64::ceil`/`floor` are libm calls without SSE4.1.
+    let (l, h) = (lo as i64, hi as i64);
+    let l = if (l as f64) < lo { l + 1 } else { l };
+    let h = if (h as f64) > hi { h - 1 } else { h };
+    l..=h
 }
 
-/// S_v: voxel centres within `r` of the vertex.
-fn vertex_sphere(v: &Primitive, r: f64, sink: &mut Sink) {
+/// Values of `v` with `a v^2 + 2 b v + c <= 0` (`a > 0`), widened by `MARGIN`; empty when none.
+#[inline]
+fn quadratic_range(a: f64, b: f64, c: f64) -> std::ops::RangeInclusive<i64> {
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return 1..=0;
+    }
+    let root = disc.sqrt();
+    int_range((-b - root) / a - MARGIN, (-b + root) / a + MARGIN)
+}
+
+/// S_v: voxel centres within `r` of the vertex (that `keep` accepts).
+fn vertex_sphere(
+    v: &Primitive,
+    r: f64,
+    keep: &impl Fn(&Primitive, DVec3) -> bool,
+    sink: &mut Sink,
+) {
     let p = v.a;
     let r2 = (r + MARGIN) * (r + MARGIN);
-    for x in int_range(p.x - r, p.x + r + MARGIN) {
-        for y in int_range(p.y - r, p.y + r + MARGIN) {
-            for z in int_range(p.z - r - MARGIN, p.z + r + MARGIN) {
-                let d2 = (DVec3::new(x as f64, y as f64, z as f64) - p).length_squared();
-                if d2 <= r2 {
+    for x in int_range(p.x - r - MARGIN, p.x + r + MARGIN) {
+        for y in int_range(p.y - r - MARGIN, p.y + r + MARGIN) {
+            let (dx, dy) = (x as f64 - p.x, y as f64 - p.y);
+            // (z - p.z)^2 <= r2 - dx^2 - dy^2
+            for z in quadratic_range(1.0, -p.z, p.z * p.z + dx * dx + dy * dy - r2) {
+                let c = DVec3::new(x as f64, y as f64, z as f64);
+                let d2 = (c - p).length_squared();
+                if d2 <= r2 && keep(v, c) {
                     sink.add([x, y, z], d2.sqrt(), v.normal);
                 }
             }
@@ -308,8 +462,14 @@ fn vertex_sphere(v: &Primitive, r: f64, sink: &mut Sink) {
     }
 }
 
-/// S_e: voxel centres within `r` of the edge whose projection falls on the edge.
-fn edge_cylinder(e: &Primitive, r: f64, sink: &mut Sink) {
+/// S_e: voxel centres within `r` of the edge whose projection falls on the edge (and that
+/// `keep` accepts).
+fn edge_cylinder(
+    e: &Primitive,
+    r: f64,
+    keep: &impl Fn(&Primitive, DVec3) -> bool,
+    sink: &mut Sink,
+) {
     let (p, d) = (e.a, e.b - e.a);
     let len2 = d.length_squared();
     if len2 == 0.0 {
@@ -321,10 +481,19 @@ fn edge_cylinder(e: &Primitive, r: f64, sink: &mut Sink) {
     // In a plane across axis w, the cylinder's section stays within r / |unit d_w| of the axis.
     let reach = r * len2.sqrt() / d[w].abs();
     let tau_margin = MARGIN / len2.sqrt();
+    let dn = d / len2.sqrt();
     for k in int_range(p[w].min(e.b[w]) - r, p[w].max(e.b[w]) + r) {
         let c = p + d * ((k as f64 - p[w]) / d[w]);
         for iu in int_range(c[u] - reach, c[u] + reach) {
-            for iv in int_range(c[v] - reach, c[v] + reach) {
+            // y = x - p with x_v = 0; dist^2(v) = |y + v e_v|^2 - ((y + v e_v)·dn)^2 <= r^2.
+            let mut y0 = -p;
+            y0[w] += k as f64;
+            y0[u] += iu as f64;
+            let along = y0.dot(dn);
+            let a = 1.0 - dn[v] * dn[v];
+            let b = y0[v] - along * dn[v];
+            let cc = y0.length_squared() - along * along - r * r;
+            for iv in quadratic_range(a, b, cc) {
                 let mut x = DVec3::ZERO;
                 x[w] = k as f64;
                 x[u] = iu as f64;
@@ -334,7 +503,7 @@ fn edge_cylinder(e: &Primitive, r: f64, sink: &mut Sink) {
                     continue;
                 }
                 let d2 = (x - p - d * tau).length_squared();
-                if d2 <= r * r {
+                if d2 <= r * r && keep(e, x) {
                     sink.add(to_coord(x), d2.sqrt(), e.normal);
                 }
             }
@@ -356,8 +525,29 @@ fn face_body(tri: &Triangle, sep: Separability, sink: &mut Sink) {
     });
     let lo = a.min(b).min(c) - DVec3::splat(t);
     let hi = a.max(b).max(c) + DVec3::splat(t);
+    let half = t / n[w].abs();
     for iu in int_range(lo[u], hi[u]) {
-        for iv in int_range(lo[v], hi[v]) {
+        // Clip the row to the columns whose slab segment can reach inside every edge plane:
+        // the best k of the slab turns each plane test into a linear bound on iv.
+        let (mut v_lo, mut v_hi) = (lo[v], hi[v]);
+        for (m, p) in &sides {
+            let slope = m[v] - m[w] * n[v] / n[w];
+            let at_zero = m[u] * (iu as f64 - p[u]) - m[v] * p[v] + m[w] * (a[w] - p[w])
+                - m[w] * (n[u] * (iu as f64 - a[u]) - n[v] * a[v]) / n[w]
+                + m[w].abs() * half
+                + ROW_SLACK;
+            if slope > 0.0 {
+                v_lo = v_lo.max(-at_zero / slope);
+            } else if slope < 0.0 {
+                v_hi = v_hi.min(-at_zero / slope);
+            } else if at_zero < 0.0 {
+                v_hi = f64::NEG_INFINITY;
+            }
+        }
+        if v_lo > v_hi {
+            continue;
+        }
+        for iv in int_range(v_lo, v_hi) {
             let s = n[u] * (iu as f64 - a[u]) + n[v] * (iv as f64 - a[v]);
             // -t <= s + n_w (k - a_w) <= t, solved for k.
             let k0 = a[w] + (-t - s) / n[w];

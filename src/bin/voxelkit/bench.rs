@@ -8,7 +8,7 @@ use std::time::Instant;
 use voxelkit::io::vdb::openvdb_mesh_to_volume;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform};
 use voxelkit::voxelize::Separability;
-use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
+use voxelkit::voxelize::separating::{Criterion, SeparatingOptions, voxelize_mesh};
 use voxelkit::{Error, Result};
 
 #[derive(Args)]
@@ -23,6 +23,9 @@ pub struct BenchArgs {
     resolutions: Vec<u32>,
     #[arg(long, value_delimiter = ',', default_value = "6,26")]
     separability: Vec<String>,
+    /// Criteria to run (huang, clipped).
+    #[arg(long, value_delimiter = ',', default_value = "huang,clipped", value_parser = crate::parse_criterion)]
+    criterion: Vec<Criterion>,
     /// Thread counts to compare.
     #[arg(long = "thread-counts", value_delimiter = ',', default_value = "1,2")]
     thread_counts: Vec<usize>,
@@ -67,10 +70,11 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
     let mut rows = Vec::new();
     if !json {
         println!(
-            "{:<14} {:>5} {:>3} {:>3} {:>10} {:>11} {:>12} {:>11} {:>8}",
+            "{:<14} {:>5} {:>3} {:>8} {:>3} {:>10} {:>11} {:>12} {:>11} {:>8}",
             "mesh",
             "res",
             "sep",
+            "criterion",
             "thr",
             "ours s",
             "ours voxels",
@@ -100,9 +104,13 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
                 let (vdb_s, vdb_voxels) = best_of(args.repeat, || {
                     openvdb_mesh_to_volume(&index_points, &tris, transform.voxel_size, 1.0, threads)
                 })?;
-                for &sep in &seps {
+                for (&sep, &criterion) in seps
+                    .iter()
+                    .flat_map(|s| args.criterion.iter().map(move |c| (s, c)))
+                {
                     let opts = SeparatingOptions {
                         separability: sep,
+                        criterion,
                         normals: false,
                     };
                     let (ours_s, voxels) = pool.install(|| {
@@ -118,6 +126,7 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
                                 .str("mesh", name.clone())
                                 .int("resolution", res as u64)
                                 .int("separability", sep.adjacency() as u64)
+                                .str("criterion", format!("{criterion:?}").to_lowercase())
                                 .int("threads", threads as u64)
                                 .num("ours_seconds", ours_s)
                                 .int("ours_voxels", voxels)
@@ -127,10 +136,11 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
                         );
                     } else {
                         println!(
-                            "{:<14} {:>5} {:>3} {:>3} {:>10.4} {:>11} {:>12.4} {:>11} {:>7.2}x",
+                            "{:<14} {:>5} {:>3} {:>8} {:>3} {:>10.4} {:>11} {:>12.4} {:>11} {:>7.2}x",
                             name,
                             res,
                             sep.adjacency(),
+                            format!("{criterion:?}").to_lowercase(),
                             threads,
                             ours_s,
                             voxels,

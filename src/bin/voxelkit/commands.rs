@@ -13,7 +13,7 @@ use voxelkit::ops::minimality::simple_voxel_count;
 use voxelkit::ops::separability::check_mesh_separation;
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{
-    SeparatingOptions, SeparatingStats, estimate_bytes, voxelize_mesh, work_items,
+    Criterion, SeparatingOptions, SeparatingStats, estimate_bytes, voxelize_mesh, work_items,
 };
 use voxelkit::voxelize::separating_analytic::{
     AnalyticSurface, Cylinder, Quadric, Sphere, voxelize_surface,
@@ -98,6 +98,14 @@ pub enum ShapeKind {
     },
 }
 
+/// The `method` metadata of a mesh voxelization.
+fn criterion_method(c: Criterion) -> &'static str {
+    match c {
+        Criterion::Huang => "huang-separating",
+        Criterion::Clipped => "huang-separating-clipped",
+    }
+}
+
 /// Metadata every output carries.
 fn metadata(
     method: &str,
@@ -134,6 +142,7 @@ fn voxelize_file(
     let transform = fit_transform(&mesh.bbox(), fit.grid_fit())?;
     let opts = SeparatingOptions {
         separability: surface.separability,
+        criterion: surface.criterion,
         normals: surface.normals,
     };
     let estimate = estimate_bytes(mesh, &transform, &opts);
@@ -168,7 +177,7 @@ pub fn mesh(
     let load_s = start.elapsed().as_secs_f64();
     let (grid, stats, voxelize_s) = voxelize_file(&mesh, fit, surface, json)?;
     let meta = metadata(
-        "huang-separating",
+        criterion_method(surface.criterion),
         surface.separability,
         &input.display().to_string(),
         &fit.describe(),
@@ -469,6 +478,7 @@ pub fn demo(folder: &Path, resolution: u32, json: bool) -> Result<()> {
         };
         let surface = SurfaceArgs {
             separability: sep,
+            criterion: Criterion::Huang,
             normals: true,
             max_memory: None,
         };

@@ -8,6 +8,7 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use voxelkit::voxelize::Separability;
+use voxelkit::voxelize::separating::Criterion;
 
 #[derive(Parser)]
 #[command(
@@ -45,6 +46,10 @@ pub struct SurfaceArgs {
     /// 6: thin surface blocking face-connected paths; 26: thicker, blocks every path.
     #[arg(short, long, default_value = "26", value_parser = parse_separability)]
     separability: Separability,
+    /// huang: the paper's full vertex spheres and edge cylinders; clipped: the same clipped
+    /// to the face slabs (still separating, far fewer redundant voxels). Meshes only.
+    #[arg(long, default_value = "huang", value_parser = parse_criterion)]
+    criterion: Criterion,
     /// Also write a `normal` grid (nearest face/edge/vertex normal per voxel).
     #[arg(long)]
     normals: bool,
@@ -55,6 +60,14 @@ pub struct SurfaceArgs {
 
 fn parse_separability(s: &str) -> Result<Separability, String> {
     s.parse()
+}
+
+pub fn parse_criterion(s: &str) -> Result<Criterion, String> {
+    match s {
+        "huang" => Ok(Criterion::Huang),
+        "clipped" => Ok(Criterion::Clipped),
+        _ => Err(format!("criterion must be huang or clipped, not `{s}`")),
+    }
 }
 
 #[derive(Subcommand)]
