@@ -1,6 +1,7 @@
 //! A dense bit volume over a box of voxel indices, for whole-volume passes (flooding,
 //! inside classification, neighbourhood tests) where hashing per voxel would dominate.
 
+use super::bits;
 use super::coord::{Coord, CoordBox};
 use super::sparse::SparseGrid;
 use crate::error::{Error, Result};
@@ -75,17 +76,17 @@ impl DenseMask {
 
     #[inline]
     pub fn get_index(&self, i: usize) -> bool {
-        self.bits[i >> 6] >> (i & 63) & 1 == 1
+        bits::get(&self.bits, i)
     }
 
     #[inline]
     pub fn set_index(&mut self, i: usize) {
-        self.bits[i >> 6] |= 1 << (i & 63);
+        bits::set(&mut self.bits, i);
     }
 
     #[inline]
     pub fn clear_index(&mut self, i: usize) {
-        self.bits[i >> 6] &= !(1 << (i & 63));
+        bits::clear(&mut self.bits, i);
     }
 
     /// False outside the box.
@@ -104,17 +105,7 @@ impl DenseMask {
 
     /// Linear indices of the set voxels.
     pub fn ones(&self) -> impl Iterator<Item = usize> + '_ {
-        self.bits.iter().enumerate().flat_map(|(w, &bits)| {
-            let mut b = bits;
-            std::iter::from_fn(move || {
-                if b == 0 {
-                    return None;
-                }
-                let t = b.trailing_zeros() as usize;
-                b &= b - 1;
-                Some(w * 64 + t)
-            })
-        })
+        bits::ones(&self.bits)
     }
 
     /// Voxels set in both.

@@ -2,6 +2,7 @@
 //! exactly like an OpenVDB LeafNode (`n = x*64 + y*8 + z`; mask word `x`, bit `y*8+z`) so
 //! leaves cross the bridge as plain arrays.
 
+use super::bits;
 use super::coord::{Coord, LEAF_VOXELS, offset_coord};
 
 /// Which optional per-voxel channels a grid carries.
@@ -47,17 +48,17 @@ impl Leaf {
 
     #[inline]
     pub fn is_on(&self, n: usize) -> bool {
-        self.mask[n >> 6] >> (n & 63) & 1 == 1
+        bits::get(&self.mask, n)
     }
 
     #[inline]
     pub fn set_on(&mut self, n: usize) {
-        self.mask[n >> 6] |= 1 << (n & 63);
+        bits::set(&mut self.mask, n);
     }
 
     #[inline]
     pub fn set_off(&mut self, n: usize) {
-        self.mask[n >> 6] &= !(1 << (n & 63));
+        bits::clear(&mut self.mask, n);
     }
 
     /// Number of active voxels.
@@ -71,17 +72,7 @@ impl Leaf {
 
     /// In-leaf offsets of the active voxels, ascending.
     pub fn offsets(&self) -> impl Iterator<Item = usize> + '_ {
-        self.mask.iter().enumerate().flat_map(|(w, &bits)| {
-            let mut b = bits;
-            std::iter::from_fn(move || {
-                if b == 0 {
-                    return None;
-                }
-                let t = b.trailing_zeros() as usize;
-                b &= b - 1;
-                Some(w * 64 + t)
-            })
-        })
+        bits::ones(&self.mask)
     }
 
     /// Coordinates of the active voxels.

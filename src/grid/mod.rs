@@ -1,6 +1,7 @@
 //! Sparse voxel grids: 8^3 leaves keyed by origin, optional per-voxel channels,
 //! a cached write accessor, Boolean operations leaf by leaf, and the index-to-world transform.
 
+mod bits;
 mod coord;
 mod leaf;
 mod sparse;

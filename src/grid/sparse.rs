@@ -32,7 +32,7 @@ impl SparseGrid {
     pub fn from_leaves(transform: Transform, channels: Channels, leaves: Vec<Leaf>) -> Self {
         let mut g = SparseGrid::new(transform, channels);
         for leaf in leaves {
-            g.merge_leaf(leaf, |dst, src| union_leaf(dst, src));
+            g.merge_leaf(leaf, union_leaf);
         }
         g
     }

@@ -271,7 +271,7 @@ pub fn random_closed(seed: u64) -> Mesh {
             .sum::<f64>()
             * 0.5
     };
-    let mut mesh = if rng.next_u64() % 2 == 0 {
+    let mut mesh = if rng.next_u64().is_multiple_of(2) {
         let mut m = icosphere(DVec3::ZERO, 1.0, 3);
         for p in &mut m.positions {
             *p *= bump(*p);

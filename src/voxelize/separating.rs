@@ -432,7 +432,7 @@ fn int_range(lo: f64, hi: f64) -> std::ops::RangeInclusive<i64> {
 fn quadratic_range(a: f64, b: f64, c: f64) -> std::ops::RangeInclusive<i64> {
     let disc = b * b - a * c;
     if disc < 0.0 {
-        return 1..=0;
+        return int_range(0.0, -1.0);
     }
     let root = disc.sqrt();
     int_range((-b - root) / a - MARGIN, (-b + root) / a + MARGIN)

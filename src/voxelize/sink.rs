@@ -38,8 +38,9 @@ impl<'g> Sink<'g> {
         let (leaf, n) = self.acc.leaf_mut(c);
         if self.nearest {
             let d = distance as f32;
+            let was_on = leaf.is_on(n);
             let values = leaf.value.as_mut().expect("nearest sink has values");
-            if !leaf.mask[n >> 6] >> (n & 63) & 1 == 1 || d < values[n] {
+            if !was_on || d < values[n] {
                 values[n] = d;
                 leaf.normal.as_mut().expect("nearest sink has normals")[n] =
                     normal.as_vec3().into();
