@@ -9,15 +9,6 @@ pub enum Adjacency {
 }
 
 impl Adjacency {
-    pub fn from_number(n: u32) -> Option<Adjacency> {
-        match n {
-            6 => Some(Adjacency::Six),
-            18 => Some(Adjacency::Eighteen),
-            26 => Some(Adjacency::TwentySix),
-            _ => None,
-        }
-    }
-
     pub fn number(self) -> u32 {
         match self {
             Adjacency::Six => 6,

@@ -6,8 +6,6 @@
 /// A voxel index `(i, j, k)`; voxel `(i,j,k)` is the unit cube centred on that integer point.
 pub type Coord = [i64; 3];
 
-/// Edge length of a leaf in voxels (OpenVDB's LeafNode log2dim = 3).
-pub const LEAF_DIM: i64 = 8;
 /// Voxels per leaf.
 pub const LEAF_VOXELS: usize = 512;
 

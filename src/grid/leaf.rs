@@ -56,11 +56,6 @@ impl Leaf {
         bits::set(&mut self.mask, n);
     }
 
-    #[inline]
-    pub fn set_off(&mut self, n: usize) {
-        bits::clear(&mut self.mask, n);
-    }
-
     /// Number of active voxels.
     pub fn count(&self) -> u32 {
         self.mask.iter().map(|w| w.count_ones()).sum()

@@ -7,7 +7,7 @@ mod leaf;
 mod sparse;
 mod transform;
 
-pub use coord::{Coord, CoordBox, LEAF_DIM, LEAF_VOXELS, leaf_offset, leaf_origin, offset_coord};
+pub use coord::{Coord, CoordBox, LEAF_VOXELS, leaf_offset, leaf_origin, offset_coord};
 pub use leaf::{Channels, Leaf};
 pub use sparse::{Accessor, SparseGrid};
 pub use transform::Transform;

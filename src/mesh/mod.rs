@@ -156,32 +156,6 @@ impl Mesh {
         })
     }
 
-    /// Faces whose fan triangles all have (near) zero area, or that repeat a vertex.
-    pub fn degenerate_face_count(&self) -> usize {
-        let scale = self.bbox().extent().length().max(f64::MIN_POSITIVE);
-        (0..self.face_count())
-            .filter(|&f| {
-                let face = self.face(f);
-                let repeats = (0..face.len()).any(|k| face[k] == face[(k + 1) % face.len()]);
-                let area = self.polygon_vector_area(face).length();
-                repeats || area <= 1e-14 * scale * scale
-            })
-            .count()
-    }
-
-    /// Half the sum of the fan's cross products: its length is the area of a planar polygon.
-    fn polygon_vector_area(&self, face: &[u32]) -> DVec3 {
-        let p0 = self.positions[face[0] as usize];
-        (1..face.len() - 1)
-            .map(|k| {
-                let a = self.positions[face[k] as usize] - p0;
-                let b = self.positions[face[k + 1] as usize] - p0;
-                a.cross(b)
-            })
-            .sum::<DVec3>()
-            * 0.5
-    }
-
     /// Surface area of the fan triangulation.
     pub fn area(&self) -> f64 {
         self.triangles()

@@ -51,8 +51,9 @@ fn parse_vec3(s: &str) -> std::result::Result<DVec3, String> {
     }
 }
 
+/// Grid fit, surface options and output file: what every voxelizing command takes.
 #[derive(Args, Clone)]
-pub struct ShapeCommon {
+pub struct VoxelizeArgs {
     #[command(flatten)]
     fit: FitArgs,
     #[command(flatten)]
@@ -71,7 +72,7 @@ pub enum ShapeKind {
         #[arg(long, value_parser = parse_vec3, default_value = "0,0,0", allow_hyphen_values = true)]
         center: DVec3,
         #[command(flatten)]
-        common: ShapeCommon,
+        common: VoxelizeArgs,
     },
     /// A closed cylinder (side, caps and sharp rims).
     Cylinder {
@@ -85,7 +86,7 @@ pub enum ShapeKind {
         #[arg(long, value_parser = parse_vec3, default_value = "0,0,1", allow_hyphen_values = true)]
         axis: DVec3,
         #[command(flatten)]
-        common: ShapeCommon,
+        common: VoxelizeArgs,
     },
     /// The surface x^2 + k y + k z = 0, clipped to the cube [-extent, extent]^3.
     Quadric {
@@ -94,7 +95,7 @@ pub enum ShapeKind {
         #[arg(long, default_value_t = 100.0)]
         extent: f64,
         #[command(flatten)]
-        common: ShapeCommon,
+        common: VoxelizeArgs,
     },
 }
 
@@ -165,13 +166,8 @@ fn voxelize_file(
     Ok((grid, stats, start.elapsed().as_secs_f64()))
 }
 
-pub fn mesh(
-    input: &Path,
-    fit: FitArgs,
-    surface: SurfaceArgs,
-    output: &Path,
-    json: bool,
-) -> Result<()> {
+pub fn mesh(input: &Path, args: &VoxelizeArgs, json: bool) -> Result<()> {
+    let (fit, surface, output) = (args.fit, args.surface, args.output.as_path());
     let start = Instant::now();
     let mesh = Mesh::load(input)?;
     let load_s = start.elapsed().as_secs_f64();
@@ -233,7 +229,8 @@ pub fn shape(kind: &ShapeKind, json: bool) -> Result<()> {
             )))
         }
     };
-    let (surface_obj, name, common): (Box<dyn AnalyticSurface>, String, &ShapeCommon) = match kind {
+    let (surface_obj, name, common): (Box<dyn AnalyticSurface>, String, &VoxelizeArgs) = match kind
+    {
         ShapeKind::Sphere {
             radius,
             center,

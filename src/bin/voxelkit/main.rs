@@ -77,12 +77,7 @@ enum Command {
         /// Input mesh: .obj (polygons kept) or .stl (binary or ASCII).
         input: PathBuf,
         #[command(flatten)]
-        fit: FitArgs,
-        #[command(flatten)]
-        surface: SurfaceArgs,
-        /// Output .vdb file.
-        #[arg(short, long)]
-        output: PathBuf,
+        args: commands::VoxelizeArgs,
     },
     /// Voxelize an analytic surface (Huang et al. §7) by exact point-to-surface distance.
     Shape {
@@ -123,12 +118,7 @@ fn main() -> ExitCode {
         return ExitCode::FAILURE;
     }
     let result = match cli.command {
-        Command::Mesh {
-            input,
-            fit,
-            surface,
-            output,
-        } => commands::mesh(&input, fit, surface, &output, cli.json),
+        Command::Mesh { input, args } => commands::mesh(&input, &args, cli.json),
         Command::Shape { shape } => commands::shape(&shape, cli.json),
         Command::Info { file } => commands::info(&file, cli.json),
         Command::Check {
