@@ -12,7 +12,10 @@ use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 #[test]
 fn blender_imports_the_volume() {
     if Command::new("blender").arg("--version").output().is_err() {
-        eprintln!("\n!!! blender is not installed: the Blender import test is SKIPPED\n");
+        let _ = std::io::Write::write_all(
+            &mut std::io::stderr(),
+            "\n!!! blender is not installed: the Blender import test is SKIPPED\n".as_bytes(),
+        );
         return;
     }
     let mesh = generate::torus(glam::DVec3::new(2.0, -1.0, 0.5), 1.0, 0.3, 64, 16);

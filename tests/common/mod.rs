@@ -13,7 +13,10 @@ pub fn data_dir() -> Option<PathBuf> {
     if dir.join("meshes").is_dir() {
         Some(dir)
     } else {
-        eprintln!(
+        // Straight to the stderr handle: libtest captures eprintln! of passing tests.
+        use std::io::Write as _;
+        let _ = writeln!(
+            std::io::stderr(),
             "\n!!! VOXELKIT_DATA: test data not found at {} — tests on the real meshes are SKIPPED.\n\
              !!! Set VOXELKIT_DATA to the shared data folder to run them.\n",
             dir.display()
