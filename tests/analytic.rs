@@ -3,7 +3,7 @@
 //! lies within the criterion's distance of the surface.
 
 use glam::DVec3;
-use voxelkit::grid::{Adjacency, CoordBox, Transform};
+use voxelkit::grid::{CoordBox, Transform};
 use voxelkit::ops::separability::check_side_separation;
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating_analytic::{
@@ -11,10 +11,8 @@ use voxelkit::voxelize::separating_analytic::{
 };
 
 fn check(surface: &dyn AnalyticSurface, transform: Transform, pad: i64) {
-    for (sep, adjacency) in [
-        (Separability::Six, Adjacency::Six),
-        (Separability::TwentySix, Adjacency::TwentySix),
-    ] {
+    for sep in [Separability::Six, Separability::TwentySix] {
+        let adjacency = sep.flood_adjacency();
         let grid = voxelize_surface(surface, transform, sep, true, &|_| {});
         let b = surface.bbox();
         let bbox = CoordBox {

@@ -5,9 +5,11 @@
 
 use std::process::Command;
 use voxelkit::io::vdb::write_vdb;
-use voxelkit::mesh::{GridFit, fit_transform, generate};
+use voxelkit::mesh::generate;
 use voxelkit::voxelize::Separability;
-use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
+use voxelkit::voxelize::separating::SeparatingOptions;
+
+mod common;
 
 #[test]
 fn blender_imports_the_volume() {
@@ -19,13 +21,12 @@ fn blender_imports_the_volume() {
         return;
     }
     let mesh = generate::torus(glam::DVec3::new(2.0, -1.0, 0.5), 1.0, 0.3, 64, 16);
-    let t = fit_transform(&mesh.bbox(), GridFit::Resolution(64)).unwrap();
     let opts = SeparatingOptions {
         separability: Separability::TwentySix,
         normals: true,
         ..Default::default()
     };
-    let (grid, _) = voxelize_mesh(&mesh, t, &opts, &|_| {}).unwrap();
+    let (grid, _) = common::voxelize_at(&mesh, 64, opts);
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("torus.vdb");
     write_vdb(&path, &grid, &[]).unwrap();

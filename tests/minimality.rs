@@ -4,26 +4,19 @@
 
 mod common;
 
-use voxelkit::grid::Adjacency;
-use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
+use voxelkit::mesh::{Mesh, generate};
 use voxelkit::ops::minimality::simple_voxel_count;
 use voxelkit::voxelize::Separability;
-use voxelkit::voxelize::separating::{Criterion, SeparatingOptions, voxelize_mesh};
+use voxelkit::voxelize::separating::{Criterion, SeparatingOptions};
 
 fn simple_share(mesh: &Mesh, resolution: u32, sep: Separability, criterion: Criterion) -> f64 {
-    let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
     let opts = SeparatingOptions {
         separability: sep,
         criterion,
         normals: false,
     };
-    let (grid, _) = voxelize_mesh(mesh, t, &opts, &|_| {}).unwrap();
-    let adjacency = if sep == Separability::Six {
-        Adjacency::Six
-    } else {
-        Adjacency::TwentySix
-    };
-    simple_voxel_count(&grid, adjacency).unwrap() as f64 / grid.voxel_count() as f64
+    let (grid, _) = common::voxelize_at(mesh, resolution, opts);
+    simple_voxel_count(&grid, sep.flood_adjacency()).unwrap() as f64 / grid.voxel_count() as f64
 }
 
 fn assert_clipped_is_nearly_minimal(mesh: &Mesh, resolution: u32, limit: f64) {

@@ -6,18 +6,10 @@
 mod common;
 
 use proptest::prelude::*;
-use voxelkit::grid::Adjacency;
-use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
+use voxelkit::mesh::{Mesh, generate};
 use voxelkit::ops::separability::check_mesh_separation;
 use voxelkit::voxelize::Separability;
-use voxelkit::voxelize::separating::{Criterion, SeparatingOptions, voxelize_mesh};
-
-fn flood_adjacency(sep: Separability) -> Adjacency {
-    match sep {
-        Separability::Six => Adjacency::Six,
-        Separability::TwentySix => Adjacency::TwentySix,
-    }
-}
+use voxelkit::voxelize::separating::{Criterion, SeparatingOptions};
 
 /// Voxelizes and floods; panics with a diagnosis when the flood leaks.
 fn assert_separates(mesh: &Mesh, resolution: u32, sep: Separability) {
@@ -27,14 +19,13 @@ fn assert_separates(mesh: &Mesh, resolution: u32, sep: Separability) {
 }
 
 fn assert_separates_with(mesh: &Mesh, resolution: u32, sep: Separability, criterion: Criterion) {
-    let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
     let opts = SeparatingOptions {
         separability: sep,
         criterion,
         normals: false,
     };
-    let (grid, stats) = voxelize_mesh(mesh, t, &opts, &|_| {}).unwrap();
-    let report = check_mesh_separation(&grid, mesh, flood_adjacency(sep)).unwrap();
+    let (grid, stats) = common::voxelize_at(mesh, resolution, opts);
+    let report = check_mesh_separation(&grid, mesh, sep.flood_adjacency()).unwrap();
     assert!(
         report.inside_empty > 0,
         "{}: no empty inside voxel at {resolution}: vacuous test",

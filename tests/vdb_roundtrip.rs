@@ -6,9 +6,11 @@ use glam::DVec3;
 use std::process::Command;
 use voxelkit::grid::SparseGrid;
 use voxelkit::io::vdb::{read_vdb_grid, read_vdb_info, write_vdb};
-use voxelkit::mesh::{GridFit, fit_transform, generate};
+use voxelkit::mesh::generate;
 use voxelkit::voxelize::Separability;
-use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
+use voxelkit::voxelize::separating::SeparatingOptions;
+
+mod common;
 
 fn sorted_voxels(g: &SparseGrid) -> Vec<[i64; 3]> {
     let mut v: Vec<_> = g.voxels().collect();
@@ -22,13 +24,12 @@ fn written_example(dir: &std::path::Path) -> (SparseGrid, std::path::PathBuf) {
     for p in &mut mesh.positions {
         *p += DVec3::new(-3.25, 1.5, -0.75);
     }
-    let t = fit_transform(&mesh.bbox(), GridFit::Resolution(96)).unwrap();
     let opts = SeparatingOptions {
         separability: Separability::TwentySix,
         normals: true,
         ..Default::default()
     };
-    let (grid, _) = voxelize_mesh(&mesh, t, &opts, &|_| {}).unwrap();
+    let (grid, _) = common::voxelize_at(&mesh, 96, opts);
     let path = dir.join("knot.vdb");
     write_vdb(
         &path,

@@ -2,7 +2,7 @@
 //! near the surface), nesting of 6 in 26, class counts, normals, and thread independence.
 
 use glam::DVec3;
-use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
+use voxelkit::mesh::{Mesh, generate};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 
@@ -26,20 +26,15 @@ fn point_triangle_distance(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+mod common;
+
 fn run(mesh: &Mesh, res: u32, sep: Separability, normals: bool) -> voxelkit::grid::SparseGrid {
-    let t = fit_transform(&mesh.bbox(), GridFit::Resolution(res)).unwrap();
-    voxelize_mesh(
-        mesh,
-        t,
-        &SeparatingOptions {
-            separability: sep,
-            normals,
-            ..Default::default()
-        },
-        &|_| {},
-    )
-    .unwrap()
-    .0
+    let opts = SeparatingOptions {
+        separability: sep,
+        normals,
+        ..Default::default()
+    };
+    common::voxelize_at(mesh, res, opts).0
 }
 
 #[test]

@@ -27,6 +27,14 @@ impl Separability {
         }
     }
 
+    /// The connectivity of the empty voxels this surface blocks (what a flood check uses).
+    pub fn flood_adjacency(self) -> crate::grid::Adjacency {
+        match self {
+            Separability::Six => crate::grid::Adjacency::Six,
+            Separability::TwentySix => crate::grid::Adjacency::TwentySix,
+        }
+    }
+
     /// Half thickness `t` of the slab around a plane with unit normal `n`, in voxels.
     pub fn slab_half_thickness(self, n: DVec3) -> f64 {
         let a = n.abs();

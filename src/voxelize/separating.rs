@@ -53,6 +53,26 @@ pub enum Criterion {
     Clipped,
 }
 
+impl Criterion {
+    /// The name used on the command line and in metadata.
+    pub fn name(self) -> &'static str {
+        match self {
+            Criterion::Huang => "huang",
+            Criterion::Clipped => "clipped",
+        }
+    }
+}
+
+impl std::str::FromStr for Criterion {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        [Criterion::Huang, Criterion::Clipped]
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| format!("criterion must be huang or clipped, not `{s}`"))
+    }
+}
+
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SeparatingOptions {
     pub separability: Separability,

@@ -38,3 +38,17 @@ pub const CLOSED_MESHES: [&str; 10] = [
     "scorpion",
     "horse",
 ];
+
+/// Voxelizes `mesh` at `resolution` voxels along its longest axis.
+pub fn voxelize_at(
+    mesh: &voxelkit::mesh::Mesh,
+    resolution: u32,
+    opts: voxelkit::voxelize::separating::SeparatingOptions,
+) -> (
+    voxelkit::grid::SparseGrid,
+    voxelkit::voxelize::separating::SeparatingStats,
+) {
+    use voxelkit::mesh::{GridFit, fit_transform};
+    let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
+    voxelkit::voxelize::separating::voxelize_mesh(mesh, t, &opts, &|_| {}).unwrap()
+}

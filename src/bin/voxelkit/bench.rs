@@ -126,7 +126,7 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
                                 .str("mesh", name.clone())
                                 .int("resolution", res as u64)
                                 .int("separability", sep.adjacency() as u64)
-                                .str("criterion", format!("{criterion:?}").to_lowercase())
+                                .str("criterion", criterion.name())
                                 .int("threads", threads as u64)
                                 .num("ours_seconds", ours_s)
                                 .int("ours_voxels", voxels)
@@ -140,7 +140,7 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
                             name,
                             res,
                             sep.adjacency(),
-                            format!("{criterion:?}").to_lowercase(),
+                            criterion.name(),
                             threads,
                             ours_s,
                             voxels,

@@ -6,7 +6,7 @@ use clap::{Args, Subcommand};
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use voxelkit::grid::{Adjacency, SparseGrid, Transform};
+use voxelkit::grid::{SparseGrid, Transform};
 use voxelkit::io::vdb::{read_vdb_info, write_vdb};
 use voxelkit::mesh::{Aabb, GridFit, Mesh, fit_transform, generate};
 use voxelkit::ops::minimality::simple_voxel_count;
@@ -408,10 +408,7 @@ pub fn info(file: &Path, json: bool) -> Result<()> {
 pub fn check(input: &Path, fit: FitArgs, surface: SurfaceArgs, json: bool) -> Result<()> {
     let mesh = Mesh::load(input)?;
     let (grid, stats, seconds) = voxelize_file(&mesh, fit, surface, json)?;
-    let adjacency = match surface.separability {
-        Separability::Six => Adjacency::Six,
-        Separability::TwentySix => Adjacency::TwentySix,
-    };
+    let adjacency = surface.separability.flood_adjacency();
     let report = check_mesh_separation(&grid, &mesh, adjacency)?;
     let simple = simple_voxel_count(&grid, adjacency)?;
     let share = simple as f64 / grid.voxel_count().max(1) as f64;
@@ -491,11 +488,7 @@ pub fn demo(folder: &Path, resolution: u32, json: bool) -> Result<()> {
                 &resolution.to_string(),
             ),
         )?;
-        let adjacency = if sep == Separability::Six {
-            Adjacency::Six
-        } else {
-            Adjacency::TwentySix
-        };
+        let adjacency = sep.flood_adjacency();
         let report = check_mesh_separation(&grid, &mesh, adjacency)?;
         if !json {
             println!(

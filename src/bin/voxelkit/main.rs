@@ -63,11 +63,7 @@ fn parse_separability(s: &str) -> Result<Separability, String> {
 }
 
 pub fn parse_criterion(s: &str) -> Result<Criterion, String> {
-    match s {
-        "huang" => Ok(Criterion::Huang),
-        "clipped" => Ok(Criterion::Clipped),
-        _ => Err(format!("criterion must be huang or clipped, not `{s}`")),
-    }
+    s.parse()
 }
 
 #[derive(Subcommand)]
