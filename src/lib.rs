@@ -8,6 +8,7 @@ pub mod grid;
 pub mod io;
 pub mod mesh;
 pub mod ops;
+pub mod subd;
 pub mod system;
 pub mod voxelize;
 

@@ -38,7 +38,7 @@ pub(super) fn load_obj(path: &Path) -> Result<Mesh> {
         positions.extend(
             m.positions
                 .chunks_exact(3)
-                .map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)),
+                .map(|p| DVec3::new(p[0], p[1], p[2])),
         );
         let mut at = 0usize;
         let arities: Vec<usize> = if m.face_arities.is_empty() {

@@ -1,0 +1,180 @@
+//! A Catmull-Clark control mesh: polygons of any size from an OBJ file, with the topology
+//! checks the limit surface needs (manifold edges and vertices, consistent orientation, no
+//! isolated vertices), each failure named by vertex or face.
+
+use super::poly_mesh::PolyMesh;
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use glam::DVec3;
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Debug)]
+pub struct ControlMesh {
+    pub(crate) mesh: PolyMesh,
+    /// One outgoing half-edge per vertex, the start of its counter-clockwise ring.
+    pub(crate) outgoing: Vec<u32>,
+    pub source: PathBuf,
+}
+
+/// What a control mesh is made of, for summaries.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ControlStats {
+    pub vertices: usize,
+    pub faces: usize,
+    pub quads: usize,
+    pub triangles: usize,
+    pub other: usize,
+    /// Interior vertices of valence other than 4.
+    pub extraordinary: usize,
+    pub boundary_vertices: usize,
+    pub max_valence: usize,
+}
+
+impl ControlMesh {
+    /// Loads an OBJ control mesh (tags such as creases are not read).
+    pub fn load(path: &Path) -> Result<ControlMesh> {
+        let mesh = Mesh::load(path)?;
+        ControlMesh::from_mesh(&mesh)
+    }
+
+    /// Checks the topology of a polygon mesh and builds the control mesh.
+    pub fn from_mesh(mesh: &Mesh) -> Result<ControlMesh> {
+        mesh.validate()?;
+        let source = mesh.source.clone();
+        let bad_face = |face: usize, message: String| Error::BadFace {
+            path: source.clone(),
+            face,
+            message,
+        };
+        let faces: Vec<&[u32]> = (0..mesh.face_count()).map(|f| mesh.face(f)).collect();
+        for (f, face) in faces.iter().enumerate() {
+            for (k, v) in face.iter().enumerate() {
+                if face[k + 1..].contains(v) {
+                    return Err(bad_face(
+                        f,
+                        format!("uses vertex {} twice (degenerate face)", v + 1),
+                    ));
+                }
+            }
+        }
+        let poly =
+            PolyMesh::build(mesh.positions.clone(), &faces, |_, _| true).map_err(|(a, b)| {
+                let users: Vec<String> = (0..faces.len())
+                    .filter(|&f| {
+                        let face = faces[f];
+                        (0..face.len()).any(|k| {
+                            let (p, q) = (face[k], face[(k + 1) % face.len()]);
+                            (p, q) == (a, b) || (p, q) == (b, a)
+                        })
+                    })
+                    .map(|f| f.to_string())
+                    .collect();
+                Error::Unsupported(format!(
+                    "{}: edge between vertices {} and {} is non-manifold or inconsistently \
+                     oriented: it is used by faces {} (a Catmull-Clark surface needs every \
+                     edge shared by at most two faces, traversed in opposite directions)",
+                    source.display(),
+                    a + 1,
+                    b + 1,
+                    users.join(", ")
+                ))
+            })?;
+        let outgoing = poly.outgoing();
+        let mut incidences = vec![0usize; poly.points.len()];
+        for &v in &poly.verts {
+            incidences[v as usize] += 1;
+        }
+        for (v, &count) in incidences.iter().enumerate() {
+            let vertex_error = |what: &str| {
+                Error::Unsupported(format!(
+                    "{}: vertex {} (at {:?}) {what}",
+                    source.display(),
+                    v + 1,
+                    poly.points[v]
+                ))
+            };
+            if count == 0 {
+                return Err(vertex_error(
+                    "is used by no face (isolated vertex); remove it from the control mesh",
+                ));
+            }
+            let (ring, _) = poly.ring(outgoing[v]);
+            if ring.len() != count {
+                return Err(vertex_error(&format!(
+                    "is non-manifold: its {count} faces form more than one fan"
+                )));
+            }
+        }
+        Ok(ControlMesh {
+            mesh: poly,
+            outgoing,
+            source,
+        })
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.mesh.points.len()
+    }
+
+    pub fn face_count(&self) -> usize {
+        self.mesh.face_count()
+    }
+
+    pub fn face_len(&self, f: usize) -> usize {
+        self.mesh.face_len(f)
+    }
+
+    pub fn positions(&self) -> &[DVec3] {
+        &self.mesh.points
+    }
+
+    /// Applies `map` to every control point. Catmull-Clark rules are affine combinations,
+    /// so the limit surface moves with any affine map (used to go to voxel index space).
+    pub fn map_points(&mut self, map: impl Fn(DVec3) -> DVec3) {
+        for p in &mut self.mesh.points {
+            *p = map(*p);
+        }
+    }
+
+    pub fn is_closed(&self) -> bool {
+        self.mesh.boundary.iter().all(|&b| !b)
+    }
+
+    pub fn bbox(&self) -> crate::mesh::Aabb {
+        let mut b = crate::mesh::Aabb {
+            min: DVec3::splat(f64::INFINITY),
+            max: DVec3::splat(f64::NEG_INFINITY),
+        };
+        for &p in &self.mesh.points {
+            b.min = b.min.min(p);
+            b.max = b.max.max(p);
+        }
+        b
+    }
+
+    pub fn stats(&self) -> ControlStats {
+        let mut s = ControlStats {
+            vertices: self.vertex_count(),
+            faces: self.face_count(),
+            ..Default::default()
+        };
+        for f in 0..self.face_count() {
+            match self.face_len(f) {
+                4 => s.quads += 1,
+                3 => s.triangles += 1,
+                _ => s.other += 1,
+            }
+        }
+        for &h in &self.outgoing {
+            let (ring, closed) = self.mesh.ring(h);
+            let valence = if closed { ring.len() } else { ring.len() + 1 };
+            s.max_valence = s.max_valence.max(valence);
+            if !closed {
+                s.boundary_vertices += 1;
+            } else if valence != 4 {
+                s.extraordinary += 1;
+            }
+        }
+        s
+    }
+}

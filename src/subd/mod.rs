@@ -1,0 +1,18 @@
+//! Catmull-Clark subdivision surfaces: control meshes, and exact evaluation of the limit
+//! surface (position, derivatives, normal) in OpenSubdiv's parametrization.
+
+mod bicubic;
+mod compare;
+mod control_mesh;
+mod limit_masks;
+mod patch;
+mod points_file;
+mod poly_mesh;
+mod subdivide;
+mod surface;
+
+pub use compare::{Comparison, angle_between, compare_points};
+pub use control_mesh::{ControlMesh, ControlStats};
+pub use patch::LimitSample;
+pub use points_file::{SurfacePoint, parse_points, read_points};
+pub use surface::{LimitSurface, PatchDomain, subface_tiles};
