@@ -28,7 +28,7 @@ fn main() {
             &["osdCPU"],
             "OpenSubdiv is missing: install it with `apt-get install libosd-dev`, or build with --no-default-features",
         );
-        println!("cargo:rustc-link-lib=osdCPU");
+        build_osd_bridge();
     }
 }
 
@@ -100,7 +100,29 @@ fn build_vdb_bridge() {
     }
     println!("cargo:rustc-link-lib=openvdb");
     println!("cargo:rustc-link-lib=tbb");
-    for f in ["cpp/vdb_bridge.cc", "cpp/vdb_bridge.h", "src/ffi/vdb.rs"] {
+    for f in [
+        "cpp/vdb_bridge.cc",
+        "cpp/vdb_bridge.h",
+        "cpp/trycatch.h",
+        "src/ffi/vdb.rs",
+    ] {
         println!("cargo:rerun-if-changed={f}");
+    }
+}
+
+fn build_osd_bridge() {
+    cxx_build::bridge("src/ffi/osd.rs")
+        .file("cpp/osd_bridge.cc")
+        .std("c++17")
+        .opt_level(2)
+        .compile("voxelkit_osd_bridge");
+    println!("cargo:rustc-link-lib=osdCPU");
+    for path in [
+        "cpp/osd_bridge.cc",
+        "cpp/osd_bridge.h",
+        "cpp/trycatch.h",
+        "src/ffi/osd.rs",
+    ] {
+        println!("cargo:rerun-if-changed={path}");
     }
 }

@@ -1,6 +1,7 @@
 // The C++ half of src/ffi/vdb.rs: OpenVDB file I/O and meshToVolume for benchmarks.
 #pragma once
 #include "rust/cxx.h"
+#include "voxelkit/cpp/trycatch.h"
 #include <memory>
 #include <openvdb/openvdb.h>
 
@@ -40,16 +41,3 @@ uint64_t openvdb_mesh_to_volume(rust::Slice<const float> points, rust::Slice<con
 
 }  // namespace voxelkit
 
-// cxx turns std::exception into Err; anything else thrown must not cross into Rust either.
-namespace rust {
-namespace behavior {
-template <typename Try, typename Fail>
-static void trycatch(Try&& func, Fail&& fail) noexcept try {
-    func();
-} catch (const std::exception& e) {
-    fail(e.what());
-} catch (...) {
-    fail("unknown C++ exception");
-}
-}  // namespace behavior
-}  // namespace rust

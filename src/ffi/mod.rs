@@ -1,3 +1,5 @@
 //! cxx bridges to the C++ libraries. No algorithm code lives here.
+#[cfg(feature = "osd")]
+pub mod osd;
 #[cfg(feature = "vdb")]
 pub mod vdb;

@@ -5,6 +5,8 @@ mod bicubic;
 mod compare;
 mod control_mesh;
 mod limit_masks;
+#[cfg(feature = "osd")]
+pub mod opensubdiv;
 mod patch;
 mod points_file;
 mod poly_mesh;

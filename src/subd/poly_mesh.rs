@@ -118,8 +118,9 @@ impl PolyMesh {
         let mut out = vec![NONE; self.points.len()];
         for h in 0..self.verts.len() as u32 {
             let v = self.from(h) as usize;
-            // A walk must start where no face precedes it clockwise: prev's twin is missing.
-            let starts_fan = self.twin(self.prev(h)).is_none();
+            // A walk goes clockwise-backwards through incoming edges: it must start at the face
+            // whose outgoing edge is unmatched, or it would miss the faces before it.
+            let starts_fan = self.twin(h).is_none();
             if out[v] == NONE || starts_fan {
                 out[v] = h;
             }

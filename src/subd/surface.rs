@@ -123,6 +123,20 @@ impl LimitSurface {
         }
     }
 
+    /// `per_patch` uniformly random points on every patch, as face `(face, u, v)`.
+    pub fn random_parameters(&self, per_patch: usize, seed: u64) -> Vec<(usize, f64, f64)> {
+        let mut rng = crate::mesh::generate::SplitMix64(seed);
+        let mut out = Vec::with_capacity(per_patch * self.patch_count());
+        for pid in 0..self.patch_count() {
+            let d = self.patch_domain(pid);
+            for _ in 0..per_patch {
+                let (s, t) = (rng.range(0.0, 1.0), rng.range(0.0, 1.0));
+                out.push((d.face, d.origin.0 + d.scale * s, d.origin.1 + d.scale * t));
+            }
+        }
+        out
+    }
+
     /// Evaluates face `face` at OpenSubdiv's `(u, v)`; derivatives are per unit of u and v.
     pub fn evaluate(&self, face: usize, u: f64, v: f64) -> Result<LimitSample> {
         let (pid, s, t, scale) = self.locate(face, u, v)?;
