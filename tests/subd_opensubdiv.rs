@@ -44,20 +44,8 @@ fn every_control_mesh_matches_opensubdiv() {
             check.random.max_relative_position_error,
             check.random.max_normal_angle
         );
-        for (what, c) in [("dyadic", check.dyadic), ("random", check.random)] {
-            assert!(c.points > 0);
-            assert!(
-                c.max_relative_position_error <= 1e-9,
-                "{name} {what}: position {:e}",
-                c.max_relative_position_error
-            );
-            assert!(
-                c.max_normal_angle <= 1e-6,
-                "{name} {what}: normal {:e} rad at {:?}",
-                c.max_normal_angle,
-                c.worst_normal_at
-            );
-        }
+        common::assert_limit_match(&format!("{name} dyadic"), &check.dyadic);
+        common::assert_limit_match(&format!("{name} random"), &check.random);
         checked += 1;
     }
     assert!(checked >= 20, "only {checked} control meshes checked");

@@ -43,18 +43,7 @@ fn reference_limit_points_are_reproduced() {
             "{name}: {} points, position {:.2e} of the diagonal, normal {:.2e} rad",
             c.points, c.max_relative_position_error, c.max_normal_angle
         );
-        assert!(c.points > 0, "{name}: no points");
-        assert!(
-            c.max_relative_position_error <= 1e-9,
-            "{name}: position error {:e} of the diagonal",
-            c.max_relative_position_error
-        );
-        assert!(
-            c.max_normal_angle <= 1e-6,
-            "{name}: normal off by {:e} rad at {:?}",
-            c.max_normal_angle,
-            c.worst_normal_at
-        );
+        common::assert_limit_match(name, &c);
         checked += 1;
     }
     assert_eq!(checked, 13);

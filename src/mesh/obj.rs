@@ -18,8 +18,11 @@ pub(super) fn load_obj(path: &Path) -> Result<Mesh> {
     Ok(Mesh::from_polygons(path, positions, &polygons))
 }
 
-/// Positions and polygons (0-based indices), or the first bad line: `(1-based line, message)`.
-fn parse_obj(text: &str) -> std::result::Result<(Vec<DVec3>, Vec<Vec<u32>>), (usize, String)> {
+/// Positions and polygons (0-based indices).
+type Parsed = (Vec<DVec3>, Vec<Vec<u32>>);
+
+/// Parses OBJ text, or names the first bad line: `(1-based line, message)`.
+fn parse_obj(text: &str) -> std::result::Result<Parsed, (usize, String)> {
     let mut positions = Vec::new();
     let mut polygons = Vec::new();
     for (n, raw) in text.lines().enumerate() {

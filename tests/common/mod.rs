@@ -52,3 +52,20 @@ pub fn voxelize_at(
     let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
     voxelkit::voxelize::separating::voxelize_mesh(mesh, t, &opts, &|_| {}).unwrap()
 }
+
+/// Asserts that the evaluator matches expected limit points: positions to 1e-9 of the bbox
+/// diagonal, normals to 1e-6 rad.
+pub fn assert_limit_match(what: &str, c: &voxelkit::subd::Comparison) {
+    assert!(c.points > 0, "{what}: no points compared");
+    assert!(
+        c.max_relative_position_error <= 1e-9,
+        "{what}: position error {:e} of the diagonal",
+        c.max_relative_position_error
+    );
+    assert!(
+        c.max_normal_angle <= 1e-6,
+        "{what}: normal off by {:e} rad at {:?}",
+        c.max_normal_angle,
+        c.worst_normal_at
+    );
+}
