@@ -43,6 +43,16 @@ fn vdb_error(path: &Path, e: impl std::fmt::Display) -> Error {
 /// Writes `grid` to `path` as `surface`, `density` and (when present) `normal` grids, each
 /// with `grid.transform` and `metadata` plus `voxelkit_version`.
 pub fn write_vdb(path: &Path, grid: &SparseGrid, metadata: &[(&str, String)]) -> Result<()> {
+    write_vdb_with_masks(path, grid, &[], metadata)
+}
+
+/// `write_vdb`, plus one bool grid per `(name, mask)` (same transform; values ignored).
+pub fn write_vdb_with_masks(
+    path: &Path,
+    grid: &SparseGrid,
+    masks_to_add: &[(&str, &SparseGrid)],
+    metadata: &[(&str, String)],
+) -> Result<()> {
     let (origins, masks, leaves) = flatten(path, grid)?;
     let mut meta: Vec<MetaEntry> = metadata
         .iter()
@@ -82,6 +92,15 @@ pub fn write_vdb(path: &Path, grid: &SparseGrid, metadata: &[(&str, String)]) ->
             normals.extend(n.iter().flatten());
         }
         add("normal", "normal", &normals)?;
+    }
+    for (name, mask) in masks_to_add {
+        let (origins, masks, _) = flatten(path, mask)?;
+        writer
+            .pin_mut()
+            .add_grid(
+                "bool", name, t.voxel_size, origin, &origins, &masks, &[], &meta,
+            )
+            .map_err(|e| vdb_error(path, e))?;
     }
     write_atomic(path, |tmp| {
         let tmp_str = tmp

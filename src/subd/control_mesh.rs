@@ -136,6 +136,14 @@ impl ControlMesh {
         }
     }
 
+    /// The control polygons as a plain mesh (for areas, bounding boxes, fitting).
+    pub fn polygon_mesh(&self) -> Mesh {
+        let faces: Vec<Vec<u32>> = (0..self.face_count())
+            .map(|f| self.mesh.face(f).to_vec())
+            .collect();
+        Mesh::from_polygons(self.source.clone(), self.mesh.points.clone(), &faces)
+    }
+
     pub fn is_closed(&self) -> bool {
         self.mesh.boundary.iter().all(|&b| !b)
     }

@@ -21,14 +21,14 @@ use voxelkit::voxelize::separating_analytic::{
 use voxelkit::{Error, Result};
 
 impl FitArgs {
-    fn grid_fit(&self) -> GridFit {
+    pub fn grid_fit(&self) -> GridFit {
         match (self.resolution, self.voxel_size) {
             (_, Some(h)) => GridFit::VoxelSize(h),
             (Some(r), None) => GridFit::Resolution(r),
             (None, None) => GridFit::Resolution(256),
         }
     }
-    fn describe(&self) -> String {
+    pub fn describe(&self) -> String {
         match self.grid_fit() {
             GridFit::Resolution(r) => r.to_string(),
             GridFit::VoxelSize(h) => format!("voxel size {h}"),

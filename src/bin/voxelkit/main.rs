@@ -3,6 +3,7 @@
 mod bench;
 mod commands;
 mod report;
+mod subdiv;
 
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
@@ -99,6 +100,9 @@ enum Command {
         #[arg(short, long, default_value_t = 256)]
         resolution: u32,
     },
+    /// Voxelize a Catmull-Clark control mesh from its exact limit surface (Lai & Cheng), or
+    /// check the limit-surface evaluator against OpenSubdiv (`subdiv check`, `subdiv eval`).
+    Subdiv(subdiv::SubdivArgs),
     /// Benchmark against OpenVDB's meshToVolume with a one-voxel band, in the same run.
     Bench(bench::BenchArgs),
 }
@@ -123,6 +127,7 @@ fn main() -> ExitCode {
             surface,
         } => commands::check(&input, fit, surface, cli.json),
         Command::Demo { output, resolution } => commands::demo(&output, resolution, cli.json),
+        Command::Subdiv(args) => subdiv::run(&args, cli.json),
         Command::Bench(args) => bench::run(&args, cli.json),
     };
     match result {
