@@ -98,7 +98,14 @@ pub fn write_vdb_with_masks(
         writer
             .pin_mut()
             .add_grid(
-                "bool", name, t.voxel_size, origin, &origins, &masks, &[], &meta,
+                "bool",
+                name,
+                t.voxel_size,
+                origin,
+                &origins,
+                &masks,
+                &[],
+                &meta,
             )
             .map_err(|e| vdb_error(path, e))?;
     }

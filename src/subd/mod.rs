@@ -1,6 +1,7 @@
 //! Catmull-Clark subdivision surfaces: control meshes, and exact evaluation of the limit
 //! surface (position, derivatives, normal) in OpenSubdiv's parametrization.
 
+mod area;
 mod bicubic;
 mod compare;
 mod control_mesh;
@@ -13,6 +14,7 @@ mod poly_mesh;
 mod subdivide;
 mod surface;
 
+pub use area::limit_area;
 pub use compare::{Comparison, angle_between, compare_points};
 pub use control_mesh::{ControlMesh, ControlStats};
 pub use patch::LimitSample;

@@ -117,6 +117,14 @@ impl PatchNode {
         }
     }
 
+    /// Which corners are extraordinary (where the patch is not polynomial nearby).
+    pub fn irregular_corners(&self) -> [bool; 4] {
+        match self {
+            PatchNode::Regular(_) => [false; 4],
+            PatchNode::Irregular(p) => p.irregular_corner,
+        }
+    }
+
     /// A box containing the piece of the patch over `[u0,u1] x [v0,v1]`.
     pub fn bound(&self, u0: f64, u1: f64, v0: f64, v1: f64) -> (DVec3, DVec3) {
         match self {

@@ -104,6 +104,54 @@ impl LimitSurface {
         self.patches[pid].bound(s0, s1, t0, t1)
     }
 
+    /// Corners of patch `pid` at extraordinary vertices, in the order (0,0), (1,0), (1,1), (0,1).
+    pub fn irregular_corners(&self, pid: usize) -> [bool; 4] {
+        self.patches[pid].irregular_corners()
+    }
+
+    /// Every patch sampled on an `(n+1) x (n+1)` grid and split into quads: a closed polygon
+    /// approximation of the limit surface of a closed control mesh. Points shared by patches
+    /// are evaluated once per patch (equal to rounding) and welded on a 1e-9 lattice.
+    pub fn tessellate(&self, n: usize) -> crate::mesh::Mesh {
+        let n = n.max(1);
+        let per_patch: Vec<Vec<glam::DVec3>> = (0..self.patch_count())
+            .into_par_iter()
+            .map(|pid| {
+                (0..=n)
+                    .flat_map(|j| (0..=n).map(move |i| (i, j)))
+                    .map(|(i, j)| {
+                        self.eval_patch(pid, i as f64 / n as f64, j as f64 / n as f64)
+                            .position
+                    })
+                    .collect()
+            })
+            .collect();
+        let b = self.control.bbox();
+        let lattice = (b.max - b.min).length().max(f64::MIN_POSITIVE) * 1e-9;
+        let mut index = rustc_hash::FxHashMap::default();
+        let mut positions = Vec::new();
+        let mut quads = Vec::with_capacity(per_patch.len() * n * n);
+        for points in per_patch {
+            let ids: Vec<u32> = points
+                .iter()
+                .map(|&p| {
+                    let key = ((p - b.min) / lattice).round().as_i64vec3().to_array();
+                    *index.entry(key).or_insert_with(|| {
+                        positions.push(p);
+                        positions.len() as u32 - 1
+                    })
+                })
+                .collect();
+            let at = |i: usize, j: usize| ids[j * (n + 1) + i];
+            for j in 0..n {
+                for i in 0..n {
+                    quads.push(vec![at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+                }
+            }
+        }
+        crate::mesh::Mesh::from_polygons(self.control.source.clone(), positions, &quads)
+    }
+
     pub fn patch_domain(&self, pid: usize) -> PatchDomain {
         let face = self.patch_face[pid] as usize;
         let n = self.control.face_len(face);

@@ -6,17 +6,22 @@
 //! receives a point whose normal disagrees (dot <= 0) is marked as crossed by two sheets
 //! (§6.1). Surface area is the sum of the final sub-patch quads (§7.2).
 //!
-//! Correction to the paper (option `enclose`): adjacent corner voxels do not make a sub-patch
-//! stay inside them — a small curved or tilted piece whose corners fall in voxels A and B can
-//! pass through a third voxel C, which then holds surface points but is not output. So eq. (3)
-//! ("every surface point lies in an output voxel"), on which the paper's separability proof
-//! rests, does not hold for its output; with 26-adjacency it cannot, as the voxels a plane
-//! touches are a thicker set than any 26-adjacent one. With `enclose`, a sub-patch that passes
-//! the adjacency test is also bounded (the box of its Bezier control points, or of its control
-//! ring near an extraordinary vertex) and is accepted only when every voxel that box touches is
-//! one of its corner voxels; otherwise it is halved further, down to the same depth guard. The
-//! output is then every voxel the surface touches (eq. 3), and every output voxel still holds an
-//! evaluated surface point (eq. 4). Without it (the default) the output is the paper's.
+//! The paper proves (§5) that the output is 6-separating for every N, from eq. (3): "every
+//! surface point lies in an output voxel". Eq. (3) does not hold for its output, though:
+//! adjacent corner voxels do not keep a sub-patch inside them — a small curved or tilted piece
+//! whose corners fall in voxels A and B can pass through a third voxel C that no sample lands
+//! in (with 26-adjacency it cannot hold at all: the voxels a plane touches form a thicker set
+//! than any 26-adjacent one). Flooding finds the output 6-separating all the same, but not
+//! 26-separating even for N = 6: a sheet can clip the corner of a voxel that holds no sample,
+//! leaving two corner-sharing empty voxels on either side.
+//!
+//! Correction (option `enclose`): a sub-patch is accepted only when a bound of it (the box of
+//! its Bezier control points, or of its control ring near an extraordinary vertex) touches no
+//! voxel but its corner voxels; otherwise it is halved, down to a guard 2^10 times finer than
+//! the paper's, where every voxel the bound touches is added (counted in `guard_voxels`). The
+//! output is then every voxel the surface touches (eq. 3), whatever N; every output voxel holds
+//! an evaluated surface point (eq. 4) except the guard voxels, which lie within a bound 2^10
+//! times smaller than the paper's guard. The result blocks 26-paths.
 
 use super::sink::Progress;
 use crate::error::Result;
@@ -58,8 +63,10 @@ pub struct ParametricStats {
     pub uniform_evaluations: u64,
     /// Sub-patches stopped by the depth guard while the test still failed.
     pub depth_guard_stops: u64,
-    /// Sub-patches that passed the adjacency test but were halved for `enclose`.
+    /// Sub-patches halved because their bound left their corner voxels (`enclose`).
     pub enclose_splits: u64,
+    /// Voxels added from bounds at the finer guard of `enclose`.
+    pub guard_voxels: u64,
     /// Surface area from the final sub-patch quads, in world units.
     pub area: f64,
     pub voxels: u64,
@@ -213,6 +220,7 @@ fn merge_partials(
     stats.uniform_evaluations += s.uniform_evaluations;
     stats.depth_guard_stops += s.depth_guard_stops;
     stats.enclose_splits += s.enclose_splits;
+    stats.guard_voxels += s.guard_voxels;
     stats.area += s.area;
     (grid, opposite, stats)
 }
@@ -229,6 +237,9 @@ struct Run<'a> {
     /// The paper's depth guard: stop when a sub-patch side is below 1 / max(M).
     guard: f64,
 }
+
+/// How much finer than the paper's guard the enclosure refinement may go.
+const ENCLOSE_GUARD_FACTOR: f64 = 1024.0;
 
 impl Run<'_> {
     fn corner(&self, pid: usize, s: f64, t: f64, part: &mut Partial) -> Corner {
@@ -257,7 +268,12 @@ impl Run<'_> {
         let mut finest = step;
         for j in 0..k {
             for i in 0..k {
-                let rect = [i as f64 * step, (i + 1) as f64 * step, j as f64 * step, (j + 1) as f64 * step];
+                let rect = [
+                    i as f64 * step,
+                    (i + 1) as f64 * step,
+                    j as f64 * step,
+                    (j + 1) as f64 * step,
+                ];
                 let corners = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
                 self.subpatch(pid, rect, corners, part, &mut finest);
             }
@@ -267,24 +283,41 @@ impl Run<'_> {
     }
 
     /// VoxelizeSubPatch: corners in the order (u1,v1), (u2,v1), (u2,v2), (u1,v2).
-    fn subpatch(&self, pid: usize, rect: [f64; 4], c: [Corner; 4], part: &mut Partial, finest: &mut f64) {
+    fn subpatch(
+        &self,
+        pid: usize,
+        rect: [f64; 4],
+        c: [Corner; 4],
+        part: &mut Partial,
+        finest: &mut f64,
+    ) {
         let [u1, u2, v1, v2] = rect;
-        let passes = adjacent(self.options.adjacency, &c);
-        let done = if u2 - u1 < self.guard {
-            if !passes {
-                part.stats.depth_guard_stops += 1;
+        let size = u2 - u1;
+        let done = if self.options.enclose {
+            let (lo, hi) = self.surface.bound_patch(pid, u1, u2, v1, v2);
+            let (lo, hi) = ((lo + 0.5).floor(), (hi + 0.5).floor());
+            if enclosed(lo, hi, &c) {
+                true
+            } else if size < self.guard / ENCLOSE_GUARD_FACTOR {
+                for voxel in box_voxels(lo, hi) {
+                    part.stats.guard_voxels += 1;
+                    part.add(voxel, c[0].sample.normal);
+                }
+                true
+            } else {
+                part.stats.enclose_splits += 1;
+                false
             }
+        } else if adjacent(self.options.adjacency, &c) {
             true
-        } else if !passes {
-            false
-        } else if self.options.enclose && !self.enclosed(pid, rect, &c) {
-            part.stats.enclose_splits += 1;
-            false
+        } else if size < self.guard {
+            part.stats.depth_guard_stops += 1;
+            true
         } else {
-            true
+            false
         };
         if done {
-            *finest = finest.min(u2 - u1);
+            *finest = finest.min(size);
             part.stats.subpatches += 1;
             let p = c.map(|x| x.sample.position);
             part.stats.area += 0.5 * (p[2] - p[0]).cross(p[3] - p[1]).length();
@@ -299,33 +332,48 @@ impl Run<'_> {
         let top = self.corner(pid, um, v2, part);
         let left = self.corner(pid, u1, vm, part);
         let centre = self.corner(pid, um, vm, part);
-        self.subpatch(pid, [u1, um, v1, vm], [c[0], bottom, centre, left], part, finest);
-        self.subpatch(pid, [um, u2, v1, vm], [bottom, c[1], right, centre], part, finest);
-        self.subpatch(pid, [um, u2, vm, v2], [centre, right, c[2], top], part, finest);
-        self.subpatch(pid, [u1, um, vm, v2], [left, centre, top, c[3]], part, finest);
+        self.subpatch(
+            pid,
+            [u1, um, v1, vm],
+            [c[0], bottom, centre, left],
+            part,
+            finest,
+        );
+        self.subpatch(
+            pid,
+            [um, u2, v1, vm],
+            [bottom, c[1], right, centre],
+            part,
+            finest,
+        );
+        self.subpatch(
+            pid,
+            [um, u2, vm, v2],
+            [centre, right, c[2], top],
+            part,
+            finest,
+        );
+        self.subpatch(
+            pid,
+            [u1, um, vm, v2],
+            [left, centre, top, c[3]],
+            part,
+            finest,
+        );
     }
+}
 
-    /// Whether every voxel touched by a bound of the sub-patch is one of its corner voxels.
-    fn enclosed(&self, pid: usize, [u1, u2, v1, v2]: [f64; 4], c: &[Corner; 4]) -> bool {
-        let (lo, hi) = self.surface.bound_patch(pid, u1, u2, v1, v2);
-        let lo = (lo + 0.5).floor();
-        let hi = (hi + 0.5).floor();
-        let count = (hi - lo + DVec3::ONE).element_product();
-        // At most four distinct corner voxels: a larger box cannot be covered.
-        if count > 4.0 {
-            return false;
-        }
-        for x in lo.x as i64..=hi.x as i64 {
-            for y in lo.y as i64..=hi.y as i64 {
-                for z in lo.z as i64..=hi.z as i64 {
-                    if !c.iter().any(|k| k.voxel == [x, y, z]) {
-                        return false;
-                    }
-                }
-            }
-        }
-        true
-    }
+/// Whether every voxel of the box `lo..=hi` (voxel indices) is one of the corner voxels.
+fn enclosed(lo: DVec3, hi: DVec3, c: &[Corner; 4]) -> bool {
+    // At most four distinct corner voxels: a larger box cannot be covered.
+    (hi - lo + DVec3::ONE).element_product() <= 4.0
+        && box_voxels(lo, hi).all(|v| c.iter().any(|k| k.voxel == v))
+}
+
+fn box_voxels(lo: DVec3, hi: DVec3) -> impl Iterator<Item = Coord> {
+    let (lo, hi) = (lo.as_i64vec3(), hi.as_i64vec3());
+    (lo.x..=hi.x)
+        .flat_map(move |x| (lo.y..=hi.y).flat_map(move |y| (lo.z..=hi.z).map(move |z| [x, y, z])))
 }
 
 /// The paper's lines 6-11: the spread of the corner voxels along each axis.

@@ -141,7 +141,12 @@ fn voxelize(input: &Path, args: &SubdivVoxelizeArgs, json: bool) -> Result<()> {
         ("presplit", args.presplit.to_string()),
         ("surface_area", s.area.to_string()),
     ];
-    write_vdb_with_masks(output, &out.surface, &[("opposite_normals", &out.opposite)], &meta)?;
+    write_vdb_with_masks(
+        output,
+        &out.surface,
+        &[("opposite_normals", &out.opposite)],
+        &meta,
+    )?;
     let total_s = start.elapsed().as_secs_f64();
     if json {
         let j = Json::default()
@@ -195,13 +200,24 @@ fn check(input: &Path, per_patch: usize, reference: Option<&Path>, json: bool) -
         Some(path) => Some(compare_points(&surface, &read_points(path)?)?),
         None => None,
     };
-    let rows = [("OpenSubdiv Limit() at level-3 corners", Some(live.dyadic)), ("OpenSubdiv Bfr::Surface at random (u, v)", Some(live.random)), ("reference file", reference)];
+    let rows = [
+        ("OpenSubdiv Limit() at level-3 corners", Some(live.dyadic)),
+        (
+            "OpenSubdiv Bfr::Surface at random (u, v)",
+            Some(live.random),
+        ),
+        ("reference file", reference),
+    ];
     if json {
         let mut j = Json::default()
             .str("input", input.display().to_string())
             .int("faces", stats.faces as u64)
             .int("patches", surface.patch_count() as u64);
-        for (key, c) in [("dyadic", Some(live.dyadic)), ("random", Some(live.random)), ("reference", reference)] {
+        for (key, c) in [
+            ("dyadic", Some(live.dyadic)),
+            ("random", Some(live.random)),
+            ("reference", reference),
+        ] {
             if let Some(c) = c {
                 j = j.obj(
                     key,
@@ -256,7 +272,12 @@ fn eval(input: &Path, points: &Path) -> Result<()> {
         path: "<stdout>".into(),
         source,
     };
-    writeln!(out, "# face u v x y z nx ny nz (limit surface of {})", input.display()).map_err(io_error)?;
+    writeln!(
+        out,
+        "# face u v x y z nx ny nz (limit surface of {})",
+        input.display()
+    )
+    .map_err(io_error)?;
     for q in queries {
         let s = surface.evaluate(q.face, q.u, q.v)?;
         let (p, n) = (s.position, s.normal);

@@ -1,0 +1,83 @@
+//! The area of the limit surface by Gauss-Legendre quadrature of |P_s x P_t| over every patch:
+//! an independent reference for the area the voxelizer sums from its sub-patch quads.
+
+use super::surface::LimitSurface;
+use rayon::prelude::*;
+
+/// 5-point Gauss-Legendre nodes and weights on [0, 1].
+const NODES: [f64; 5] = [
+    0.046_910_077_030_668_004,
+    0.230_765_344_947_158_45,
+    0.5,
+    0.769_234_655_052_841_6,
+    0.953_089_922_969_332,
+];
+const WEIGHTS: [f64; 5] = [
+    0.118_463_442_528_094_54,
+    0.239_314_335_249_683_23,
+    0.284_444_444_444_444_45,
+    0.239_314_335_249_683_23,
+    0.118_463_442_528_094_54,
+];
+
+/// Cells per patch side; the B-spline pieces of a patch are aligned with them.
+const CELLS: usize = 8;
+/// Cells touching an extraordinary corner are halved this many times more: the surface is
+/// piecewise polynomial on ever smaller rings there.
+const CORNER_DEPTH: u32 = 30;
+
+pub fn limit_area(surface: &LimitSurface) -> f64 {
+    (0..surface.patch_count())
+        .into_par_iter()
+        .map(|pid| {
+            let irregular = surface.irregular_corners(pid);
+            let h = 1.0 / CELLS as f64;
+            let mut sum = 0.0;
+            for j in 0..CELLS {
+                for i in 0..CELLS {
+                    sum += cell(surface, pid, &irregular, [i as f64 * h, j as f64 * h], h, 0);
+                }
+            }
+            sum
+        })
+        .sum()
+}
+
+fn cell(
+    surface: &LimitSurface,
+    pid: usize,
+    irregular: &[bool; 4],
+    at: [f64; 2],
+    h: f64,
+    depth: u32,
+) -> f64 {
+    let corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+    let touches = corners.iter().zip(irregular).any(|(&(cu, cv), &irr)| {
+        irr && (at[0] - cu).abs().min((at[0] + h - cu).abs()) == 0.0
+            && (at[1] - cv).abs().min((at[1] + h - cv).abs()) == 0.0
+    });
+    if touches && depth < CORNER_DEPTH {
+        let g = h / 2.0;
+        return [(0.0, 0.0), (g, 0.0), (0.0, g), (g, g)]
+            .iter()
+            .map(|&(du, dv)| {
+                cell(
+                    surface,
+                    pid,
+                    irregular,
+                    [at[0] + du, at[1] + dv],
+                    g,
+                    depth + 1,
+                )
+            })
+            .sum();
+    }
+    let mut sum = 0.0;
+    for (a, wa) in NODES.iter().zip(WEIGHTS) {
+        for (b, wb) in NODES.iter().zip(WEIGHTS) {
+            let s = surface.eval_patch(pid, at[0] + a * h, at[1] + b * h);
+            sum += wa * wb * s.du.cross(s.dv).length();
+        }
+    }
+    sum * h * h
+}
