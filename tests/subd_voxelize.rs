@@ -60,7 +60,7 @@ fn closed_surfaces_separate_at_every_adjacency() {
             // A polygon approximation far finer than a voxel decides inside and outside.
             let segments =
                 (4.0 * resolution as f64 / (surface.patch_count() as f64).sqrt()).ceil() as usize;
-            let polygons = surface.tessellate(segments.clamp(2, 32));
+            let polygons = surface.tessellate(|_| segments.clamp(2, 32));
             // The paper proves 6-separability for every N (§5): a sheet can clip the corner of a
             // voxel that no sample lands in, so 26-paths may pass. The enclosed output holds
             // every voxel the surface touches and blocks 26-paths too.

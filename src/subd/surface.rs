@@ -109,29 +109,31 @@ impl LimitSurface {
         self.patches[pid].irregular_corners()
     }
 
-    /// Every patch sampled on an `(n+1) x (n+1)` grid and split into quads: a closed polygon
-    /// approximation of the limit surface of a closed control mesh. Points shared by patches
-    /// are evaluated once per patch (equal to rounding) and welded on a 1e-9 lattice.
-    pub fn tessellate(&self, n: usize) -> crate::mesh::Mesh {
-        let n = n.max(1);
-        let per_patch: Vec<Vec<glam::DVec3>> = (0..self.patch_count())
+    /// Every patch `pid` sampled on an `(n+1) x (n+1)` grid, `n = segments(pid)`, and split
+    /// into quads: a closed polygon approximation of the limit surface of a closed control
+    /// mesh. Points shared by patches are evaluated once per patch (equal to rounding) and
+    /// welded on a 1e-9 lattice.
+    pub fn tessellate(&self, segments: impl Fn(usize) -> usize + Sync) -> crate::mesh::Mesh {
+        let per_patch: Vec<(usize, Vec<glam::DVec3>)> = (0..self.patch_count())
             .into_par_iter()
             .map(|pid| {
-                (0..=n)
+                let n = segments(pid).max(1);
+                let points = (0..=n)
                     .flat_map(|j| (0..=n).map(move |i| (i, j)))
                     .map(|(i, j)| {
                         self.eval_patch(pid, i as f64 / n as f64, j as f64 / n as f64)
                             .position
                     })
-                    .collect()
+                    .collect();
+                (n, points)
             })
             .collect();
         let b = self.control.bbox();
         let lattice = (b.max - b.min).length().max(f64::MIN_POSITIVE) * 1e-9;
         let mut index = rustc_hash::FxHashMap::default();
         let mut positions = Vec::new();
-        let mut quads = Vec::with_capacity(per_patch.len() * n * n);
-        for points in per_patch {
+        let mut quads = Vec::new();
+        for (n, points) in per_patch {
             let ids: Vec<u32> = points
                 .iter()
                 .map(|&p| {

@@ -17,11 +17,12 @@
 //!
 //! Correction (option `enclose`): a sub-patch is accepted only when a bound of it (the box of
 //! its Bezier control points, or of its control ring near an extraordinary vertex) touches no
-//! voxel but its corner voxels; otherwise it is halved, down to a guard 2^10 times finer than
-//! the paper's, where every voxel the bound touches is added (counted in `guard_voxels`). The
-//! output is then every voxel the surface touches (eq. 3), whatever N; every output voxel holds
-//! an evaluated surface point (eq. 4) except the guard voxels, which lie within a bound 2^10
-//! times smaller than the paper's guard. The result blocks 26-paths.
+//! voxel but its corner voxels; otherwise it is halved until the bound is smaller than
+//! `ENCLOSE_TOLERANCE` voxels, and then every voxel the bound touches is added (counted in
+//! `guard_voxels`; this is where the surface crosses a voxel edge or corner in a sliver no
+//! corner sample lands in). The output is then every voxel the surface touches (eq. 3),
+//! whatever N; every output voxel holds an evaluated surface point (eq. 4) or lies within
+//! `ENCLOSE_TOLERANCE` of one. The result blocks 26-paths.
 
 use super::sink::Progress;
 use crate::error::Result;
@@ -65,7 +66,7 @@ pub struct ParametricStats {
     pub depth_guard_stops: u64,
     /// Sub-patches halved because their bound left their corner voxels (`enclose`).
     pub enclose_splits: u64,
-    /// Voxels added from bounds at the finer guard of `enclose`.
+    /// Voxels added from bounds smaller than `ENCLOSE_TOLERANCE` (`enclose`).
     pub guard_voxels: u64,
     /// Surface area from the final sub-patch quads, in world units.
     pub area: f64,
@@ -238,8 +239,9 @@ struct Run<'a> {
     guard: f64,
 }
 
-/// How much finer than the paper's guard the enclosure refinement may go.
-const ENCLOSE_GUARD_FACTOR: f64 = 1024.0;
+/// The enclosure refinement stops once a sub-patch's bound is this small (in voxels), and
+/// outputs the voxels the bound touches: they lie within this distance of the surface.
+pub const ENCLOSE_TOLERANCE: f64 = 0.01;
 
 impl Run<'_> {
     fn corner(&self, pid: usize, s: f64, t: f64, part: &mut Partial) -> Corner {
@@ -294,11 +296,11 @@ impl Run<'_> {
         let [u1, u2, v1, v2] = rect;
         let size = u2 - u1;
         let done = if self.options.enclose {
-            let (lo, hi) = self.surface.bound_patch(pid, u1, u2, v1, v2);
-            let (lo, hi) = ((lo + 0.5).floor(), (hi + 0.5).floor());
+            let (lo_exact, hi_exact) = self.surface.bound_patch(pid, u1, u2, v1, v2);
+            let (lo, hi) = ((lo_exact + 0.5).floor(), (hi_exact + 0.5).floor());
             if enclosed(lo, hi, &c) {
                 true
-            } else if size < self.guard / ENCLOSE_GUARD_FACTOR {
+            } else if (hi_exact - lo_exact).max_element() < ENCLOSE_TOLERANCE {
                 for voxel in box_voxels(lo, hi) {
                     part.stats.guard_voxels += 1;
                     part.add(voxel, c[0].sample.normal);

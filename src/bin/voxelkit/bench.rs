@@ -12,7 +12,10 @@ use voxelkit::voxelize::separating::{Criterion, SeparatingOptions, voxelize_mesh
 use voxelkit::{Error, Result};
 
 #[derive(Args)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct BenchArgs {
+    #[command(subcommand)]
+    subdiv: Option<BenchKind>,
     /// Meshes to run: names in DATA/meshes (without .obj) or paths to .obj/.stl files.
     #[arg(long, value_delimiter = ',', default_value = "igea,skull,bunny-closed")]
     meshes: Vec<String>,
@@ -34,6 +37,21 @@ pub struct BenchArgs {
     repeat: usize,
 }
 
+#[derive(clap::Subcommand)]
+enum BenchKind {
+    /// The Catmull-Clark voxelizer: evaluations against uniform sampling, and time against
+    /// OpenVDB's meshToVolume on a tessellation of the same limit surface.
+    Subdiv(crate::bench_subdiv::SubdivBenchArgs),
+}
+
+/// The data folder: `--data`, else `$VOXELKIT_DATA`, else `../shared/data`.
+pub fn data_folder(explicit: &Option<PathBuf>) -> PathBuf {
+    explicit
+        .clone()
+        .or_else(|| std::env::var_os("VOXELKIT_DATA").map(PathBuf::from))
+        .unwrap_or_else(|| PathBuf::from("../shared/data"))
+}
+
 fn resolve(name: &str, data: &std::path::Path) -> PathBuf {
     let p = PathBuf::from(name);
     if p.extension().is_some() {
@@ -44,7 +62,7 @@ fn resolve(name: &str, data: &std::path::Path) -> PathBuf {
 }
 
 /// Fastest of `repeat` runs of `f`, in seconds, with its last result.
-fn best_of<T>(repeat: usize, mut f: impl FnMut() -> Result<T>) -> Result<(f64, T)> {
+pub fn best_of<T>(repeat: usize, mut f: impl FnMut() -> Result<T>) -> Result<(f64, T)> {
     let mut best = f64::INFINITY;
     let mut last = None;
     for _ in 0..repeat.max(1) {
@@ -57,11 +75,10 @@ fn best_of<T>(repeat: usize, mut f: impl FnMut() -> Result<T>) -> Result<(f64, T
 }
 
 pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
-    let data = args
-        .data
-        .clone()
-        .or_else(|| std::env::var_os("VOXELKIT_DATA").map(PathBuf::from))
-        .unwrap_or_else(|| PathBuf::from("../shared/data"));
+    if let Some(BenchKind::Subdiv(sub)) = &args.subdiv {
+        return crate::bench_subdiv::run(sub, json);
+    }
+    let data = data_folder(&args.data);
     let seps: Vec<Separability> = args
         .separability
         .iter()

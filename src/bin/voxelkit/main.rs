@@ -1,6 +1,7 @@
 //! The `voxelkit` command line: a thin shell over the library.
 
 mod bench;
+mod bench_subdiv;
 mod commands;
 mod report;
 mod subdiv;
@@ -103,7 +104,8 @@ enum Command {
     /// Voxelize a Catmull-Clark control mesh from its exact limit surface (Lai & Cheng), or
     /// check the limit-surface evaluator against OpenSubdiv (`subdiv check`, `subdiv eval`).
     Subdiv(subdiv::SubdivArgs),
-    /// Benchmark against OpenVDB's meshToVolume with a one-voxel band, in the same run.
+    /// Benchmark against OpenVDB's meshToVolume with a one-voxel band, in the same run
+    /// (`bench subdiv`: the Catmull-Clark voxelizer).
     Bench(bench::BenchArgs),
 }
 
