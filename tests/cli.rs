@@ -3,22 +3,9 @@
 #![cfg(feature = "vdb")]
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod cli_support;
 
-fn voxelkit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_voxelkit"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
+use cli_support::{text, voxelkit};
 
 /// Files in `dir` other than `keep`.
 fn extra_files(dir: &Path, keep: &[&Path]) -> Vec<PathBuf> {

@@ -9,10 +9,12 @@
 //!   so t1 x t2 points to the side from which the faces are counter-clockwise.
 //! Boundary (crease) vertex with k faces, edges e_0..e_k counter-clockwise from the leading
 //! boundary edge: position = (e_0 + 4 v + e_k) / 6, tangent along the boundary (e_0 - e_k)/2,
-//! and across it OpenSubdiv's cross tangent (Biermann et al.; with θ = π/k):
-//! `4R(cosθ - 1) v - R(1 + 2cosθ)(e_0 + e_k) + Σ_{i=1}^{k-1} 4 sin(iθ) e_i
-//!  + Σ_{i=0}^{k-1} (sin(iθ) + sin((i+1)θ)) f_i` with `R = (cosθ + 1)/sinθ`,
-//! up to a positive factor. That cross tangent is not an eigenvector of the standard crease
+//! and across it OpenSubdiv's cross tangent (Biermann et al.; θ = π/k, R = (cosθ + 1)/sinθ),
+//! up to a positive factor:
+//!
+//! `4R(cosθ - 1) v - R(1 + 2cosθ)(e_0 + e_k) + Σ_{i=1}^{k-1} 4 sin(iθ) e_i + Σ_{i=0}^{k-1} (sin(iθ) + sin((i+1)θ)) f_i`
+//!
+//! That cross tangent is not an eigenvector of the standard crease
 //! rule, so its value depends on the ring it is applied to (OpenSubdiv's `Limit()` changes with
 //! the refinement level there); we apply it to the ring where all faces are quads. On
 //! catmark_helmet this is 6e-3 rad from the normal that nearby points converge to. Positions are

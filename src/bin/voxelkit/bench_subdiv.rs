@@ -2,8 +2,8 @@
 //! adjacency — seconds, evaluations, evaluations per second, and the evaluations a uniform
 //! grid at the same finest spacing would need (the paper's case for adaptivity). The reference
 //! in the same process: OpenVDB's meshToVolume (one-voxel band) on a tessellation of the same
-//! limit surface with at most half a voxel between samples, on the same thread count
-//! (tessellating is not timed).
+//! limit surface with about one voxel between samples, on the same thread count (tessellating
+//! is not timed).
 
 use crate::bench::{best_of, data_folder};
 use crate::report::Json;
@@ -158,7 +158,7 @@ pub fn run(args: &SubdivBenchArgs, json: bool) -> Result<()> {
     Ok(())
 }
 
-/// OpenVDB meshToVolume on a tessellation with at most half a voxel between samples.
+/// OpenVDB meshToVolume on a tessellation with about one voxel between samples.
 fn reference_seconds(
     limit: &LimitSurface,
     transform: voxelkit::grid::Transform,
@@ -167,8 +167,23 @@ fn reference_seconds(
 ) -> Result<f64> {
     let mesh = pool.install(|| {
         limit.tessellate(|pid| {
-            let (lo, hi) = limit.bound_patch(pid, 0.0, 1.0, 0.0, 1.0);
-            ((2.0 * (hi - lo).max_element() / transform.voxel_size).ceil() as usize).clamp(1, 256)
+            // The patch's extent from a coarse sample grid (its control bound can be loose).
+            let (mut lo, mut hi) = (
+                glam::DVec3::splat(f64::INFINITY),
+                glam::DVec3::splat(f64::NEG_INFINITY),
+            );
+            for j in 0..=4 {
+                for i in 0..=4 {
+                    let p = limit
+                        .eval_patch(pid, i as f64 / 4.0, j as f64 / 4.0)
+                        .position;
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+            }
+            ((hi - lo).max_element() / transform.voxel_size)
+                .ceil()
+                .clamp(1.0, 256.0) as usize
         })
     });
     let points: Vec<f32> = mesh

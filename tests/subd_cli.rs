@@ -1,0 +1,217 @@
+//! `voxelkit subdiv` end to end on control meshes the tests write: the .vdb it writes read
+//! back by OpenVDB, `subdiv eval` against the library, and bad control meshes refused with an
+//! error naming the vertex, face or line, a non-zero exit and no output file.
+#![cfg(feature = "vdb")]
+
+use std::path::Path;
+mod cli_support;
+
+use cli_support::{text, voxelkit};
+use voxelkit::io::vdb::read_vdb_info;
+use voxelkit::subd::{ControlMesh, LimitSurface};
+
+/// A cube control mesh: 8 valence-3 extraordinary vertices.
+const CUBE: &str = "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
+f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+
+fn write(dir: &Path, name: &str, content: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, content).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+#[test]
+fn subdiv_writes_a_vdb_that_openvdb_reads_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write(dir.path(), "cube.obj", CUBE);
+    let output = dir.path().join("cube.vdb");
+    let o = voxelkit(&[
+        "subdiv",
+        &input,
+        "-a",
+        "6",
+        "-r",
+        "64",
+        "-o",
+        output.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let summary = text(&o);
+    for word in ["voxels", "evaluations", "area", "6-adjacent"] {
+        assert!(summary.contains(word), "`{word}` missing from: {summary}");
+    }
+    let grids = read_vdb_info(&output).unwrap();
+    let grid = |name: &str| grids.iter().find(|g| g.name == name).unwrap();
+    assert_eq!(grids.len(), 4);
+    let surface = grid("surface");
+    assert!(surface.active_voxels > 1000);
+    assert_eq!(grid("density").active_voxels, surface.active_voxels);
+    assert_eq!(grid("normal").active_voxels, surface.active_voxels);
+    assert_eq!(grid("opposite_normals").active_voxels, 0);
+    let meta = |key: &str| {
+        surface
+            .metadata
+            .iter()
+            .find(|m| m.key == key)
+            .map(|m| m.value.clone())
+    };
+    assert_eq!(meta("adjacency").as_deref(), Some("6"));
+    assert_eq!(meta("method").as_deref(), Some("lai-cheng-parametric"));
+}
+
+#[test]
+fn subdiv_eval_prints_the_limit_surface() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write(dir.path(), "cube.obj", CUBE);
+    let points = write(
+        dir.path(),
+        "uv.txt",
+        "# face u v\n0 0 0\n3 0.25 0.75\n5 1 1\n",
+    );
+    let o = voxelkit(&["subdiv", "eval", &input, "--points", &points]);
+    assert!(o.status.success(), "{}", text(&o));
+    let surface = LimitSurface::new(ControlMesh::load(Path::new(&input)).unwrap());
+    let lines: Vec<String> = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(String::from)
+        .collect();
+    assert_eq!(lines.len(), 3);
+    for line in lines {
+        let f: Vec<f64> = line
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        let s = surface.evaluate(f[0] as usize, f[1], f[2]).unwrap();
+        assert!((s.position - glam::DVec3::new(f[3], f[4], f[5])).length() < 1e-15);
+        assert!((s.normal - glam::DVec3::new(f[6], f[7], f[8])).length() < 1e-15);
+    }
+    // At the valence-3 corner (-1,-1,-1): (n² v + 4 Σe + Σf) / (n (n + 5)) per axis is
+    // (9·(-1) + 4·(-1) + 1) / 24 = -1/2.
+    let corner = surface.evaluate(0, 0.0, 0.0).unwrap().position;
+    assert!(
+        (corner - glam::DVec3::splat(-0.5)).length() < 1e-14,
+        "{corner:?}"
+    );
+}
+
+/// Runs `voxelkit` with `args` (`IN` and `OUT` replaced by the written input and an output
+/// path) and checks the failure: non-zero exit, every piece of `expect`, nothing written.
+fn assert_fails(content: &str, args: &[&str], expect: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write(dir.path(), "in.obj", content);
+    let output = dir.path().join("out.vdb");
+    let args: Vec<&str> = args
+        .iter()
+        .map(|&a| match a {
+            "IN" => input.as_str(),
+            "OUT" => output.to_str().unwrap(),
+            a => a,
+        })
+        .collect();
+    let o = voxelkit(&args);
+    let msg = text(&o);
+    assert!(!o.status.success(), "expected failure, got: {msg}");
+    for e in expect {
+        assert!(msg.contains(e), "`{e}` missing from: {msg}");
+    }
+    assert!(!msg.contains("panicked"), "{msg}");
+    assert!(!output.exists(), "output left behind");
+}
+
+#[test]
+fn bad_control_meshes_are_refused_by_name() {
+    let voxelize = ["subdiv", "IN", "-r", "32", "-o", "OUT"];
+    // Three quads on one edge (vertices 1 and 2).
+    let fin = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 1 0 1\nv 0 0 1\nv 1 -1 0\nv 0 -1 0\n\
+f 1 2 3 4\nf 2 1 6 5\nf 1 2 7 8\n";
+    assert_fails(
+        fin,
+        &voxelize,
+        &[
+            "in.obj",
+            "vertices 1 and 2",
+            "non-manifold",
+            "faces 0, 1, 2",
+        ],
+    );
+    // Vertex 9 is used by no face.
+    assert_fails(
+        &format!("{CUBE}v 5 5 5\n"),
+        &voxelize,
+        &["in.obj", "vertex 9", "isolated"],
+    );
+    // Face 1 is flipped: its edges run the same way as face 0's.
+    let flipped = CUBE.replace("f 5 6 7 8", "f 8 7 6 5");
+    assert_fails(&flipped, &voxelize, &["in.obj", "inconsistently"]);
+    // Two pyramids touching at their apex (vertex 5): one vertex, two fans.
+    let bowtie = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nv 0 0 2\nv 1 0 2\nv 1 1 2\nv 0 1 2\n\
+f 1 4 3 2\nf 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\nf 6 7 8 9\nf 7 6 5\nf 8 7 5\nf 9 8 5\nf 6 9 5\n";
+    assert_fails(
+        bowtie,
+        &voxelize,
+        &["in.obj", "vertex 5", "more than one fan"],
+    );
+    // A face that repeats a vertex.
+    assert_fails(
+        &CUBE.replace("f 5 6 7 8", "f 5 6 6 8"),
+        &voxelize,
+        &["in.obj", "face 1", "twice"],
+    );
+    // Unreadable coordinates, with the line.
+    assert_fails(
+        &CUBE.replace("v 1 1 1", "v 1 nan 1"),
+        &voxelize,
+        &["in.obj:7", "non-finite"],
+    );
+    // An empty mesh.
+    assert_fails("# nothing\n", &voxelize, &["in.obj", "empty"]);
+    // An output folder that does not exist.
+    assert_fails(
+        CUBE,
+        &[
+            "subdiv",
+            "IN",
+            "-r",
+            "32",
+            "-o",
+            "/nonexistent-folder/x.vdb",
+        ],
+        &["nonexistent-folder"],
+    );
+    // A resolution whose memory estimate exceeds the limit.
+    assert_fails(
+        CUBE,
+        &[
+            "subdiv",
+            "IN",
+            "-r",
+            "100000",
+            "--max-memory",
+            "64",
+            "-o",
+            "OUT",
+        ],
+        &["resolution too large"],
+    );
+}
+
+#[test]
+fn bad_points_are_refused_with_their_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write(dir.path(), "cube.obj", CUBE);
+    for (points, expect) in [
+        ("0 0.5 0.5\n0 0.5\n", "uv.txt:2"),
+        ("0 0.5 x\n", "not a finite number"),
+        ("7 0.5 0.5\n", "face 7 does not exist"),
+        ("0 1.5 0.5\n", "outside face 0"),
+    ] {
+        let file = write(dir.path(), "uv.txt", points);
+        let o = voxelkit(&["subdiv", "eval", &input, "--points", &file]);
+        let msg = text(&o);
+        assert!(
+            !o.status.success() && msg.contains(expect),
+            "`{expect}` missing from: {msg}"
+        );
+    }
+}
