@@ -124,6 +124,16 @@ impl ControlMesh {
         self.mesh.face_len(f)
     }
 
+    /// Patches of the limit surface: one per quad, n per n-gon.
+    pub fn patch_count(&self) -> usize {
+        (0..self.face_count())
+            .map(|f| match self.face_len(f) {
+                4 => 1,
+                n => n,
+            })
+            .sum()
+    }
+
     pub fn positions(&self) -> &[DVec3] {
         &self.mesh.points
     }

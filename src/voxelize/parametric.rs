@@ -94,7 +94,7 @@ pub fn estimate_bytes(control: &ControlMesh, transform: &Transform) -> u64 {
 }
 
 /// Voxelizes the limit surface of `control` on the grid of `transform`; `progress` receives
-/// the number of patches finished.
+/// the number of patches finished (`control.patch_count()` in all).
 pub fn voxelize_subdivision(
     control: &ControlMesh,
     transform: Transform,

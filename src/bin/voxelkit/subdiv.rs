@@ -122,7 +122,7 @@ fn voxelize(input: &Path, args: &SubdivVoxelizeArgs, json: bool) -> Result<()> {
         presplit: args.presplit,
         enclose: args.enclose,
     };
-    let bar = progress_bar(control.face_count() as u64, "voxelizing", json);
+    let bar = progress_bar(control.patch_count() as u64, "voxelizing", json);
     let voxelize_start = Instant::now();
     let out = voxelize_subdivision(&control, transform, &options, &|n| bar.inc(n))?;
     bar.finish_and_clear();
