@@ -64,3 +64,28 @@ fn every_reference_file_is_listed() {
         }
     }
 }
+
+#[test]
+fn normals_at_irregular_boundary_vertices_are_the_limit_of_nearby_normals() {
+    // catmark_helmet face 36, corner (1, 1): a boundary vertex with 3 faces, where no
+    // closed-form mask gives the tangent plane. Normals approaching it along the face's edge
+    // and diagonal converge to the one reported there.
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    let control = ControlMesh::load(&data.join("subd/catmark_helmet.obj")).unwrap();
+    let surface = LimitSurface::new(control);
+    let at = surface.evaluate(36, 1.0, 1.0).unwrap().normal;
+    let off = |k: i32, diagonal: bool| {
+        let e = 0.5f64.powi(k);
+        let v = if diagonal { 1.0 - e } else { 1.0 };
+        voxelkit::subd::angle_between(surface.evaluate(36, 1.0 - e, v).unwrap().normal, at)
+    };
+    for diagonal in [false, true] {
+        let (near, nearer) = (off(20, diagonal), off(35, diagonal));
+        assert!(
+            nearer < near / 4.0 && nearer < 2e-4,
+            "{near:e} then {nearer:e}"
+        );
+    }
+}

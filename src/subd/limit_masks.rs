@@ -8,18 +8,11 @@
 //!   i shifted by one quarter turn (sines), A = 1 + cos(2π/n) + cos(π/n) √(2 (9 + cos(2π/n))),
 //!   so t1 x t2 points to the side from which the faces are counter-clockwise.
 //! Boundary (crease) vertex with k faces, edges e_0..e_k counter-clockwise from the leading
-//! boundary edge: position = (e_0 + 4 v + e_k) / 6, tangent along the boundary (e_0 - e_k)/2,
-//! and across it OpenSubdiv's cross tangent (Biermann et al.; θ = π/k, R = (cosθ + 1)/sinθ),
-//! up to a positive factor:
-//!
-//! `4R(cosθ - 1) v - R(1 + 2cosθ)(e_0 + e_k) + Σ_{i=1}^{k-1} 4 sin(iθ) e_i + Σ_{i=0}^{k-1} (sin(iθ) + sin((i+1)θ)) f_i`
-//!
-//! That cross tangent is not an eigenvector of the standard crease
-//! rule, so its value depends on the ring it is applied to (OpenSubdiv's `Limit()` changes with
-//! the refinement level there); we apply it to the ring where all faces are quads. On
-//! catmark_helmet this is 6e-3 rad from the normal that nearby points converge to. Positions are
-//! exact everywhere; only normals exactly at such vertices carry this convention.
+//! boundary edge: position = (e_0 + 4 v + e_k) / 6; the tangent plane comes from the
+//! eigenvectors of the local subdivision matrix (`boundary_tangent.rs`), as no closed-form
+//! mask fits the standard crease rule there.
 
+use super::boundary_tangent::boundary_tangent_plane;
 use super::poly_mesh::PolyMesh;
 use super::subdivide::boundary_neighbours;
 use glam::DVec3;
@@ -38,23 +31,24 @@ pub(crate) fn vertex_limit(mesh: &PolyMesh, v: u32, start: u32) -> (DVec3, Optio
             let normal = (first - p).cross(last - p).try_normalize();
             return (p, normal);
         }
-        let k = ring.len() as f64;
-        let theta = PI / k;
-        let r = (theta.cos() + 1.0) / theta.sin();
-        let mut across =
-            4.0 * r * (theta.cos() - 1.0) * p - r * (1.0 + 2.0 * theta.cos()) * (first + last);
-        for (i, &h) in ring.iter().enumerate() {
-            let (si, sj) = ((i as f64 * theta).sin(), ((i + 1) as f64 * theta).sin());
-            if i > 0 {
-                across += 4.0 * si * edge(h);
-            }
-            across += (si + sj) * diagonal(h);
-        }
-        let along = first - last;
-        return (
-            (first + 4.0 * p + last) / 6.0,
-            along.cross(across).try_normalize(),
-        );
+        let mut edges: Vec<DVec3> = ring.iter().map(|&h| edge(h)).collect();
+        edges.push(last);
+        let diagonals: Vec<DVec3> = ring.iter().map(|&h| diagonal(h)).collect();
+        let (a, b) = boundary_tangent_plane(p, &edges, &diagonals);
+        // Orient like the faces: along the boundary from e_k to e_0, then into the surface.
+        let inner = edges[1..edges.len() - 1]
+            .iter()
+            .chain(&diagonals)
+            .sum::<DVec3>()
+            / (edges.len() - 2 + diagonals.len()) as f64;
+        let reference = (first - last).cross(inner - p);
+        let normal = a.cross(b);
+        let normal = if normal.dot(reference) < 0.0 {
+            -normal
+        } else {
+            normal
+        };
+        return ((first + 4.0 * p + last) / 6.0, normal.try_normalize());
     }
     let n = ring.len();
     let nf = n as f64;

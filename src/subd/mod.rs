@@ -3,6 +3,7 @@
 
 mod area;
 mod bicubic;
+mod boundary_tangent;
 mod compare;
 mod control_mesh;
 mod limit_masks;

@@ -56,8 +56,8 @@ fn osd_error(control: &ControlMesh, e: cxx::Exception) -> Error {
 /// Every corner of every face after `level` uniform refinements, with OpenSubdiv's exact limit
 /// position and normal. Left out: interior valence-2 vertices (OpenSubdiv's `Limit()` gives them
 /// the corner mask) and boundary vertices with 3 or more faces (its normal there changes with
-/// `level`: on catmark_helmet by 1.3e-3 rad from level 1 to 6, as the crease rule's tangent
-/// plane is not what its cross-tangent mask assumes).
+/// `level`: on catmark_helmet by 1.3e-3 rad from level 1 to 6, converging slowly to the
+/// tangent plane voxelkit computes from the subdivision matrix's eigenvectors).
 pub fn dyadic_limit_points(control: &ControlMesh, level: u32) -> Result<Vec<SurfacePoint>> {
     let flat = flatten(control);
     let out = bridge::limit_at_dyadic(
