@@ -9,7 +9,7 @@ use std::time::Instant;
 use voxelkit::grid::Adjacency;
 use voxelkit::io::vdb::write_vdb_with_masks;
 use voxelkit::mesh::fit_transform;
-use voxelkit::subd::{ControlMesh, LimitSurface, compare_points, read_points};
+use voxelkit::subd::{ControlMesh, LimitSurface, compare_points, limit_area, read_points};
 use voxelkit::voxelize::parametric::{ParametricOptions, estimate_bytes, voxelize_subdivision};
 use voxelkit::{Error, Result};
 
@@ -52,7 +52,8 @@ pub struct SubdivVoxelizeArgs {
 #[derive(Subcommand)]
 enum SubdivAction {
     /// Compare the limit-surface evaluator with OpenSubdiv: at every corner of the level-3
-    /// refinement (Far::PrimvarRefiner::Limit) and at random (u, v) (Bfr::Surface).
+    /// refinement (Far::PrimvarRefiner::Limit) and at random (u, v) (Bfr::Surface); also
+    /// prints the limit surface's area by Gauss quadrature.
     Check {
         /// Control mesh (.obj).
         input: PathBuf,
@@ -196,6 +197,7 @@ fn check(input: &Path, per_patch: usize, reference: Option<&Path>, json: bool) -
     let stats = control.stats();
     let surface = LimitSurface::new(control);
     let live = check_against_opensubdiv(&surface, per_patch, 1)?;
+    let area = limit_area(&surface);
     let reference = match reference {
         Some(path) => Some(compare_points(&surface, &read_points(path)?)?),
         None => None,
@@ -212,7 +214,8 @@ fn check(input: &Path, per_patch: usize, reference: Option<&Path>, json: bool) -
         let mut j = Json::default()
             .str("input", input.display().to_string())
             .int("faces", stats.faces as u64)
-            .int("patches", surface.patch_count() as u64);
+            .int("patches", surface.patch_count() as u64)
+            .num("limit_area", area);
         for (key, c) in [
             ("dyadic", Some(live.dyadic)),
             ("random", Some(live.random)),
@@ -233,7 +236,7 @@ fn check(input: &Path, per_patch: usize, reference: Option<&Path>, json: bool) -
         return Ok(());
     }
     println!(
-        "{}: {} vertices, {} faces ({} quads, {} triangles, {} other), {} extraordinary, {} on the boundary, {} patches",
+        "{}: {} vertices, {} faces ({} quads, {} triangles, {} other), {} extraordinary, {} on the boundary, {} patches; limit surface area {area:.10} (Gauss quadrature)",
         input.display(),
         stats.vertices,
         stats.faces,
