@@ -27,8 +27,9 @@ pub struct SubdivArgs {
 
 #[derive(Args)]
 pub struct SubdivVoxelizeArgs {
-    /// The adjacency of the corner voxels of every final sub-patch: 6 gives a thick surface
-    /// that blocks every path (26-separating), 18 and 26 thinner ones that block 6-paths.
+    /// The adjacency the corner voxels of every final sub-patch must have: 6 gives the
+    /// thickest surface, 26 the thinnest; all three block 6-paths (the paper's guarantee,
+    /// checked by flooding). Use --enclose to block 26-paths as well.
     #[arg(short, long, default_value = "26", value_parser = parse_adjacency)]
     adjacency: Adjacency,
     #[command(flatten)]
