@@ -161,6 +161,7 @@ fn voxelize(input: &Path, args: &SubdivVoxelizeArgs, json: bool) -> Result<()> {
             .int("subpatches", s.subpatches)
             .int("depth_guard_stops", s.depth_guard_stops)
             .int("enclose_splits", s.enclose_splits)
+            .int("tolerance_voxels", s.guard_voxels)
             .num("area", s.area)
             .num("voxel_size", transform.voxel_size)
             .int("adjacency", args.adjacency.number() as u64)
