@@ -66,7 +66,8 @@ pub struct ParametricStats {
     pub depth_guard_stops: u64,
     /// Sub-patches halved because their bound left their corner voxels (`enclose`).
     pub enclose_splits: u64,
-    /// Voxels added from bounds smaller than `ENCLOSE_TOLERANCE` (`enclose`).
+    /// Voxel insertions from bounds smaller than `ENCLOSE_TOLERANCE` (`enclose`); most land
+    /// in voxels that also hold a sample.
     pub guard_voxels: u64,
     /// Surface area from the final sub-patch quads, in world units.
     pub area: f64,
