@@ -43,6 +43,16 @@ pub enum Error {
     },
     #[error("{path}: OpenVDB: {message}")]
     Vdb { path: PathBuf, message: String },
+    #[error(
+        "formula, column {column}: {message}\n  {text}\n  {caret:>column$}",
+        caret = "^"
+    )]
+    Formula {
+        text: String,
+        /// 1-based column (in characters) where the problem starts.
+        column: usize,
+        message: String,
+    },
     #[error("{0}")]
     Unsupported(String),
 }

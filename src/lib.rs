@@ -5,6 +5,7 @@
 
 pub mod error;
 pub mod grid;
+pub mod implicit;
 pub mod io;
 pub mod mesh;
 pub mod ops;

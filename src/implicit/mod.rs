@@ -1,0 +1,69 @@
+//! Implicit surfaces typed as formulas (Stolte & Kaufman): a small language compiled to a
+//! tape, evaluated at points, over interval boxes with a guaranteed enclosure, and with its
+//! gradient, in Cartesian, spherical or cylindrical coordinates.
+
+mod dual;
+mod interval;
+mod parse;
+mod tape;
+
+pub use dual::Dual;
+pub use interval::Interval;
+pub use tape::{Instr, Number, Tape};
+
+use crate::error::Result;
+
+/// The coordinate system a formula is written in. Spherical follows the paper: theta is
+/// measured in the XZ plane from the X axis, phi from the XZ plane, so
+/// `(x, y, z) = (r cos(theta) cos(phi), r sin(phi), r sin(theta) cos(phi))`; cylindrical
+/// uses r and theta in the XZ plane and y along the axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Coordinates {
+    Cartesian,
+    Spherical,
+    Cylindrical,
+}
+
+impl Coordinates {
+    /// The variable names, in tape slot order.
+    pub fn variables(self) -> [&'static str; 3] {
+        match self {
+            Coordinates::Cartesian => ["x", "y", "z"],
+            Coordinates::Spherical => ["r", "theta", "phi"],
+            Coordinates::Cylindrical => ["r", "theta", "y"],
+        }
+    }
+}
+
+impl std::str::FromStr for Coordinates {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "cartesian" => Ok(Coordinates::Cartesian),
+            "spherical" => Ok(Coordinates::Spherical),
+            "cylindrical" => Ok(Coordinates::Cylindrical),
+            _ => Err(format!(
+                "coordinates must be cartesian, spherical or cylindrical, not `{s}`"
+            )),
+        }
+    }
+}
+
+/// A compiled formula F; the surface is F = 0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Formula {
+    pub text: String,
+    pub coordinates: Coordinates,
+    pub tape: Tape,
+}
+
+impl Formula {
+    /// Parses `text`; errors point at the column.
+    pub fn parse(text: &str, coordinates: Coordinates) -> Result<Formula> {
+        Ok(Formula {
+            text: text.to_string(),
+            coordinates,
+            tape: parse::parse(text, coordinates.variables())?,
+        })
+    }
+}
