@@ -3,7 +3,7 @@
 
 use proptest::prelude::*;
 use voxelkit::Error;
-use voxelkit::implicit::{Coordinates, Dual, Formula, Interval};
+use voxelkit::implicit::{BoxTest, Coordinates, Dual, Formula, Interval, test_box, to_coordinates};
 
 fn value(text: &str, at: [f64; 3]) -> f64 {
     Formula::parse(text, Coordinates::Cartesian)
@@ -88,10 +88,15 @@ fn errors_point_at_the_column() {
 
 /// Random formulas over x, y, z using every operation.
 fn formula() -> impl Strategy<Value = String> {
+    formula_over(["x", "y", "z"])
+}
+
+/// Random formulas over the three `variables` using every operation.
+fn formula_over(variables: [&'static str; 3]) -> impl Strategy<Value = String> {
     let leaf = prop_oneof![
-        Just("x".to_string()),
-        Just("y".to_string()),
-        Just("z".to_string()),
+        Just(variables[0].to_string()),
+        Just(variables[1].to_string()),
+        Just(variables[2].to_string()),
         (-3.0f64..3.0).prop_map(|c| format!("({c})")),
     ];
     leaf.prop_recursive(5, 40, 2, |inner| {
@@ -167,4 +172,91 @@ proptest! {
                 "{text} at {p:?}: d/d{k} = {} vs {numeric}", d.grad[k]);
         }
     }
+}
+
+/// Boxes and points for the conversion property: a Cartesian box, and points in it.
+fn box_and_points() -> impl Strategy<Value = ([f64; 3], [f64; 3], Vec<[f64; 3]>)> {
+    (
+        prop::array::uniform3(-2.0f64..2.0),
+        prop::array::uniform3(0.001f64..2.0),
+        prop::collection::vec(prop::array::uniform3(0.0f64..=1.0), 8),
+    )
+}
+
+fn check_conversion(
+    coords: Coordinates,
+    text: &str,
+    lo: [f64; 3],
+    size: [f64; 3],
+    samples: Vec<[f64; 3]>,
+) -> Result<(), TestCaseError> {
+    let f = Formula::parse(text, coords).unwrap();
+    let boxed: [Interval; 3] = std::array::from_fn(|k| Interval::new(lo[k], lo[k] + size[k]));
+    for t in samples {
+        let p: [f64; 3] = std::array::from_fn(|k| lo[k] + size[k] * t[k]);
+        let v = f.tape.eval(to_coordinates(coords, p));
+        if !v.is_finite() {
+            continue;
+        }
+        // F - v is zero at p, so the box must not be ruled out.
+        let shifted = Formula::parse(&format!("({text}) - ({v:?})"), coords).unwrap();
+        let mut slots = Vec::new();
+        let test = test_box(&shifted.tape, coords, boxed, false, false, &mut slots);
+        prop_assert!(
+            test != BoxTest::Empty,
+            "{text} = {v} at {p:?} in box {boxed:?}"
+        );
+        let bounded = test_box(&shifted.tape, coords, boxed, false, true, &mut slots);
+        prop_assert_eq!(bounded, BoxTest::MayContain, "{} on the axis", text);
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(1000))]
+
+    /// Boxes converted to spherical coordinates enclose the coordinates of their points.
+    #[test]
+    fn spherical_boxes_enclose_their_points(text in formula_over(["r", "theta", "phi"]), (lo, size, samples) in box_and_points()) {
+        check_conversion(Coordinates::Spherical, &text, lo, size, samples)?;
+    }
+
+    /// The same for cylindrical coordinates.
+    #[test]
+    fn cylindrical_boxes_enclose_their_points(text in formula_over(["r", "theta", "y"]), (lo, size, samples) in box_and_points()) {
+        check_conversion(Coordinates::Cylindrical, &text, lo, size, samples)?;
+    }
+}
+
+#[test]
+fn boxes_across_the_cut_and_on_the_axis() {
+    let theta = Formula::parse("theta - 3.1", Coordinates::Cylindrical).unwrap();
+    let test = |f: &Formula, b: [Interval; 3], both_signs: bool, whole_axis: bool| {
+        test_box(
+            &f.tape,
+            f.coordinates,
+            b,
+            both_signs,
+            whole_axis,
+            &mut Vec::new(),
+        )
+    };
+    let i = |a: f64, b: f64| Interval::new(a, b);
+    // Across the negative x axis: θ near +π on one side and -π on the other.
+    let across = [i(-1.0, -0.5), i(0.0, 1.0), i(-0.1, 0.1)];
+    assert_eq!(test(&theta, across, false, false), BoxTest::MayContain);
+    let minus = Formula::parse("theta + 3.1", Coordinates::Cylindrical).unwrap();
+    assert_eq!(test(&minus, across, false, false), BoxTest::MayContain);
+    // Away from the cut, θ near 0 only.
+    let right = [i(0.5, 1.0), i(0.0, 1.0), i(-0.1, 0.1)];
+    assert_eq!(test(&theta, right, false, false), BoxTest::Empty);
+    // On the axis θ is anything: undecided, or bounded by [-π, π].
+    let axis = [i(-0.1, 0.1), i(0.0, 1.0), i(-0.1, 0.1)];
+    assert_eq!(test(&theta, axis, false, false), BoxTest::Undecided);
+    assert_eq!(test(&theta, axis, false, true), BoxTest::MayContain);
+    // Negative r: r + 0.5 = 0 has no point at r >= 0, but one at r = -0.5.
+    let negative = Formula::parse("r + 0.5", Coordinates::Spherical).unwrap();
+    let shell = [i(0.4, 0.6), i(-0.05, 0.05), i(-0.05, 0.05)];
+    assert_eq!(test(&negative, shell, false, false), BoxTest::Empty);
+    assert_eq!(test(&negative, shell, true, false), BoxTest::MayContain);
 }

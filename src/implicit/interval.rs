@@ -71,6 +71,19 @@ impl Interval {
         self.contains(0.0)
     }
 
+    /// Moved out by the libm margin (for bounds computed with libm or from rounded constants).
+    pub fn widened(self) -> Self {
+        widen(self.lo, self.hi, LIBM_ULPS)
+    }
+
+    /// Intersection with `[lo, hi]` moved out one ulp (`lo`, `hi` rounded constants).
+    pub fn clamp_to(self, lo: f64, hi: f64) -> Self {
+        Interval {
+            lo: self.lo.max(lo.next_down()),
+            hi: self.hi.min(hi.next_up()),
+        }
+    }
+
     pub fn width(&self) -> f64 {
         self.hi - self.lo
     }
@@ -276,21 +289,32 @@ impl Number for Interval {
             return EMPTY;
         }
         // The angle of a box that meets the origin or the cut along the negative x axis
-        // can be anything; otherwise it is extreme at the box's corners.
+        // can be anything. Otherwise x and y keep their signs on the box wherever the angle's
+        // partial derivatives (x / r², -y / r²) would change theirs, so the angle is extreme
+        // at two corners that the signs alone pick.
         if x.lo <= 0.0 && y.contains_zero() {
             return Interval::new(-PI, PI);
         }
-        let corners = [
-            y.lo.atan2(x.lo),
-            y.lo.atan2(x.hi),
-            y.hi.atan2(x.lo),
-            y.hi.atan2(x.hi),
-        ];
-        let w = widen(
-            corners.iter().copied().fold(f64::INFINITY, f64::min),
-            corners.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            LIBM_ULPS,
+        let y_near_axis = if y.lo > 0.0 { y.lo } else { y.hi };
+        let (x_max, y_max, x_min, y_min) = (
+            if y.hi < 0.0 { x.hi } else { x.lo },
+            if x.lo > 0.0 {
+                y.hi
+            } else if x.hi < 0.0 {
+                y.lo
+            } else {
+                y_near_axis
+            },
+            if y.lo > 0.0 { x.hi } else { x.lo },
+            if x.lo > 0.0 {
+                y.lo
+            } else if x.hi < 0.0 {
+                y.hi
+            } else {
+                y_near_axis
+            },
         );
+        let w = widen(y_min.atan2(x_min), y_max.atan2(x_max), LIBM_ULPS);
         Interval {
             lo: w.lo.max(-PI.next_up()),
             hi: w.hi.min(PI.next_up()),

@@ -2,11 +2,13 @@
 //! tape, evaluated at points, over interval boxes with a guaranteed enclosure, and with its
 //! gradient, in Cartesian, spherical or cylindrical coordinates.
 
+mod coordinates;
 mod dual;
 mod interval;
 mod parse;
 mod tape;
 
+pub use coordinates::{BoxTest, test_box, to_coordinates};
 pub use dual::Dual;
 pub use interval::Interval;
 pub use tape::{Instr, Number, Tape};

@@ -46,7 +46,7 @@ pub fn write_vdb(path: &Path, grid: &SparseGrid, metadata: &[(&str, String)]) ->
     write_vdb_with_masks(path, grid, &[], metadata)
 }
 
-/// `write_vdb`, plus one bool grid per `(name, mask)` (same transform; values ignored).
+/// `write_vdb`, plus one bool grid per `(name, mask)`, each with its own transform.
 pub fn write_vdb_with_masks(
     path: &Path,
     grid: &SparseGrid,
@@ -95,13 +95,14 @@ pub fn write_vdb_with_masks(
     }
     for (name, mask) in masks_to_add {
         let (origins, masks, _) = flatten(path, mask)?;
+        let mt = mask.transform;
         writer
             .pin_mut()
             .add_grid(
                 "bool",
                 name,
-                t.voxel_size,
-                origin,
+                mt.voxel_size,
+                mt.origin.to_array(),
                 &origins,
                 &masks,
                 &[],

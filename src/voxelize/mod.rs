@@ -1,5 +1,6 @@
 //! Voxelization methods, one file each, named for what they do.
 
+pub mod interval_octree;
 pub mod parametric;
 pub mod separating;
 pub mod separating_analytic;

@@ -189,9 +189,7 @@ pub fn mesh(input: &Path, args: &VoxelizeArgs, json: bool) -> Result<()> {
             .int("separability", surface.separability.adjacency() as u64)
             .obj("classes", stats_json(&stats))
             .num("load_seconds", load_s)
-            .num("voxelize_seconds", voxelize_s)
-            .num("seconds", total_s)
-            .num("peak_mib", peak_mib());
+            .timings(voxelize_s, total_s);
         println!("{}", j.render());
     } else {
         if stats.degenerate_faces > 0 {

@@ -3,6 +3,7 @@
 mod bench;
 mod bench_subdiv;
 mod commands;
+mod implicit;
 mod report;
 mod subdiv;
 
@@ -101,6 +102,9 @@ enum Command {
         #[arg(short, long, default_value_t = 256)]
         resolution: u32,
     },
+    /// Voxelize an implicit surface F = 0 typed as a formula, by interval octree (Stolte &
+    /// Kaufman): every level of the octree envelops the surface.
+    Implicit(implicit::ImplicitArgs),
     /// Voxelize a Catmull-Clark control mesh from its exact limit surface (Lai & Cheng), or
     /// check the limit-surface evaluator against OpenSubdiv (`subdiv check`, `subdiv eval`).
     Subdiv(subdiv::SubdivArgs),
@@ -130,6 +134,7 @@ fn main() -> ExitCode {
         } => commands::check(&input, fit, surface, cli.json),
         Command::Demo { output, resolution } => commands::demo(&output, resolution, cli.json),
         Command::Subdiv(args) => subdiv::run(&args, cli.json),
+        Command::Implicit(args) => implicit::run(&args, cli.json),
         Command::Bench(args) => bench::run(&args, cli.json),
     };
     match result {

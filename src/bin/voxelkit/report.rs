@@ -54,6 +54,13 @@ impl Json {
         self.put(key, Value::Raw(format!("[{}]", inner.join(","))))
     }
 
+    /// The closing fields of every voxelizing command.
+    pub fn timings(self, voxelize_seconds: f64, seconds: f64) -> Self {
+        self.num("voxelize_seconds", voxelize_seconds)
+            .num("seconds", seconds)
+            .num("peak_mib", peak_mib())
+    }
+
     pub fn render(&self) -> String {
         let mut s = String::from("{");
         for (i, (k, v)) in self.0.iter().enumerate() {

@@ -165,9 +165,7 @@ fn voxelize(input: &Path, args: &SubdivVoxelizeArgs, json: bool) -> Result<()> {
             .num("area", s.area)
             .num("voxel_size", transform.voxel_size)
             .int("adjacency", args.adjacency.number() as u64)
-            .num("voxelize_seconds", voxelize_s)
-            .num("seconds", total_s)
-            .num("peak_mib", peak_mib());
+            .timings(voxelize_s, total_s);
         println!("{}", j.render());
     } else {
         println!(

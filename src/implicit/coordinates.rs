@@ -1,0 +1,112 @@
+//! From Cartesian points and boxes to the coordinates a formula is written in, and the test
+//! whether a box may hold a point of the surface F = 0 (Stolte & Kaufman §3).
+//!
+//! Boxes: r = sqrt(x² + y² + z²) (or sqrt(x² + z²) for cylinders) in interval arithmetic is
+//! exactly [nearest, farthest distance] up to rounding. θ = atan2(z, x) is extreme at the
+//! box's corners unless the box meets the cut along the negative x axis, where it is split
+//! into the two pieces on either side of ±π (the paper's nine θ cases reduce to this), or
+//! contains the y axis (the paper's case 4), where θ can be anything: `Undecided` asks the
+//! caller to subdivide further. φ = atan2(y, sqrt(x² + z²)) lies in [-π/2, π/2].
+//!
+//! Negative r: a point with coordinates (r, θ, φ) also has (-r, θ + π, -φ) (cylinders:
+//! (-r, θ + π, y)). With `both_signs`, a box is kept when F contains 0 on either; the second
+//! set sees θ + π unreduced.
+
+use super::Coordinates;
+use super::interval::Interval;
+use super::tape::{Number, Tape};
+use std::f64::consts::PI;
+
+/// Coordinates of a Cartesian point, over any number type.
+pub fn to_coordinates<N: Number>(c: Coordinates, [x, y, z]: [N; 3]) -> [N; 3] {
+    match c {
+        Coordinates::Cartesian => [x, y, z],
+        Coordinates::Spherical => {
+            let horizontal = x.powi(2).add(z.powi(2));
+            [
+                horizontal.add(y.powi(2)).sqrt(),
+                z.atan2(x),
+                y.atan2(horizontal.sqrt()),
+            ]
+        }
+        Coordinates::Cylindrical => [x.powi(2).add(z.powi(2)).sqrt(), z.atan2(x), y],
+    }
+}
+
+/// What interval evaluation says about a box.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BoxTest {
+    /// F excludes 0 on the box: no surface.
+    Empty,
+    /// F may be 0 somewhere in the box.
+    MayContain,
+    /// The box contains the axis, where θ is unbounded: subdivide further.
+    Undecided,
+}
+
+/// Intervals of θ = atan2(z, x) over the box (one or two), or `None` if the box contains
+/// the y axis.
+fn theta_pieces(x: Interval, z: Interval) -> Option<([Interval; 2], usize)> {
+    if x.contains_zero() && z.contains_zero() {
+        return None;
+    }
+    if x.hi < 0.0 && z.contains_zero() {
+        // Across the cut at ±π: above it θ falls from π, below it rises from -π.
+        let upper = Interval::new(z.hi.atan2(x.hi), PI).widened();
+        let lower = Interval::new(-PI, z.lo.atan2(x.hi)).widened();
+        return Some(([upper, lower], 2));
+    }
+    let theta = z.atan2(x);
+    Some(([theta, theta], 1))
+}
+
+/// Whether the Cartesian box `b` may hold a point where `tape` (written in `c`) is zero;
+/// `slots` is scratch space. With `whole_axis`, a box on the axis is bounded with θ in
+/// [-π, π] instead of being `Undecided` (for boxes too small to subdivide further).
+pub fn test_box(
+    tape: &Tape,
+    c: Coordinates,
+    b: [Interval; 3],
+    both_signs: bool,
+    whole_axis: bool,
+    slots: &mut Vec<Interval>,
+) -> BoxTest {
+    let [x, _, z] = b;
+    let contains =
+        |v: [Interval; 3], slots: &mut Vec<Interval>| tape.eval_with(v, slots).contains_zero();
+    if c == Coordinates::Cartesian {
+        return if contains(b, slots) {
+            BoxTest::MayContain
+        } else {
+            BoxTest::Empty
+        };
+    }
+    let (thetas, count) = match theta_pieces(x, z) {
+        Some(t) => t,
+        None if whole_axis => ([Interval::new(-PI, PI).widened(); 2], 1),
+        None => return BoxTest::Undecided,
+    };
+    let [r, _, third] = to_coordinates(c, b);
+    let third = match c {
+        Coordinates::Spherical => {
+            third.clamp_to(-std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2)
+        }
+        _ => third,
+    };
+    let half_turn = Interval::point(PI).widened();
+    for &theta in &thetas[..count] {
+        if contains([r, theta, third], slots) {
+            return BoxTest::MayContain;
+        }
+        if both_signs {
+            let flipped = match c {
+                Coordinates::Spherical => third.neg(),
+                _ => third,
+            };
+            if contains([r.neg(), theta.add(half_turn), flipped], slots) {
+                return BoxTest::MayContain;
+            }
+        }
+    }
+    BoxTest::Empty
+}
