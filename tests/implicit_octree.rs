@@ -1,0 +1,169 @@
+//! The interval octree (Stolte & Kaufman): every level envelops the surface. Points on the
+//! true surface, found by root finding along random rays, all lie in output voxels; every
+//! kept cell's parent is kept.
+
+use glam::DVec3;
+use voxelkit::implicit::{Coordinates, Formula, to_coordinates};
+use voxelkit::mesh::generate::SplitMix64;
+use voxelkit::voxelize::interval_octree::{OctreeOptions, voxelize_implicit};
+
+const SURFACES: [(&str, Coordinates, &str); 3] = [
+    ("sphere", Coordinates::Cartesian, "x^2 + y^2 + z^2 - 0.8^2"),
+    (
+        "torus",
+        Coordinates::Cartesian,
+        "(sqrt(x^2 + z^2) - 0.6)^2 + y^2 - 0.25^2",
+    ),
+    (
+        "sinsin",
+        Coordinates::Spherical,
+        "sin(3*theta)*sin(4*phi) - r",
+    ),
+];
+
+/// F at a Cartesian point; with `negative`, at the same point written with -r.
+fn value(f: &Formula, p: DVec3, negative: bool) -> f64 {
+    let [r, theta, third] = to_coordinates(f.coordinates, p.to_array());
+    if negative {
+        f.tape.eval([-r, theta + std::f64::consts::PI, -third])
+    } else {
+        f.tape.eval([r, theta, third])
+    }
+}
+
+/// Points where F changes sign along random rays through [-1, 1]^3, refined by bisection.
+fn roots(f: &Formula, negative: bool, rays: usize) -> Vec<DVec3> {
+    let mut rng = SplitMix64(5);
+    let mut found = Vec::new();
+    for _ in 0..rays {
+        let o = DVec3::new(
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+        );
+        let d = rng.unit_vector();
+        let at = |t: f64| o + d * t;
+        let inside = |p: DVec3| p.abs().max_element() <= 1.0;
+        let step = 1e-3;
+        let mut t = -3.5;
+        while t < 3.5 {
+            let (a, b) = (at(t), at(t + step));
+            let (fa, fb) = (value(f, a, negative), value(f, b, negative));
+            if inside(a)
+                && inside(b)
+                && fa.is_finite()
+                && fb.is_finite()
+                && (fa < 0.0) != (fb < 0.0)
+            {
+                let (mut lo, mut hi) = (t, t + step);
+                for _ in 0..60 {
+                    let mid = 0.5 * (lo + hi);
+                    if (value(f, at(mid), negative) < 0.0) == (fa < 0.0) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                found.push(at(0.5 * (lo + hi)));
+            }
+            t += step;
+        }
+    }
+    found
+}
+
+#[test]
+fn surface_points_lie_in_output_voxels_at_every_resolution() {
+    for (name, coords, text) in SURFACES {
+        let f = Formula::parse(text, coords).unwrap();
+        let mut points = roots(&f, false, 500);
+        if coords != Coordinates::Cartesian {
+            points.extend(roots(&f, true, 500));
+        }
+        assert!(points.len() > 300, "{name}: only {} roots", points.len());
+        for resolution in [64, 128, 256, 512] {
+            let options = OctreeOptions {
+                resolution,
+                ..Default::default()
+            };
+            let out =
+                voxelize_implicit(&f, DVec3::splat(-1.0), DVec3::ONE, &options, &|_| {}).unwrap();
+            let t = out.surface.transform;
+            let missed: Vec<&DVec3> = points
+                .iter()
+                .filter(|&&p| !out.surface.contains(t.world_to_voxel(p)))
+                .collect();
+            eprintln!(
+                "{name} {resolution}: {} voxels, {} cells tested; {} of {} surface points outside",
+                out.stats.voxels,
+                out.stats.cells_tested,
+                missed.len(),
+                points.len()
+            );
+            assert!(
+                missed.is_empty(),
+                "{name} {resolution}: {:?} outside",
+                &missed[..missed.len().min(3)]
+            );
+        }
+    }
+}
+
+#[test]
+fn every_level_envelops_and_every_cell_has_its_parent() {
+    for (name, coords, text) in SURFACES {
+        let f = Formula::parse(text, coords).unwrap();
+        let points = roots(&f, false, 100);
+        let options = OctreeOptions {
+            resolution: 128,
+            levels: true,
+            ..Default::default()
+        };
+        let out = voxelize_implicit(&f, DVec3::splat(-1.0), DVec3::ONE, &options, &|_| {}).unwrap();
+        assert_eq!(out.levels.len(), 8, "{name}: levels 0..=7");
+        assert_eq!(out.levels[0].voxel_count(), 1);
+        let finest = out.levels.last().unwrap();
+        assert_eq!(finest.voxel_count(), out.surface.voxel_count());
+        for (l, level) in out.levels.iter().enumerate().skip(1) {
+            for c in level.voxels() {
+                let parent = [c[0] >> 1, c[1] >> 1, c[2] >> 1];
+                assert!(
+                    out.levels[l - 1].contains(parent),
+                    "{name}: level {l} cell {c:?} has no parent"
+                );
+            }
+            for &p in &points {
+                assert!(
+                    level.contains(level.transform.world_to_voxel(p)),
+                    "{name}: level {l} misses {p}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn normals_are_unit_gradients() {
+    let f = Formula::parse("x^2 + y^2 + z^2 - 0.8^2", Coordinates::Cartesian).unwrap();
+    let out = voxelize_implicit(
+        &f,
+        DVec3::splat(-1.0),
+        DVec3::ONE,
+        &OctreeOptions::default(),
+        &|_| {},
+    )
+    .unwrap();
+    let t = out.surface.transform;
+    for leaf in out.surface.leaves() {
+        let normals = leaf.normal.as_ref().unwrap();
+        for n in leaf.offsets() {
+            let c = voxelkit::grid::offset_coord(leaf.origin, n);
+            let radial = t.index_to_world(c).normalize();
+            let normal = glam::Vec3::from_array(normals[n]).as_dvec3();
+            assert!(
+                (normal.length() - 1.0).abs() < 1e-6 && normal.dot(radial) > 0.9999,
+                "{normal} at {c:?}"
+            );
+        }
+    }
+}
