@@ -3,7 +3,7 @@
 //! kept cell's parent is kept.
 
 use glam::DVec3;
-use voxelkit::implicit::{Coordinates, Formula, to_coordinates};
+use voxelkit::implicit::{Coordinates, Formula, value_at};
 use voxelkit::mesh::generate::SplitMix64;
 use voxelkit::voxelize::interval_octree::{OctreeOptions, voxelize_implicit};
 
@@ -21,14 +21,8 @@ const SURFACES: [(&str, Coordinates, &str); 3] = [
     ),
 ];
 
-/// F at a Cartesian point; with `negative`, at the same point written with -r.
 fn value(f: &Formula, p: DVec3, negative: bool) -> f64 {
-    let [r, theta, third] = to_coordinates(f.coordinates, p.to_array());
-    if negative {
-        f.tape.eval([-r, theta + std::f64::consts::PI, -third])
-    } else {
-        f.tape.eval([r, theta, third])
-    }
+    value_at(&f.tape, f.coordinates, p.to_array(), negative)
 }
 
 /// Points where F changes sign along random rays through [-1, 1]^3, refined by bisection.

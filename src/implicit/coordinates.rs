@@ -33,6 +33,21 @@ pub fn to_coordinates<N: Number>(c: Coordinates, [x, y, z]: [N; 3]) -> [N; 3] {
     }
 }
 
+/// F at a Cartesian point; with `negative`, at the same point written with -r:
+/// `(-r, θ + π, -φ)` in spherical, `(-r, θ + π, y)` in cylindrical coordinates.
+pub fn value_at(tape: &Tape, c: Coordinates, p: [f64; 3], negative: bool) -> f64 {
+    let [r, theta, third] = to_coordinates(c, p);
+    if !negative || c == Coordinates::Cartesian {
+        return tape.eval([r, theta, third]);
+    }
+    let third = if c == Coordinates::Spherical {
+        -third
+    } else {
+        third
+    };
+    tape.eval([-r, theta + PI, third])
+}
+
 /// What interval evaluation says about a box.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BoxTest {

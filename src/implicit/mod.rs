@@ -8,7 +8,7 @@ mod interval;
 mod parse;
 mod tape;
 
-pub use coordinates::{BoxTest, test_box, to_coordinates};
+pub use coordinates::{BoxTest, test_box, to_coordinates, value_at};
 pub use dual::Dual;
 pub use interval::Interval;
 pub use tape::{Instr, Number, Tape};

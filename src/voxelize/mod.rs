@@ -4,6 +4,7 @@ pub mod interval_octree;
 pub mod parametric;
 pub mod separating;
 pub mod separating_analytic;
+pub mod sign_change;
 mod sink;
 
 pub use sink::Progress;

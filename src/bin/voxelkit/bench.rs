@@ -15,7 +15,7 @@ use voxelkit::{Error, Result};
 #[command(args_conflicts_with_subcommands = true)]
 pub struct BenchArgs {
     #[command(subcommand)]
-    subdiv: Option<BenchKind>,
+    kind: Option<BenchKind>,
     /// Meshes to run: names in DATA/meshes (without .obj) or paths to .obj/.stl files.
     #[arg(long, value_delimiter = ',', default_value = "igea,skull,bunny-closed")]
     meshes: Vec<String>,
@@ -42,6 +42,8 @@ enum BenchKind {
     /// The Catmull-Clark voxelizer: evaluations against uniform sampling, and time against
     /// OpenVDB's meshToVolume on a tessellation of the same limit surface.
     Subdiv(crate::bench_subdiv::SubdivBenchArgs),
+    /// Implicit surfaces: the paper's Fig. 5 by interval octree, against naive corner signs.
+    Implicit(crate::bench_implicit::ImplicitBenchArgs),
 }
 
 /// The data folder: `--data`, else `$VOXELKIT_DATA`, else `../shared/data`.
@@ -75,8 +77,10 @@ pub fn best_of<T>(repeat: usize, mut f: impl FnMut() -> Result<T>) -> Result<(f6
 }
 
 pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
-    if let Some(BenchKind::Subdiv(sub)) = &args.subdiv {
-        return crate::bench_subdiv::run(sub, json);
+    match &args.kind {
+        Some(BenchKind::Subdiv(sub)) => return crate::bench_subdiv::run(sub, json),
+        Some(BenchKind::Implicit(imp)) => return crate::bench_implicit::run(imp, json),
+        None => {}
     }
     let data = data_folder(&args.data);
     let seps: Vec<Separability> = args

@@ -1,6 +1,7 @@
 //! The `voxelkit` command line: a thin shell over the library.
 
 mod bench;
+mod bench_implicit;
 mod bench_subdiv;
 mod commands;
 mod implicit;
@@ -109,7 +110,7 @@ enum Command {
     /// check the limit-surface evaluator against OpenSubdiv (`subdiv check`, `subdiv eval`).
     Subdiv(subdiv::SubdivArgs),
     /// Benchmark against OpenVDB's meshToVolume with a one-voxel band, in the same run
-    /// (`bench subdiv`: the Catmull-Clark voxelizer).
+    /// (`bench subdiv`: the Catmull-Clark voxelizer; `bench implicit`: the interval octree).
     Bench(bench::BenchArgs),
 }
 
