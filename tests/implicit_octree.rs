@@ -78,6 +78,7 @@ fn surface_points_lie_in_output_voxels_at_every_resolution() {
         for resolution in [64, 128, 256, 512] {
             let options = OctreeOptions {
                 resolution,
+                both_signs: true,
                 ..Default::default()
             };
             let out =

@@ -96,10 +96,10 @@ pub fn test_box(
             BoxTest::Empty
         };
     }
-    let (thetas, count) = match theta_pieces(x, z) {
-        Some(t) => t,
-        None if whole_axis => ([Interval::new(-PI, PI).widened(); 2], 1),
-        None => return BoxTest::Undecided,
+    // On the axis, θ in [-π, π] still rules many boxes out; the others are undecided.
+    let (thetas, count, on_axis) = match theta_pieces(x, z) {
+        Some((t, n)) => (t, n, false),
+        None => ([Interval::new(-PI, PI).widened(); 2], 1, !whole_axis),
     };
     let [r, _, third] = to_coordinates(c, b);
     let third = match c {
@@ -109,9 +109,14 @@ pub fn test_box(
         _ => third,
     };
     let half_turn = Interval::point(PI).widened();
+    let may_contain = if on_axis {
+        BoxTest::Undecided
+    } else {
+        BoxTest::MayContain
+    };
     for &theta in &thetas[..count] {
         if contains([r, theta, third], slots) {
-            return BoxTest::MayContain;
+            return may_contain;
         }
         if both_signs {
             let flipped = match c {
@@ -119,7 +124,7 @@ pub fn test_box(
                 _ => third,
             };
             if contains([r.neg(), theta.add(half_turn), flipped], slots) {
-                return BoxTest::MayContain;
+                return may_contain;
             }
         }
     }

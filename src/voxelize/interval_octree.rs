@@ -23,7 +23,8 @@ const AXIS_DEPTH: u32 = 4;
 pub struct OctreeOptions {
     /// Voxels along the longest side of the bounds.
     pub resolution: u32,
-    /// Also look for the surface at negative r (spherical and cylindrical).
+    /// Also look for the surface at negative r (spherical and cylindrical): r is a distance,
+    /// r >= 0, unless asked (the paper: "points with r < 0" are significant for some surfaces).
     pub both_signs: bool,
     /// Keep every level of the octree, not only the finest.
     pub levels: bool,
@@ -33,7 +34,7 @@ impl Default for OctreeOptions {
     fn default() -> Self {
         OctreeOptions {
             resolution: 256,
-            both_signs: true,
+            both_signs: false,
             levels: false,
         }
     }

@@ -21,9 +21,9 @@ pub struct ImplicitBenchArgs {
     /// Resolutions at which the naive corner-sign method also runs.
     #[arg(long, value_delimiter = ',', default_value = "256,512")]
     naive: Vec<u32>,
-    /// Only r >= 0 (the paper's main case); by default both signs of r.
+    /// Also negative r (both signs); by default r >= 0.
     #[arg(long)]
-    positive_r: bool,
+    negative_r: bool,
     #[arg(long, default_value_t = 2)]
     threads: usize,
     /// Runs per measurement; the fastest is reported.
@@ -74,7 +74,7 @@ pub fn run(args: &ImplicitBenchArgs, json: bool) -> Result<()> {
         for &res in &args.resolutions {
             let options = OctreeOptions {
                 resolution: res,
-                both_signs: !args.positive_r,
+                both_signs: args.negative_r,
                 levels: false,
             };
             let (seconds, out) = pool.install(|| {

@@ -72,9 +72,10 @@ pub struct ImplicitArgs {
     /// surface).
     #[arg(long)]
     levels: bool,
-    /// Spherical and cylindrical only: do not look for the surface at negative r.
+    /// Spherical and cylindrical only: also look for the surface at negative r, i.e. where
+    /// F(-r, theta + pi, -phi) = 0 (cylindrical: F(-r, theta + pi, y) = 0).
     #[arg(long)]
-    positive_r: bool,
+    negative_r: bool,
     /// Output .vdb file: `surface`, `density`, `normal` (and the levels).
     #[arg(short, long)]
     output: PathBuf,
@@ -124,7 +125,7 @@ pub fn run(args: &ImplicitArgs, json: bool) -> Result<()> {
     let (min, max) = parse_bounds(&args.bounds)?;
     let options = OctreeOptions {
         resolution: args.resolution,
-        both_signs: !args.positive_r,
+        both_signs: args.negative_r,
         levels: args.levels,
     };
     let start = Instant::now();
