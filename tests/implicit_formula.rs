@@ -221,6 +221,27 @@ proptest! {
         check_conversion(Coordinates::Spherical, &text, lo, size, samples)?;
     }
 
+    /// Formulas G(θ, φ) - r, where r is compared with G as squares.
+    #[test]
+    fn isolated_r_boxes_enclose_their_points(text in formula_over(["theta", "phi", "theta"]), (lo, size, samples) in box_and_points(), negative in any::<bool>()) {
+        let g = Formula::parse(&text, Coordinates::Spherical).unwrap();
+        let boxed: [Interval; 3] = std::array::from_fn(|k| Interval::new(lo[k], lo[k] + size[k]));
+        for t in samples {
+            let p: [f64; 3] = std::array::from_fn(|k| lo[k] + size[k] * t[k]);
+            let [r, theta, phi] = to_coordinates(Coordinates::Spherical, p);
+            let (r, theta, phi) = if negative { (-r, theta + std::f64::consts::PI, -phi) } else { (r, theta, phi) };
+            let v = g.tape.eval([r, theta, phi]) - r;
+            if !v.is_finite() {
+                continue;
+            }
+            // (G - v) - r is zero at p (written with -r when `negative`).
+            let shifted = Formula::parse(&format!("({text}) - ({v:?}) - r"), Coordinates::Spherical).unwrap();
+            prop_assert!(shifted.tape.isolated(0).is_some());
+            let test = test_box(&shifted.tape, Coordinates::Spherical, boxed, negative, true, &mut Vec::new());
+            prop_assert_eq!(test, BoxTest::MayContain, "{} at {:?}", text, p);
+        }
+    }
+
     /// The same for cylindrical coordinates.
     #[test]
     fn cylindrical_boxes_enclose_their_points(text in formula_over(["r", "theta", "y"]), (lo, size, samples) in box_and_points()) {

@@ -8,6 +8,10 @@
 //! contains the y axis (the paper's case 4), where θ can be anything: `Undecided` asks the
 //! caller to subdivide further. φ = atan2(y, sqrt(x² + z²)) lies in [-π/2, π/2].
 //!
+//! F = G - r with r nowhere else in G (the paper's examples): the box may hold a point of the
+//! surface when G (taken non-negative, as r >= 0) and r overlap, compared as squares: r² is
+//! x² + y² + z² (or x² + z²) in interval arithmetic, with no square root.
+//!
 //! Negative r: a point with coordinates (r, θ, φ) also has (-r, θ + π, -φ) (cylinders:
 //! (-r, θ + π, y)). With `both_signs`, a box is kept when F contains 0 on either; the second
 //! set sees θ + π unreduced.
@@ -102,6 +106,18 @@ pub fn test_box(
         None => ([Interval::new(-PI, PI).widened(); 2], 1, !whole_axis),
     };
     let [r, _, third] = to_coordinates(c, b);
+    let isolated = tape.isolated(0);
+    let r_squared = match (isolated, c) {
+        (None, _) => Interval::point(0.0),
+        (Some(_), Coordinates::Spherical) => x.powi(2).add(b[1].powi(2)).add(z.powi(2)),
+        (Some(_), _) => x.powi(2).add(z.powi(2)),
+    };
+    // G = r >= 0 (or, for the point written with -r, G = -r <= 0): compare squares.
+    let meets_r = |g: Interval, negative: bool| {
+        let g = if negative { g.neg() } else { g };
+        let g = Interval::new(g.lo.max(0.0), g.hi);
+        !g.is_empty() && g.lo <= g.hi && g.powi(2).overlaps(r_squared)
+    };
     let third = match c {
         Coordinates::Spherical => {
             third.clamp_to(-std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2)
@@ -114,8 +130,15 @@ pub fn test_box(
     } else {
         BoxTest::MayContain
     };
+    let holds = |v: [Interval; 3], negative: bool, slots: &mut Vec<Interval>| match isolated {
+        Some(g) => {
+            tape.eval_with(v, slots);
+            meets_r(slots[g as usize], negative)
+        }
+        None => contains(v, slots),
+    };
     for &theta in &thetas[..count] {
-        if contains([r, theta, third], slots) {
+        if holds([r, theta, third], false, slots) {
             return may_contain;
         }
         if both_signs {
@@ -123,7 +146,7 @@ pub fn test_box(
                 Coordinates::Spherical => third.neg(),
                 _ => third,
             };
-            if contains([r.neg(), theta.add(half_turn), flipped], slots) {
+            if holds([r.neg(), theta.add(half_turn), flipped], true, slots) {
                 return may_contain;
             }
         }

@@ -67,6 +67,11 @@ impl Interval {
         self.lo <= x && x <= self.hi
     }
 
+    /// Whether the two intervals share a point (false if either is empty).
+    pub fn overlaps(&self, o: Interval) -> bool {
+        self.lo <= o.hi && o.lo <= self.hi
+    }
+
     pub fn contains_zero(&self) -> bool {
         self.contains(0.0)
     }

@@ -63,6 +63,18 @@ impl Tape {
         self.instrs.is_empty()
     }
 
+    /// When the formula is `G - v` with variable `k` (v) appearing nowhere else, the slot of
+    /// G: then F = 0 is `G = v`, and G's interval can be compared with v's directly.
+    pub fn isolated(&self, k: u8) -> Option<u32> {
+        let uses = self.instrs.iter().filter(|&&i| i == Instr::Var(k)).count();
+        match self.instrs.last() {
+            Some(&Instr::Sub(g, v)) if uses == 1 && self.instrs[v as usize] == Instr::Var(k) => {
+                Some(g)
+            }
+            _ => None,
+        }
+    }
+
     /// Runs the tape with the three coordinate variables; `slots` is scratch space kept
     /// between calls to avoid allocating. The value of the last instruction is returned.
     pub fn eval_with<N: Number>(&self, vars: [N; 3], slots: &mut Vec<N>) -> N {

@@ -55,7 +55,11 @@ pub struct ImplicitArgs {
     /// (spherical: theta in the XZ plane from +X, phi from the XZ plane), r theta y
     /// (cylindrical). Operators + - * / ^ (integer powers), functions sqrt abs sin cos tan
     /// exp log atan2 min max, `pi`, and `name = expr;` sub-expressions.
-    #[arg(required_unless_present = "example", conflicts_with = "example")]
+    #[arg(
+        required_unless_present = "example",
+        conflicts_with = "example",
+        allow_hyphen_values = true
+    )]
     formula: Option<String>,
     /// A named example instead of a formula: sphere, torus, sinsin, gear, crankshaft.
     #[arg(long)]
