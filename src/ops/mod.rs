@@ -1,6 +1,9 @@
 //! Operations on voxel sets: flooding, inside classification, topology checks.
 
 pub mod flood;
+pub mod flood_spans;
+pub mod flood_xyz;
 pub mod inside;
 pub mod minimality;
+pub mod seed;
 pub mod separability;
