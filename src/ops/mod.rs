@@ -4,6 +4,7 @@ pub mod flood;
 pub mod flood_spans;
 pub mod flood_xyz;
 pub mod inside;
+pub mod measure;
 pub mod minimality;
 pub mod seed;
 pub mod separability;

@@ -1,0 +1,86 @@
+//! Measuring solids: the exact volume of a closed mesh lies between the inside voxels and the
+//! inside plus surface voxels, and the bracket closes as the resolution grows; genus from the
+//! Euler characteristic of the voxel solid.
+
+use glam::DVec3;
+use voxelkit::grid::{Adjacency, DenseMask};
+use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
+use voxelkit::ops::flood::{flood_from_border, padded};
+use voxelkit::ops::measure::{components, euler_characteristic, measure_solid};
+use voxelkit::voxelize::Separability;
+use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
+
+/// (inside, surface) of a 26-separating voxelization of `mesh`.
+fn solid(mesh: &Mesh, resolution: u32) -> (DenseMask, DenseMask, f64) {
+    let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
+    let options = SeparatingOptions {
+        separability: Separability::TwentySix,
+        ..Default::default()
+    };
+    let (grid, _) = voxelize_mesh(mesh, t, &options, &|_| {}).unwrap();
+    let bbox = padded(grid.bbox().unwrap(), 2);
+    let surface = DenseMask::from_grid(&grid, bbox).unwrap();
+    let exterior = flood_from_border(&surface, Adjacency::TwentySix).unwrap();
+    let mut inside = DenseMask::new(bbox).unwrap();
+    for i in 0..inside.len() {
+        if !surface.get_index(i) && !exterior.get_index(i) {
+            inside.set_index(i);
+        }
+    }
+    (inside, surface, t.voxel_size)
+}
+
+#[test]
+fn volume_is_bracketed_and_converges() {
+    let shapes = [
+        ("sphere", generate::icosphere(DVec3::ZERO, 1.0, 5)),
+        ("torus", generate::torus(DVec3::ZERO, 1.0, 0.35, 64, 32)),
+        (
+            "box",
+            generate::cuboid(DVec3::new(-1.0, -0.5, -0.25), DVec3::new(1.0, 0.5, 0.25)),
+        ),
+    ];
+    for (name, mesh) in shapes {
+        let exact = mesh.signed_volume();
+        let mut previous = f64::INFINITY;
+        for resolution in [32, 64, 128] {
+            let (inside, surface, h) = solid(&mesh, resolution);
+            let m = measure_solid(&inside, &surface, h);
+            eprintln!(
+                "{name} {resolution}: {:.6} <= {exact:.6} <= {:.6}",
+                m.volume_inside, m.volume_with_surface
+            );
+            assert!(
+                m.volume_inside <= exact && exact <= m.volume_with_surface,
+                "{name} {resolution}"
+            );
+            let gap = (m.volume_with_surface - m.volume_inside) / exact;
+            assert!(
+                gap < previous,
+                "{name}: the bracket did not close at {resolution}"
+            );
+            previous = gap;
+            let (low, high) = m.mass(2.0);
+            assert_eq!(
+                (low, high),
+                (2.0 * m.volume_inside, 2.0 * m.volume_with_surface)
+            );
+        }
+    }
+}
+
+#[test]
+fn genus_of_voxel_solids() {
+    for (name, mesh, genus) in [
+        ("sphere", generate::icosphere(DVec3::ZERO, 1.0, 4), 0),
+        ("torus", generate::torus(DVec3::ZERO, 1.0, 0.35, 48, 24), 1),
+    ] {
+        let (inside, surface, _) = solid(&mesh, 48);
+        let mut all = inside.clone();
+        for i in surface.ones() {
+            all.set_index(i);
+        }
+        let g = components(&all, Adjacency::Six) as i64 - euler_characteristic(&all);
+        assert_eq!(g, genus, "{name}");
+    }
+}
