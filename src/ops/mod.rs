@@ -1,5 +1,6 @@
 //! Operations on voxel sets: flooding, inside classification, topology checks.
 
+pub mod csg;
 pub mod flood;
 pub mod flood_spans;
 pub mod flood_xyz;
