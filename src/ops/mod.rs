@@ -9,3 +9,4 @@ pub mod measure;
 pub mod minimality;
 pub mod seed;
 pub mod separability;
+pub mod solid;
