@@ -6,6 +6,7 @@ mod bench_subdiv;
 mod commands;
 mod implicit;
 mod report;
+mod solids;
 mod subdiv;
 
 use clap::{Args, Parser, Subcommand};
@@ -103,6 +104,15 @@ enum Command {
         #[arg(short, long, default_value_t = 256)]
         resolution: u32,
     },
+    /// Fill a closed mesh: its 26-separating surface plus everything the exterior flood
+    /// cannot reach; prints volumes, mass, components and genus.
+    Solid(solids::SolidArgs),
+    /// Boolean of two voxel grids (.vdb): union, intersection or difference.
+    Csg(solids::CsgArgs),
+    /// The intersection curve of two voxel surfaces (.vdb): the voxels they share.
+    Intersect(solids::IntersectArgs),
+    /// Volume, mass, components and genus of a closed mesh or a closed .vdb surface.
+    Measure(solids::MeasureArgs),
     /// Voxelize an implicit surface F = 0 typed as a formula, by interval octree (Stolte &
     /// Kaufman): every level of the octree envelops the surface.
     Implicit(implicit::ImplicitArgs),
@@ -142,6 +152,10 @@ fn main() -> ExitCode {
         Command::Demo { output, resolution } => commands::demo(&output, resolution, cli.json),
         Command::Subdiv(args) => subdiv::run(&args, cli.json),
         Command::Implicit(args) => implicit::run(&args, cli.json),
+        Command::Solid(args) => solids::solid(&args, cli.json),
+        Command::Csg(args) => solids::csg(&args, cli.json),
+        Command::Intersect(args) => solids::intersect(&args, cli.json),
+        Command::Measure(args) => solids::measure(&args, cli.json),
         Command::Bench(args) => bench::run(&args, cli.json),
     };
     match result {

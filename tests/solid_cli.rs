@@ -1,0 +1,133 @@
+//! `voxelkit solid`, `measure`, `csg` and `intersect` end to end on generated meshes.
+#![cfg(feature = "vdb")]
+
+mod cli_support;
+
+use cli_support::{text, voxelkit};
+use glam::DVec3;
+use voxelkit::io::vdb::{read_vdb_grid, read_vdb_info};
+use voxelkit::mesh::generate;
+
+fn json_field(out: &str, key: &str) -> f64 {
+    let start = out
+        .find(&format!("\"{key}\":"))
+        .unwrap_or_else(|| panic!("{key} missing from {out}"))
+        + key.len()
+        + 3;
+    out[start..]
+        .split([',', '}'])
+        .next()
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap()
+}
+
+#[test]
+fn solid_measure_csg_and_intersect() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    generate::torus(DVec3::ZERO, 1.0, 0.35, 64, 32)
+        .write_obj(dir.path().join("torus.obj").as_path())
+        .unwrap();
+    generate::icosphere(DVec3::new(1.0, 0.0, 0.0), 0.5, 4)
+        .write_obj(dir.path().join("ball.obj").as_path())
+        .unwrap();
+
+    // A solid torus: volume bracketed, genus 1, the density grid on the whole solid.
+    let o = voxelkit(&[
+        "--json",
+        "solid",
+        &p("torus.obj"),
+        "-r",
+        "96",
+        "--flood",
+        "xyz",
+        "--graystack",
+        "256",
+        "-o",
+        &p("torus.vdb"),
+    ]);
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    let exact = generate::torus(DVec3::ZERO, 1.0, 0.35, 64, 32).signed_volume();
+    assert!(
+        json_field(&out, "volume_inside") < exact
+            && exact < json_field(&out, "volume_with_surface"),
+        "{out}"
+    );
+    assert_eq!(json_field(&out, "genus"), 1.0);
+    assert!(json_field(&out, "sweeps") >= 1.0);
+    let grids = read_vdb_info(dir.path().join("torus.vdb").as_path()).unwrap();
+    let count = |name: &str| grids.iter().find(|g| g.name == name).unwrap().active_voxels;
+    assert_eq!(count("density"), count("boundary") + count("interior"));
+
+    // measure reads the solid back and agrees; on the mesh it voxelizes first.
+    let o = voxelkit(&["--json", "measure", &p("torus.vdb")]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(
+        json_field(&text(&o), "inside_voxels"),
+        count("interior") as f64
+    );
+    let o = voxelkit(&["--json", "measure", &p("torus.obj"), "-r", "96"]);
+    assert!((json_field(&text(&o), "mesh_signed_volume") - exact).abs() < 1e-9);
+
+    // Surfaces on one grid each; Booleans need --resample across grids.
+    for name in ["torus", "ball"] {
+        let o = voxelkit(&[
+            "mesh",
+            &p(&format!("{name}.obj")),
+            "-r",
+            "96",
+            "-o",
+            &p(&format!("{name}-s.vdb")),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+    }
+    let o = voxelkit(&[
+        "intersect",
+        &p("torus-s.vdb"),
+        &p("ball-s.vdb"),
+        "-o",
+        &p("curve.vdb"),
+    ]);
+    assert!(
+        !o.status.success() && text(&o).contains("transforms differ"),
+        "{}",
+        text(&o)
+    );
+    assert!(!dir.path().join("curve.vdb").exists());
+    let o = voxelkit(&[
+        "intersect",
+        &p("torus-s.vdb"),
+        &p("ball-s.vdb"),
+        "--resample",
+        "-o",
+        &p("curve.vdb"),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let curve = read_vdb_grid(dir.path().join("curve.vdb").as_path(), Some("surface")).unwrap();
+    assert!(curve.voxel_count() > 100);
+    let o = voxelkit(&[
+        "csg",
+        "union",
+        &p("torus-s.vdb"),
+        &p("ball-s.vdb"),
+        "--resample",
+        "-o",
+        &p("union.vdb"),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let union = read_vdb_grid(dir.path().join("union.vdb").as_path(), Some("surface")).unwrap();
+    let torus = read_vdb_grid(dir.path().join("torus-s.vdb").as_path(), Some("surface")).unwrap();
+    assert!(union.voxel_count() > torus.voxel_count());
+    let o = voxelkit(&[
+        "csg",
+        "xor",
+        &p("torus-s.vdb"),
+        &p("ball-s.vdb"),
+        "-o",
+        &p("x.vdb"),
+    ]);
+    assert!(!o.status.success() && text(&o).contains("union, intersection or difference"));
+}
