@@ -148,9 +148,10 @@ fn report(
     solid: &Solid,
     density: f64,
     extra: Json,
-    seconds: f64,
+    start: Instant,
     json: bool,
 ) -> Result<()> {
+    let seconds = start.elapsed().as_secs_f64();
     let m = solid.measures;
     let (parts, genus) = topology(surface, solid)?;
     let (mass_low, mass_high) = m.mass(density);
@@ -228,14 +229,13 @@ pub fn solid(args: &SolidArgs, json: bool) -> Result<()> {
         args.output.display(),
         mesh.signed_volume()
     );
-    let seconds = start.elapsed().as_secs_f64();
     report(
         &what,
         &surface,
         &solid,
         args.fill.density,
         extra,
-        seconds,
+        start,
         json,
     )
 }
@@ -270,14 +270,13 @@ pub fn measure(args: &MeasureArgs, json: bool) -> Result<()> {
         (mesh_surface(&mesh, args.fill.fit, json)?, extra, what)
     };
     let solid = solid_from_surface(&surface, args.fill.flood.method())?;
-    let seconds = start.elapsed().as_secs_f64();
     report(
         &what,
         &surface,
         &solid,
         args.fill.density,
         extra,
-        seconds,
+        start,
         json,
     )
 }
