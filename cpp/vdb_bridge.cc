@@ -187,7 +187,7 @@ void VdbFile::read_leaves(size_t index, rust::Vec<int32_t>& leaf_origins, rust::
 }
 
 uint64_t openvdb_mesh_to_volume(rust::Slice<const float> points, rust::Slice<const uint32_t> triangles,
-                                double voxel_size, float band, size_t threads) {
+                                double voxel_size, float exterior_band, float interior_band, size_t threads) {
     ensure_initialized();
     std::vector<openvdb::Vec3s> pts(points.size() / 3);
     for (size_t i = 0; i < pts.size(); ++i) pts[i] = openvdb::Vec3s(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
@@ -197,7 +197,7 @@ uint64_t openvdb_mesh_to_volume(rust::Slice<const float> points, rust::Slice<con
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     auto xform = openvdb::math::Transform::createLinearTransform(voxel_size);
     openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> mesh(pts, tris);
-    auto grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(mesh, *xform, band, band);
+    auto grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(mesh, *xform, exterior_band, interior_band);
     return grid->activeVoxelCount();
 }
 

@@ -37,7 +37,7 @@ private:
 std::unique_ptr<VdbWriter> new_vdb_writer();
 std::unique_ptr<VdbFile> open_vdb(rust::Str path);
 uint64_t openvdb_mesh_to_volume(rust::Slice<const float> points, rust::Slice<const uint32_t> triangles,
-                                double voxel_size, float band, size_t threads);
+                                double voxel_size, float exterior_band, float interior_band, size_t threads);
 
 }  // namespace voxelkit
 

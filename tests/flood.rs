@@ -1,6 +1,6 @@
 //! Lai & Cheng's volume flooding: FloodingXYZ with a bounded GRAYSTACK and its resume sweep,
-//! the fast span flood, and the plain flood reach exactly the same voxels; seeds chosen from
-//! normals land inside.
+//! their linear baseline, the fast span flood and the plain flood reach exactly the same
+//! voxels; seeds chosen from normals land inside.
 
 mod common;
 
@@ -8,6 +8,7 @@ use voxelkit::grid::{Adjacency, CoordBox, DenseMask};
 use voxelkit::mesh::generate::SplitMix64;
 use voxelkit::mesh::{GridFit, fit_transform, generate};
 use voxelkit::ops::flood::{flood, flood_from_border, padded};
+use voxelkit::ops::flood_linear::flood_linear;
 use voxelkit::ops::flood_spans::flood_spans;
 use voxelkit::ops::flood_xyz::flood_xyz;
 use voxelkit::ops::seed::seed_from_normals;

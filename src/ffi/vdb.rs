@@ -65,14 +65,16 @@ pub mod bridge {
             values: &mut Vec<f32>,
         ) -> Result<()>;
 
-        /// OpenVDB's own narrow-band conversion (`tools::meshToVolume`) of a triangle mesh
-        /// given in index space, with `band` voxels outside and inside, on at most `threads`
-        /// threads. Returns the number of active voxels (for benchmarks).
+        /// OpenVDB's own conversion (`tools::meshToVolume`) of a triangle mesh given in index
+        /// space, with `exterior_band` voxels outside and `interior_band` inside (the largest
+        /// float fills the whole interior), on at most `threads` threads. Returns the number of
+        /// active voxels (for benchmarks).
         fn openvdb_mesh_to_volume(
             points: &[f32],
             triangles: &[u32],
             voxel_size: f64,
-            band: f32,
+            exterior_band: f32,
+            interior_band: f32,
             threads: usize,
         ) -> Result<u64>;
     }

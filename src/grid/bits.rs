@@ -15,6 +15,33 @@ pub fn clear(words: &mut [u64], i: usize) {
     words[i >> 6] &= !(1 << (i & 63));
 }
 
+/// The `n` (at most 64) bits from bit `i` on, as the low bits of a word.
+#[inline]
+pub fn range(words: &[u64], i: usize, n: usize) -> u64 {
+    let (w, b) = (i >> 6, i & 63);
+    let mut v = words[w] >> b;
+    if b + n > 64 {
+        v |= words[w + 1] << (64 - b);
+    }
+    if n < 64 { v & ((1u64 << n) - 1) } else { v }
+}
+
+/// Sets bits `first..=last`.
+pub fn set_range(words: &mut [u64], first: usize, last: usize) {
+    let (fw, lw) = (first >> 6, last >> 6);
+    let low = u64::MAX << (first & 63);
+    let high = u64::MAX >> (63 - (last & 63));
+    if fw == lw {
+        words[fw] |= low & high;
+        return;
+    }
+    words[fw] |= low;
+    for w in &mut words[fw + 1..lw] {
+        *w = u64::MAX;
+    }
+    words[lw] |= high;
+}
+
 /// Indices of the set bits, ascending.
 pub fn ones(words: &[u64]) -> impl Iterator<Item = usize> + '_ {
     words.iter().enumerate().flat_map(|(w, &bits)| {
@@ -28,4 +55,32 @@ pub fn ones(words: &[u64]) -> impl Iterator<Item = usize> + '_ {
             Some(w * 64 + t)
         })
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_match_single_bits() {
+        let mut words = vec![0u64; 4];
+        for (first, last) in [(3, 3), (5, 70), (60, 130), (64, 127), (0, 255)] {
+            words.iter_mut().for_each(|w| *w = 0);
+            set_range(&mut words, first, last);
+            for i in 0..256 {
+                assert_eq!(
+                    get(&words, i),
+                    (first..=last).contains(&i),
+                    "{first}..={last} at {i}"
+                );
+            }
+            for (i, n) in [(0, 64), (3, 8), (60, 8), (62, 64), (120, 17)] {
+                let expect = (0..n)
+                    .filter(|&k| get(&words, i + k))
+                    .map(|k| 1u64 << k)
+                    .sum::<u64>();
+                assert_eq!(range(&words, i, n), expect);
+            }
+        }
+    }
 }

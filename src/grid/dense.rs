@@ -99,6 +99,70 @@ impl DenseMask {
         self.set_index(i);
     }
 
+    /// Sets the voxels of linear indices `first..=last`.
+    pub fn set_index_range(&mut self, first: usize, last: usize) {
+        bits::set_range(&mut self.bits, first, last);
+    }
+
+    /// The voxels set in neither `a` nor `b` (same box).
+    pub fn neither(a: &DenseMask, b: &DenseMask) -> DenseMask {
+        assert_eq!(a.bbox, b.bbox, "masks over different boxes");
+        let mut out = a.clone();
+        for (o, w) in out.bits.iter_mut().zip(&b.bits) {
+            *o = !(*o | w);
+        }
+        let tail = out.len() % 64;
+        if tail != 0 {
+            let last = out.bits.len() - 1;
+            out.bits[last] &= (1u64 << tail) - 1;
+        }
+        out
+    }
+
+    /// The set voxels as a sparse grid on `transform`, built leaf by leaf from 8-voxel rows.
+    pub fn to_grid(&self, transform: super::Transform) -> SparseGrid {
+        let mut leaves = Vec::new();
+        let lo = super::coord::leaf_origin(self.bbox.min);
+        let hi = self.bbox.max;
+        let mut origin = lo;
+        while origin[0] <= hi[0] {
+            origin[1] = lo[1];
+            while origin[1] <= hi[1] {
+                origin[2] = lo[2];
+                while origin[2] <= hi[2] {
+                    let mut leaf = super::Leaf::new(origin, super::Channels::NONE);
+                    let z0 = origin[2].max(self.bbox.min[2]);
+                    let z1 = (origin[2] + 7).min(hi[2]);
+                    for dx in 0..8 {
+                        let x = origin[0] + dx;
+                        if x < self.bbox.min[0] || x > hi[0] {
+                            continue;
+                        }
+                        for dy in 0..8 {
+                            let y = origin[1] + dy;
+                            if y < self.bbox.min[1] || y > hi[1] {
+                                continue;
+                            }
+                            let row = bits::range(
+                                &self.bits,
+                                self.index([x, y, z0]),
+                                (z1 - z0 + 1) as usize,
+                            );
+                            leaf.mask[dx as usize] |= row << (dy * 8 + (z0 - origin[2]));
+                        }
+                    }
+                    if !leaf.is_empty() {
+                        leaves.push(leaf);
+                    }
+                    origin[2] += 8;
+                }
+                origin[1] += 8;
+            }
+            origin[0] += 8;
+        }
+        SparseGrid::from_leaves(transform, super::Channels::NONE, leaves)
+    }
+
     pub fn count(&self) -> u64 {
         self.bits.iter().map(|w| w.count_ones() as u64).sum()
     }

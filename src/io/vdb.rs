@@ -189,19 +189,27 @@ pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
     Ok(SparseGrid::from_leaves(transform, channels, leaves))
 }
 
-/// OpenVDB's `meshToVolume` on a triangle mesh in index space (benchmark reference):
-/// returns its active voxel count.
+/// OpenVDB's `meshToVolume` on a triangle mesh in index space (benchmark reference), with
+/// `exterior_band` and `interior_band` voxels (`f32::MAX` inside fills the solid): returns its
+/// active voxel count.
 pub fn openvdb_mesh_to_volume(
     index_points: &[f32],
     triangles: &[u32],
     voxel_size: f64,
-    band: f32,
+    exterior_band: f32,
+    interior_band: f32,
     threads: usize,
 ) -> Result<u64> {
-    bridge::openvdb_mesh_to_volume(index_points, triangles, voxel_size, band, threads).map_err(
-        |e| Error::Vdb {
-            path: "<meshToVolume>".into(),
-            message: e.to_string(),
-        },
+    bridge::openvdb_mesh_to_volume(
+        index_points,
+        triangles,
+        voxel_size,
+        exterior_band,
+        interior_band,
+        threads,
     )
+    .map_err(|e| Error::Vdb {
+        path: "<meshToVolume>".into(),
+        message: e.to_string(),
+    })
 }

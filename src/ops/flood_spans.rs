@@ -30,9 +30,7 @@ pub fn flood_spans(blocked: &DenseMask, seeds: &[Coord]) -> Result<DenseMask> {
         while last + 1 < row + nz && free(&reached, last + 1) {
             last += 1;
         }
-        for j in first..=last {
-            reached.set_index(j);
-        }
+        reached.set_index_range(first, last);
         let (x, y) = (row / (ny * nz), (row / nz) % ny);
         let neighbours = [
             (x > 0).then(|| row - ny * nz),

@@ -30,10 +30,9 @@ pub struct Solid {
 
 /// The solid enclosed by `surface` (an empty surface encloses nothing).
 pub fn solid_from_surface(surface: &SparseGrid, method: FloodMethod) -> Result<Solid> {
-    let mut inside = SparseGrid::new(surface.transform, Channels::NONE);
     let Some(bbox) = surface.bbox() else {
         return Ok(Solid {
-            inside,
+            inside: SparseGrid::new(surface.transform, Channels::NONE),
             measures: SolidMeasures::default(),
             xyz_stats: None,
         });
@@ -48,16 +47,8 @@ pub fn solid_from_surface(surface: &SparseGrid, method: FloodMethod) -> Result<S
             (reached, Some(stats))
         }
     };
-    let mut inside_mask = DenseMask::new(bbox)?;
-    {
-        let mut acc = inside.accessor();
-        for i in 0..blocked.len() {
-            if !blocked.get_index(i) && !exterior.get_index(i) {
-                inside_mask.set_index(i);
-                acc.insert(blocked.coord(i));
-            }
-        }
-    }
+    let inside_mask = DenseMask::neither(&blocked, &exterior);
+    let inside = inside_mask.to_grid(surface.transform);
     let measures = measure_solid(&inside_mask, &blocked, surface.transform.voxel_size);
     Ok(Solid {
         inside,

@@ -44,6 +44,8 @@ enum BenchKind {
     Subdiv(crate::bench_subdiv::SubdivBenchArgs),
     /// Implicit surfaces: the paper's Fig. 5 by interval octree, against naive corner signs.
     Implicit(crate::bench_implicit::ImplicitBenchArgs),
+    /// Solids: surface plus flood against OpenVDB's meshToVolume with the interior filled.
+    Solid(crate::bench_solid::SolidBenchArgs),
 }
 
 /// The data folder: `--data`, else `$VOXELKIT_DATA`, else `../shared/data`.
@@ -80,6 +82,7 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
     match &args.kind {
         Some(BenchKind::Subdiv(sub)) => return crate::bench_subdiv::run(sub, json),
         Some(BenchKind::Implicit(imp)) => return crate::bench_implicit::run(imp, json),
+        Some(BenchKind::Solid(solid)) => return crate::bench_solid::run(solid, json),
         None => {}
     }
     let data = data_folder(&args.data);
@@ -123,7 +126,14 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
                         Error::InvalidArgument(format!("cannot start {threads} threads: {e}"))
                     })?;
                 let (vdb_s, vdb_voxels) = best_of(args.repeat, || {
-                    openvdb_mesh_to_volume(&index_points, &tris, transform.voxel_size, 1.0, threads)
+                    openvdb_mesh_to_volume(
+                        &index_points,
+                        &tris,
+                        transform.voxel_size,
+                        1.0,
+                        1.0,
+                        threads,
+                    )
                 })?;
                 for (&sep, &criterion) in seps
                     .iter()

@@ -193,7 +193,7 @@ fn reference_seconds(
         .collect();
     let tris: Vec<u32> = mesh.triangles().flat_map(|(_, t)| t).collect();
     let (seconds, _) = best_of(args.repeat, || {
-        openvdb_mesh_to_volume(&points, &tris, transform.voxel_size, 1.0, args.threads)
+        openvdb_mesh_to_volume(&points, &tris, transform.voxel_size, 1.0, 1.0, args.threads)
     })?;
     Ok(seconds)
 }

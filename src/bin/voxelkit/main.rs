@@ -2,6 +2,7 @@
 
 mod bench;
 mod bench_implicit;
+mod bench_solid;
 mod bench_subdiv;
 mod commands;
 mod implicit;
@@ -120,7 +121,7 @@ enum Command {
     /// check the limit-surface evaluator against OpenSubdiv (`subdiv check`, `subdiv eval`).
     Subdiv(subdiv::SubdivArgs),
     /// Benchmark against OpenVDB's meshToVolume with a one-voxel band, in the same run
-    /// (`bench subdiv`: the Catmull-Clark voxelizer; `bench implicit`: the interval octree).
+    /// (`bench subdiv`: the Catmull-Clark voxelizer; `bench implicit`: the interval octree; `bench solid`: filled solids).
     Bench(bench::BenchArgs),
 }
 
