@@ -48,6 +48,11 @@ fn all_floods_agree_on_random_volumes() {
             same(&reference, &spans),
             "round {round}: span flood differs"
         );
+        let (linear, _) = flood_linear(&blocked, &seeds).unwrap();
+        assert!(
+            same(&reference, &linear),
+            "round {round}: linear flood differs"
+        );
         for capacity in [1, 7, 1 << 20] {
             let (xyz, stats) = flood_xyz(&blocked, &seeds, capacity).unwrap();
             assert!(

@@ -48,6 +48,14 @@ enum BenchKind {
     Solid(crate::bench_solid::SolidBenchArgs),
 }
 
+/// A pool of `threads` workers for one side of a comparison.
+pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::InvalidArgument(format!("cannot start {threads} threads: {e}")))
+}
+
 /// The data folder: `--data`, else `$VOXELKIT_DATA`, else `../shared/data`.
 pub fn data_folder(explicit: &Option<PathBuf>) -> PathBuf {
     explicit
@@ -119,12 +127,7 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
                 .flat_map(|&p| transform.world_to_index(p).as_vec3().to_array())
                 .collect();
             for &threads in &args.thread_counts {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .map_err(|e| {
-                        Error::InvalidArgument(format!("cannot start {threads} threads: {e}"))
-                    })?;
+                let pool = thread_pool(threads)?;
                 let (vdb_s, vdb_voxels) = best_of(args.repeat, || {
                     openvdb_mesh_to_volume(
                         &index_points,

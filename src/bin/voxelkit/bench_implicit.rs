@@ -41,12 +41,7 @@ fn parse_nm(s: &str) -> Result<(u32, u32)> {
 }
 
 pub fn run(args: &ImplicitBenchArgs, json: bool) -> Result<()> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads)
-        .build()
-        .map_err(|e| {
-            Error::InvalidArgument(format!("cannot start {} threads: {e}", args.threads))
-        })?;
+    let pool = crate::bench::thread_pool(args.threads)?;
     let (min, max) = (DVec3::splat(-1.0), DVec3::ONE);
     let mut rows = Vec::new();
     if !json {

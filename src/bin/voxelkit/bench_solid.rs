@@ -7,6 +7,7 @@ use crate::bench::{best_of, data_folder};
 use crate::report::Json;
 use clap::Args;
 use std::path::PathBuf;
+use voxelkit::Result;
 use voxelkit::grid::DenseMask;
 use voxelkit::io::vdb::openvdb_mesh_to_volume;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform};
@@ -15,7 +16,6 @@ use voxelkit::ops::flood_linear::flood_linear;
 use voxelkit::ops::solid::{FloodMethod, solid_from_surface};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
-use voxelkit::{Error, Result};
 
 #[derive(Args)]
 pub struct SolidBenchArgs {
@@ -41,12 +41,7 @@ pub struct SolidBenchArgs {
 
 pub fn run(args: &SolidBenchArgs, json: bool) -> Result<()> {
     let data = data_folder(&args.data);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads)
-        .build()
-        .map_err(|e| {
-            Error::InvalidArgument(format!("cannot start {} threads: {e}", args.threads))
-        })?;
+    let pool = crate::bench::thread_pool(args.threads)?;
     let mut rows = Vec::new();
     if !json {
         println!(

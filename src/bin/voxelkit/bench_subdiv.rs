@@ -55,12 +55,7 @@ fn adjacency(n: u32) -> Result<Adjacency> {
 
 pub fn run(args: &SubdivBenchArgs, json: bool) -> Result<()> {
     let data = data_folder(&args.data);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads)
-        .build()
-        .map_err(|e| {
-            Error::InvalidArgument(format!("cannot start {} threads: {e}", args.threads))
-        })?;
+    let pool = crate::bench::thread_pool(args.threads)?;
     let mut variants = Vec::new();
     for &n in &args.adjacency {
         variants.push((adjacency(n)?, false));
