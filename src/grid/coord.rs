@@ -47,10 +47,8 @@ impl CoordBox {
 
     /// Grows the box to hold `c`.
     pub fn expand(&mut self, c: Coord) {
-        for a in 0..3 {
-            self.min[a] = self.min[a].min(c[a]);
-            self.max[a] = self.max[a].max(c[a]);
-        }
+        self.min = std::array::from_fn(|a| self.min[a].min(c[a]));
+        self.max = std::array::from_fn(|a| self.max[a].max(c[a]));
     }
 
     /// The smallest box holding both.

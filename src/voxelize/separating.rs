@@ -300,7 +300,7 @@ fn edges_and_vertices(
         .map(|f| mesh.face(f).len() == 3 || is_planar(mesh.face(f), pos, face_normals[f]))
         .collect();
     let for_each_edge = |visit: &mut dyn FnMut(u32, u32, u32)| {
-        for f in 0..mesh.face_count() {
+        for (f, &flat) in planar.iter().enumerate() {
             let face = mesh.face(f);
             for k in 0..face.len() {
                 let (a, b) = (face[k], face[(k + 1) % face.len()]);
@@ -308,7 +308,7 @@ fn edges_and_vertices(
                     visit(a.min(b), a.max(b), f as u32);
                 }
             }
-            if !planar[f] {
+            if !flat {
                 for k in 2..face.len() - 1 {
                     visit(face[0].min(face[k]), face[0].max(face[k]), f as u32);
                 }
