@@ -130,16 +130,23 @@ fn mesh_surface(mesh: &Mesh, fit: FitArgs, quiet: bool) -> Result<SparseGrid> {
 
 /// Components and genus of surface plus inside (26-connected components; genus of the
 /// boundary for solids without cavities).
-fn topology(surface: &SparseGrid, solid: &Solid) -> Result<(u64, i64)> {
+/// `None` above `TOPOLOGY_LIMIT` voxels, where the Euler characteristic (a hash set of cube
+/// faces, edges and vertices) would cost more than everything else together.
+fn topology(surface: &SparseGrid, solid: &Solid) -> Result<Option<(u64, i64)>> {
+    const TOPOLOGY_LIMIT: u64 = 20_000_000;
+    let m = solid.measures;
+    if m.inside_voxels + m.surface_voxels > TOPOLOGY_LIMIT {
+        return Ok(None);
+    }
     let Some(bbox) = surface.bbox() else {
-        return Ok((0, 0));
+        return Ok(Some((0, 0)));
     };
     let mut all = DenseMask::from_grid(surface, padded(bbox, 1))?;
     for c in solid.inside.voxels() {
         all.set(c);
     }
     let parts = components(&all, Adjacency::TwentySix);
-    Ok((parts, parts as i64 - euler_characteristic(&all)))
+    Ok(Some((parts, parts as i64 - euler_characteristic(&all))))
 }
 
 fn report(
@@ -153,7 +160,11 @@ fn report(
 ) -> Result<()> {
     let seconds = start.elapsed().as_secs_f64();
     let m = solid.measures;
-    let (parts, genus) = topology(surface, solid)?;
+    let topo = topology(surface, solid)?;
+    let topo_text = match topo {
+        Some((parts, genus)) => format!("{parts} component(s), genus {genus}"),
+        None => "components and genus skipped (over 20M voxels)".to_string(),
+    };
     let (mass_low, mass_high) = m.mass(density);
     if json {
         let mut j = extra
@@ -163,8 +174,8 @@ fn report(
             .num("volume_with_surface", m.volume_with_surface)
             .num("mass_inside", mass_low)
             .num("mass_with_surface", mass_high)
-            .int("components", parts)
-            .num("genus", genus as f64)
+            .num("components", topo.map_or(f64::NAN, |t| t.0 as f64))
+            .num("genus", topo.map_or(f64::NAN, |t| t.1 as f64))
             .str(
                 "seed_rule",
                 "exterior flood from the corner of the padded box (no normals needed)",
@@ -181,7 +192,7 @@ fn report(
     } else {
         println!(
             "{what}: {} inside + {} surface voxels; volume {:.6} (inside) .. {:.6} (with surface); mass {:.6} .. {:.6} at density {density}; \
-             {parts} component(s), genus {genus}; inside = what the exterior flood (from the box corner, no normals needed) cannot reach{}; {:.2} s, peak {:.0} MiB",
+             {topo_text}; inside = what the exterior flood (from the box corner, no normals needed) cannot reach{}; {:.2} s, peak {:.0} MiB",
             m.inside_voxels,
             m.surface_voxels,
             m.volume_inside,
