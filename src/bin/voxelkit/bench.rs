@@ -64,12 +64,13 @@ pub fn data_folder(explicit: &Option<PathBuf>) -> PathBuf {
         .unwrap_or_else(|| PathBuf::from("../shared/data"))
 }
 
-fn resolve(name: &str, data: &std::path::Path) -> PathBuf {
+/// A path as given (it has an extension), or `DATA/folder/NAME.obj` for a bare name.
+pub fn resolve(name: &str, data: &std::path::Path, folder: &str) -> PathBuf {
     let p = PathBuf::from(name);
     if p.extension().is_some() {
         p
     } else {
-        data.join("meshes").join(format!("{name}.obj"))
+        data.join(folder).join(format!("{name}.obj"))
     }
 }
 
@@ -116,7 +117,7 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
         );
     }
     for name in &args.meshes {
-        let path = resolve(name, &data);
+        let path = resolve(name, &data, "meshes");
         let mesh = Mesh::load(&path)?;
         let tris: Vec<u32> = mesh.triangles().flat_map(|(_, t)| t).collect();
         for &res in &args.resolutions {

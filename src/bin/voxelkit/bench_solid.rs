@@ -59,11 +59,7 @@ pub fn run(args: &SolidBenchArgs, json: bool) -> Result<()> {
         );
     }
     for name in &args.meshes {
-        let path = if name.contains('.') {
-            PathBuf::from(name)
-        } else {
-            data.join("meshes").join(format!("{name}.obj"))
-        };
+        let path = crate::bench::resolve(name, &data, "meshes");
         let mesh = Mesh::load(&path)?;
         let tris: Vec<u32> = mesh.triangles().flat_map(|(_, t)| t).collect();
         for &res in &args.resolutions {

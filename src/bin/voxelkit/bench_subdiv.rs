@@ -81,11 +81,7 @@ pub fn run(args: &SubdivBenchArgs, json: bool) -> Result<()> {
         );
     }
     for name in &args.meshes {
-        let path = if name.ends_with(".obj") {
-            PathBuf::from(name)
-        } else {
-            data.join("subd").join(format!("{name}.obj"))
-        };
+        let path = crate::bench::resolve(name, &data, "subd");
         let control = ControlMesh::load(&path)?;
         let bbox = control.polygon_mesh().bbox();
         let limit = LimitSurface::new(control.clone());
