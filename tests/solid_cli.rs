@@ -131,3 +131,83 @@ fn solid_measure_csg_and_intersect() {
     ]);
     assert!(!o.status.success() && text(&o).contains("union, intersection or difference"));
 }
+
+#[test]
+fn depth_layer_solids_report_what_they_cannot_classify() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    generate::g_between_plates()
+        .write_obj(dir.path().join("g.obj").as_path())
+        .unwrap();
+    generate::spheres_in_box()
+        .write_obj(dir.path().join("boxed.obj").as_path())
+        .unwrap();
+    let mut open = generate::cuboid(DVec3::splat(-1.0), DVec3::splat(1.0));
+    open.face_starts.pop(); // drop the last face: a box without a side
+    open.write_obj(dir.path().join("open.obj").as_path())
+        .unwrap();
+
+    // The G: single layers fill its hollow, double layers do not; both agree with the flood
+    // on a closed mesh up to the surface voxels.
+    let run = |input: &str, extra: &[&str], out: &str| {
+        let mut args = vec!["--json", "solid", input, "-r", "70", "-o", out];
+        args.extend_from_slice(extra);
+        let o = voxelkit(&args);
+        assert!(o.status.success(), "{}", text(&o));
+        text(&o)
+    };
+    let double = run(&p("g.obj"), &["--method", "depth-layers"], &p("g2.vdb"));
+    let single = run(
+        &p("g.obj"),
+        &[
+            "--method",
+            "depth-layers",
+            "--layers",
+            "single",
+            "--directions",
+            "3",
+        ],
+        &p("g1.vdb"),
+    );
+    let exact = generate::g_between_plates().signed_volume();
+    let (v2, v1) = (json_field(&double, "volume"), json_field(&single, "volume"));
+    assert!((v2 - exact).abs() < 0.02 * exact, "{v2} vs {exact}");
+    // The part of the hollow no axis sees: 12 of the G's cells of (1/7)^3.
+    let unseen = 12.0 / 343.0;
+    assert!(
+        v1 - exact > 0.8 * unseen,
+        "single layers should fill the hollow: {v1} vs {exact}"
+    );
+    assert_eq!(json_field(&double, "unclassified_voxels"), 0.0);
+    let grids = read_vdb_info(dir.path().join("g2.vdb").as_path()).unwrap();
+    let count = |name: &str| grids.iter().find(|g| g.name == name).unwrap().active_voxels;
+    assert_eq!(count("density"), count("boundary") + count("interior"));
+    assert_eq!(count("unclassified"), 0);
+
+    // Spheres in a hollow box: unclassifiable voxels, written as their own grid.
+    let boxed = run(
+        &p("boxed.obj"),
+        &["--method", "depth-layers"],
+        &p("boxed.vdb"),
+    );
+    assert!(
+        json_field(&boxed, "unclassified_voxels") > 1000.0,
+        "{boxed}"
+    );
+    assert_eq!(json_field(&boxed, "odd_rays"), 0.0);
+    let u = read_vdb_grid(dir.path().join("boxed.vdb").as_path(), Some("unclassified")).unwrap();
+    assert_eq!(
+        u.voxel_count() as f64,
+        json_field(&boxed, "unclassified_voxels")
+    );
+
+    // An open box: the flood refuses it, naming the file and an edge; depth layers report it.
+    let o = voxelkit(&["solid", &p("open.obj"), "-r", "32", "-o", &p("o.vdb")]);
+    let msg = text(&o);
+    assert!(!o.status.success() && msg.contains("open.obj") && msg.contains("boundary edge"));
+    assert!(!dir.path().join("o.vdb").exists());
+    let open = run(&p("open.obj"), &["--method", "depth-layers"], &p("o.vdb"));
+    assert!(json_field(&open, "odd_rays") > 0.0);
+    assert!(json_field(&open, "unclassified_on_odd_rays") > 0.0);
+    assert_eq!(json_field(&open, "boundary_edges"), 4.0);
+}

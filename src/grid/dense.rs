@@ -163,6 +163,39 @@ impl DenseMask {
         SparseGrid::from_leaves(transform, super::Channels::NONE, leaves)
     }
 
+    /// The set voxels with a face neighbour that is clear (or outside the box).
+    pub fn boundary(&self) -> DenseMask {
+        let mut out = DenseMask {
+            bbox: self.bbox,
+            dims: self.dims,
+            bits: vec![0; self.bits.len()],
+        };
+        for i in self.ones() {
+            let c = self.coord(i);
+            let exposed = (0..3).any(|a| {
+                [-1, 1].iter().any(|&s| {
+                    let mut n = c;
+                    n[a] += s;
+                    !self.get(n)
+                })
+            });
+            if exposed {
+                out.set_index(i);
+            }
+        }
+        out
+    }
+
+    /// The voxels set in `self` but not in `other` (same box).
+    pub fn minus(&self, other: &DenseMask) -> DenseMask {
+        assert_eq!(self.bbox, other.bbox, "masks over different boxes");
+        let mut out = self.clone();
+        for (o, w) in out.bits.iter_mut().zip(&other.bits) {
+            *o &= !w;
+        }
+        out
+    }
+
     pub fn count(&self) -> u64 {
         self.bits.iter().map(|w| w.count_ones() as u64).sum()
     }

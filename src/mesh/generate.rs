@@ -1,6 +1,7 @@
 //! The project's own closed test and demo meshes, generated so every test and the demo run
-//! in a clean clone: spheres, tori, boxes, a G-shaped slab, a trefoil-knot tube and random
-//! closed meshes. All are closed, manifold and oriented outward.
+//! in a clean clone: spheres, tori, boxes, a G-shaped slab, a G between plates, spheres in a
+//! hollow box, a trefoil-knot tube and random closed meshes. All are closed, manifold and
+//! oriented outward.
 
 use super::Mesh;
 use glam::DVec3;
@@ -206,6 +207,129 @@ pub fn g_shape() -> Mesh {
         .collect();
     path.push([0.35, 0.0]);
     extruded_band("G", &path, 0.18, 0.5)
+}
+
+/// The closed boundary of a set of unit cubes (`cells`, lattice corners scaled by `size`):
+/// one quad per cube face not shared with another cube, oriented outward. The cells must not
+/// touch only along an edge or at a corner, or the boundary would not be manifold there.
+pub fn polycube(name: &str, cells: &[[i64; 3]], size: f64) -> Mesh {
+    let filled: std::collections::HashSet<[i64; 3]> = cells.iter().copied().collect();
+    let mut index = std::collections::HashMap::new();
+    let mut positions = Vec::new();
+    let mut vertex = |p: [i64; 3]| -> u32 {
+        *index.entry(p).or_insert_with(|| {
+            positions.push(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) * size);
+            positions.len() as u32 - 1
+        })
+    };
+    let mut polys = Vec::new();
+    for &c in cells {
+        for axis in 0..3 {
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            for side in [0, 1] {
+                let mut n = c;
+                n[axis] += 2 * side - 1;
+                if filled.contains(&n) {
+                    continue;
+                }
+                let corner = |du: i64, dv: i64| {
+                    let mut p = c;
+                    p[axis] += side;
+                    p[u] += du;
+                    p[v] += dv;
+                    p
+                };
+                // (e_u, e_v) turn counter-clockwise about +axis.
+                let mut quad: Vec<u32> = [(0, 0), (1, 0), (1, 1), (0, 1)]
+                    .iter()
+                    .map(|&(du, dv)| vertex(corner(du, dv)))
+                    .collect();
+                if side == 0 {
+                    quad.reverse();
+                }
+                polys.push(quad);
+            }
+        }
+    }
+    Mesh::from_polygons(name, positions, &polys)
+}
+
+/// The letter G standing between two square plates, as one closed solid: the G's inner
+/// hollow opens to the outside only through its mouth, sideways, so every axis-parallel line
+/// through the hollow meets the solid on both sides (Passalis et al.'s Fig. 2 in 3D). With one
+/// depth layer per side no axis sees the hollow; with two layers the z axis does.
+pub fn g_between_plates() -> Mesh {
+    const G: [&str; 7] = [
+        "XXXXXXX", // y = 6
+        "X......", "X......", "X..XXXX", "X.....X", "X.....X", "XXXXXXX", // y = 0
+    ];
+    let mut cells = Vec::new();
+    for (row, line) in G.iter().enumerate() {
+        let y = 6 - row as i64;
+        for (x, ch) in line.chars().enumerate() {
+            cells.push([x as i64, y, 0]);
+            cells.push([x as i64, y, 2]);
+            if ch == 'X' {
+                cells.push([x as i64, y, 1]);
+            }
+        }
+    }
+    polycube("G between plates", &cells, 1.0 / 7.0)
+}
+
+/// The G's hollow: the empty cells of `g_between_plates` (the middle layer's dots), as boxes
+/// in the same units, for tests that ask which voxels must stay outside.
+pub fn g_hollow_cells() -> Vec<(DVec3, DVec3)> {
+    let mut cells = Vec::new();
+    for y in 1..6 {
+        for x in 1..7 {
+            let open = match y {
+                4 | 5 => true,
+                3 => x < 3,
+                _ => x < 6,
+            };
+            if open {
+                let lo = DVec3::new(x as f64, y as f64, 1.0) / 7.0;
+                cells.push((lo, lo + DVec3::splat(1.0 / 7.0)));
+            }
+        }
+    }
+    cells
+}
+
+/// Several meshes as one (faces renumbered, nothing welded).
+pub fn combine(name: &str, parts: &[Mesh]) -> Mesh {
+    let mut out = Mesh {
+        face_starts: vec![0],
+        source: name.into(),
+        ..Default::default()
+    };
+    for m in parts {
+        let base = out.positions.len() as u32;
+        out.positions.extend_from_slice(&m.positions);
+        for f in 0..m.face_count() {
+            out.indices.extend(m.face(f).iter().map(|&i| i + base));
+            out.face_starts.push(out.indices.len() as u32);
+        }
+    }
+    out
+}
+
+/// Passalis et al.'s teapots in boxes with spheres for teapots: two spheres inside a hollow box
+/// (an outer box and an inward-facing inner box), so every line through a sphere crosses the
+/// box's walls on both sides of it: six crossings or more in every direction.
+pub fn spheres_in_box() -> Mesh {
+    let mut inner = cuboid(DVec3::splat(-0.8), DVec3::splat(0.8));
+    reverse_faces(&mut inner);
+    combine(
+        "spheres in a hollow box",
+        &[
+            cuboid(DVec3::splat(-1.0), DVec3::splat(1.0)),
+            inner,
+            icosphere(DVec3::new(-0.35, -0.3, 0.0), 0.3, 3),
+            icosphere(DVec3::new(0.35, 0.3, 0.1), 0.3, 3),
+        ],
+    )
 }
 
 /// Flips every face (turns an inward-oriented mesh outward).

@@ -1,11 +1,13 @@
 //! Polygon meshes: loading (OBJ with n-gons kept, binary and ASCII STL), validation,
 //! measurement, fitting to a grid, and the project's own generated fixtures.
 
+mod closed;
 mod fit;
 pub mod generate;
 mod obj;
 mod stl;
 
+pub use closed::EdgeCounts;
 pub use fit::{GridFit, fit_transform};
 
 use crate::error::{Error, Result};

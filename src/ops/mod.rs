@@ -1,5 +1,6 @@
 //! Operations on voxel sets: flooding, inside classification, topology checks.
 
+pub mod crossings;
 pub mod csg;
 pub mod flood;
 pub mod flood_linear;

@@ -7,6 +7,7 @@ mod bench_subdiv;
 mod commands;
 mod implicit;
 mod report;
+mod solid_depth;
 mod solids;
 mod subdiv;
 
@@ -105,8 +106,9 @@ enum Command {
         #[arg(short, long, default_value_t = 256)]
         resolution: u32,
     },
-    /// Fill a closed mesh: its 26-separating surface plus everything the exterior flood
-    /// cannot reach; prints volumes, mass, components and genus.
+    /// Fill a mesh: by exterior flooding of its 26-separating surface (closed meshes), or by
+    /// depth layers, which report the voxels they cannot classify; prints volumes, mass,
+    /// components and genus.
     Solid(solids::SolidArgs),
     /// Boolean of two voxel grids (.vdb): union, intersection or difference.
     Csg(solids::CsgArgs),

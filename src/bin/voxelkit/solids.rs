@@ -50,24 +50,39 @@ impl FloodArgs {
 #[derive(Args, Clone, Copy)]
 pub struct FillArgs {
     #[command(flatten)]
-    fit: FitArgs,
+    pub fit: FitArgs,
     #[command(flatten)]
     flood: FloodArgs,
     /// Density (mass per unit volume) for the mass.
     #[arg(long, default_value_t = 1.0)]
-    density: f64,
+    pub density: f64,
+}
+
+/// How a solid is found.
+#[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
+pub enum SolidMethod {
+    /// The 26-separating surface plus everything the exterior flood cannot reach (Lai & Cheng).
+    Flood,
+    /// Depth buffers with a stencil count (Passalis et al.): exact at voxel centres, and
+    /// voxels no direction can decide are reported as unclassifiable.
+    DepthLayers,
 }
 
 #[derive(Args)]
 pub struct SolidArgs {
-    /// Closed input mesh (.obj or .stl); its orientation does not matter.
-    input: PathBuf,
+    /// Closed input mesh (.obj or .stl); its orientation does not matter. With
+    /// --method depth-layers open meshes are accepted and their undecidable voxels reported.
+    pub input: PathBuf,
+    #[arg(long, value_enum, default_value = "flood")]
+    pub method: SolidMethod,
     #[command(flatten)]
-    fill: FillArgs,
-    /// Output .vdb: `surface` and `density` (1 on the whole solid), `boundary` (the surface
-    /// voxels) and `interior`.
+    pub fill: FillArgs,
+    #[command(flatten)]
+    pub depth: crate::solid_depth::DepthArgs,
+    /// Output .vdb: `surface` and `density` (1 on the whole solid), `boundary` (its outer
+    /// voxels) and `interior`; depth layers add `unclassified`.
     #[arg(short, long)]
-    output: PathBuf,
+    pub output: PathBuf,
 }
 
 #[derive(Args)]
@@ -210,9 +225,17 @@ fn report(
     Ok(())
 }
 
+/// Why the flood needs a closed mesh, for the error that refuses an open one.
+const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it and leave the solid hollow \
+     (--method depth-layers reports which voxels an open mesh leaves undecidable)";
+
 pub fn solid(args: &SolidArgs, json: bool) -> Result<()> {
+    if args.method == SolidMethod::DepthLayers {
+        return crate::solid_depth::run(args, json);
+    }
     let start = Instant::now();
     let mesh = Mesh::load(&args.input)?;
+    mesh.require_closed(FLOOD_NEEDS_CLOSED)?;
     let surface = mesh_surface(&mesh, args.fill.fit, json)?;
     let solid = solid_from_surface(&surface, args.fill.flood.method())?;
     let mut whole = SparseGrid::new(surface.transform, voxelkit::grid::Channels::NONE);
@@ -268,6 +291,7 @@ pub fn measure(args: &MeasureArgs, json: bool) -> Result<()> {
         )
     } else {
         let mesh = Mesh::load(&args.input)?;
+        mesh.require_closed(FLOOD_NEEDS_CLOSED)?;
         let extra = Json::default()
             .str("input", args.input.display().to_string())
             .num("mesh_area", mesh.area())

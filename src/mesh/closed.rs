@@ -1,0 +1,73 @@
+//! Whether a mesh is closed: every edge shared by exactly two faces. The exterior flood and
+//! every inside test need it; an open mesh is refused with the first offending edge named.
+
+use super::Mesh;
+use crate::error::{Error, Result};
+use rustc_hash::FxHashMap;
+
+/// Edges used by one face (holes) and by more than two (non-manifold), with one example of
+/// each as 1-based vertex numbers of the file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct EdgeCounts {
+    pub boundary: u64,
+    pub non_manifold: u64,
+    pub first_boundary: Option<[u32; 2]>,
+    pub first_non_manifold: Option<[u32; 2]>,
+}
+
+impl EdgeCounts {
+    pub fn is_closed(&self) -> bool {
+        self.boundary == 0 && self.non_manifold == 0
+    }
+}
+
+impl Mesh {
+    pub fn edge_counts(&self) -> EdgeCounts {
+        let mut uses: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+        for f in 0..self.face_count() {
+            let face = self.face(f);
+            for k in 0..face.len() {
+                let (a, b) = (face[k], face[(k + 1) % face.len()]);
+                *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        let mut counts = EdgeCounts::default();
+        let mut edges: Vec<_> = uses.into_iter().collect();
+        edges.sort_unstable();
+        for ((a, b), n) in edges {
+            let edge = Some([a + 1, b + 1]);
+            if n == 1 {
+                counts.boundary += 1;
+                counts.first_boundary = counts.first_boundary.or(edge);
+            } else if n > 2 {
+                counts.non_manifold += 1;
+                counts.first_non_manifold = counts.first_non_manifold.or(edge);
+            }
+        }
+        counts
+    }
+
+    /// An error naming the file and the first hole or non-manifold edge, unless closed;
+    /// `why` says what needs it closed.
+    pub fn require_closed(&self, why: &str) -> Result<()> {
+        let c = self.edge_counts();
+        let edge = |e: Option<[u32; 2]>| e.map_or(String::new(), |[a, b]| format!("{a}-{b}"));
+        if c.boundary > 0 {
+            return Err(Error::InvalidArgument(format!(
+                "{}: the mesh is open: {} boundary edge(s), the first between vertices {}; {why}",
+                self.source.display(),
+                c.boundary,
+                edge(c.first_boundary)
+            )));
+        }
+        if c.non_manifold > 0 {
+            return Err(Error::InvalidArgument(format!(
+                "{}: {} edge(s) are shared by more than two faces, the first between vertices {}; {why}",
+                self.source.display(),
+                c.non_manifold,
+                edge(c.first_non_manifold)
+            )));
+        }
+        Ok(())
+    }
+}
