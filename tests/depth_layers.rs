@@ -6,16 +6,16 @@ mod common;
 
 use glam::DVec3;
 use voxelkit::grid::{DenseMask, SparseGrid, Transform};
-use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
+use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate, index_box};
 use voxelkit::ops::inside::inside_centres;
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::depth_layers::{
-    DepthLayerOptions, DepthLayerSolid, Layers, depth_layer_solid, mesh_volume_box,
+    DepthLayerOptions, DepthLayerSolid, Layers, depth_layer_solid,
 };
 use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 
 fn solid(mesh: &Mesh, t: &Transform, directions: usize, layers: Layers) -> DepthLayerSolid {
-    let bbox = mesh_volume_box(mesh, t);
+    let bbox = index_box(&mesh.bbox(), t);
     depth_layer_solid(mesh, t, bbox, &DepthLayerOptions { directions, layers }).unwrap()
 }
 

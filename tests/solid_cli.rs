@@ -3,25 +3,10 @@
 
 mod cli_support;
 
-use cli_support::{text, voxelkit};
+use cli_support::{json_field, text, voxelkit};
 use glam::DVec3;
 use voxelkit::io::vdb::{read_vdb_grid, read_vdb_info};
 use voxelkit::mesh::generate;
-
-fn json_field(out: &str, key: &str) -> f64 {
-    let start = out
-        .find(&format!("\"{key}\":"))
-        .unwrap_or_else(|| panic!("{key} missing from {out}"))
-        + key.len()
-        + 3;
-    out[start..]
-        .split([',', '}'])
-        .next()
-        .unwrap()
-        .trim()
-        .parse()
-        .unwrap()
-}
 
 #[test]
 fn solid_measure_csg_and_intersect() {

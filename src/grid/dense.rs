@@ -186,13 +186,19 @@ impl DenseMask {
         out
     }
 
+    /// Combines `other` into `self` word by word with `f` (same box); `f` must map clear
+    /// bits to clear bits (union, intersection, difference do).
+    pub fn combine_words(&mut self, other: &DenseMask, f: impl Fn(u64, u64) -> u64) {
+        assert_eq!(self.bbox, other.bbox, "masks over different boxes");
+        for (o, w) in self.bits.iter_mut().zip(&other.bits) {
+            *o = f(*o, *w);
+        }
+    }
+
     /// The voxels set in `self` but not in `other` (same box).
     pub fn minus(&self, other: &DenseMask) -> DenseMask {
-        assert_eq!(self.bbox, other.bbox, "masks over different boxes");
         let mut out = self.clone();
-        for (o, w) in out.bits.iter_mut().zip(&other.bits) {
-            *o &= !w;
-        }
+        out.combine_words(other, |a, b| a & !b);
         out
     }
 

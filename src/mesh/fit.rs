@@ -8,7 +8,7 @@
 
 use super::Aabb;
 use crate::error::{Error, Result};
-use crate::grid::Transform;
+use crate::grid::{CoordBox, Transform};
 
 /// How to choose the voxel size for a mesh.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,6 +42,19 @@ pub fn fit_transform(bbox: &Aabb, fit: GridFit) -> Result<Transform> {
         }
     };
     Ok(Transform::new(bbox.min + 0.5 * voxel_size, voxel_size))
+}
+
+/// The voxels covering `bbox` on `transform`, one more on every side: a dense volume in which
+/// every voxel centre inside the box has outside neighbours around it.
+pub fn index_box(bbox: &Aabb, transform: &Transform) -> CoordBox {
+    let (lo, hi) = (
+        transform.world_to_index(bbox.min),
+        transform.world_to_index(bbox.max),
+    );
+    CoordBox {
+        min: lo.to_array().map(|v| v.floor() as i64 - 1),
+        max: hi.to_array().map(|v| v.ceil() as i64 + 1),
+    }
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@ mod obj;
 mod stl;
 
 pub use closed::EdgeCounts;
-pub use fit::{GridFit, fit_transform};
+pub use fit::{GridFit, fit_transform, index_box};
 
 use crate::error::{Error, Result};
 use glam::DVec3;

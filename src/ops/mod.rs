@@ -2,6 +2,7 @@
 
 pub mod crossings;
 pub mod csg;
+pub mod csg_tree;
 pub mod flood;
 pub mod flood_linear;
 pub mod flood_spans;
@@ -12,3 +13,4 @@ pub mod minimality;
 pub mod seed;
 pub mod separability;
 pub mod solid;
+pub mod solid_leaves;

@@ -437,17 +437,3 @@ pub fn depth_layer_solid(
         stats,
     })
 }
-
-/// The volume around `mesh` on `transform`: its bounding box in voxels, one voxel larger on
-/// every side.
-pub fn mesh_volume_box(mesh: &Mesh, transform: &Transform) -> CoordBox {
-    let b = mesh.bbox();
-    let (lo, hi) = (
-        transform.world_to_index(b.min),
-        transform.world_to_index(b.max),
-    );
-    CoordBox {
-        min: lo.to_array().map(|v| v.floor() as i64 - 1),
-        max: hi.to_array().map(|v| v.ceil() as i64 + 1),
-    }
-}

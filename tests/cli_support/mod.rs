@@ -18,3 +18,19 @@ pub fn text(o: &Output) -> String {
         String::from_utf8_lossy(&o.stderr)
     )
 }
+
+/// A numeric field of a `--json` object.
+pub fn json_field(out: &str, key: &str) -> f64 {
+    let start = out
+        .find(&format!("\"{key}\":"))
+        .unwrap_or_else(|| panic!("{key} missing from {out}"))
+        + key.len()
+        + 3;
+    out[start..]
+        .split([',', '}'])
+        .next()
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap()
+}

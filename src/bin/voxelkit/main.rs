@@ -5,6 +5,7 @@ mod bench_implicit;
 mod bench_solid;
 mod bench_subdiv;
 mod commands;
+mod csg_tree;
 mod implicit;
 mod report;
 mod solid_depth;
@@ -110,7 +111,8 @@ enum Command {
     /// depth layers, which report the voxels they cannot classify; prints volumes, mass,
     /// components and genus.
     Solid(solids::SolidArgs),
-    /// Boolean of two voxel grids (.vdb): union, intersection or difference.
+    /// Boolean of two voxel grids (.vdb): union, intersection or difference; or a whole CSG
+    /// tree of shapes, formulas, meshes and grids from a JSON file (--tree).
     Csg(solids::CsgArgs),
     /// The intersection curve of two voxel surfaces (.vdb): the voxels they share.
     Intersect(solids::IntersectArgs),

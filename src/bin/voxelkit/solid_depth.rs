@@ -7,10 +7,8 @@ use clap::Args;
 use std::time::Instant;
 use voxelkit::Result;
 use voxelkit::io::vdb::write_vdb_with_masks;
-use voxelkit::mesh::{Mesh, fit_transform};
-use voxelkit::voxelize::depth_layers::{
-    DIRECTIONS, DepthLayerOptions, Layers, depth_layer_solid, mesh_volume_box,
-};
+use voxelkit::mesh::{Mesh, fit_transform, index_box};
+use voxelkit::voxelize::depth_layers::{DIRECTIONS, DepthLayerOptions, Layers, depth_layer_solid};
 
 #[derive(clap::ValueEnum, Clone, Copy)]
 enum LayersKind {
@@ -41,7 +39,7 @@ pub fn run(args: &SolidArgs, json: bool) -> Result<()> {
     let mesh = Mesh::load(&args.input)?;
     let edges = mesh.edge_counts();
     let transform = fit_transform(&mesh.bbox(), args.fill.fit.grid_fit())?;
-    let bbox = mesh_volume_box(&mesh, &transform);
+    let bbox = index_box(&mesh.bbox(), &transform);
     let layers = match args.depth.layers {
         LayersKind::Double => Layers::Double,
         LayersKind::Single => Layers::Single,

@@ -87,13 +87,20 @@ pub struct SolidArgs {
 
 #[derive(Args)]
 pub struct CsgArgs {
-    /// union, intersection or difference.
-    #[arg(value_parser = parse_op)]
-    operation: BooleanOp,
+    /// union, intersection or difference (of A and B); or give --tree instead.
+    #[arg(value_parser = parse_op, required_unless_present = "tree")]
+    operation: Option<BooleanOp>,
     /// First .vdb (its transform is the result's).
-    a: PathBuf,
+    #[arg(required_unless_present = "tree")]
+    a: Option<PathBuf>,
     /// Second .vdb.
-    b: PathBuf,
+    #[arg(required_unless_present = "tree")]
+    b: Option<PathBuf>,
+    /// A CSG tree in JSON: union / intersection / difference over box, cylinder, sphere,
+    /// formula (solid where F < 0), mesh (closed .obj/.stl) and vdb leaves, with a resolution
+    /// or voxel_size (see examples/csg/).
+    #[arg(long, conflicts_with_all = ["operation", "a", "b"])]
+    tree: Option<PathBuf>,
     /// The grid read from both files.
     #[arg(long, default_value = "surface")]
     grid: String,
@@ -364,16 +371,23 @@ fn write_result(
 
 pub fn csg(args: &CsgArgs, json: bool) -> Result<()> {
     let start = Instant::now();
-    let a = read_surface(&args.a, &args.grid)?;
-    let b = read_surface(&args.b, &args.grid)?;
-    let out = combine(&a, &b, args.operation, args.resample)
-        .map_err(|e| both_files(args.a.as_path(), args.b.as_path(), e))?;
-    let method = format!("{:?}", args.operation).to_lowercase();
+    let (Some(operation), Some(a_path), Some(b_path)) = (args.operation, &args.a, &args.b) else {
+        let tree = args
+            .tree
+            .as_deref()
+            .expect("clap requires --tree or A and B");
+        return crate::csg_tree::run(tree, &args.output, json);
+    };
+    let a = read_surface(a_path, &args.grid)?;
+    let b = read_surface(b_path, &args.grid)?;
+    let out =
+        combine(&a, &b, operation, args.resample).map_err(|e| both_files(a_path, b_path, e))?;
+    let method = format!("{operation:?}").to_lowercase();
     write_result(
         &args.output,
         &out,
         &method,
-        [&args.a, &args.b],
+        [a_path, b_path],
         json,
         start.elapsed().as_secs_f64(),
     )

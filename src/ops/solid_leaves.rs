@@ -1,0 +1,203 @@
+//! The leaves of a CSG tree as solids over one dense volume, each voxel classified by its
+//! centre: boxes, cylinders and spheres exactly; formulas by the sign of F (inside where
+//! F < 0); closed meshes by depth layers (exact ray parity at the centres); voxel grids from
+//! .vdb files as they are, resampled when their transform differs.
+
+use super::csg::{resample, same_transform};
+use crate::error::{Error, Result};
+use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
+use crate::implicit::{Formula, to_coordinates};
+use crate::mesh::{Aabb, Mesh, index_box};
+use crate::voxelize::depth_layers::{DepthLayerOptions, Layers, depth_layer_solid};
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// A solid given by its shape parameters, in world units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Primitive {
+    Box {
+        min: DVec3,
+        max: DVec3,
+    },
+    /// From `base` along the unit `axis` for `height`.
+    Cylinder {
+        base: DVec3,
+        axis: DVec3,
+        radius: f64,
+        height: f64,
+    },
+    Sphere {
+        center: DVec3,
+        radius: f64,
+    },
+}
+
+impl Primitive {
+    pub fn contains(&self, p: DVec3) -> bool {
+        match *self {
+            Primitive::Box { min, max } => p.cmpge(min).all() && p.cmple(max).all(),
+            Primitive::Cylinder {
+                base,
+                axis,
+                radius,
+                height,
+            } => {
+                let d = p - base;
+                let along = d.dot(axis);
+                (0.0..=height).contains(&along)
+                    && (d - along * axis).length_squared() <= radius * radius
+            }
+            Primitive::Sphere { center, radius } => p.distance_squared(center) <= radius * radius,
+        }
+    }
+
+    /// A short description for summaries.
+    pub fn describe(&self) -> String {
+        let v = |p: DVec3| format!("({}, {}, {})", p.x, p.y, p.z);
+        match *self {
+            Primitive::Box { min, max } => format!("box {} .. {}", v(min), v(max)),
+            Primitive::Cylinder {
+                base,
+                axis,
+                radius,
+                height,
+            } => format!(
+                "cylinder from {} along {} radius {radius} height {height}",
+                v(base),
+                v(axis)
+            ),
+            Primitive::Sphere { center, radius } => format!("sphere {} radius {radius}", v(center)),
+        }
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        match *self {
+            Primitive::Box { min, max } => Aabb { min, max },
+            Primitive::Cylinder {
+                base,
+                axis,
+                radius,
+                height,
+            } => {
+                // The disc of radius r about axis a reaches r * sqrt(1 - a_i^2) along axis i.
+                let reach = (DVec3::ONE - axis * axis).max(DVec3::ZERO).powf(0.5) * radius;
+                let top = base + axis * height;
+                Aabb {
+                    min: base.min(top) - reach,
+                    max: base.max(top) + reach,
+                }
+            }
+            Primitive::Sphere { center, radius } => Aabb {
+                min: center - radius,
+                max: center + radius,
+            },
+        }
+    }
+}
+
+/// The voxels of `bbox` whose centres, within `bounds`, satisfy `inside`; `scratch` makes
+/// per-thread state.
+fn fill_centres<S>(
+    bbox: CoordBox,
+    transform: &Transform,
+    bounds: &Aabb,
+    scratch: impl Fn() -> S + Sync,
+    inside: impl Fn(&mut S, DVec3) -> bool + Sync,
+) -> Result<DenseMask> {
+    let mut mask = DenseMask::new(bbox)?;
+    let near = index_box(bounds, transform);
+    let lo: [i64; 3] = std::array::from_fn(|a| near.min[a].max(bbox.min[a]));
+    let hi: [i64; 3] = std::array::from_fn(|a| near.max[a].min(bbox.max[a]));
+    if (0..3).any(|a| lo[a] > hi[a]) {
+        return Ok(mask);
+    }
+    let runs: Vec<Vec<(usize, usize)>> = (lo[0]..=hi[0])
+        .into_par_iter()
+        .map_init(&scratch, |state, x| {
+            let mut runs: Vec<(usize, usize)> = Vec::new();
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    if inside(state, transform.index_to_world([x, y, z])) {
+                        let i = mask.index([x, y, z]);
+                        match runs.last_mut() {
+                            Some(r) if r.1 + 1 == i => r.1 = i,
+                            _ => runs.push((i, i)),
+                        }
+                    }
+                }
+            }
+            runs
+        })
+        .collect();
+    for (a, b) in runs.into_iter().flatten() {
+        mask.set_index_range(a, b);
+    }
+    Ok(mask)
+}
+
+pub fn primitive_solid(p: &Primitive, transform: &Transform, bbox: CoordBox) -> Result<DenseMask> {
+    fill_centres(bbox, transform, &p.bounds(), || (), |_, c| p.contains(c))
+}
+
+/// Voxels whose centres lie in `bounds` with F < 0.
+pub fn formula_solid(
+    f: &Formula,
+    bounds: &Aabb,
+    transform: &Transform,
+    bbox: CoordBox,
+) -> Result<DenseMask> {
+    fill_centres(
+        bbox,
+        transform,
+        bounds,
+        || Vec::with_capacity(f.tape.len()),
+        |slots, c| {
+            let vars = to_coordinates(f.coordinates, c.to_array());
+            f.tape.eval_with(vars, slots) < 0.0
+        },
+    )
+}
+
+/// A closed mesh by depth layers over all directions; voxels they cannot decide are an error
+/// naming the mesh.
+pub fn mesh_solid(mesh: &Mesh, transform: &Transform, bbox: CoordBox) -> Result<DenseMask> {
+    mesh.require_closed("a CSG leaf must be a closed solid")?;
+    let options = DepthLayerOptions {
+        directions: crate::voxelize::depth_layers::DIRECTIONS.len(),
+        layers: Layers::Double,
+    };
+    let s = depth_layer_solid(mesh, transform, bbox, &options)?;
+    if s.stats.unclassified_voxels > 0 {
+        return Err(Error::InvalidArgument(format!(
+            "{}: {} voxels cannot be classified by depth layers (crossed more than four times \
+             along all {} directions)",
+            mesh.source.display(),
+            s.stats.unclassified_voxels,
+            options.directions
+        )));
+    }
+    Ok(s.inside)
+}
+
+/// The active voxels of `grid` on `transform` (resampled when the transforms differ) that
+/// lie in `bbox`.
+pub fn grid_solid(grid: &SparseGrid, transform: &Transform, bbox: CoordBox) -> Result<DenseMask> {
+    let resampled;
+    let grid = if same_transform(&grid.transform, transform) {
+        grid
+    } else {
+        resampled = resample(grid, *transform);
+        &resampled
+    };
+    DenseMask::from_grid(grid, bbox)
+}
+
+/// The world box a grid's active voxels cover.
+pub fn grid_bounds(grid: &SparseGrid) -> Option<Aabb> {
+    let b = grid.bbox()?;
+    let h = grid.transform.voxel_size / 2.0;
+    Some(Aabb {
+        min: grid.transform.index_to_world(b.min) - h,
+        max: grid.transform.index_to_world(b.max) + h,
+    })
+}

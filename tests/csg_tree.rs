@@ -1,0 +1,178 @@
+//! `voxelkit csg --tree`: the bundled mechanical part against its exact volume, trees over
+//! meshes and .vdb grids, and errors that name the file and the node.
+#![cfg(feature = "vdb")]
+
+mod cli_support;
+
+use cli_support::{json_field, text, voxelkit};
+use glam::DVec3;
+use std::f64::consts::PI;
+use voxelkit::io::vdb::read_vdb_grid;
+use voxelkit::mesh::generate;
+
+/// The flange of examples/csg/flange.json: plate + boss - bore - two holes - half a torus.
+fn flange_volume() -> f64 {
+    let groove = (PI * 0.01 / 2.0) * 2.0 * PI * (0.8 - 0.4 / (3.0 * PI)); // Pappus
+    4.0 + 0.64 * PI - 0.16 * PI * 1.5 - 2.0 * 0.0625 * PI * 0.5 - groove
+}
+
+#[test]
+fn the_flange_example_matches_its_exact_volume() {
+    let dir = tempfile::tempdir().unwrap();
+    let example = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/csg/flange.json");
+    let text_in = std::fs::read_to_string(example).unwrap();
+    let exact = flange_volume();
+    for resolution in [128, 256, 512] {
+        let tree = dir.path().join(format!("flange{resolution}.json"));
+        std::fs::write(
+            &tree,
+            text_in.replace(
+                "\"resolution\": 256",
+                &format!("\"resolution\": {resolution}"),
+            ),
+        )
+        .unwrap();
+        let out = dir.path().join("flange.vdb");
+        let o = voxelkit(&[
+            "--json",
+            "csg",
+            "--tree",
+            tree.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let t = text(&o);
+        assert!(o.status.success(), "{t}");
+        let volume = json_field(&t, "volume");
+        let error = (volume - exact).abs() / exact;
+        eprintln!(
+            "flange at {resolution}: volume {volume:.6}, exact {exact:.6}, error {error:.2e}"
+        );
+        // Centre sampling: the error shrinks with the voxel size.
+        assert!(
+            error < 1.0 / resolution as f64,
+            "{resolution}: {volume} vs {exact}"
+        );
+        let grid = read_vdb_grid(&out, Some("surface")).unwrap();
+        assert_eq!(grid.voxel_count() as f64, json_field(&t, "voxels"));
+    }
+}
+
+#[test]
+fn trees_over_meshes_and_grids_obey_the_boolean_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |n: &str| dir.path().join(n);
+    let p = |n: &str| path(n).to_str().unwrap().to_string();
+    generate::torus(DVec3::ZERO, 1.0, 0.35, 64, 32)
+        .write_obj(&path("torus.obj"))
+        .unwrap();
+    // A solid ball as a .vdb, on another grid: the tree resamples it.
+    generate::icosphere(DVec3::new(1.0, 0.0, 0.0), 0.5, 4)
+        .write_obj(&path("ball.obj"))
+        .unwrap();
+    let o = voxelkit(&[
+        "solid",
+        &p("ball.obj"),
+        "-r",
+        "50",
+        "--method",
+        "depth-layers",
+        "-o",
+        &p("ball.vdb"),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let bounds =
+        r#""bounds": {"min": [-1.5, -1.5, -1.5], "max": [1.5, 1.5, 1.5]}, "resolution": 96"#;
+    let (mesh, vdb) = (r#"{ "mesh": "torus.obj" }"#, r#"{ "vdb": "ball.vdb" }"#);
+    let run = |name: &str, op: &str, first: &str, second: &str| {
+        let tree = format!(r#"{{ {bounds}, "tree": {{ "{op}": [ {first}, {second} ] }} }}"#);
+        std::fs::write(path(name), tree).unwrap();
+        let o = voxelkit(&[
+            "--json",
+            "csg",
+            "--tree",
+            &p(name),
+            "-o",
+            &p(&format!("{name}.vdb")),
+        ]);
+        let t = text(&o);
+        assert!(o.status.success(), "{t}");
+        json_field(&t, "voxels")
+    };
+    let union = run("u.json", "union", mesh, vdb);
+    let inter = run("i.json", "intersection", mesh, vdb);
+    let diff = run("d.json", "difference", mesh, vdb);
+    let a = run("a.json", "union", mesh, mesh);
+    let b = run("b.json", "union", vdb, vdb);
+    assert_eq!(run("u2.json", "union", vdb, mesh), union);
+    let written = read_vdb_grid(&path("d.json.vdb"), Some("surface")).unwrap();
+    assert_eq!(written.voxel_count() as f64, diff);
+    eprintln!("|A| {a} |B| {b} union {union} intersection {inter} difference {diff}");
+    // |A| = |A - B| + |A ∩ B| and |A ∪ B| = |A| + |B| - |A ∩ B|.
+    assert!(inter > 0.0 && diff > 0.0);
+    assert_eq!(a, diff + inter);
+    assert_eq!(union, a + b - inter);
+    let exact = generate::torus(DVec3::ZERO, 1.0, 0.35, 64, 32).signed_volume();
+    let h: f64 = 3.0 / 96.0;
+    assert!((a * h.powi(3) - exact).abs() < 0.02 * exact, "{a}");
+}
+
+#[test]
+fn bad_trees_are_refused_naming_the_file_and_the_node() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |n: &str| dir.path().join(n);
+    let mut open = generate::cuboid(DVec3::splat(-1.0), DVec3::splat(1.0));
+    open.face_starts.pop();
+    open.write_obj(&path("open.obj")).unwrap();
+    let cases = [
+        ("syntax.json", "{ \"tree\": \n { \"box\": ", "syntax.json:2"),
+        (
+            "kind.json",
+            r#"{ "tree": { "union": [ { "torus": 1 } ] } }"#,
+            "tree.union[0]: needs exactly one of",
+        ),
+        (
+            "radius.json",
+            r#"{ "tree": { "sphere": { "center": [0, 0, 0], "radius": -1 } } }"#,
+            "tree.sphere.radius: must be positive",
+        ),
+        (
+            "formula.json",
+            r#"{ "bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}, "tree": { "formula": "x^2 + * y" } }"#,
+            "tree.formula: formula, column",
+        ),
+        (
+            "nobounds.json",
+            r#"{ "tree": { "formula": "x^2 + y^2 + z^2 - 1" } }"#,
+            "no leaf has bounds",
+        ),
+        (
+            "open.json",
+            r#"{ "tree": { "mesh": "open.obj" } }"#,
+            "open.obj: the mesh is open",
+        ),
+        (
+            "missing.json",
+            r#"{ "tree": { "mesh": "nowhere.obj" } }"#,
+            "nowhere.obj",
+        ),
+    ];
+    for (name, body, expected) in cases {
+        std::fs::write(path(name), body).unwrap();
+        let out = path("out.vdb");
+        let o = voxelkit(&[
+            "csg",
+            "--tree",
+            path(name).to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let t = text(&o);
+        assert!(!o.status.success(), "{name}: {t}");
+        assert!(
+            t.contains(expected) && t.contains(name.split('.').next().unwrap()),
+            "{name}: {t}"
+        );
+        assert!(!out.exists());
+    }
+}
