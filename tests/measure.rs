@@ -1,12 +1,16 @@
 //! Measuring solids: the exact volume of a closed mesh lies between the inside voxels and the
 //! inside plus surface voxels, and the bracket closes as the resolution grows; genus from the
-//! Euler characteristic of the voxel solid.
+//! Euler characteristic of the voxel solid; volume and face-weighted area of exact solids
+//! (formulas) converging to their known values.
 
 use glam::DVec3;
 use voxelkit::grid::{Adjacency, DenseMask};
+use voxelkit::implicit::reference::reference_solids;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
 use voxelkit::ops::flood::{flood_from_border, padded};
-use voxelkit::ops::measure::{components, euler_characteristic, measure_solid};
+use voxelkit::ops::measure::{
+    components, euler_characteristic, measure_formula_solid, measure_solid,
+};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 
@@ -82,5 +86,33 @@ fn genus_of_voxel_solids() {
         }
         let g = components(&all, Adjacency::Six) as i64 - euler_characteristic(&all);
         assert_eq!(g, genus, "{name}");
+    }
+}
+
+#[test]
+fn volume_and_area_of_exact_solids_converge() {
+    for shape in reference_solids() {
+        for resolution in [64, 128, 256] {
+            let (volume, area) =
+                measure_formula_solid(&shape.formula, &shape.bounds, resolution).unwrap();
+            let ev = (volume - shape.volume).abs() / shape.volume;
+            let ea = (area - shape.area).abs() / shape.area;
+            eprintln!(
+                "{} {resolution}: volume {volume:.6} ({ev:.1e}), area {area:.6} ({ea:.1e})",
+                shape.name
+            );
+            // Centre sampling is noisy but first order at worst (the cube's edges add about
+            // h per unit of edge length to the area error): bound the errors by h.
+            assert!(
+                ev < 0.6 / resolution as f64,
+                "{} {resolution}: volume",
+                shape.name
+            );
+            assert!(
+                ea < 1.0 / resolution as f64,
+                "{} {resolution}: area",
+                shape.name
+            );
+        }
     }
 }

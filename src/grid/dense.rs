@@ -195,6 +195,16 @@ impl DenseMask {
         }
     }
 
+    /// Up to 64 voxels of row `(x, y)` (offsets in the box) from `z` on, as the low bits of
+    /// a word; clear for rows outside the box.
+    pub fn row_bits(&self, x: i64, y: i64, z: usize, n: usize) -> u64 {
+        let [nx, ny, nz] = self.dims;
+        if x < 0 || y < 0 || x as usize >= nx || y as usize >= ny {
+            return 0;
+        }
+        bits::range(&self.bits, (x as usize * ny + y as usize) * nz + z, n)
+    }
+
     /// The voxels set in `self` but not in `other` (same box).
     pub fn minus(&self, other: &DenseMask) -> DenseMask {
         let mut out = self.clone();

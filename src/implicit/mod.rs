@@ -6,6 +6,7 @@ mod coordinates;
 mod dual;
 mod interval;
 mod parse;
+pub mod reference;
 mod tape;
 
 pub use coordinates::{BoxTest, test_box, to_coordinates, value_at};
@@ -67,5 +68,15 @@ impl Formula {
             coordinates,
             tape: parse::parse(text, coordinates.variables())?,
         })
+    }
+
+    /// The Cartesian gradient of F at the world point `p`; `slots` is scratch space.
+    pub fn gradient_at(&self, p: [f64; 3], slots: &mut Vec<Dual>) -> glam::DVec3 {
+        let vars: [Dual; 3] = std::array::from_fn(|a| Dual::variable(p[a], a));
+        let g = self
+            .tape
+            .eval_with(to_coordinates(self.coordinates, vars), slots)
+            .grad;
+        glam::DVec3::from_array(g)
     }
 }

@@ -14,3 +14,4 @@ pub mod seed;
 pub mod separability;
 pub mod solid;
 pub mod solid_leaves;
+pub mod surface_area;

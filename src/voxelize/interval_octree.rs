@@ -12,7 +12,7 @@
 use super::sink::Progress;
 use crate::error::{Error, Result};
 use crate::grid::{Channels, Coord, SparseGrid, Transform};
-use crate::implicit::{BoxTest, Dual, Formula, Interval, test_box, to_coordinates};
+use crate::implicit::{BoxTest, Dual, Formula, Interval, test_box};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -311,15 +311,8 @@ impl Run<'_> {
 
     /// Unit Cartesian gradient of F at the centre of voxel `c` (zero where undefined).
     fn normal(&self, c: Coord, slots: &mut Vec<Dual>) -> [f32; 3] {
-        let p: [Dual; 3] =
-            std::array::from_fn(|a| Dual::variable(self.min[a] + (c[a] as f64 + 0.5) * self.h, a));
-        let f = self.formula;
-        let g = f
-            .tape
-            .eval_with(to_coordinates(f.coordinates, p), slots)
-            .grad;
-        let g = DVec3::from_array(g);
-        match g.try_normalize() {
+        let p = std::array::from_fn(|a| self.min[a] + (c[a] as f64 + 0.5) * self.h);
+        match self.formula.gradient_at(p, slots).try_normalize() {
             Some(n) => n.as_vec3().into(),
             None => [0.0; 3],
         }

@@ -46,6 +46,8 @@ enum BenchKind {
     Implicit(crate::bench_implicit::ImplicitBenchArgs),
     /// Solids: surface plus flood against OpenVDB's meshToVolume with the interior filled.
     Solid(crate::bench_solid::SolidBenchArgs),
+    /// Volume and area convergence on exact solids; depth-layer volumes of real meshes.
+    Measure(crate::bench_measure::MeasureBenchArgs),
 }
 
 /// A pool of `threads` workers for one side of a comparison.
@@ -92,6 +94,7 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
         Some(BenchKind::Subdiv(sub)) => return crate::bench_subdiv::run(sub, json),
         Some(BenchKind::Implicit(imp)) => return crate::bench_implicit::run(imp, json),
         Some(BenchKind::Solid(solid)) => return crate::bench_solid::run(solid, json),
+        Some(BenchKind::Measure(m)) => return crate::bench_measure::run(m, json),
         None => {}
     }
     let data = data_folder(&args.data);

@@ -2,6 +2,7 @@
 
 mod bench;
 mod bench_implicit;
+mod bench_measure;
 mod bench_solid;
 mod bench_subdiv;
 mod commands;
