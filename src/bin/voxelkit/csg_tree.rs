@@ -4,30 +4,17 @@ use crate::report::{Json, peak_mib};
 use std::path::Path;
 use std::time::Instant;
 use voxelkit::Result;
-use voxelkit::io::vdb::write_vdb_with_masks;
 use voxelkit::ops::csg_tree::read_csg_tree;
 
 pub fn run(tree_path: &Path, output: &Path, json: bool) -> Result<()> {
     let start = Instant::now();
     let tree = read_csg_tree(tree_path)?;
     let (transform, solid, leaves) = tree.evaluate()?;
-    let boundary = solid.boundary();
-    let interior = solid.minus(&boundary);
-    let grid = solid.to_grid(transform);
     let meta = vec![
         ("method", "csg-tree (voxel centres)".to_string()),
         ("source_file", tree_path.display().to_string()),
     ];
-    write_vdb_with_masks(
-        output,
-        &grid,
-        &[
-            ("boundary", &boundary.to_grid(transform)),
-            ("interior", &interior.to_grid(transform)),
-        ],
-        &meta,
-    )?;
-    let voxels = grid.voxel_count();
+    let voxels = crate::solids::write_centre_solid(output, &solid, transform, &[], &meta)?;
     let volume = voxels as f64 * transform.voxel_size.powi(3);
     let seconds = start.elapsed().as_secs_f64();
     if json {

@@ -2,11 +2,10 @@
 //! its unclassifiable voxels and summarised direction by direction.
 
 use crate::report::{Json, peak_mib};
-use crate::solids::SolidArgs;
+use crate::solids::{SolidArgs, write_centre_solid};
 use clap::Args;
 use std::time::Instant;
 use voxelkit::Result;
-use voxelkit::io::vdb::write_vdb_with_masks;
 use voxelkit::mesh::{Mesh, fit_transform, index_box};
 use voxelkit::voxelize::depth_layers::{DIRECTIONS, DepthLayerOptions, Layers, depth_layer_solid};
 
@@ -50,9 +49,6 @@ pub fn run(args: &SolidArgs, json: bool) -> Result<()> {
     };
     let solid = depth_layer_solid(&mesh, &transform, bbox, &options)?;
     let classify_seconds = start.elapsed().as_secs_f64();
-    let boundary = solid.inside.boundary();
-    let interior = solid.inside.minus(&boundary);
-    let grid = solid.inside.to_grid(transform);
     let method = format!(
         "depth-layers ({}, {} directions)",
         match layers {
@@ -66,14 +62,11 @@ pub fn run(args: &SolidArgs, json: bool) -> Result<()> {
         ("source_file", args.input.display().to_string()),
         ("resolution", args.fill.fit.describe()),
     ];
-    write_vdb_with_masks(
+    write_centre_solid(
         &args.output,
-        &grid,
-        &[
-            ("boundary", &boundary.to_grid(transform)),
-            ("interior", &interior.to_grid(transform)),
-            ("unclassified", &solid.unclassified.to_grid(transform)),
-        ],
+        &solid.inside,
+        transform,
+        &[("unclassified", &solid.unclassified.to_grid(transform))],
         &meta,
     )?;
     let s = &solid.stats;

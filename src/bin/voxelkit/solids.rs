@@ -232,6 +232,26 @@ fn report(
     Ok(())
 }
 
+/// Writes a solid classified at voxel centres: `surface` and `density` on the whole solid,
+/// `boundary` (voxels with a face towards the outside), `interior`, then `extra` grids.
+/// Returns the solid's voxel count.
+pub fn write_centre_solid(
+    path: &Path,
+    solid: &DenseMask,
+    transform: voxelkit::grid::Transform,
+    extra: &[(&str, &SparseGrid)],
+    meta: &[(&str, String)],
+) -> Result<u64> {
+    let outer = solid.boundary();
+    let interior = solid.minus(&outer).to_grid(transform);
+    let boundary = outer.to_grid(transform);
+    let grid = solid.to_grid(transform);
+    let mut masks = vec![("boundary", &boundary), ("interior", &interior)];
+    masks.extend_from_slice(extra);
+    write_vdb_with_masks(path, &grid, &masks, meta)?;
+    Ok(grid.voxel_count())
+}
+
 /// Why the flood needs a closed mesh, for the error that refuses an open one.
 const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it and leave the solid hollow \
      (--method depth-layers reports which voxels an open mesh leaves undecidable)";
