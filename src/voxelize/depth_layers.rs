@@ -176,21 +176,6 @@ impl View {
     /// buffers of direction `d` over a volume of `dims` voxels.
     fn render(d: [i64; 3], dims: [usize; 3], points: &[DVec3], mesh: &Mesh) -> Result<View> {
         let (k, i, j) = View::frame(d);
-        let mut view = View {
-            d,
-            k,
-            i,
-            j,
-            window: RayWindow {
-                a0: 0,
-                b0: 0,
-                width: 0,
-                height: 0,
-            },
-            count: Vec::new(),
-            near: Vec::new(),
-            far: Vec::new(),
-        };
         // The window: the (a, b) range of the volume's corners.
         let (mut lo, mut hi) = ([i64::MAX; 2], [i64::MIN; 2]);
         for corner in 0..8 {
@@ -208,13 +193,13 @@ impl View {
                 hi[c] = hi[c].max(ab[c]);
             }
         }
-        view.window = RayWindow {
+        let window = RayWindow {
             a0: lo[0],
             b0: lo[1],
             width: (hi[0] - lo[0] + 1) as usize,
             height: (hi[1] - lo[1] + 1) as usize,
         };
-        let rays = view.window.len();
+        let rays = window.len();
         let bytes = rays as u64 * 18;
         if bytes > 8 << 30 {
             return Err(Error::TooLarge {
@@ -223,9 +208,16 @@ impl View {
                 detail: format!("depth buffers of {rays} rays along {d:?}"),
             });
         }
-        view.count = vec![0; rays];
-        view.near = vec![[f32::INFINITY; 2]; rays];
-        view.far = vec![[f32::NEG_INFINITY; 2]; rays];
+        let mut view = View {
+            d,
+            k,
+            i,
+            j,
+            window,
+            count: vec![0; rays],
+            near: vec![[f32::INFINITY; 2]; rays],
+            far: vec![[f32::NEG_INFINITY; 2]; rays],
+        };
         let ray_points: Vec<DVec3> = points.iter().map(|&p| view.to_ray(p)).collect();
         let (count, near, far) = (&mut view.count, &mut view.near, &mut view.far);
         for_each_crossing(
