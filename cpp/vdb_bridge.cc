@@ -78,15 +78,16 @@ void VdbWriter::add_grid(rust::Str kind, rust::Str name, double voxel_size, std:
         });
         g->setGridClass(openvdb::GRID_FOG_VOLUME);
         grid = g;
-    } else if (k == "normal") {
+    } else if (k == "normal" || k == "color") {
         if (values.size() != 3 * 512 * count)
-            throw std::invalid_argument("normal grid: expected 3 x 512 values per leaf");
+            throw std::invalid_argument(k + " grid: expected 3 x 512 values per leaf");
         auto g = build_grid<openvdb::Vec3SGrid>(
             leaf_origins, masks, openvdb::Vec3s(0.0f), [&](auto& leaf, size_t i, openvdb::Index n) {
                 const float* v = &values[3 * (512 * i + n)];
                 leaf.setValueOn(n, openvdb::Vec3s(v[0], v[1], v[2]));
             });
-        g->setVectorType(openvdb::VEC_COVARIANT_NORMALIZE);
+        // Normals transform covariantly; colours are plain triples.
+        g->setVectorType(k == "normal" ? openvdb::VEC_COVARIANT_NORMALIZE : openvdb::VEC_INVARIANT);
         grid = g;
     } else {
         throw std::invalid_argument("unknown grid kind " + k);

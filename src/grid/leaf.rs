@@ -12,7 +12,7 @@ pub struct Channels {
     pub value: bool,
     /// A unit normal per voxel.
     pub normal: bool,
-    /// An RGB colour per voxel.
+    /// A linear RGB colour per voxel (written as the `Cd` grid).
     pub color: bool,
 }
 
@@ -31,7 +31,7 @@ pub struct Leaf {
     pub mask: [u64; 8],
     pub value: Option<Box<[f32; LEAF_VOXELS]>>,
     pub normal: Option<Box<[[f32; 3]; LEAF_VOXELS]>>,
-    pub color: Option<Box<[[u8; 3]; LEAF_VOXELS]>>,
+    pub color: Option<Box<[[f32; 3]; LEAF_VOXELS]>>,
 }
 
 impl Leaf {
@@ -42,7 +42,7 @@ impl Leaf {
             mask: [0; 8],
             value: channels.value.then(|| Box::new([0.0; LEAF_VOXELS])),
             normal: channels.normal.then(|| Box::new([[0.0; 3]; LEAF_VOXELS])),
-            color: channels.color.then(|| Box::new([[0; 3]; LEAF_VOXELS])),
+            color: channels.color.then(|| Box::new([[0.0; 3]; LEAF_VOXELS])),
         }
     }
 

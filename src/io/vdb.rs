@@ -1,6 +1,7 @@
 //! OpenVDB files through the bridge: one `.vdb` holding `surface` (BoolGrid), `density`
-//! (fog volume: 1 on every voxel of the set, what Blender's volume object reads) and
-//! `normal` (Vec3s, covariant-normalize) when the grid carries normals; and reading any
+//! (fog volume: 1 on every voxel of the set, what Blender's volume object reads),
+//! `normal` (Vec3s, covariant-normalize) when the grid carries normals and `Cd` (Vec3s, the
+//! Houdini name for colour) when it carries colours; and reading any
 //! Bool, Mask or Float grid back. Writes are atomic (temporary file, then rename).
 
 use super::atomic::write_atomic;
@@ -40,7 +41,7 @@ fn vdb_error(path: &Path, e: impl std::fmt::Display) -> Error {
     }
 }
 
-/// Writes `grid` to `path` as `surface`, `density` and (when present) `normal` grids, each
+/// Writes `grid` to `path` as `surface`, `density` and (when present) `normal` and `Cd` grids, each
 /// with `grid.transform` and `metadata` plus `voxelkit_version`.
 pub fn write_vdb(path: &Path, grid: &SparseGrid, metadata: &[(&str, String)]) -> Result<()> {
     write_vdb_with_masks(path, grid, &[], metadata)
@@ -92,6 +93,14 @@ pub fn write_vdb_with_masks(
             normals.extend(n.iter().flatten());
         }
         add("normal", "normal", &normals)?;
+    }
+    if grid.channels().color {
+        let mut colors = Vec::with_capacity(leaves.len() * LEAF_VOXELS * 3);
+        for leaf in &leaves {
+            let c = leaf.color.as_ref().expect("grid with colour channel");
+            colors.extend(c.iter().flatten());
+        }
+        add("color", "Cd", &colors)?;
     }
     for (name, mask) in masks_to_add {
         let (origins, masks, _) = flatten(path, mask)?;

@@ -11,7 +11,7 @@ pub use closed::EdgeCounts;
 pub use fit::{GridFit, fit_transform, index_box};
 
 use crate::error::{Error, Result};
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use std::path::{Path, PathBuf};
 
 /// A polygon mesh: shared positions and faces of any size (kept as in the file).
@@ -24,6 +24,10 @@ pub struct Mesh {
     pub face_starts: Vec<u32>,
     /// Where the mesh came from (a file, or a generator name), for error messages and metadata.
     pub source: PathBuf,
+    /// One RGB colour per position (OBJ `v x y z r g b`), or empty.
+    pub colors: Vec<Vec3>,
+    /// Polylines (OBJ `l`), as vertex indices.
+    pub polylines: Vec<Vec<u32>>,
 }
 
 /// Axis-aligned bounding box in world space.
@@ -57,11 +61,33 @@ impl Mesh {
             indices,
             face_starts,
             source: source.into(),
+            ..Default::default()
         }
     }
 
-    /// Loads an `.obj` or `.stl` file (chosen by extension) and validates it.
+    /// Loads an `.obj` or `.stl` file (chosen by extension) and checks it has faces, as every
+    /// surface and solid method needs.
     pub fn load(path: &Path) -> Result<Mesh> {
+        let mesh = Self::read(path)?;
+        mesh.validate()?;
+        Ok(mesh)
+    }
+
+    /// Loads an `.obj` or `.stl` file for line voxelization: polylines, faces or both.
+    pub fn load_lines(path: &Path) -> Result<Mesh> {
+        let mesh = Self::read(path)?;
+        if mesh.polylines.is_empty() {
+            mesh.validate()?;
+        } else {
+            mesh.validate_positions()?;
+            if mesh.face_count() > 0 {
+                mesh.validate_faces()?;
+            }
+        }
+        Ok(mesh)
+    }
+
+    fn read(path: &Path) -> Result<Mesh> {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
@@ -75,12 +101,11 @@ impl Mesh {
                 });
             }
         };
-        mesh.validate()?;
         Ok(mesh)
     }
 
     pub fn face_count(&self) -> usize {
-        self.face_starts.len() - 1
+        self.face_starts.len().saturating_sub(1)
     }
 
     pub fn face(&self, f: usize) -> &[u32] {
@@ -90,15 +115,28 @@ impl Mesh {
     /// Checks what every algorithm relies on: a face, finite positions, indices in range,
     /// at least three corners per face.
     pub fn validate(&self) -> Result<()> {
-        if self.face_count() == 0 || self.positions.is_empty() {
-            return Err(Error::EmptyMesh {
-                path: self.source.clone(),
-                message: format!(
-                    "{} vertices, {} faces",
-                    self.positions.len(),
-                    self.face_count()
-                ),
-            });
+        if self.face_count() == 0 {
+            return Err(self.empty_error());
+        }
+        self.validate_positions()?;
+        self.validate_faces()
+    }
+
+    fn empty_error(&self) -> Error {
+        Error::EmptyMesh {
+            path: self.source.clone(),
+            message: format!(
+                "{} vertices, {} faces, {} lines",
+                self.positions.len(),
+                self.face_count(),
+                self.polylines.len()
+            ),
+        }
+    }
+
+    fn validate_positions(&self) -> Result<()> {
+        if self.positions.is_empty() {
+            return Err(self.empty_error());
         }
         if let Some(v) = self.positions.iter().position(|p| !p.is_finite()) {
             return Err(Error::InvalidArgument(format!(
@@ -108,6 +146,10 @@ impl Mesh {
                 self.positions[v]
             )));
         }
+        Ok(())
+    }
+
+    fn validate_faces(&self) -> Result<()> {
         let n = self.positions.len() as u32;
         for f in 0..self.face_count() {
             let face = self.face(f);
@@ -137,12 +179,13 @@ impl Mesh {
         }
     }
 
+    /// The box around every vertex a face or polyline uses.
     pub fn bbox(&self) -> Aabb {
         let mut b = Aabb {
             min: DVec3::splat(f64::INFINITY),
             max: DVec3::splat(f64::NEG_INFINITY),
         };
-        for &i in &self.indices {
+        for &i in self.indices.iter().chain(self.polylines.iter().flatten()) {
             let p = self.positions[i as usize];
             b.min = b.min.min(p);
             b.max = b.max.max(p);

@@ -35,8 +35,10 @@ pub fn inside_centres(mesh: &Mesh, transform: &Transform, bbox: CoordBox) -> Res
         for pair in column.chunks_exact(2) {
             let z0 = (pair[0].1.ceil() as i64).max(bbox.min[2]);
             let z1 = (pair[1].1.floor() as i64).min(bbox.max[2]);
-            for z in z0..=z1 {
-                inside.set([bbox.min[0] + x as i64, bbox.min[1] + y as i64, z]);
+            if z0 <= z1 {
+                let column = [bbox.min[0] + x as i64, bbox.min[1] + y as i64];
+                let first = inside.index([column[0], column[1], z0]);
+                inside.set_index_range(first, first + (z1 - z0) as usize);
             }
         }
     }

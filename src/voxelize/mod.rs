@@ -3,6 +3,7 @@
 pub mod depth_layers;
 pub mod interval_octree;
 pub mod parametric;
+pub mod projective;
 pub mod separating;
 pub mod separating_analytic;
 pub mod sign_change;

@@ -1,9 +1,9 @@
-//! Where distance-criterion voxelizers put their voxels: a thread-local grid that keeps,
-//! per voxel, the distance to and normal of the nearest primitive, and the parallel
+//! Where voxelizers put their voxels: a thread-local grid that keeps, per voxel, the
+//! distance to and the normal or colour of the nearest primitive, and the parallel
 //! fold/merge that turns many such grids into one.
 
 use crate::grid::{Channels, Coord, Leaf, SparseGrid, Transform};
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 /// Called with the number of work items just finished (for progress bars).
@@ -25,42 +25,65 @@ pub(crate) struct Sink<'g> {
 
 impl<'g> Sink<'g> {
     pub fn new(grid: &'g mut SparseGrid) -> Self {
-        let nearest = grid.channels().normal;
+        let nearest = grid.channels().value;
         Sink {
             acc: grid.accessor(),
             nearest,
         }
     }
 
+    /// Marks voxel `c` and returns its leaf and offset when the grid keeps the nearest
+    /// primitive per voxel and this one, `distance` away, is nearer than any before.
+    #[inline]
+    fn claim(&mut self, c: Coord, distance: f64) -> Option<(&mut Leaf, usize)> {
+        let (leaf, n) = self.acc.leaf_mut(c);
+        let was_on = leaf.is_on(n);
+        leaf.set_on(n);
+        if !self.nearest {
+            return None;
+        }
+        let d = distance as f32;
+        let values = leaf.value.as_mut().expect("nearest sink has values");
+        if was_on && d >= values[n] {
+            return None;
+        }
+        values[n] = d;
+        Some((leaf, n))
+    }
+
     /// Marks voxel `c`; with channels, keeps the nearest primitive's distance and normal.
     #[inline]
     pub fn add(&mut self, c: Coord, distance: f64, normal: DVec3) {
-        let (leaf, n) = self.acc.leaf_mut(c);
-        if self.nearest {
-            let d = distance as f32;
-            let was_on = leaf.is_on(n);
-            let values = leaf.value.as_mut().expect("nearest sink has values");
-            if !was_on || d < values[n] {
-                values[n] = d;
-                leaf.normal.as_mut().expect("nearest sink has normals")[n] =
-                    normal.as_vec3().into();
-            }
+        if let Some((leaf, n)) = self.claim(c, distance) {
+            leaf.normal.as_mut().expect("nearest sink has normals")[n] = normal.as_vec3().into();
         }
-        leaf.set_on(n);
+    }
+
+    /// Marks voxel `c`; with channels, keeps the nearest primitive's distance and colour.
+    #[inline]
+    pub fn add_color(&mut self, c: Coord, distance: f64, color: Vec3) {
+        if let Some((leaf, n)) = self.claim(c, distance) {
+            leaf.color.as_mut().expect("colour sink has colours")[n] = color.into();
+        }
     }
 }
 
-/// ORs `src` into `dst`; where both hold a voxel, keeps the smaller distance and its normal.
+/// ORs `src` into `dst`; where both hold a voxel, keeps the smaller distance and its
+/// normal and colour.
 pub(crate) fn merge_nearest(dst: &mut Leaf, src: &Leaf) {
     if let (Some(dv), Some(sv)) = (dst.value.as_mut(), src.value.as_ref()) {
-        let (dn, sn) = (dst.normal.as_mut().unwrap(), src.normal.as_ref().unwrap());
         for w in 0..8 {
             let mut b = src.mask[w];
             while b != 0 {
                 let n = w * 64 + b.trailing_zeros() as usize;
                 if dst.mask[w] >> (n & 63) & 1 == 0 || sv[n] < dv[n] {
                     dv[n] = sv[n];
-                    dn[n] = sn[n];
+                    if let (Some(d), Some(s)) = (dst.normal.as_mut(), src.normal.as_ref()) {
+                        d[n] = s[n];
+                    }
+                    if let (Some(d), Some(s)) = (dst.color.as_mut(), src.color.as_ref()) {
+                        d[n] = s[n];
+                    }
                 }
                 b &= b - 1;
             }

@@ -55,12 +55,12 @@ fn parse_vec3(s: &str) -> std::result::Result<DVec3, String> {
 #[derive(Args, Clone)]
 pub struct VoxelizeArgs {
     #[command(flatten)]
-    fit: FitArgs,
+    pub fit: FitArgs,
     #[command(flatten)]
-    surface: SurfaceArgs,
+    pub surface: SurfaceArgs,
     /// Output .vdb file.
     #[arg(short, long)]
-    output: PathBuf,
+    pub output: PathBuf,
 }
 
 #[derive(Subcommand, Clone)]

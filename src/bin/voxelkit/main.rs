@@ -8,6 +8,7 @@ mod bench_subdiv;
 mod commands;
 mod csg_tree;
 mod implicit;
+mod projective;
 mod report;
 mod solid_depth;
 mod solids;
@@ -64,7 +65,7 @@ pub struct SurfaceArgs {
     normals: bool,
     /// Refuse work whose estimated memory exceeds this many MiB [default: available memory].
     #[arg(long, value_name = "MIB")]
-    max_memory: Option<u64>,
+    pub max_memory: Option<u64>,
 }
 
 fn parse_separability(s: &str) -> Result<Separability, String> {
@@ -77,13 +78,24 @@ pub fn parse_criterion(s: &str) -> Result<Criterion, String> {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Voxelize a polygon mesh (.obj or .stl) into a separating surface.
+    /// Voxelize a polygon mesh (.obj or .stl) into a separating surface, or by projective
+    /// scan-lines with vertex colours carried into a `Cd` grid.
     Mesh {
-        /// Input mesh: .obj (polygons kept) or .stl (binary or ASCII).
+        /// Input mesh: .obj (polygons kept; `v x y z r g b` colours read) or .stl.
         input: PathBuf,
+        /// separating: Huang et al.'s 6/26-separating surface; projective: Jegathese et al.'s
+        /// scan-lines in each triangle's dominant plane (fast, colours, no separability
+        /// guarantee where triangles meet; ignores -s, --criterion and --normals).
+        #[arg(long, value_enum, default_value = "separating")]
+        method: MeshMethod,
+        #[command(flatten)]
+        color: projective::ColorArgs,
         #[command(flatten)]
         args: commands::VoxelizeArgs,
     },
+    /// Voxelize 3D polylines (OBJ `l`) or the edges of a mesh by marching each segment's
+    /// dominant axis (Jegathese et al.), carrying vertex colours into a `Cd` grid.
+    Lines(projective::LinesArgs),
     /// Voxelize an analytic surface (Huang et al. §7) by exact point-to-surface distance.
     Shape {
         #[command(subcommand)]
@@ -130,6 +142,13 @@ enum Command {
     Bench(bench::BenchArgs),
 }
 
+/// How `voxelkit mesh` voxelizes.
+#[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
+enum MeshMethod {
+    Separating,
+    Projective,
+}
+
 fn main() -> ExitCode {
     // Like other command-line tools, stop quietly when the reader of stdout goes away
     // (`voxelkit info x.vdb | head`) instead of panicking on the broken pipe.
@@ -147,7 +166,26 @@ fn main() -> ExitCode {
         return ExitCode::FAILURE;
     }
     let result = match cli.command {
-        Command::Mesh { input, args } => commands::mesh(&input, &args, cli.json),
+        Command::Mesh {
+            input,
+            method: MeshMethod::Separating,
+            args,
+            ..
+        } => commands::mesh(&input, &args, cli.json),
+        Command::Mesh {
+            input,
+            method: MeshMethod::Projective,
+            color,
+            args,
+        } => projective::mesh(
+            &input,
+            args.fit,
+            &color,
+            args.surface.max_memory,
+            &args.output,
+            cli.json,
+        ),
+        Command::Lines(args) => projective::lines(&args, cli.json),
         Command::Shape { shape } => commands::shape(&shape, cli.json),
         Command::Info { file } => commands::info(&file, cli.json),
         Command::Check {

@@ -66,6 +66,9 @@ pub enum SolidMethod {
     /// Depth buffers with a stencil count (Passalis et al.): exact at voxel centres, and
     /// voxels no direction can decide are reported as unclassifiable.
     DepthLayers,
+    /// The projective surface plus the beams of voxels between front and back faces along z
+    /// (Jegathese et al.); closed meshes only.
+    Beam,
 }
 
 #[derive(Args)]
@@ -171,10 +174,16 @@ fn topology(surface: &SparseGrid, solid: &Solid) -> Result<Option<(u64, i64)>> {
     Ok(Some((parts, parts as i64 - euler_characteristic(&all))))
 }
 
-fn report(
+/// How the flood decides what is inside, for the summary.
+const FLOOD_RULE: &str =
+    "inside = what the exterior flood (from the box corner, no normals needed) cannot reach";
+
+#[allow(clippy::too_many_arguments)]
+pub fn report(
     what: &str,
     surface: &SparseGrid,
     solid: &Solid,
+    rule: &str,
     density: f64,
     extra: Json,
     start: Instant,
@@ -198,10 +207,7 @@ fn report(
             .num("mass_with_surface", mass_high)
             .num("components", topo.map_or(f64::NAN, |t| t.0 as f64))
             .num("genus", topo.map_or(f64::NAN, |t| t.1 as f64))
-            .str(
-                "seed_rule",
-                "exterior flood from the corner of the padded box (no normals needed)",
-            )
+            .str("inside_rule", rule)
             .num("seconds", seconds)
             .num("peak_mib", peak_mib());
         if let Some(s) = solid.xyz_stats {
@@ -214,7 +220,7 @@ fn report(
     } else {
         println!(
             "{what}: {} inside + {} surface voxels; volume {:.6} (inside) .. {:.6} (with surface); mass {:.6} .. {:.6} at density {density}; \
-             {topo_text}; inside = what the exterior flood (from the box corner, no normals needed) cannot reach{}; {:.2} s, peak {:.0} MiB",
+             {topo_text}; {rule}{}; {:.2} s, peak {:.0} MiB",
             m.inside_voxels,
             m.surface_voxels,
             m.volume_inside,
@@ -257,8 +263,10 @@ const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it and l
      (--method depth-layers reports which voxels an open mesh leaves undecidable)";
 
 pub fn solid(args: &SolidArgs, json: bool) -> Result<()> {
-    if args.method == SolidMethod::DepthLayers {
-        return crate::solid_depth::run(args, json);
+    match args.method {
+        SolidMethod::DepthLayers => return crate::solid_depth::run(args, json),
+        SolidMethod::Beam => return crate::projective::beam(args, json),
+        SolidMethod::Flood => {}
     }
     let start = Instant::now();
     let mesh = Mesh::load(&args.input)?;
@@ -294,6 +302,7 @@ pub fn solid(args: &SolidArgs, json: bool) -> Result<()> {
         &what,
         &surface,
         &solid,
+        FLOOD_RULE,
         args.fill.density,
         extra,
         start,
@@ -336,6 +345,7 @@ pub fn measure(args: &MeasureArgs, json: bool) -> Result<()> {
         &what,
         &surface,
         &solid,
+        FLOOD_RULE,
         args.fill.density,
         extra,
         start,

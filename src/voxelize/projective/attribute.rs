@@ -1,0 +1,60 @@
+//! What the projective scan carries besides position: nothing, or a colour, interpolated by
+//! the same increments as the coordinates.
+
+use glam::Vec3;
+
+/// A value interpolated linearly along lines and across triangles.
+pub trait Attribute: Copy + Send + Sync {
+    fn add(self, d: Self) -> Self;
+    fn sub(self, o: Self) -> Self;
+    fn scale(self, s: f64) -> Self;
+    /// Component-wise `lo.min(hi) <= self <= lo.max(hi)` clamp: interpolation stops at the
+    /// values of the primitive's vertices where a voxel centre lies just beyond it.
+    fn clamp_between(self, lo: Self, hi: Self) -> Self;
+    fn min(self, o: Self) -> Self;
+    fn max(self, o: Self) -> Self;
+}
+
+/// No attribute: the scan compiles down to coordinates only.
+impl Attribute for () {
+    #[inline]
+    fn add(self, _: Self) -> Self {}
+    #[inline]
+    fn sub(self, _: Self) -> Self {}
+    #[inline]
+    fn scale(self, _: f64) -> Self {}
+    #[inline]
+    fn clamp_between(self, _: Self, _: Self) -> Self {}
+    #[inline]
+    fn min(self, _: Self) -> Self {}
+    #[inline]
+    fn max(self, _: Self) -> Self {}
+}
+
+/// An RGB colour.
+impl Attribute for Vec3 {
+    #[inline]
+    fn add(self, d: Self) -> Self {
+        self + d
+    }
+    #[inline]
+    fn sub(self, o: Self) -> Self {
+        self - o
+    }
+    #[inline]
+    fn scale(self, s: f64) -> Self {
+        self * s as f32
+    }
+    #[inline]
+    fn clamp_between(self, lo: Self, hi: Self) -> Self {
+        self.clamp(lo.min(hi), lo.max(hi))
+    }
+    #[inline]
+    fn min(self, o: Self) -> Self {
+        Vec3::min(self, o)
+    }
+    #[inline]
+    fn max(self, o: Self) -> Self {
+        Vec3::max(self, o)
+    }
+}
