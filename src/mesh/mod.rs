@@ -195,10 +195,19 @@ impl Mesh {
 
     /// Fan triangulation of every face: `(face, [a, b, c])`.
     pub fn triangles(&self) -> impl Iterator<Item = (usize, [u32; 3])> + '_ {
-        (0..self.face_count()).flat_map(move |f| {
-            let face = self.face(f);
-            (1..face.len() - 1).map(move |k| (f, [face[0], face[k], face[k + 1]]))
-        })
+        (0..self.face_count()).flat_map(move |f| self.fan(f).map(move |t| (f, t)))
+    }
+
+    /// Fan triangulation of face `f`.
+    #[inline]
+    pub fn fan(&self, f: usize) -> impl Iterator<Item = [u32; 3]> + '_ {
+        let face = self.face(f);
+        (1..face.len() - 1).map(move |k| [face[0], face[k], face[k + 1]])
+    }
+
+    /// Number of triangles in the fan triangulation.
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() - 2 * self.face_count()
     }
 
     /// Surface area of the fan triangulation.

@@ -24,6 +24,7 @@ use crate::grid::{Channels, SparseGrid, Transform};
 use crate::mesh::Mesh;
 use attribute::Attribute;
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 
 /// Where the colours of the voxels come from.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -71,7 +72,7 @@ impl Deposit for () {
     }
 }
 
-impl Deposit for Vec3 {
+impl Deposit for DVec3 {
     fn channels() -> Channels {
         Channels {
             value: true,
@@ -81,17 +82,17 @@ impl Deposit for Vec3 {
     }
     #[inline]
     fn deposit(self, sink: &mut Sink, voxel: [i64; 3], distance: f64) {
-        sink.add_color(voxel, distance, self);
+        sink.add_color(voxel, distance, self.as_vec3());
     }
 }
 
 /// The per-vertex colours `coloring` asks for, or an error naming the mesh.
-fn vertex_colors(mesh: &Mesh, coloring: Coloring) -> Result<Option<Vec<Vec3>>> {
+fn vertex_colors(mesh: &Mesh, coloring: Coloring) -> Result<Option<Vec<DVec3>>> {
     match coloring {
         Coloring::None => Ok(None),
-        Coloring::Constant(c) => Ok(Some(vec![c; mesh.positions.len()])),
+        Coloring::Constant(c) => Ok(Some(vec![c.as_dvec3(); mesh.positions.len()])),
         Coloring::Vertex if mesh.colors.len() == mesh.positions.len() => {
-            Ok(Some(mesh.colors.clone()))
+            Ok(Some(mesh.colors.iter().map(|c| c.as_dvec3()).collect()))
         }
         Coloring::Vertex => Err(Error::InvalidArgument(format!(
             "{}: the vertices carry no colours (OBJ `v x y z r g b`); give a constant colour instead",
@@ -133,13 +134,13 @@ pub fn estimate_bytes(
 
 fn index_positions(mesh: &Mesh, transform: &Transform) -> Vec<DVec3> {
     mesh.positions
-        .iter()
+        .par_iter()
         .map(|&p| transform.world_to_index(p))
         .collect()
 }
 
 /// Voxelizes every face of `mesh` (fan-triangulated) by projective scan-lines.
-/// `progress` counts triangles.
+/// `progress` counts faces.
 pub fn voxelize_triangles(
     mesh: &Mesh,
     transform: Transform,
@@ -147,39 +148,51 @@ pub fn voxelize_triangles(
     progress: Progress,
 ) -> Result<(SparseGrid, ProjectiveStats)> {
     let pos = index_positions(mesh, &transform);
-    let triangles: Vec<[u32; 3]> = mesh.triangles().map(|(_, t)| t).collect();
-    let degenerate = triangles
-        .iter()
-        .filter(|t| {
-            let p = t.map(|i| pos[i as usize]);
-            (p[1] - p[0]).cross(p[2] - p[0]) == DVec3::ZERO
+    let faces: Vec<u32> = (0..mesh.face_count() as u32).collect();
+    let degenerate = faces
+        .par_iter()
+        .map(|&f| {
+            mesh.fan(f as usize)
+                .filter(|t| triangle::is_degenerate(t.map(|i| pos[i as usize])))
+                .count() as u64
         })
-        .count() as u64;
+        .sum();
     let stats = ProjectiveStats {
-        triangles: triangles.len() as u64,
+        triangles: mesh.triangle_count() as u64,
         degenerate_triangles: degenerate,
         segments: 0,
     };
     let grid = match vertex_colors(mesh, coloring)? {
-        None => scan_triangles(&triangles, &pos, &vec![(); pos.len()], transform, progress),
-        Some(colors) => scan_triangles(&triangles, &pos, &colors, transform, progress),
+        None => scan_faces(
+            mesh,
+            &faces,
+            &pos,
+            &vec![(); pos.len()],
+            transform,
+            progress,
+        ),
+        Some(colors) => scan_faces(mesh, &faces, &pos, &colors, transform, progress),
     };
     Ok((grid, stats))
 }
 
-fn scan_triangles<A: Deposit>(
-    triangles: &[[u32; 3]],
+/// Scans the fan triangles of `faces`; `progress` counts faces.
+fn scan_faces<A: Deposit>(
+    mesh: &Mesh,
+    faces: &[u32],
     pos: &[DVec3],
     attrs: &[A],
     transform: Transform,
     progress: Progress,
 ) -> SparseGrid {
-    voxelize_parallel(triangles, transform, A::channels(), progress, |t, sink| {
-        triangle::voxelize_triangle(
-            t.map(|i| pos[i as usize]),
-            t.map(|i| attrs[i as usize]),
-            |v, d, a: A| a.deposit(sink, v, d),
-        )
+    voxelize_parallel(faces, transform, A::channels(), progress, |&f, sink| {
+        for t in mesh.fan(f as usize) {
+            triangle::voxelize_triangle(
+                t.map(|i| pos[i as usize]),
+                t.map(|i| attrs[i as usize]),
+                |v, d, a: A| a.deposit(sink, v, d),
+            )
+        }
     })
 }
 

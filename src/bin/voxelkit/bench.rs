@@ -48,6 +48,9 @@ enum BenchKind {
     Solid(crate::bench_solid::SolidBenchArgs),
     /// Volume and area convergence on exact solids; depth-layer volumes of real meshes.
     Measure(crate::bench_measure::MeasureBenchArgs),
+    /// The projective voxelizer in triangles/s and lines/s against the separating one;
+    /// with --leaks, voxel counts and flood leaks of both.
+    Projective(crate::bench_projective::ProjectiveBenchArgs),
 }
 
 /// A pool of `threads` workers for one side of a comparison.
@@ -95,6 +98,7 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
         Some(BenchKind::Implicit(imp)) => return crate::bench_implicit::run(imp, json),
         Some(BenchKind::Solid(solid)) => return crate::bench_solid::run(solid, json),
         Some(BenchKind::Measure(m)) => return crate::bench_measure::run(m, json),
+        Some(BenchKind::Projective(p)) => return crate::bench_projective::run(p, json),
         None => {}
     }
     let data = data_folder(&args.data);

@@ -3,6 +3,7 @@
 mod bench;
 mod bench_implicit;
 mod bench_measure;
+mod bench_projective;
 mod bench_solid;
 mod bench_subdiv;
 mod commands;

@@ -219,7 +219,7 @@ pub fn mesh(
     let mesh = Mesh::load(input)?;
     let coloring = color.coloring(&mesh);
     let transform = fitted(&mesh, fit, coloring, None, max_memory)?;
-    let bar = progress_bar(mesh.triangles().count() as u64, "triangles", json);
+    let bar = progress_bar(mesh.face_count() as u64, "faces", json);
     let scan = Instant::now();
     let (grid, stats) = voxelize_triangles(&mesh, transform, coloring, &|n| bar.inc(n))?;
     let voxelize_s = scan.elapsed().as_secs_f64();
@@ -240,7 +240,7 @@ pub fn beam(args: &crate::solids::SolidArgs, json: bool) -> Result<()> {
     let mesh = Mesh::load(&args.input)?;
     let fit = args.fill.fit;
     let transform = fitted(&mesh, fit, Coloring::None, None, None)?;
-    let bar = progress_bar(mesh.triangles().count() as u64, "faces", json);
+    let bar = progress_bar(mesh.face_count() as u64, "faces", json);
     let (surface, solid, _) = beam_solid(&mesh, transform, &|n| bar.inc(n))?;
     bar.finish_and_clear();
     let mut whole = surface.clone();

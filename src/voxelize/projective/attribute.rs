@@ -1,7 +1,7 @@
 //! What the projective scan carries besides position: nothing, or a colour, interpolated by
 //! the same increments as the coordinates.
 
-use glam::Vec3;
+use glam::DVec3;
 
 /// A value interpolated linearly along lines and across triangles.
 pub trait Attribute: Copy + Send + Sync {
@@ -31,8 +31,9 @@ impl Attribute for () {
     fn max(self, _: Self) -> Self {}
 }
 
-/// An RGB colour.
-impl Attribute for Vec3 {
+/// An RGB colour, carried in double precision: a sliver's gradient is the difference of two
+/// large terms, and long spans add many increments.
+impl Attribute for DVec3 {
     #[inline]
     fn add(self, d: Self) -> Self {
         self + d
@@ -43,7 +44,7 @@ impl Attribute for Vec3 {
     }
     #[inline]
     fn scale(self, s: f64) -> Self {
-        self * s as f32
+        self * s
     }
     #[inline]
     fn clamp_between(self, lo: Self, hi: Self) -> Self {
@@ -51,10 +52,10 @@ impl Attribute for Vec3 {
     }
     #[inline]
     fn min(self, o: Self) -> Self {
-        Vec3::min(self, o)
+        DVec3::min(self, o)
     }
     #[inline]
     fn max(self, o: Self) -> Self {
-        Vec3::max(self, o)
+        DVec3::max(self, o)
     }
 }

@@ -21,9 +21,13 @@ pub fn voxel_of(p: DVec3) -> [i64; 3] {
     [round(p.x), round(p.y), round(p.z)]
 }
 
+/// `floor(x + 1/2)`: the voxel of coordinate `x`. Written out because `f64::floor` is a
+/// library call on baseline x86-64, and this runs once or more per voxel.
 #[inline]
 pub fn round(x: f64) -> i64 {
-    (x + 0.5).floor() as i64
+    let y = x + 0.5;
+    let t = y as i64;
+    t - ((t as f64) > y) as i64
 }
 
 /// The axis of the largest component of `d`; ties go to x, then y (the paper's order).
@@ -61,7 +65,7 @@ pub fn voxelize_segment<A: Attribute>(
     let axis = dominant_axis(d);
     if d[axis] != 0.0 {
         let (k0, k1) = (round(a[axis]), round(b[axis]));
-        let step = if k1 >= k0 { 1 } else { -1 };
+        let step = if d[axis] > 0.0 { 1 } else { -1 };
         // Increments per unit step along the axis, in the direction of travel.
         let dp = d / d[axis].abs();
         let dc = cb.sub(ca).scale(1.0 / d[axis].abs());

@@ -18,14 +18,11 @@
 //!   between them is left uncovered.
 //! - The attribute is the triangle's affine interpolant at the voxel's projection onto the
 //!   plane along the dominant axis, held within the range of the vertex values.
-//! - A triangle without area is voxelized as its longest edge.
+//! - A triangle without area (the sine of an angle below 1e-9) is voxelized as its longest edge.
 
 use super::attribute::Attribute;
-use super::line::{round, voxelize_segment};
+use super::line::{dominant_axis, round, voxel_of, voxelize_segment};
 use glam::DVec3;
-
-/// Scan-lines kept on the stack; larger triangles take a heap buffer.
-const STACK_LINES: usize = 32;
 
 /// Calls `emit(voxel, distance, attribute)` for the voxels of triangle `p` (index space) with
 /// vertex attributes `c`, `distance` being how far the plane lies from the voxel centre along
@@ -37,59 +34,55 @@ pub fn voxelize_triangle<A: Attribute>(
     mut emit: impl FnMut([i64; 3], f64, A),
 ) {
     let n = (p[1] - p[0]).cross(p[2] - p[0]);
-    let an = n.abs();
-    // The paper's choice: z unless x or y is strictly larger.
-    let w = if an.x > an.y && an.x > an.z {
-        0
-    } else if an.y > an.x && an.y > an.z {
-        1
-    } else {
-        2
-    };
-    if an[w] == 0.0 || !an[w].is_finite() {
+    if is_degenerate(p) {
         let (a, b) = longest_edge(p);
         return voxelize_segment(p[a], p[b], c[a], c[b], emit);
     }
+    let w = dominant_axis(n);
     let (u, v) = ((w + 1) % 3, (w + 2) % 3);
-    let dw_du = -n[u] / n[w];
-    let dw_dv = -n[v] / n[w];
-    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
-    // The attribute's gradient in the projection plane (Cramer's rule on the two edges).
-    let det = e1[u] * e2[v] - e1[v] * e2[u];
-    let (c1, c2) = (c[1].sub(c[0]), c[2].sub(c[0]));
-    let da_du = c1.scale(e2[v] / det).sub(c2.scale(e1[v] / det));
-    let da_dv = c2.scale(e1[u] / det).sub(c1.scale(e2[u] / det));
-    let (c_lo, c_hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
+    let inv_nw = 1.0 / n[w];
+    let dw_du = -n[u] * inv_nw;
+    let dw_dv = -n[v] * inv_nw;
     let w_lo = p[0][w].min(p[1][w]).min(p[2][w]);
     let w_hi = p[0][w].max(p[1][w]).max(p[2][w]);
-
-    let v_lo = p[0][v].min(p[1][v]).min(p[2][v]);
-    let v_hi = p[0][v].max(p[1][v]).max(p[2][v]);
-    let (j0, j1) = (round(v_lo), round(v_hi));
-    let lines = (j1 - j0 + 1) as usize;
-    let mut stack = [(f64::INFINITY, f64::NEG_INFINITY); STACK_LINES];
-    let mut heap = Vec::new();
-    let spans: &mut [(f64, f64)] = if lines <= STACK_LINES {
-        &mut stack[..lines]
-    } else {
-        heap.resize(lines, (f64::INFINITY, f64::NEG_INFINITY));
-        &mut heap
-    };
-    for (a, b) in [(0, 1), (1, 2), (2, 0)] {
-        let (a, b) = if p[a][v] <= p[b][v] {
-            (p[a], p[b])
-        } else {
-            (p[b], p[a])
-        };
-        scan_edge([a[u], a[v]], [b[u], b[v]], j0, spans);
+    let first = voxel_of(p[0]);
+    if voxel_of(p[1]) == first && voxel_of(p[2]) == first {
+        // Inside one voxel (the common case for fine meshes): the scan would give just that
+        // voxel, with the plane and attribute taken at its centre as below.
+        let du0 = first[u] as f64 - p[0][u];
+        let dv0 = first[v] as f64 - p[0][v];
+        let held = (p[0][w] + dw_du * du0 + dw_dv * dv0).clamp(w_lo, w_hi);
+        let attr = affine_at(c[0], attribute_gradient(p, c, u, v), du0, dv0);
+        let (c_lo, c_hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
+        return emit(
+            first,
+            (held - first[w] as f64).abs(),
+            attr.clamp_between(c_lo, c_hi),
+        );
     }
-    for (line, &(left, right)) in spans.iter().enumerate() {
-        let j = j0 + line as i64;
+    let gradient = attribute_gradient(p, c, u, v);
+    let (c_lo, c_hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
+    let q = p.map(|x| [x[u], x[v]]);
+    let (j0, j1) = (
+        round(q[0][1].min(q[1][1]).min(q[2][1])),
+        round(q[0][1].max(q[1][1]).max(q[2][1])),
+    );
+    // One scan-line (most triangles of a fine mesh) spans all three corners; more need the
+    // sides.
+    let sides = (j1 > j0).then(|| Sides::new(q));
+    for j in j0..=j1 {
+        let (left, right) = match &sides {
+            Some(sides) => sides.band(j),
+            None => (
+                q[0][0].min(q[1][0]).min(q[2][0]),
+                q[0][0].max(q[1][0]).max(q[2][0]),
+            ),
+        };
         let (i0, i1) = (round(left), round(right));
         let du0 = i0 as f64 - p[0][u];
         let dv0 = j as f64 - p[0][v];
         let mut depth = p[0][w] + dw_du * du0 + dw_dv * dv0;
-        let mut attr = c[0].add(da_du.scale(du0)).add(da_dv.scale(dv0));
+        let mut attr = affine_at(c[0], gradient, du0, dv0);
         for i in i0..=i1 {
             let held = depth.clamp(w_lo, w_hi);
             let k = round(held);
@@ -103,33 +96,102 @@ pub fn voxelize_triangle<A: Attribute>(
                 attr.clamp_between(c_lo, c_hi),
             );
             depth += dw_du;
-            attr = attr.add(da_du);
+            attr = attr.add(gradient.0);
         }
     }
 }
 
-/// Widens the span of every scan-line band `[j - 1/2, j + 1/2]` the edge `a`-`b` (given as
-/// `(u, v)` with `a.v <= b.v`) passes through by the edge's extent within the band.
+/// The projected triangle as its two sides between the lowest and highest vertex along the
+/// scan axis `v`: the long edge `q0-q2`, and the short edges `q0-q1-q2`.
+struct Sides {
+    /// `(u, v)` corners sorted by `v`.
+    q: [[f64; 2]; 3],
+    /// `du/dv` along `q0-q2`, `q0-q1` and `q1-q2` (0 where an edge has no extent in `v`).
+    slope: [f64; 3],
+}
+
+impl Sides {
+    #[inline]
+    fn new(mut q: [[f64; 2]; 3]) -> Self {
+        if q[0][1] > q[1][1] {
+            q.swap(0, 1);
+        }
+        if q[1][1] > q[2][1] {
+            q.swap(1, 2);
+        }
+        if q[0][1] > q[1][1] {
+            q.swap(0, 1);
+        }
+        let slope = |a: [f64; 2], b: [f64; 2]| {
+            let dv = b[1] - a[1];
+            if dv > 0.0 { (b[0] - a[0]) / dv } else { 0.0 }
+        };
+        Sides {
+            q,
+            slope: [slope(q[0], q[2]), slope(q[0], q[1]), slope(q[1], q[2])],
+        }
+    }
+
+    /// The ends of the cross-section at `v = y`, for `y` in the triangle's range.
+    #[inline]
+    fn section(&self, y: f64) -> (f64, f64) {
+        let [a, m, _] = self.q;
+        let long = a[0] + self.slope[0] * (y - a[1]);
+        let short = if y < m[1] {
+            a[0] + self.slope[1] * (y - a[1])
+        } else {
+            m[0] + self.slope[2] * (y - m[1])
+        };
+        (long.min(short), long.max(short))
+    }
+
+    /// The left and right ends of the triangle over the band `[j - 1/2, j + 1/2]`: the
+    /// cross-sections where the band's edges cut it, and the middle corner when it lies in the
+    /// band.
+    #[inline]
+    fn band(&self, j: i64) -> (f64, f64) {
+        let [a, m, b] = self.q;
+        let y0 = (j as f64 - 0.5).max(a[1]);
+        let y1 = (j as f64 + 0.5).min(b[1]);
+        let (l0, r0) = self.section(y0);
+        let (l1, r1) = self.section(y1);
+        let (mut left, mut right) = (l0.min(l1), r0.max(r1));
+        if y0 <= m[1] && m[1] <= y1 {
+            left = left.min(m[0]);
+            right = right.max(m[0]);
+        }
+        (left, right)
+    }
+}
+
+/// The gradient of the affine interpolant of `c` in the `(u, v)` projection plane (Cramer's
+/// rule on the two edges from vertex 0).
 #[inline]
-fn scan_edge(a: [f64; 2], b: [f64; 2], j0: i64, spans: &mut [(f64, f64)]) {
-    let widen = |span: &mut (f64, f64), x0: f64, x1: f64| {
-        span.0 = span.0.min(x0.min(x1));
-        span.1 = span.1.max(x0.max(x1));
-    };
-    let (ja, jb) = (round(a[1]), round(b[1]));
-    if ja == jb {
-        return widen(&mut spans[(ja - j0) as usize], a[0], b[0]);
-    }
-    let du_dv = (b[0] - a[0]) / (b[1] - a[1]);
-    // u where the edge leaves each band, stepped from band to band.
-    let mut exit = a[0] + du_dv * (ja as f64 + 0.5 - a[1]);
-    widen(&mut spans[(ja - j0) as usize], a[0], exit);
-    for j in ja + 1..jb {
-        let enter = exit;
-        exit += du_dv;
-        widen(&mut spans[(j - j0) as usize], enter, exit);
-    }
-    widen(&mut spans[(jb - j0) as usize], exit, b[0]);
+fn attribute_gradient<A: Attribute>(p: [DVec3; 3], c: [A; 3], u: usize, v: usize) -> (A, A) {
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let det = e1[u] * e2[v] - e1[v] * e2[u];
+    let (c1, c2) = (c[1].sub(c[0]), c[2].sub(c[0]));
+    let da_du = c1.scale(e2[v] / det).sub(c2.scale(e1[v] / det));
+    let da_dv = c2.scale(e1[u] / det).sub(c1.scale(e2[u] / det));
+    (da_du, da_dv)
+}
+
+/// The affine interpolant with value `c0` at vertex 0 and gradient `(da_du, da_dv)`, at
+/// `(du0, dv0)` from vertex 0 in the projection plane.
+#[inline]
+fn affine_at<A: Attribute>(c0: A, (da_du, da_dv): (A, A), du0: f64, dv0: f64) -> A {
+    c0.add(da_du.scale(du0)).add(da_dv.scale(dv0))
+}
+
+/// Whether triangle `p` has too little area for a plane: the sine of its angle at `p[0]` is
+/// below 1e-9 (its width across the longest edge is then far below a voxel, and the plane's
+/// normal is rounding noise).
+#[inline]
+pub fn is_degenerate(p: [DVec3; 3]) -> bool {
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let n = e1.cross(e2);
+    let nn = n.length_squared();
+    !nn.is_finite() || nn <= 1e-18 * e1.length_squared() * e2.length_squared()
 }
 
 /// The two vertices farthest apart.
