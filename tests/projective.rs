@@ -337,3 +337,40 @@ fn the_beam_refuses_an_open_mesh() {
         "{err}"
     );
 }
+
+/// Measured on every closed mesh: the projective surface (naive planes, one voxel thick along
+/// each triangle's dominant axis) blocks every 6-connected path from outside, like the 6-separating
+/// surface, and like it lets 26-connected paths through.
+#[test]
+fn the_projective_surface_separates_under_6_flooding_and_leaks_under_26() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    use voxelkit::grid::Adjacency;
+    use voxelkit::ops::separability::check_mesh_separation;
+    let real = common::CLOSED_MESHES
+        .iter()
+        .map(|name| Mesh::load(&data.join("meshes").join(format!("{name}.obj"))).unwrap());
+    let random = (0..24).map(voxelkit::mesh::generate::random_closed);
+    for mesh in real.chain(random) {
+        let name = mesh.source.display().to_string();
+        for res in [64, 128] {
+            let t = fit_transform(&mesh.bbox(), GridFit::Resolution(res)).unwrap();
+            let (surface, _) = voxelize_triangles(&mesh, t, Coloring::None, &|_| {}).unwrap();
+            let six = check_mesh_separation(&surface, &mesh, Adjacency::Six).unwrap();
+            let all = check_mesh_separation(&surface, &mesh, Adjacency::TwentySix).unwrap();
+            eprintln!(
+                "{name} at {res}: {} voxels, 6-flood leaks {}, 26-flood leaks {} of {} inside",
+                surface.voxel_count(),
+                six.leaked,
+                all.leaked,
+                all.inside_empty
+            );
+            assert!(six.separates(), "{name} at {res}: {six:?}");
+            assert!(
+                all.leaked > 0,
+                "{name} at {res}: a naive surface should leak under 26"
+            );
+        }
+    }
+}

@@ -232,17 +232,29 @@ impl Mesh {
         self.positions[i as usize]
     }
 
-    /// Writes the mesh as OBJ text (used by `voxelkit demo` to ship the model it voxelizes).
+    /// Writes the mesh as OBJ text, with vertex colours and polylines when it has them (used by
+    /// `voxelkit demo` to ship the model it voxelizes).
     pub fn write_obj(&self, path: &Path) -> Result<()> {
         use std::fmt::Write as _;
         let mut s = String::new();
         let _ = writeln!(s, "# written by voxelkit {}", env!("CARGO_PKG_VERSION"));
-        for p in &self.positions {
-            let _ = writeln!(s, "v {} {} {}", p.x, p.y, p.z);
+        for (i, p) in self.positions.iter().enumerate() {
+            let _ = write!(s, "v {} {} {}", p.x, p.y, p.z);
+            if let Some(c) = self.colors.get(i) {
+                let _ = write!(s, " {} {} {}", c.x, c.y, c.z);
+            }
+            s.push('\n');
         }
         for f in 0..self.face_count() {
             s.push('f');
             for &i in self.face(f) {
+                let _ = write!(s, " {}", i + 1);
+            }
+            s.push('\n');
+        }
+        for line in &self.polylines {
+            s.push('l');
+            for &i in line {
                 let _ = write!(s, " {}", i + 1);
             }
             s.push('\n');
