@@ -7,6 +7,8 @@ use std::process::Command;
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
+    // The shared library behind include/voxelkit.h, found at run time by this name.
+    println!("cargo:rustc-cdylib-link-arg=-Wl,-soname,libvoxelkit.so");
     let vdb = std::env::var_os("CARGO_FEATURE_VDB").is_some();
     let osd = std::env::var_os("CARGO_FEATURE_OSD").is_some();
     if vdb {

@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # Installs what voxelkit needs on Debian 12: OpenVDB, Boost headers, TBB, OpenSubdiv,
-# pyopenvdb (an independent .vdb reader for the tests) and, when cargo is missing, Rust.
+# pyopenvdb (an independent .vdb reader for the tests), CMake and valgrind (the C and C++
+# interface tests) and, when cargo is missing, Rust.
 set -euo pipefail
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends \
-    build-essential pkg-config curl ca-certificates \
+    build-essential pkg-config cmake valgrind curl ca-certificates \
     libopenvdb-dev libboost-dev libtbb-dev libosd-dev python3-openvdb >/dev/null
 if ! command -v cargo >/dev/null 2>&1; then
     curl -sSf https://sh.rustup.rs | sh -s -- -y --profile minimal

@@ -14,4 +14,8 @@ pub mod system;
 pub mod voxelize;
 
 pub use error::{Error, Result};
+/// The C interface of `include/voxelkit.h`: exported symbols only, not Rust API (its
+/// functions take raw pointers from C).
+#[cfg(feature = "vdb")]
+mod capi;
 pub mod ffi;

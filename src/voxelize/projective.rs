@@ -38,6 +38,17 @@ pub enum Coloring {
     Constant(Vec3),
 }
 
+impl Coloring {
+    /// The mesh's own colours when it has them, else none.
+    pub fn of(mesh: &Mesh) -> Coloring {
+        if mesh.colors.is_empty() {
+            Coloring::None
+        } else {
+            Coloring::Vertex
+        }
+    }
+}
+
 /// Which lines `voxelize_lines` scans.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct LineSource {

@@ -143,9 +143,10 @@ impl Adjacency {
     }
 }
 
-/// Work items: number of vertices, edges and triangles the voxelizer will process.
+/// Work items, as `progress` counts them: vertices, edges and triangles (edges estimated as
+/// half the face corners, exact for closed meshes).
 pub fn work_items(mesh: &Mesh) -> u64 {
-    (mesh.positions.len() + 2 * mesh.indices.len()) as u64
+    (mesh.positions.len() + mesh.indices.len() / 2 + mesh.triangle_count()) as u64
 }
 
 /// Rough peak memory for voxelizing `mesh` with `transform`, in bytes, from its area in

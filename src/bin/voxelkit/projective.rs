@@ -45,8 +45,7 @@ impl ColorArgs {
         match (self.color, self.no_color) {
             (Some(c), _) => Coloring::Constant(c),
             (None, true) => Coloring::None,
-            (None, false) if !mesh.colors.is_empty() => Coloring::Vertex,
-            (None, false) => Coloring::None,
+            (None, false) => Coloring::of(mesh),
         }
     }
 }

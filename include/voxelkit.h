@@ -1,0 +1,252 @@
+/*
+ * voxelkit.h: the C interface of voxelkit, voxelization with guaranteed topology.
+ *
+ * Install with `scripts/install.sh PREFIX`, then link with
+ * `pkg-config --cflags --libs voxelkit` (shared library) or
+ * `pkg-config --cflags --libs voxelkit-static` (static library), or from CMake:
+ *
+ *     find_package(voxelkit REQUIRED)
+ *     target_link_libraries(app PRIVATE voxelkit::voxelkit)        # or voxelkit::voxelkit_static
+ *
+ * Conventions
+ * - Every function that can fail returns a vk_status; VK_OK is 0. On failure,
+ *   vk_last_error() returns a message naming what went wrong (the file and line of a bad
+ *   OBJ, the face of a bad mesh, ...). The message belongs to the calling thread and stays
+ *   valid until its next voxelkit call.
+ * - Objects are opaque handles: vk_mesh, vk_grid, vk_options. Each is created by one
+ *   function and released by its vk_*_free. Handles are checked on every call: NULL, a
+ *   released handle, or a handle of the wrong kind gives VK_ERROR_INVALID_HANDLE instead of
+ *   a crash, and releasing a handle twice is reported, not undefined. vk_*_free(NULL) is a
+ *   no-op that returns VK_OK.
+ * - Outputs are written only on success. Output pointers must not be NULL.
+ * - No C++ exception and no Rust panic crosses this interface: an internal error comes back
+ *   as VK_ERROR_INTERNAL with its message.
+ * - Index space: voxel (i, j, k) is the unit cube centred on the integer point (i, j, k);
+ *   world = origin + voxel_size * index. Leaves are 8x8x8 blocks laid out like OpenVDB's
+ *   LeafNode: origin a multiple of 8, voxel n = x*64 + y*8 + z, mask word x, bit y*8 + z.
+ * - Functions may be called from several threads at once on different handles. A handle may
+ *   be read from several threads at once; it must not be freed while in use.
+ */
+#ifndef VOXELKIT_H
+#define VOXELKIT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum vk_status {
+    VK_OK = 0,
+    /* An argument is out of range, or a size does not match (the message says which). */
+    VK_ERROR_INVALID_ARGUMENT = 1,
+    /* NULL, released, or of the wrong kind. */
+    VK_ERROR_INVALID_HANDLE = 2,
+    /* A file could not be read or written. */
+    VK_ERROR_IO = 3,
+    /* A malformed input file or formula (file, line or column in the message). */
+    VK_ERROR_PARSE = 4,
+    /* A mesh the operation cannot use: empty, degenerate, open, non-manifold. */
+    VK_ERROR_BAD_MESH = 5,
+    /* The estimated memory exceeds what is available. */
+    VK_ERROR_TOO_LARGE = 6,
+    /* OpenVDB refused to read or write a .vdb file. */
+    VK_ERROR_VDB = 7,
+    /* The cancel flag was set, or the progress callback asked to stop. */
+    VK_ERROR_CANCELLED = 8,
+    /* A caller buffer is too small; the count needed is returned. */
+    VK_ERROR_BUFFER_TOO_SMALL = 9,
+    /* A bug in voxelkit (a caught panic); the message says where. */
+    VK_ERROR_INTERNAL = 10
+} vk_status;
+
+typedef struct vk_mesh vk_mesh;
+typedef struct vk_grid vk_grid;
+typedef struct vk_options vk_options;
+
+/* How vk_voxelize_mesh makes a surface. */
+typedef enum vk_surface_method {
+    /* Huang et al.'s 6- or 26-separating surface (see vk_options_set_separability). */
+    VK_SURFACE_SEPARATING = 0,
+    /* Jegathese et al.'s projective scan-lines: fast, colours, no separability guarantee. */
+    VK_SURFACE_PROJECTIVE = 1
+} vk_surface_method;
+
+/* How vk_fill_mesh finds a solid. */
+typedef enum vk_fill_method {
+    /* The 26-separating surface plus everything the exterior flood cannot reach. */
+    VK_FILL_FLOOD = 0,
+    /* Depth layers with a stencil count: exact at voxel centres (inside voxels only). */
+    VK_FILL_DEPTH_LAYERS = 1,
+    /* The projective surface plus the beams between front and back faces along z. */
+    VK_FILL_BEAM = 2
+} vk_fill_method;
+
+typedef enum vk_criterion {
+    VK_CRITERION_HUANG = 0,  /* the paper's full vertex spheres and edge cylinders */
+    VK_CRITERION_CLIPPED = 1 /* the same clipped to the face slabs: near-minimal */
+} vk_criterion;
+
+typedef enum vk_coordinates {
+    VK_CARTESIAN = 0,   /* x y z */
+    VK_SPHERICAL = 1,   /* r theta phi */
+    VK_CYLINDRICAL = 2  /* r theta y */
+} vk_coordinates;
+
+typedef enum vk_boolean {
+    VK_UNION = 0,
+    VK_INTERSECTION = 1,
+    VK_DIFFERENCE = 2
+} vk_boolean;
+
+/*
+ * Progress of a long call: `done` of `total` work items. Called from worker threads, never
+ * two at a time. Return 0 to go on, anything else to cancel (the call then returns
+ * VK_ERROR_CANCELLED).
+ */
+typedef int (*vk_progress_fn)(uint64_t done, uint64_t total, void *user_data);
+
+/* What a solid measures. Volumes in world units cubed. */
+typedef struct vk_measures {
+    uint64_t inside_voxels;
+    uint64_t surface_voxels;
+    double volume_inside;       /* the inside voxels only: a lower bound */
+    double volume_with_surface; /* inside plus surface voxels: an upper bound */
+} vk_measures;
+
+/* The library version, e.g. "0.1.0" (static storage). */
+const char *vk_version(void);
+
+/* The message of the calling thread's last failure ("" after a success). */
+const char *vk_last_error(void);
+
+/* ---- meshes ---------------------------------------------------------------------------- */
+
+/* Loads an .obj (polygons, `l` polylines, `v x y z r g b` colours) or .stl file. */
+vk_status vk_mesh_load(const char *path, vk_mesh **out);
+
+/*
+ * A triangle mesh from arrays: `positions` holds 3 * vertex_count doubles (x, y, z),
+ * `triangles` 3 * triangle_count zero-based vertex indices. The arrays are copied.
+ */
+vk_status vk_mesh_from_triangles(const double *positions, size_t vertex_count,
+                                 const uint32_t *triangles, size_t triangle_count,
+                                 vk_mesh **out);
+
+/* Vertex and face counts. */
+vk_status vk_mesh_counts(const vk_mesh *mesh, size_t *vertices, size_t *faces);
+
+vk_status vk_mesh_free(vk_mesh *mesh);
+
+/* ---- options ---------------------------------------------------------------------------- */
+
+/* Options with the defaults: resolution 256, 26-separating, Huang's criterion, no normals,
+ * separating surface, flood fill, all cores, no progress callback, no cancel flag. */
+vk_status vk_options_new(vk_options **out);
+vk_status vk_options_free(vk_options *options);
+
+/* Voxels along the longest bounding-box axis (1 ..= 65536). Clears a voxel size. */
+vk_status vk_options_set_resolution(vk_options *options, uint32_t resolution);
+/* Voxel edge length in world units (> 0); replaces the resolution. */
+vk_status vk_options_set_voxel_size(vk_options *options, double voxel_size);
+/* 6 or 26. */
+vk_status vk_options_set_separability(vk_options *options, int separability);
+vk_status vk_options_set_criterion(vk_options *options, vk_criterion criterion);
+/* Non-zero: separating surfaces carry the nearest primitive's normal per voxel. */
+vk_status vk_options_set_normals(vk_options *options, int normals);
+vk_status vk_options_set_surface_method(vk_options *options, vk_surface_method method);
+vk_status vk_options_set_fill_method(vk_options *options, vk_fill_method method);
+/* Worker threads for calls with these options; 0 means all cores. */
+vk_status vk_options_set_threads(vk_options *options, uint32_t threads);
+/* Progress callback (NULL to remove) and the pointer it receives. */
+vk_status vk_options_set_progress(vk_options *options, vk_progress_fn callback, void *user_data);
+/*
+ * A flag another thread sets to non-zero (with an atomic store) to cancel a long call;
+ * NULL to remove. It must stay valid while calls with these options run.
+ */
+vk_status vk_options_set_cancel_flag(vk_options *options, const int32_t *flag);
+
+/* ---- voxelization ----------------------------------------------------------------------- */
+
+/* A voxel surface of `mesh` by the surface method of `options`. */
+vk_status vk_voxelize_mesh(const vk_mesh *mesh, const vk_options *options, vk_grid **out);
+
+/* The polylines of `mesh` (or, without any, the edges of its faces) by dominant-axis
+ * marching; vertex colours, when the file has them, go into the grid's colour channel. */
+vk_status vk_voxelize_lines(const vk_mesh *mesh, const vk_options *options, vk_grid **out);
+
+/* The limit surface of `mesh` taken as a Catmull-Clark control mesh (Lai & Cheng), with the
+ * adjacency of vk_options_set_separability; normals always. */
+vk_status vk_voxelize_subdivision(const vk_mesh *mesh, const vk_options *options,
+                                  vk_grid **out);
+
+/* The implicit surface `formula` = 0 inside the box bounds_min .. bounds_max by interval
+ * octree (Stolte & Kaufman); the resolution of `options` spans the longest side. */
+vk_status vk_voxelize_formula(const char *formula, vk_coordinates coordinates,
+                              const double bounds_min[3], const double bounds_max[3],
+                              const vk_options *options, vk_grid **out);
+
+/* ---- solids, Booleans, measures --------------------------------------------------------- */
+
+/* The solid of the closed `mesh` (surface and inside voxels) by the fill method of
+ * `options`; `measures` may be NULL. Depth layers refuse voxels they cannot classify. */
+vk_status vk_fill_mesh(const vk_mesh *mesh, const vk_options *options, vk_grid **solid,
+                       vk_measures *measures);
+
+/* The inside of a closed voxel surface by exterior flooding, and its measures. */
+vk_status vk_measure_surface(const vk_grid *surface, vk_measures *measures);
+
+/* a op b on a's transform; b is resampled when `resample` is non-zero and the transforms
+ * differ (an error otherwise). */
+vk_status vk_grid_combine(const vk_grid *a, const vk_grid *b, vk_boolean op, int resample,
+                          vk_grid **out);
+
+/* ---- grids ------------------------------------------------------------------------------ */
+
+/* Reads grid `name` (NULL: the first Bool, Mask or Float grid) of a .vdb file. */
+vk_status vk_grid_read_vdb(const char *path, const char *name, vk_grid **out);
+
+/* Writes `surface`, `density` and, when the grid has them, `normal` and `Cd` grids
+ * (written to a temporary file, then renamed). */
+vk_status vk_grid_write_vdb(const vk_grid *grid, const char *path);
+
+vk_status vk_grid_voxel_count(const vk_grid *grid, uint64_t *count);
+vk_status vk_grid_leaf_count(const vk_grid *grid, size_t *count);
+vk_status vk_grid_transform(const vk_grid *grid, double *voxel_size, double origin[3]);
+
+/*
+ * Copies leaves first .. first + count: `origins` receives 3 * count int32 (x, y, z, the
+ * index of the leaf's voxel (0, 0, 0)), `masks` 8 * count uint64 (OpenVDB's mask words).
+ * Leaves with coordinates beyond 32 bits are refused.
+ */
+vk_status vk_grid_copy_leaves(const vk_grid *grid, size_t first, size_t count,
+                              int32_t *origins, uint64_t *masks);
+
+/*
+ * Copies per-voxel normals or colours of leaves first .. first + count: 3 * 512 floats per
+ * leaf in voxel order n (zeros where a voxel is off). VK_ERROR_INVALID_ARGUMENT when the
+ * grid has no such channel.
+ */
+vk_status vk_grid_copy_normals(const vk_grid *grid, size_t first, size_t count, float *normals);
+vk_status vk_grid_copy_colors(const vk_grid *grid, size_t first, size_t count, float *colors);
+
+/*
+ * Copies the coordinates of every active voxel, 3 int64 each, into `coords` (room for
+ * `capacity` voxels). `written` receives the voxel count; when it exceeds `capacity` nothing
+ * is copied and VK_ERROR_BUFFER_TOO_SMALL is returned.
+ */
+vk_status vk_grid_copy_voxels(const vk_grid *grid, int64_t *coords, size_t capacity,
+                              size_t *written);
+
+vk_status vk_grid_free(vk_grid *grid);
+
+/* Panics inside Rust on purpose and returns what the caller sees (VK_ERROR_INTERNAL): lets
+ * bindings check their error path. */
+vk_status vk_debug_panic(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VOXELKIT_H */

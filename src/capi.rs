@@ -1,0 +1,1055 @@
+//! The C interface of `include/voxelkit.h`: opaque handles, status codes with a per-thread
+//! message, and no panic across the boundary.
+//!
+//! Every export runs its body under `catch_unwind`. Handles are registered in a table of live
+//! objects and looked up (with their kind) before any dereference, so NULL, freed and
+//! mistyped handles and double frees are errors, not undefined behaviour. Cancellation (the
+//! flag, or a progress callback that returns non-zero) unwinds out of the worker threads with
+//! a private payload that the export turns into `VK_ERROR_CANCELLED`; everything the call
+//! built is dropped on the way out. No algorithm lives here.
+
+use crate::error::Error;
+use crate::grid::{DenseMask, LEAF_VOXELS, SparseGrid};
+use crate::implicit::{Coordinates, Formula};
+use crate::io::vdb::{read_vdb_grid, write_vdb};
+use crate::mesh::{GridFit, Mesh, fit_transform, index_box};
+use crate::ops::csg::{BooleanOp, combine};
+use crate::ops::measure::SolidMeasures;
+use crate::ops::solid::{FloodMethod, solid_from_surface};
+use crate::ops::solid_leaves::mesh_solid;
+use crate::subd::ControlMesh;
+use crate::voxelize::Separability;
+use crate::voxelize::interval_octree::{OctreeOptions, progress_total, voxelize_implicit};
+use crate::voxelize::parametric::{ParametricOptions, voxelize_subdivision};
+use crate::voxelize::projective::beam::beam_solid;
+use crate::voxelize::projective::{self, Coloring, LineSource};
+use crate::voxelize::separating::{self, Criterion, SeparatingOptions, voxelize_mesh, work_items};
+use glam::DVec3;
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::ffi::{CStr, CString, c_char, c_int, c_void};
+use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicI32, AtomicU64, Ordering};
+use std::sync::{LazyLock, Mutex};
+
+/// `vk_status`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VkStatus {
+    Ok = 0,
+    InvalidArgument = 1,
+    InvalidHandle = 2,
+    Io = 3,
+    Parse = 4,
+    BadMesh = 5,
+    TooLarge = 6,
+    Vdb = 7,
+    Cancelled = 8,
+    BufferTooSmall = 9,
+    Internal = 10,
+}
+
+/// `vk_measures`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct VkMeasures {
+    pub inside_voxels: u64,
+    pub surface_voxels: u64,
+    pub volume_inside: f64,
+    pub volume_with_surface: f64,
+}
+
+impl From<SolidMeasures> for VkMeasures {
+    fn from(m: SolidMeasures) -> Self {
+        VkMeasures {
+            inside_voxels: m.inside_voxels,
+            surface_voxels: m.surface_voxels,
+            volume_inside: m.volume_inside,
+            volume_with_surface: m.volume_with_surface,
+        }
+    }
+}
+
+/// `vk_progress_fn`.
+pub type VkProgressFn = extern "C" fn(done: u64, total: u64, user_data: *mut c_void) -> c_int;
+
+/// `vk_mesh`.
+pub struct VkMesh(Mesh);
+/// `vk_grid`.
+pub struct VkGrid(SparseGrid);
+/// `vk_options`.
+pub struct VkOptions(Options);
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum SurfaceMethod {
+    Separating,
+    Projective,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum FillMethod {
+    Flood,
+    DepthLayers,
+    Beam,
+}
+
+#[derive(Clone, Copy)]
+struct Options {
+    fit: GridFit,
+    separability: Separability,
+    criterion: Criterion,
+    normals: bool,
+    surface: SurfaceMethod,
+    fill: FillMethod,
+    threads: u32,
+    progress: Option<(VkProgressFn, *mut c_void)>,
+    cancel: *const AtomicI32,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            fit: GridFit::Resolution(256),
+            separability: Separability::TwentySix,
+            criterion: Criterion::Huang,
+            normals: false,
+            surface: SurfaceMethod::Separating,
+            fill: FillMethod::Flood,
+            threads: 0,
+            progress: None,
+            cancel: std::ptr::null(),
+        }
+    }
+}
+
+/// A failed call: its status and message.
+struct Failure {
+    status: VkStatus,
+    message: String,
+}
+
+impl Failure {
+    fn new(status: VkStatus, message: impl Into<String>) -> Self {
+        Failure {
+            status,
+            message: message.into(),
+        }
+    }
+}
+
+impl From<Error> for Failure {
+    fn from(e: Error) -> Self {
+        let status = match &e {
+            Error::Io { .. } => VkStatus::Io,
+            Error::Parse { .. } | Error::Formula { .. } | Error::UnsupportedFormat { .. } => {
+                VkStatus::Parse
+            }
+            Error::BadFace { .. } | Error::EmptyMesh { .. } => VkStatus::BadMesh,
+            Error::TooLarge { .. } => VkStatus::TooLarge,
+            Error::Vdb { .. } => VkStatus::Vdb,
+            _ => VkStatus::InvalidArgument,
+        };
+        Failure::new(status, e.to_string())
+    }
+}
+
+type Outcome = std::result::Result<(), Failure>;
+
+thread_local! {
+    static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
+}
+
+fn set_last_error(message: &str) {
+    let text = CString::new(message.replace('\0', " ")).unwrap_or_default();
+    LAST_ERROR.with(|e| *e.borrow_mut() = text);
+}
+
+/// The payload of a cancelled call's unwind.
+struct Cancelled;
+
+/// Runs an export's body: no panic escapes, the message is kept, the status returned.
+fn guard(body: impl FnOnce() -> Outcome) -> VkStatus {
+    let outcome = catch_unwind(AssertUnwindSafe(body)).unwrap_or_else(|payload| {
+        Err(if payload.is::<Cancelled>() {
+            Failure::new(VkStatus::Cancelled, "cancelled")
+        } else {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            Failure::new(
+                VkStatus::Internal,
+                format!("internal error (a bug in voxelkit, please report it): {what}"),
+            )
+        })
+    });
+    match outcome {
+        Ok(()) => {
+            set_last_error("");
+            VkStatus::Ok
+        }
+        Err(f) => {
+            set_last_error(&f.message);
+            f.status
+        }
+    }
+}
+
+/// What kind of object a live handle points to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Mesh,
+    Grid,
+    Options,
+}
+
+impl Kind {
+    fn name(self) -> &'static str {
+        match self {
+            Kind::Mesh => "vk_mesh",
+            Kind::Grid => "vk_grid",
+            Kind::Options => "vk_options",
+        }
+    }
+}
+
+/// Every handle given out and not yet freed, by address.
+static LIVE: LazyLock<Mutex<HashMap<usize, Kind>>> = LazyLock::new(Default::default);
+
+fn live() -> std::sync::MutexGuard<'static, HashMap<usize, Kind>> {
+    // A panic never happens while the table is locked, but do not let one poison it.
+    LIVE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Moves `value` to the heap, registers it and writes the handle to `out`.
+fn hand_out<T>(value: T, kind: Kind, out: *mut *mut T) -> Outcome {
+    let out = non_null_out(out)?;
+    let p = Box::into_raw(Box::new(value));
+    live().insert(p as usize, kind);
+    // SAFETY: `out` is non-null and, by the header's contract, points to writable storage.
+    unsafe { *out = p };
+    Ok(())
+}
+
+/// The object behind a live handle of `kind`.
+fn borrow<'a, T>(p: *const T, kind: Kind) -> std::result::Result<&'a T, Failure> {
+    if p.is_null() {
+        return Err(Failure::new(
+            VkStatus::InvalidHandle,
+            format!("{} is NULL", kind.name()),
+        ));
+    }
+    match live().get(&(p as usize)) {
+        // SAFETY: the address was produced by `hand_out` for this kind and is not freed yet.
+        Some(&k) if k == kind => Ok(unsafe { &*p }),
+        Some(&k) => Err(Failure::new(
+            VkStatus::InvalidHandle,
+            format!(
+                "a {} was passed where a {} is expected",
+                k.name(),
+                kind.name()
+            ),
+        )),
+        None => Err(Failure::new(
+            VkStatus::InvalidHandle,
+            format!(
+                "{} {p:p} is not a live handle (freed already, or never created)",
+                kind.name()
+            ),
+        )),
+    }
+}
+
+/// Releases a handle of `kind`; NULL is fine, anything not live is an error.
+fn release<T>(p: *mut T, kind: Kind) -> Outcome {
+    if p.is_null() {
+        return Ok(());
+    }
+    borrow(p as *const T, kind)?;
+    live().remove(&(p as usize));
+    // SAFETY: the handle was live, so it came from `Box::into_raw` and is freed only here.
+    drop(unsafe { Box::from_raw(p) });
+    Ok(())
+}
+
+/// Mutable access to the options behind a live handle.
+fn options_mut<'a>(p: *mut VkOptions) -> std::result::Result<&'a mut Options, Failure> {
+    borrow(p as *const VkOptions, Kind::Options)?;
+    // SAFETY: live, and the header forbids using one options object from two threads while
+    // one of them changes it.
+    Ok(unsafe { &mut (*p).0 })
+}
+
+fn non_null_out<T>(out: *mut T) -> std::result::Result<*mut T, Failure> {
+    if out.is_null() {
+        Err(Failure::new(
+            VkStatus::InvalidArgument,
+            "an output pointer is NULL",
+        ))
+    } else {
+        Ok(out)
+    }
+}
+
+/// Writes `value` through a non-null output pointer.
+fn put<T>(out: *mut T, value: T) -> Outcome {
+    let out = non_null_out(out)?;
+    // SAFETY: non-null and writable by the header's contract.
+    unsafe { out.write(value) };
+    Ok(())
+}
+
+fn c_str<'a>(p: *const c_char, what: &str) -> std::result::Result<&'a str, Failure> {
+    if p.is_null() {
+        return Err(Failure::new(
+            VkStatus::InvalidArgument,
+            format!("{what} is NULL"),
+        ));
+    }
+    // SAFETY: non-null, and the caller passes a NUL-terminated string.
+    unsafe { CStr::from_ptr(p) }
+        .to_str()
+        .map_err(|_| Failure::new(VkStatus::InvalidArgument, format!("{what} is not UTF-8")))
+}
+
+/// A caller array of `len` elements; NULL only when empty.
+fn slice<'a, T>(p: *const T, len: usize, what: &str) -> std::result::Result<&'a [T], Failure> {
+    if len == 0 {
+        return Ok(&[]);
+    }
+    if p.is_null() {
+        return Err(Failure::new(
+            VkStatus::InvalidArgument,
+            format!("{what} is NULL but {len} elements were announced"),
+        ));
+    }
+    // SAFETY: non-null and, by the caller's contract, `len` readable elements.
+    Ok(unsafe { std::slice::from_raw_parts(p, len) })
+}
+
+fn slice_mut<'a, T>(
+    p: *mut T,
+    len: usize,
+    what: &str,
+) -> std::result::Result<&'a mut [T], Failure> {
+    if len == 0 {
+        return Ok(&mut []);
+    }
+    if p.is_null() {
+        return Err(Failure::new(
+            VkStatus::InvalidArgument,
+            format!("{what} is NULL but room for {len} elements was announced"),
+        ));
+    }
+    // SAFETY: non-null and, by the caller's contract, `len` writable elements.
+    Ok(unsafe { std::slice::from_raw_parts_mut(p, len) })
+}
+
+fn invalid(message: impl Into<String>) -> Failure {
+    Failure::new(VkStatus::InvalidArgument, message)
+}
+
+/// Progress reporting and cancellation for one call.
+struct Reporter {
+    total: u64,
+    done: AtomicU64,
+    callback: Option<(VkProgressFn, *mut c_void)>,
+    cancel: *const AtomicI32,
+    /// Held while the callback runs, so it is never called twice at once.
+    calling: Mutex<()>,
+    stop: AtomicBool,
+}
+
+// SAFETY: the raw pointers are the caller's: the user data goes back to the caller's own
+// callback (never two calls at once), and the cancel flag is only read atomically, as the
+// header requires of the caller's writes.
+unsafe impl Sync for Reporter {}
+
+impl Reporter {
+    fn new(options: &Options, total: u64) -> Self {
+        Reporter {
+            total,
+            done: AtomicU64::new(0),
+            callback: options.progress,
+            cancel: options.cancel,
+            calling: Mutex::new(()),
+            stop: AtomicBool::new(false),
+        }
+    }
+
+    fn cancelled(&self) -> bool {
+        // SAFETY: a non-null flag stays valid while calls with these options run.
+        self.stop.load(Ordering::Relaxed)
+            || (!self.cancel.is_null() && unsafe { &*self.cancel }.load(Ordering::Relaxed) != 0)
+    }
+
+    /// Tells the callback the work is done (item counts are estimates for some methods).
+    fn finish(&self) {
+        if let Some((callback, user)) = self.callback {
+            callback(self.total, self.total, user);
+        }
+    }
+
+    fn advance(&self, n: u64) {
+        let done = self.done.fetch_add(n, Ordering::Relaxed) + n;
+        if let Some((callback, user)) = self.callback
+            && let Ok(_one_at_a_time) = self.calling.try_lock()
+            && callback(done.min(self.total), self.total, user) != 0
+        {
+            self.stop.store(true, Ordering::Relaxed);
+        }
+        if self.cancelled() {
+            resume_unwind(Box::new(Cancelled));
+        }
+    }
+}
+
+/// Runs `work` with the options' threads, progress and cancel flag.
+fn run<T: Send>(
+    options: &Options,
+    total: u64,
+    work: impl FnOnce(&(dyn Fn(u64) + Sync)) -> crate::Result<T> + Send,
+) -> std::result::Result<T, Failure> {
+    let reporter = Reporter::new(options, total);
+    if reporter.cancelled() {
+        return Err(Failure::new(
+            VkStatus::Cancelled,
+            "cancelled before it started",
+        ));
+    }
+    let advance = |n: u64| reporter.advance(n);
+    let result = if options.threads == 0 {
+        work(&advance)
+    } else {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(options.threads as usize)
+            .build()
+            .map_err(|e| invalid(format!("cannot start {} threads: {e}", options.threads)))?
+            .install(|| work(&advance))
+    }?;
+    reporter.finish();
+    Ok(result)
+}
+
+fn fitted(mesh: &Mesh, options: &Options) -> std::result::Result<crate::grid::Transform, Failure> {
+    Ok(fit_transform(&mesh.bbox(), options.fit)?)
+}
+
+/// Refuses work whose estimated memory exceeds what is available.
+fn check_memory(mesh: &Mesh, bytes: u64) -> Outcome {
+    Ok(crate::system::check_fits(
+        bytes,
+        None,
+        &format!("{}; lower the resolution", mesh.source.display()),
+    )?)
+}
+
+/// The common shape of an export that makes a grid from a mesh: checked handles and output,
+/// then `make`.
+fn grid_from_mesh(
+    mesh: *const VkMesh,
+    options: *const VkOptions,
+    out: *mut *mut VkGrid,
+    make: impl FnOnce(&Mesh, &Options) -> std::result::Result<SparseGrid, Failure>,
+) -> VkStatus {
+    guard(|| {
+        let m = &borrow(mesh, Kind::Mesh)?.0;
+        let o = &borrow(options, Kind::Options)?.0;
+        non_null_out(out)?;
+        let grid = make(m, o)?;
+        hand_out(VkGrid(grid), Kind::Grid, out)
+    })
+}
+
+// ---- exports ---------------------------------------------------------------------------------
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_version() -> *const c_char {
+    concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_last_error() -> *const c_char {
+    LAST_ERROR.with(|e| e.borrow().as_ptr())
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_debug_panic() -> VkStatus {
+    guard(|| panic!("vk_debug_panic was called"))
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_mesh_load(path: *const c_char, out: *mut *mut VkMesh) -> VkStatus {
+    guard(|| {
+        non_null_out(out)?;
+        let mesh = Mesh::load_lines(&PathBuf::from(c_str(path, "path")?))?;
+        hand_out(VkMesh(mesh), Kind::Mesh, out)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_mesh_from_triangles(
+    positions: *const f64,
+    vertex_count: usize,
+    triangles: *const u32,
+    triangle_count: usize,
+    out: *mut *mut VkMesh,
+) -> VkStatus {
+    guard(|| {
+        non_null_out(out)?;
+        let coords = vertex_count
+            .checked_mul(3)
+            .ok_or_else(|| invalid("vertex_count is too large"))?;
+        let corners = triangle_count
+            .checked_mul(3)
+            .ok_or_else(|| invalid("triangle_count is too large"))?;
+        let p = slice(positions, coords, "positions")?;
+        let t = slice(triangles, corners, "triangles")?;
+        let points: Vec<DVec3> = p.chunks_exact(3).map(DVec3::from_slice).collect();
+        let polygons: Vec<Vec<u32>> = t.chunks_exact(3).map(|c| c.to_vec()).collect();
+        let mesh = Mesh::from_polygons("vk_mesh_from_triangles", points, &polygons);
+        mesh.validate()?;
+        hand_out(VkMesh(mesh), Kind::Mesh, out)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_mesh_counts(
+    mesh: *const VkMesh,
+    vertices: *mut usize,
+    faces: *mut usize,
+) -> VkStatus {
+    guard(|| {
+        let m = &borrow(mesh, Kind::Mesh)?.0;
+        non_null_out(vertices)?;
+        non_null_out(faces)?;
+        put(vertices, m.positions.len())?;
+        put(faces, m.face_count())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_mesh_free(mesh: *mut VkMesh) -> VkStatus {
+    guard(|| release(mesh, Kind::Mesh))
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_new(out: *mut *mut VkOptions) -> VkStatus {
+    guard(|| hand_out(VkOptions(Options::default()), Kind::Options, out))
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_free(options: *mut VkOptions) -> VkStatus {
+    guard(|| release(options, Kind::Options))
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_resolution(options: *mut VkOptions, resolution: u32) -> VkStatus {
+    guard(|| {
+        let o = options_mut(options)?;
+        if !(1..=1 << 16).contains(&resolution) {
+            return Err(invalid(format!(
+                "resolution {resolution} must be between 1 and 65536"
+            )));
+        }
+        o.fit = GridFit::Resolution(resolution);
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_voxel_size(options: *mut VkOptions, voxel_size: f64) -> VkStatus {
+    guard(|| {
+        let o = options_mut(options)?;
+        if !(voxel_size > 0.0 && voxel_size.is_finite()) {
+            return Err(invalid(format!(
+                "voxel size {voxel_size} must be positive and finite"
+            )));
+        }
+        o.fit = GridFit::VoxelSize(voxel_size);
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_separability(
+    options: *mut VkOptions,
+    separability: c_int,
+) -> VkStatus {
+    guard(|| {
+        let o = options_mut(options)?;
+        o.separability = separability.to_string().parse().map_err(invalid)?;
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_criterion(options: *mut VkOptions, criterion: c_int) -> VkStatus {
+    guard(|| {
+        let o = options_mut(options)?;
+        o.criterion = match criterion {
+            0 => Criterion::Huang,
+            1 => Criterion::Clipped,
+            _ => return Err(invalid(format!("unknown vk_criterion {criterion}"))),
+        };
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_normals(options: *mut VkOptions, normals: c_int) -> VkStatus {
+    guard(|| {
+        options_mut(options)?.normals = normals != 0;
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_surface_method(
+    options: *mut VkOptions,
+    method: c_int,
+) -> VkStatus {
+    guard(|| {
+        let o = options_mut(options)?;
+        o.surface = match method {
+            0 => SurfaceMethod::Separating,
+            1 => SurfaceMethod::Projective,
+            _ => return Err(invalid(format!("unknown vk_surface_method {method}"))),
+        };
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_fill_method(options: *mut VkOptions, method: c_int) -> VkStatus {
+    guard(|| {
+        let o = options_mut(options)?;
+        o.fill = match method {
+            0 => FillMethod::Flood,
+            1 => FillMethod::DepthLayers,
+            2 => FillMethod::Beam,
+            _ => return Err(invalid(format!("unknown vk_fill_method {method}"))),
+        };
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_threads(options: *mut VkOptions, threads: u32) -> VkStatus {
+    guard(|| {
+        options_mut(options)?.threads = threads;
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_progress(
+    options: *mut VkOptions,
+    callback: Option<VkProgressFn>,
+    user_data: *mut c_void,
+) -> VkStatus {
+    guard(|| {
+        options_mut(options)?.progress = callback.map(|c| (c, user_data));
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_cancel_flag(
+    options: *mut VkOptions,
+    flag: *const i32,
+) -> VkStatus {
+    guard(|| {
+        // An `int32_t` written atomically by the caller has the layout of an `AtomicI32`.
+        options_mut(options)?.cancel = flag.cast();
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_voxelize_mesh(
+    mesh: *const VkMesh,
+    options: *const VkOptions,
+    out: *mut *mut VkGrid,
+) -> VkStatus {
+    grid_from_mesh(mesh, options, out, |m, o| {
+        m.validate()?;
+        let t = fitted(m, o)?;
+        Ok(match o.surface {
+            SurfaceMethod::Separating => {
+                let opts = SeparatingOptions {
+                    separability: o.separability,
+                    criterion: o.criterion,
+                    normals: o.normals,
+                };
+                check_memory(m, separating::estimate_bytes(m, &t, &opts))?;
+                run(o, work_items(m), |p| voxelize_mesh(m, t, &opts, p))?.0
+            }
+            SurfaceMethod::Projective => {
+                let coloring = Coloring::of(m);
+                check_memory(m, projective::estimate_bytes(m, &t, coloring, None))?;
+                let faces = m.face_count() as u64;
+                run(o, faces, |p| {
+                    projective::voxelize_triangles(m, t, coloring, p)
+                })?
+                .0
+            }
+        })
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_voxelize_lines(
+    mesh: *const VkMesh,
+    options: *const VkOptions,
+    out: *mut *mut VkGrid,
+) -> VkStatus {
+    grid_from_mesh(mesh, options, out, |m, o| {
+        let source = LineSource {
+            polylines: true,
+            edges: m.polylines.is_empty(),
+        };
+        let coloring = Coloring::of(m);
+        let t = fitted(m, o)?;
+        check_memory(m, projective::estimate_bytes(m, &t, coloring, Some(source)))?;
+        let total = projective::line_segments(m, source).len() as u64;
+        let (grid, _) = run(o, total, |p| {
+            projective::voxelize_lines(m, t, source, coloring, p)
+        })?;
+        Ok(grid)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_voxelize_subdivision(
+    mesh: *const VkMesh,
+    options: *const VkOptions,
+    out: *mut *mut VkGrid,
+) -> VkStatus {
+    grid_from_mesh(mesh, options, out, |m, o| {
+        let control = ControlMesh::from_mesh(m)?;
+        let t = fit_transform(&control.bbox(), o.fit)?;
+        check_memory(m, crate::voxelize::parametric::estimate_bytes(&control, &t))?;
+        let opts = ParametricOptions {
+            adjacency: o.separability.flood_adjacency(),
+            ..Default::default()
+        };
+        let total = control.patch_count() as u64;
+        Ok(run(o, total, |p| voxelize_subdivision(&control, t, &opts, p))?.surface)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_voxelize_formula(
+    formula: *const c_char,
+    coordinates: c_int,
+    bounds_min: *const f64,
+    bounds_max: *const f64,
+    options: *const VkOptions,
+    out: *mut *mut VkGrid,
+) -> VkStatus {
+    guard(|| {
+        let o = &borrow(options, Kind::Options)?.0;
+        non_null_out(out)?;
+        let coordinates = match coordinates {
+            0 => Coordinates::Cartesian,
+            1 => Coordinates::Spherical,
+            2 => Coordinates::Cylindrical,
+            _ => return Err(invalid(format!("unknown vk_coordinates {coordinates}"))),
+        };
+        let formula = Formula::parse(c_str(formula, "formula")?, coordinates)?;
+        let min = DVec3::from_slice(slice(bounds_min, 3, "bounds_min")?);
+        let max = DVec3::from_slice(slice(bounds_max, 3, "bounds_max")?);
+        let resolution = match o.fit {
+            GridFit::Resolution(r) => r,
+            GridFit::VoxelSize(h) => ((max - min).max_element() / h).ceil().min(65536.0) as u32,
+        };
+        let opts = OctreeOptions {
+            resolution,
+            ..Default::default()
+        };
+        let output = run(o, progress_total(&opts), |p| {
+            voxelize_implicit(&formula, min, max, &opts, p)
+        })?;
+        hand_out(VkGrid(output.surface), Kind::Grid, out)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_fill_mesh(
+    mesh: *const VkMesh,
+    options: *const VkOptions,
+    solid: *mut *mut VkGrid,
+    measures: *mut VkMeasures,
+) -> VkStatus {
+    guard(|| {
+        let m = &borrow(mesh, Kind::Mesh)?.0;
+        let o = &borrow(options, Kind::Options)?.0;
+        non_null_out(solid)?;
+        m.validate()?;
+        let t = fitted(m, o)?;
+        let (grid, found) = match o.fill {
+            FillMethod::Flood => {
+                m.require_closed("the exterior flood would leak through it")?;
+                let opts = SeparatingOptions {
+                    separability: Separability::TwentySix,
+                    ..Default::default()
+                };
+                check_memory(m, separating::estimate_bytes(m, &t, &opts))?;
+                let (surface, inside) = run(o, work_items(m), |p| {
+                    let (surface, _) = voxelize_mesh(m, t, &opts, p)?;
+                    let solid = solid_from_surface(&surface, FloodMethod::Spans)?;
+                    Ok((surface, solid))
+                })?;
+                let mut whole = surface;
+                whole.union(&inside.inside);
+                (whole, inside.measures.into())
+            }
+            FillMethod::Beam => {
+                let faces = m.face_count() as u64;
+                let (surface, inside, _) = run(o, faces, |p| beam_solid(m, t, p))?;
+                let mut whole = surface;
+                whole.union(&inside.inside);
+                (whole, inside.measures.into())
+            }
+            FillMethod::DepthLayers => {
+                let inside: DenseMask = run(o, 0, |_| mesh_solid(m, &t, index_box(&m.bbox(), &t)))?;
+                let count = inside.count();
+                let volume = count as f64 * t.voxel_size.powi(3);
+                let found = VkMeasures {
+                    inside_voxels: count,
+                    surface_voxels: 0,
+                    volume_inside: volume,
+                    volume_with_surface: volume,
+                };
+                (inside.to_grid(t), found)
+            }
+        };
+        if !measures.is_null() {
+            put(measures, found)?;
+        }
+        hand_out(VkGrid(grid), Kind::Grid, solid)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_measure_surface(
+    surface: *const VkGrid,
+    measures: *mut VkMeasures,
+) -> VkStatus {
+    guard(|| {
+        let g = &borrow(surface, Kind::Grid)?.0;
+        non_null_out(measures)?;
+        let solid = solid_from_surface(g, FloodMethod::Spans)?;
+        put(measures, solid.measures.into())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_combine(
+    a: *const VkGrid,
+    b: *const VkGrid,
+    op: c_int,
+    resample: c_int,
+    out: *mut *mut VkGrid,
+) -> VkStatus {
+    guard(|| {
+        let (a, b) = (&borrow(a, Kind::Grid)?.0, &borrow(b, Kind::Grid)?.0);
+        non_null_out(out)?;
+        let op = match op {
+            0 => BooleanOp::Union,
+            1 => BooleanOp::Intersection,
+            2 => BooleanOp::Difference,
+            _ => return Err(invalid(format!("unknown vk_boolean {op}"))),
+        };
+        let grid = combine(a, b, op, resample != 0)?;
+        hand_out(VkGrid(grid), Kind::Grid, out)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_read_vdb(
+    path: *const c_char,
+    name: *const c_char,
+    out: *mut *mut VkGrid,
+) -> VkStatus {
+    guard(|| {
+        non_null_out(out)?;
+        let name = if name.is_null() {
+            None
+        } else {
+            Some(c_str(name, "name")?)
+        };
+        let grid = read_vdb_grid(&PathBuf::from(c_str(path, "path")?), name)?;
+        hand_out(VkGrid(grid), Kind::Grid, out)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_write_vdb(grid: *const VkGrid, path: *const c_char) -> VkStatus {
+    guard(|| {
+        let g = &borrow(grid, Kind::Grid)?.0;
+        let path = PathBuf::from(c_str(path, "path")?);
+        let meta = [("source", "voxelkit C API".to_string())];
+        Ok(write_vdb(&path, g, &meta)?)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_voxel_count(grid: *const VkGrid, count: *mut u64) -> VkStatus {
+    guard(|| {
+        let g = &borrow(grid, Kind::Grid)?.0;
+        put(count, g.voxel_count())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_leaf_count(grid: *const VkGrid, count: *mut usize) -> VkStatus {
+    guard(|| {
+        let g = &borrow(grid, Kind::Grid)?.0;
+        put(count, g.leaf_count())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_transform(
+    grid: *const VkGrid,
+    voxel_size: *mut f64,
+    origin: *mut f64,
+) -> VkStatus {
+    guard(|| {
+        let g = &borrow(grid, Kind::Grid)?.0;
+        non_null_out(voxel_size)?;
+        let o = slice_mut(origin, 3, "origin")?;
+        o.copy_from_slice(&g.transform.origin.to_array());
+        put(voxel_size, g.transform.voxel_size)
+    })
+}
+
+/// Leaves `first .. first + count` of `grid`, or an error naming the valid range.
+fn leaf_range(
+    grid: &SparseGrid,
+    first: usize,
+    count: usize,
+) -> std::result::Result<&[crate::grid::Leaf], Failure> {
+    let n = grid.leaf_count();
+    match first.checked_add(count) {
+        Some(end) if end <= n => Ok(&grid.leaves()[first..end]),
+        _ => Err(invalid(format!(
+            "leaves {first} .. {first}+{count} are out of range: the grid has {n}"
+        ))),
+    }
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_copy_leaves(
+    grid: *const VkGrid,
+    first: usize,
+    count: usize,
+    origins: *mut i32,
+    masks: *mut u64,
+) -> VkStatus {
+    guard(|| {
+        let g = &borrow(grid, Kind::Grid)?.0;
+        let leaves = leaf_range(g, first, count)?;
+        let origins = slice_mut(origins, 3 * count, "origins")?;
+        let masks = slice_mut(masks, 8 * count, "masks")?;
+        for (k, leaf) in leaves.iter().enumerate() {
+            for a in 0..3 {
+                origins[3 * k + a] = i32::try_from(leaf.origin[a])
+                    .ok()
+                    .filter(|v| v.checked_add(7).is_some())
+                    .ok_or_else(|| {
+                        invalid(format!(
+                            "leaf {} at {:?} lies beyond 32-bit coordinates",
+                            first + k,
+                            leaf.origin
+                        ))
+                    })?;
+            }
+            masks[8 * k..8 * k + 8].copy_from_slice(&leaf.mask);
+        }
+        Ok(())
+    })
+}
+
+/// Copies a per-voxel `[f32; 3]` channel of leaves `first .. first + count`.
+fn copy_channel(
+    grid: *const VkGrid,
+    first: usize,
+    count: usize,
+    out: *mut f32,
+    name: &str,
+    channel: fn(&crate::grid::Leaf) -> Option<&[[f32; 3]; LEAF_VOXELS]>,
+) -> VkStatus {
+    guard(|| {
+        let g = &borrow(grid, Kind::Grid)?.0;
+        let leaves = leaf_range(g, first, count)?;
+        let out = slice_mut(out, 3 * LEAF_VOXELS * count, name)?;
+        for (k, leaf) in leaves.iter().enumerate() {
+            let values =
+                channel(leaf).ok_or_else(|| invalid(format!("the grid has no {name} channel")))?;
+            let dst = &mut out[3 * LEAF_VOXELS * k..3 * LEAF_VOXELS * (k + 1)];
+            dst.fill(0.0);
+            for n in leaf.offsets() {
+                dst[3 * n..3 * n + 3].copy_from_slice(&values[n]);
+            }
+        }
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_copy_normals(
+    grid: *const VkGrid,
+    first: usize,
+    count: usize,
+    normals: *mut f32,
+) -> VkStatus {
+    copy_channel(grid, first, count, normals, "normals", |l| {
+        l.normal.as_deref()
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_copy_colors(
+    grid: *const VkGrid,
+    first: usize,
+    count: usize,
+    colors: *mut f32,
+) -> VkStatus {
+    copy_channel(grid, first, count, colors, "colors", |l| l.color.as_deref())
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_copy_voxels(
+    grid: *const VkGrid,
+    coords: *mut i64,
+    capacity: usize,
+    written: *mut usize,
+) -> VkStatus {
+    guard(|| {
+        let g = &borrow(grid, Kind::Grid)?.0;
+        non_null_out(written)?;
+        let n = g.voxel_count() as usize;
+        put(written, n)?;
+        if n > capacity {
+            return Err(Failure::new(
+                VkStatus::BufferTooSmall,
+                format!("the grid has {n} voxels but there is room for {capacity}"),
+            ));
+        }
+        let out = slice_mut(coords, 3 * n, "coords")?;
+        for (k, c) in g.voxels().enumerate() {
+            out[3 * k..3 * k + 3].copy_from_slice(&c);
+        }
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_free(grid: *mut VkGrid) -> VkStatus {
+    guard(|| release(grid, Kind::Grid))
+}

@@ -1,0 +1,199 @@
+/*
+ * The C interface end to end, and every misuse it must survive: run under valgrind by
+ * tests/capi.rs. Exits 0 when every check holds, prints the first failure otherwise.
+ *
+ *   smoke MESH.obj OUT.vdb
+ */
+#include <voxelkit.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int failures = 0;
+
+#define CHECK(cond)                                                                      \
+    do {                                                                                 \
+        if (!(cond)) {                                                                   \
+            fprintf(stderr, "%s:%d: check failed: %s (last error: %s)\n", __FILE__,      \
+                    __LINE__, #cond, vk_last_error());                                   \
+            failures++;                                                                  \
+        }                                                                                \
+    } while (0)
+
+#define OK(call) CHECK((call) == VK_OK)
+
+static int stop_at_once(uint64_t done, uint64_t total, void *user_data) {
+    (void)done;
+    (void)total;
+    *(int *)user_data += 1;
+    return 1;
+}
+
+static int count_calls(uint64_t done, uint64_t total, void *user_data) {
+    (void)total;
+    if (done > 0) *(int *)user_data += 1;
+    return 0;
+}
+
+/* A closed unit cube as 12 triangles, outward. */
+static vk_mesh *cube(void) {
+    static const double p[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
+    static const uint32_t t[] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                                 1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+    vk_mesh *m = NULL;
+    OK(vk_mesh_from_triangles(p, 8, t, 12, &m));
+    return m;
+}
+
+int main(int argc, char **argv) {
+    if (argc != 3) {
+        fprintf(stderr, "usage: %s MESH.obj OUT.vdb\n", argv[0]);
+        return 2;
+    }
+    CHECK(strlen(vk_version()) > 0);
+
+    vk_options *opts = NULL;
+    OK(vk_options_new(&opts));
+    OK(vk_options_set_resolution(opts, 40));
+    OK(vk_options_set_threads(opts, 2));
+
+    /* A mesh from a file: separating surface with normals, then projective. */
+    vk_mesh *mesh = NULL;
+    OK(vk_mesh_load(argv[1], &mesh));
+    size_t vertices = 0, faces = 0;
+    OK(vk_mesh_counts(mesh, &vertices, &faces));
+    CHECK(vertices > 0 && faces > 0);
+    int calls = 0;
+    OK(vk_options_set_progress(opts, count_calls, &calls));
+    OK(vk_options_set_normals(opts, 1));
+    vk_grid *surface = NULL;
+    OK(vk_voxelize_mesh(mesh, opts, &surface));
+    CHECK(calls > 0);
+    OK(vk_options_set_progress(opts, NULL, NULL));
+    uint64_t voxels = 0;
+    size_t leaves = 0;
+    OK(vk_grid_voxel_count(surface, &voxels));
+    OK(vk_grid_leaf_count(surface, &leaves));
+    CHECK(voxels > 0 && leaves > 0);
+
+    /* Leaves, normals and voxels into caller buffers; the counts agree. */
+    int32_t *origins = malloc(3 * leaves * sizeof *origins);
+    uint64_t *masks = malloc(8 * leaves * sizeof *masks);
+    float *normals = malloc(3 * 512 * leaves * sizeof *normals);
+    OK(vk_grid_copy_leaves(surface, 0, leaves, origins, masks));
+    OK(vk_grid_copy_normals(surface, 0, leaves, normals));
+    uint64_t bits = 0;
+    for (size_t i = 0; i < 8 * leaves; i++) bits += (uint64_t)__builtin_popcountll(masks[i]);
+    CHECK(bits == voxels);
+    CHECK(vk_grid_copy_colors(surface, 0, leaves, normals) == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(vk_grid_copy_leaves(surface, leaves, 1, origins, masks) == VK_ERROR_INVALID_ARGUMENT);
+    size_t written = 0;
+    CHECK(vk_grid_copy_voxels(surface, NULL, 0, &written) == VK_ERROR_BUFFER_TOO_SMALL);
+    CHECK(written == voxels);
+    int64_t *coords = malloc(3 * written * sizeof *coords);
+    OK(vk_grid_copy_voxels(surface, coords, written, &written));
+    free(coords);
+    free(normals);
+    free(masks);
+    free(origins);
+    double voxel_size = 0, origin[3];
+    OK(vk_grid_transform(surface, &voxel_size, origin));
+    CHECK(voxel_size > 0);
+
+    /* Write and read back. */
+    OK(vk_grid_write_vdb(surface, argv[2]));
+    vk_grid *back = NULL;
+    OK(vk_grid_read_vdb(argv[2], "surface", &back));
+    uint64_t back_voxels = 0;
+    OK(vk_grid_voxel_count(back, &back_voxels));
+    CHECK(back_voxels == voxels);
+    CHECK(vk_grid_read_vdb(argv[2], "no-such-grid", &back) == VK_ERROR_VDB);
+
+    /* The surface's measures, and a solid by each fill method. */
+    vk_measures flooded, m;
+    OK(vk_measure_surface(surface, &flooded));
+    CHECK(flooded.inside_voxels > 0 && flooded.volume_inside < flooded.volume_with_surface);
+    vk_mesh *box = cube();
+    for (int method = VK_FILL_FLOOD; method <= VK_FILL_BEAM; method++) {
+        vk_grid *solid = NULL;
+        OK(vk_options_set_fill_method(opts, (vk_fill_method)method));
+        OK(vk_fill_mesh(box, opts, &solid, &m));
+        CHECK(m.volume_inside <= 1.0 + 1e-9 && m.volume_with_surface >= 1.0 - 1e-9);
+        OK(vk_grid_free(solid));
+    }
+
+    /* Booleans: a - a is empty, a | a is a. */
+    vk_grid *diff = NULL, *both = NULL;
+    OK(vk_grid_combine(surface, back, VK_DIFFERENCE, 0, &diff));
+    OK(vk_grid_combine(surface, back, VK_UNION, 0, &both));
+    uint64_t n_diff = 1, n_both = 0;
+    OK(vk_grid_voxel_count(diff, &n_diff));
+    OK(vk_grid_voxel_count(both, &n_both));
+    CHECK(n_diff == 0 && n_both == voxels);
+    OK(vk_grid_free(diff));
+    OK(vk_grid_free(both));
+
+    /* The other voxelizers. */
+    vk_grid *g = NULL;
+    OK(vk_options_set_surface_method(opts, VK_SURFACE_PROJECTIVE));
+    OK(vk_voxelize_mesh(mesh, opts, &g));
+    OK(vk_grid_free(g));
+    OK(vk_voxelize_lines(mesh, opts, &g));
+    OK(vk_grid_free(g));
+    OK(vk_voxelize_subdivision(box, opts, &g));
+    OK(vk_grid_free(g));
+    const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
+    OK(vk_voxelize_formula("x^2 + y^2 + z^2 - 0.5", VK_CARTESIAN, lo, hi, opts, &g));
+    OK(vk_grid_free(g));
+    CHECK(vk_voxelize_formula("x^2 +* y", VK_CARTESIAN, lo, hi, opts, &g) == VK_ERROR_PARSE);
+    CHECK(strstr(vk_last_error(), "column") != NULL);
+
+    /* Cancellation: by the flag, and by the progress callback. */
+    int32_t cancel = 1;
+    OK(vk_options_set_cancel_flag(opts, &cancel));
+    CHECK(vk_voxelize_mesh(mesh, opts, &g) == VK_ERROR_CANCELLED);
+    OK(vk_options_set_cancel_flag(opts, NULL));
+    int stops = 0;
+    OK(vk_options_set_progress(opts, stop_at_once, &stops));
+    CHECK(vk_voxelize_mesh(mesh, opts, &g) == VK_ERROR_CANCELLED);
+    CHECK(stops >= 1);
+    OK(vk_options_set_progress(opts, NULL, NULL));
+
+    /* Misuse: NULL, wrong kinds, bad values, bad files, double frees, panics. */
+    CHECK(vk_voxelize_mesh(NULL, opts, &g) == VK_ERROR_INVALID_HANDLE);
+    CHECK(vk_voxelize_mesh(mesh, NULL, &g) == VK_ERROR_INVALID_HANDLE);
+    CHECK(vk_voxelize_mesh(mesh, opts, NULL) == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(vk_voxelize_mesh((const vk_mesh *)surface, opts, &g) == VK_ERROR_INVALID_HANDLE);
+    CHECK(strstr(vk_last_error(), "vk_grid") != NULL);
+    CHECK(vk_grid_voxel_count(surface, NULL) == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(vk_options_set_separability(opts, 18) == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(vk_options_set_resolution(opts, 0) == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(vk_options_set_voxel_size(opts, -1.0) == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(vk_options_set_fill_method(opts, (vk_fill_method)7) == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(vk_mesh_load("no/such/file.obj", &mesh) == VK_ERROR_IO);
+    CHECK(strstr(vk_last_error(), "no/such/file.obj") != NULL);
+    CHECK(vk_mesh_load(NULL, &mesh) == VK_ERROR_INVALID_ARGUMENT);
+    static const double bad_p[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    static const uint32_t bad_t[] = {0, 1, 7};
+    vk_mesh *bad = NULL;
+    CHECK(vk_mesh_from_triangles(bad_p, 3, bad_t, 1, &bad) == VK_ERROR_BAD_MESH);
+    CHECK(vk_mesh_from_triangles(NULL, 3, bad_t, 1, &bad) == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(bad == NULL);
+    CHECK(vk_grid_write_vdb(surface, "/no/such/dir/out.vdb") != VK_OK);
+    CHECK(vk_debug_panic() == VK_ERROR_INTERNAL);
+    CHECK(strstr(vk_last_error(), "vk_debug_panic") != NULL);
+
+    OK(vk_grid_free(back));
+    CHECK(vk_grid_free(back) == VK_ERROR_INVALID_HANDLE);
+    OK(vk_grid_free(surface));
+    OK(vk_mesh_free(box));
+    OK(vk_mesh_free(mesh));
+    CHECK(vk_mesh_free(mesh) == VK_ERROR_INVALID_HANDLE);
+    OK(vk_options_free(opts));
+    OK(vk_grid_free(NULL));
+    CHECK(strcmp(vk_last_error(), "") == 0);
+
+    if (failures == 0) printf("ok\n");
+    return failures == 0 ? 0 : 1;
+}
