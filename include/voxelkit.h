@@ -142,7 +142,8 @@ vk_status vk_mesh_free(vk_mesh *mesh);
 /* ---- options ---------------------------------------------------------------------------- */
 
 /* Options with the defaults: resolution 256, 26-separating, Huang's criterion, no normals,
- * separating surface, flood fill, all cores, no progress callback, no cancel flag. */
+ * separating surface, flood fill by spans, 16 directions of double depth layers, pre-split 8,
+ * all cores, no progress callback, no cancel flag. */
 vk_status vk_options_new(vk_options **out);
 vk_status vk_options_free(vk_options *options);
 
@@ -157,6 +158,16 @@ vk_status vk_options_set_criterion(vk_options *options, vk_criterion criterion);
 vk_status vk_options_set_normals(vk_options *options, int normals);
 vk_status vk_options_set_surface_method(vk_options *options, vk_surface_method method);
 vk_status vk_options_set_fill_method(vk_options *options, vk_fill_method method);
+/* The exterior flood of VK_FILL_FLOOD: non-zero `flooding_xyz` for Lai & Cheng's
+ * FloodingXYZ with a GRAYSTACK of `graystack` entries (sweeps resume it when full), zero for
+ * the scan-line span flood (the default). */
+vk_status vk_options_set_flood(vk_options *options, int flooding_xyz, size_t graystack);
+/* VK_FILL_DEPTH_LAYERS: 3 (the axes) to 16 directions (default 16), double layers with a
+ * stencil count (non-zero, the default) or Karabassi's single layers (zero). */
+vk_status vk_options_set_depth_layers(vk_options *options, uint32_t directions, int double_layers);
+/* vk_voxelize_subdivision: each patch pre-split presplit x presplit (>= 1, default 8);
+ * non-zero `enclose` refines until every voxel the surface touches is output. */
+vk_status vk_options_set_subdivision(vk_options *options, uint32_t presplit, int enclose);
 /* Worker threads for calls with these options; 0 means all cores. */
 vk_status vk_options_set_threads(vk_options *options, uint32_t threads);
 /* Progress callback (NULL to remove) and the pointer it receives. */

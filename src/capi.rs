@@ -16,9 +16,10 @@ use crate::mesh::{GridFit, Mesh, fit_transform, index_box};
 use crate::ops::csg::{BooleanOp, combine};
 use crate::ops::measure::SolidMeasures;
 use crate::ops::solid::{FloodMethod, solid_from_surface};
-use crate::ops::solid_leaves::mesh_solid;
+use crate::ops::solid_leaves::{ALL_DIRECTIONS, mesh_solid};
 use crate::subd::ControlMesh;
 use crate::voxelize::Separability;
+use crate::voxelize::depth_layers::{DIRECTIONS, DepthLayerOptions, Layers};
 use crate::voxelize::interval_octree::{OctreeOptions, progress_total, voxelize_implicit};
 use crate::voxelize::parametric::{ParametricOptions, voxelize_subdivision};
 use crate::voxelize::projective::beam::beam_solid;
@@ -102,6 +103,9 @@ struct Options {
     normals: bool,
     surface: SurfaceMethod,
     fill: FillMethod,
+    flood: FloodMethod,
+    depth: DepthLayerOptions,
+    subdivision: ParametricOptions,
     threads: u32,
     progress: Option<(VkProgressFn, *mut c_void)>,
     cancel: *const AtomicI32,
@@ -116,6 +120,9 @@ impl Default for Options {
             normals: false,
             surface: SurfaceMethod::Separating,
             fill: FillMethod::Flood,
+            flood: FloodMethod::Spans,
+            depth: ALL_DIRECTIONS,
+            subdivision: ParametricOptions::default(),
             threads: 0,
             progress: None,
             cancel: std::ptr::null(),
@@ -637,6 +644,67 @@ pub extern "C" fn vk_options_set_fill_method(options: *mut VkOptions, method: c_
 }
 
 #[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_flood(
+    options: *mut VkOptions,
+    flooding_xyz: c_int,
+    graystack: usize,
+) -> VkStatus {
+    guard(|| {
+        options_mut(options)?.flood = if flooding_xyz != 0 {
+            FloodMethod::Xyz {
+                capacity: graystack.max(1),
+            }
+        } else {
+            FloodMethod::Spans
+        };
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_depth_layers(
+    options: *mut VkOptions,
+    directions: u32,
+    double_layers: c_int,
+) -> VkStatus {
+    guard(|| {
+        let o = options_mut(options)?;
+        if !(3..=DIRECTIONS.len() as u32).contains(&directions) {
+            return Err(invalid(format!(
+                "depth layers take 3 to {} directions, not {directions}",
+                DIRECTIONS.len()
+            )));
+        }
+        o.depth = DepthLayerOptions {
+            directions: directions as usize,
+            layers: if double_layers != 0 {
+                Layers::Double
+            } else {
+                Layers::Single
+            },
+        };
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_subdivision(
+    options: *mut VkOptions,
+    presplit: u32,
+    enclose: c_int,
+) -> VkStatus {
+    guard(|| {
+        let o = options_mut(options)?;
+        if presplit == 0 {
+            return Err(invalid("the pre-split count must be at least 1"));
+        }
+        o.subdivision.presplit = presplit;
+        o.subdivision.enclose = enclose != 0;
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_threads(options: *mut VkOptions, threads: u32) -> VkStatus {
     guard(|| {
         options_mut(options)?.threads = threads;
@@ -734,7 +802,7 @@ pub extern "C" fn vk_voxelize_subdivision(
         check_memory(m, crate::voxelize::parametric::estimate_bytes(&control, &t))?;
         let opts = ParametricOptions {
             adjacency: o.separability.flood_adjacency(),
-            ..Default::default()
+            ..o.subdivision
         };
         let total = control.patch_count() as u64;
         Ok(run(o, total, |p| voxelize_subdivision(&control, t, &opts, p))?.surface)
@@ -798,9 +866,10 @@ pub extern "C" fn vk_fill_mesh(
                     ..Default::default()
                 };
                 check_memory(m, separating::estimate_bytes(m, &t, &opts))?;
+                let flood = o.flood;
                 let (surface, inside) = run(o, work_items(m), |p| {
                     let (surface, _) = voxelize_mesh(m, t, &opts, p)?;
-                    let solid = solid_from_surface(&surface, FloodMethod::Spans)?;
+                    let solid = solid_from_surface(&surface, flood)?;
                     Ok((surface, solid))
                 })?;
                 let mut whole = surface;
@@ -815,7 +884,10 @@ pub extern "C" fn vk_fill_mesh(
                 (whole, inside.measures.into())
             }
             FillMethod::DepthLayers => {
-                let inside: DenseMask = run(o, 0, |_| mesh_solid(m, &t, index_box(&m.bbox(), &t)))?;
+                let depth = o.depth;
+                let inside: DenseMask = run(o, 0, |_| {
+                    mesh_solid(m, &t, index_box(&m.bbox(), &t), &depth)
+                })?;
                 let count = inside.count();
                 let volume = count as f64 * t.voxel_size.powi(3);
                 let found = VkMeasures {

@@ -20,7 +20,7 @@
 
 use super::csg::BooleanOp;
 use super::solid_leaves::{
-    Primitive, formula_solid, grid_bounds, grid_solid, mesh_solid, primitive_solid,
+    ALL_DIRECTIONS, Primitive, formula_solid, grid_bounds, grid_solid, mesh_solid, primitive_solid,
 };
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
@@ -326,7 +326,7 @@ impl CsgNode {
             ),
             CsgNode::Mesh(m) => (
                 format!("mesh {}", m.source.display()),
-                mesh_solid(m, transform, bbox)?,
+                mesh_solid(m, transform, bbox, &ALL_DIRECTIONS)?,
             ),
             CsgNode::Grid { grid, source } => (
                 format!("vdb {}", source.display()),

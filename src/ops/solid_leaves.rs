@@ -158,15 +158,21 @@ pub fn formula_solid(
     )
 }
 
-/// A closed mesh by depth layers over all directions; voxels they cannot decide are an error
-/// naming the mesh.
-pub fn mesh_solid(mesh: &Mesh, transform: &Transform, bbox: CoordBox) -> Result<DenseMask> {
-    mesh.require_closed("a CSG leaf must be a closed solid")?;
-    let options = DepthLayerOptions {
-        directions: crate::voxelize::depth_layers::DIRECTIONS.len(),
-        layers: Layers::Double,
-    };
-    let s = depth_layer_solid(mesh, transform, bbox, &options)?;
+/// Depth layers over all directions, the most that can be decided.
+pub const ALL_DIRECTIONS: DepthLayerOptions = DepthLayerOptions {
+    directions: crate::voxelize::depth_layers::DIRECTIONS.len(),
+    layers: Layers::Double,
+};
+
+/// A closed mesh by depth layers; voxels they cannot decide are an error naming the mesh.
+pub fn mesh_solid(
+    mesh: &Mesh,
+    transform: &Transform,
+    bbox: CoordBox,
+    options: &DepthLayerOptions,
+) -> Result<DenseMask> {
+    mesh.require_closed("a solid must be closed")?;
+    let s = depth_layer_solid(mesh, transform, bbox, options)?;
     if s.stats.unclassified_voxels > 0 {
         return Err(Error::InvalidArgument(format!(
             "{}: {} voxels cannot be classified by depth layers (crossed more than four times \

@@ -115,6 +115,9 @@ int main(int argc, char **argv) {
     OK(vk_measure_surface(surface, &flooded));
     CHECK(flooded.inside_voxels > 0 && flooded.volume_inside < flooded.volume_with_surface);
     vk_mesh *box = cube();
+    OK(vk_options_set_flood(opts, 1, 64));
+    OK(vk_options_set_depth_layers(opts, 3, 1));
+    CHECK(vk_options_set_depth_layers(opts, 17, 1) == VK_ERROR_INVALID_ARGUMENT);
     for (int method = VK_FILL_FLOOD; method <= VK_FILL_BEAM; method++) {
         vk_grid *solid = NULL;
         OK(vk_options_set_fill_method(opts, (vk_fill_method)method));
@@ -141,6 +144,8 @@ int main(int argc, char **argv) {
     OK(vk_grid_free(g));
     OK(vk_voxelize_lines(mesh, opts, &g));
     OK(vk_grid_free(g));
+    OK(vk_options_set_subdivision(opts, 4, 1));
+    CHECK(vk_options_set_subdivision(opts, 0, 0) == VK_ERROR_INVALID_ARGUMENT);
     OK(vk_voxelize_subdivision(box, opts, &g));
     OK(vk_grid_free(g));
     const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
