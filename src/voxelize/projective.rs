@@ -18,13 +18,14 @@ pub mod line;
 pub mod triangle;
 
 use super::Progress;
-use super::sink::{Sink, voxelize_parallel};
+use super::sink::{Sink, voxelize_indexed, voxelize_parallel};
 use crate::error::{Error, Result};
 use crate::grid::{Channels, SparseGrid, Transform};
 use crate::mesh::Mesh;
 use attribute::Attribute;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Where the colours of the voxels come from.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -159,52 +160,54 @@ pub fn voxelize_triangles(
     progress: Progress,
 ) -> Result<(SparseGrid, ProjectiveStats)> {
     let pos = index_positions(mesh, &transform);
-    let faces: Vec<u32> = (0..mesh.face_count() as u32).collect();
-    let degenerate = faces
-        .par_iter()
-        .map(|&f| {
-            mesh.fan(f as usize)
-                .filter(|t| triangle::is_degenerate(t.map(|i| pos[i as usize])))
-                .count() as u64
-        })
-        .sum();
-    let stats = ProjectiveStats {
-        triangles: mesh.triangle_count() as u64,
-        degenerate_triangles: degenerate,
-        segments: 0,
-    };
+    let degenerate = AtomicU64::new(0);
     let grid = match vertex_colors(mesh, coloring)? {
         None => scan_faces(
             mesh,
-            &faces,
             &pos,
             &vec![(); pos.len()],
             transform,
+            &degenerate,
             progress,
         ),
-        Some(colors) => scan_faces(mesh, &faces, &pos, &colors, transform, progress),
+        Some(colors) => scan_faces(mesh, &pos, &colors, transform, &degenerate, progress),
+    };
+    let stats = ProjectiveStats {
+        triangles: mesh.triangle_count() as u64,
+        degenerate_triangles: degenerate.into_inner(),
+        segments: 0,
     };
     Ok((grid, stats))
 }
 
-/// Scans the fan triangles of `faces`; `progress` counts faces.
+/// Scans the fan triangles of every face, counting those without area in `degenerate`;
+/// `progress` counts faces.
 fn scan_faces<A: Deposit>(
     mesh: &Mesh,
-    faces: &[u32],
     pos: &[DVec3],
     attrs: &[A],
     transform: Transform,
+    degenerate: &AtomicU64,
     progress: Progress,
 ) -> SparseGrid {
-    voxelize_parallel(faces, transform, A::channels(), progress, |&f, sink| {
-        for t in mesh.fan(f as usize) {
-            triangle::voxelize_triangle(
-                t.map(|i| pos[i as usize]),
-                t.map(|i| attrs[i as usize]),
-                |v, d, a: A| a.deposit(sink, v, d),
-            )
-        }
-    })
+    voxelize_indexed(
+        mesh.face_count(),
+        transform,
+        A::channels(),
+        progress,
+        |f, sink| {
+            for t in mesh.fan(f) {
+                let flat = triangle::voxelize_triangle(
+                    t.map(|i| pos[i as usize]),
+                    t.map(|i| attrs[i as usize]),
+                    |v, d, a: A| a.deposit(sink, v, d),
+                );
+                if flat {
+                    degenerate.fetch_add(1, Ordering::Relaxed);
+                }
+            }
+        },
+    )
 }
 
 /// The segments `source` selects: consecutive vertices of every polyline, and every edge of
@@ -217,18 +220,20 @@ pub fn line_segments(mesh: &Mesh, source: LineSource) -> Vec<[u32; 2]> {
         }
     }
     if source.edges {
-        let mut edges: Vec<[u32; 2]> = (0..mesh.face_count())
-            .flat_map(|f| {
+        // Each edge as one sortable key, lower vertex in the high half.
+        let mut keys: Vec<u64> = (0..mesh.face_count())
+            .into_par_iter()
+            .flat_map_iter(|f| {
                 let face = mesh.face(f);
                 (0..face.len()).map(move |k| {
                     let (a, b) = (face[k], face[(k + 1) % face.len()]);
-                    [a.min(b), a.max(b)]
+                    (u64::from(a.min(b)) << 32) | u64::from(a.max(b))
                 })
             })
             .collect();
-        edges.sort_unstable();
-        edges.dedup();
-        segments.extend(edges);
+        keys.par_sort_unstable();
+        keys.dedup();
+        segments.extend(keys.iter().map(|&k| [(k >> 32) as u32, k as u32]));
     }
     segments
 }

@@ -114,17 +114,32 @@ pub(crate) fn voxelize_parallel<T: Sync>(
     progress: Progress,
     emit: impl Fn(&T, &mut Sink) + Sync,
 ) -> SparseGrid {
+    voxelize_indexed(items.len(), transform, channels, progress, |i, sink| {
+        emit(&items[i], sink)
+    })
+}
+
+/// `voxelize_parallel` over the item numbers `0..count`.
+pub(crate) fn voxelize_indexed(
+    count: usize,
+    transform: Transform,
+    channels: Channels,
+    progress: Progress,
+    emit: impl Fn(usize, &mut Sink) + Sync,
+) -> SparseGrid {
     const CHUNK: usize = 1024;
-    items
-        .par_chunks(CHUNK)
+    (0..count.div_ceil(CHUNK))
+        .into_par_iter()
         .fold(
             || SparseGrid::new(transform, channels),
             |mut grid, chunk| {
+                let items = chunk * CHUNK..((chunk + 1) * CHUNK).min(count);
+                let done = items.len() as u64;
                 let mut sink = Sink::new(&mut grid);
-                for item in chunk {
-                    emit(item, &mut sink);
+                for i in items {
+                    emit(i, &mut sink);
                 }
-                progress(chunk.len() as u64);
+                progress(done);
                 grid
             },
         )

@@ -21,45 +21,50 @@
 //! - A triangle without area (the sine of an angle below 1e-9) is voxelized as its longest edge.
 
 use super::attribute::Attribute;
-use super::line::{dominant_axis, round, voxel_of, voxelize_segment};
+use super::line::{dominant_axis, round, voxelize_segment};
 use glam::DVec3;
 
 /// Calls `emit(voxel, distance, attribute)` for the voxels of triangle `p` (index space) with
 /// vertex attributes `c`, `distance` being how far the plane lies from the voxel centre along
-/// the dominant axis. Voxels may repeat.
+/// the dominant axis. Voxels may repeat. Returns whether the triangle was degenerate (and
+/// voxelized as its longest edge).
 #[inline]
 pub fn voxelize_triangle<A: Attribute>(
     p: [DVec3; 3],
     c: [A; 3],
+    emit: impl FnMut([i64; 3], f64, A),
+) -> bool {
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let n = e1.cross(e2);
+    if too_thin(n, e1, e2) {
+        let (a, b) = longest_edge(p);
+        voxelize_segment(p[a], p[b], c[a], c[b], emit);
+        return true;
+    }
+    // One copy of the scan per dominant axis, so every coordinate access is a constant.
+    match dominant_axis(n) {
+        0 => scan::<0, A>(p, c, n, emit),
+        1 => scan::<1, A>(p, c, n, emit),
+        _ => scan::<2, A>(p, c, n, emit),
+    }
+    false
+}
+
+/// The scan-lines of a triangle with dominant normal axis `W`, scanning along
+/// `u = (W + 1) % 3` in lines of constant `v = (W + 2) % 3`.
+#[inline(always)]
+fn scan<const W: usize, A: Attribute>(
+    p: [DVec3; 3],
+    c: [A; 3],
+    n: DVec3,
     mut emit: impl FnMut([i64; 3], f64, A),
 ) {
-    let n = (p[1] - p[0]).cross(p[2] - p[0]);
-    if is_degenerate(p) {
-        let (a, b) = longest_edge(p);
-        return voxelize_segment(p[a], p[b], c[a], c[b], emit);
-    }
-    let w = dominant_axis(n);
-    let (u, v) = ((w + 1) % 3, (w + 2) % 3);
-    let inv_nw = 1.0 / n[w];
+    let (u, v) = ((W + 1) % 3, (W + 2) % 3);
+    let inv_nw = 1.0 / n[W];
     let dw_du = -n[u] * inv_nw;
     let dw_dv = -n[v] * inv_nw;
-    let w_lo = p[0][w].min(p[1][w]).min(p[2][w]);
-    let w_hi = p[0][w].max(p[1][w]).max(p[2][w]);
-    let first = voxel_of(p[0]);
-    if voxel_of(p[1]) == first && voxel_of(p[2]) == first {
-        // Inside one voxel (the common case for fine meshes): the scan would give just that
-        // voxel, with the plane and attribute taken at its centre as below.
-        let du0 = first[u] as f64 - p[0][u];
-        let dv0 = first[v] as f64 - p[0][v];
-        let held = (p[0][w] + dw_du * du0 + dw_dv * dv0).clamp(w_lo, w_hi);
-        let attr = affine_at(c[0], attribute_gradient(p, c, u, v), du0, dv0);
-        let (c_lo, c_hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
-        return emit(
-            first,
-            (held - first[w] as f64).abs(),
-            attr.clamp_between(c_lo, c_hi),
-        );
-    }
+    let w_lo = p[0][W].min(p[1][W]).min(p[2][W]);
+    let w_hi = p[0][W].max(p[1][W]).max(p[2][W]);
     let gradient = attribute_gradient(p, c, u, v);
     let (c_lo, c_hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
     let q = p.map(|x| [x[u], x[v]]);
@@ -79,9 +84,9 @@ pub fn voxelize_triangle<A: Attribute>(
             ),
         };
         let (i0, i1) = (round(left), round(right));
-        let du0 = i0 as f64 - p[0][u];
-        let dv0 = j as f64 - p[0][v];
-        let mut depth = p[0][w] + dw_du * du0 + dw_dv * dv0;
+        let du0 = i0 as f64 - q[0][0];
+        let dv0 = j as f64 - q[0][1];
+        let mut depth = p[0][W] + dw_du * du0 + dw_dv * dv0;
         let mut attr = affine_at(c[0], gradient, du0, dv0);
         for i in i0..=i1 {
             let held = depth.clamp(w_lo, w_hi);
@@ -89,7 +94,7 @@ pub fn voxelize_triangle<A: Attribute>(
             let mut voxel = [0; 3];
             voxel[u] = i;
             voxel[v] = j;
-            voxel[w] = k;
+            voxel[W] = k;
             emit(
                 voxel,
                 (held - k as f64).abs(),
@@ -189,7 +194,12 @@ fn affine_at<A: Attribute>(c0: A, (da_du, da_dv): (A, A), du0: f64, dv0: f64) ->
 #[inline]
 pub fn is_degenerate(p: [DVec3; 3]) -> bool {
     let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
-    let n = e1.cross(e2);
+    too_thin(e1.cross(e2), e1, e2)
+}
+
+/// `is_degenerate` for edges `e1`, `e2` from `p[0]` and their cross product `n`.
+#[inline]
+fn too_thin(n: DVec3, e1: DVec3, e2: DVec3) -> bool {
     let nn = n.length_squared();
     !nn.is_finite() || nn <= 1e-18 * e1.length_squared() * e2.length_squared()
 }
