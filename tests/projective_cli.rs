@@ -231,6 +231,15 @@ fn bad_input_is_refused_by_file_and_line_and_leaves_no_output() {
     ]);
     assert!(err.contains("r,g,b"), "{err}");
     let err = run(&[
+        "mesh",
+        &p("plain.obj"),
+        "--color",
+        "1,0,0",
+        "-o",
+        &p("a.vdb"),
+    ]);
+    assert!(err.contains("--method projective"), "{err}");
+    let err = run(&[
         "solid",
         &p("plain.obj"),
         "--method",

@@ -168,6 +168,13 @@ fn main() -> ExitCode {
     }
     let result = match cli.command {
         Command::Mesh {
+            method: MeshMethod::Separating,
+            color,
+            ..
+        } if color.given() => Err(voxelkit::Error::InvalidArgument(
+            "--color and --no-color need --method projective (the separating surface carries no colour)".into(),
+        )),
+        Command::Mesh {
             input,
             method: MeshMethod::Separating,
             args,

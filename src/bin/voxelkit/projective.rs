@@ -41,6 +41,11 @@ pub struct ColorArgs {
 }
 
 impl ColorArgs {
+    /// Whether any colour option was given (only the projective methods use them).
+    pub fn given(&self) -> bool {
+        self.color.is_some() || self.no_color
+    }
+
     fn coloring(&self, mesh: &Mesh) -> Coloring {
         match (self.color, self.no_color) {
             (Some(c), _) => Coloring::Constant(c),
