@@ -101,9 +101,10 @@ typedef enum vk_boolean {
 } vk_boolean;
 
 /*
- * Progress of a long call: `done` of `total` work items. Called from worker threads, never
- * two at a time. Return 0 to go on, anything else to cancel (the call then returns
- * VK_ERROR_CANCELLED).
+ * Progress of a long call: `done` of `total` work items (some methods estimate `total`; the
+ * last call always reports done == total). Called from worker threads, never two at a time;
+ * it must not throw or longjmp. Return 0 to go on, anything else to cancel (the call then
+ * returns VK_ERROR_CANCELLED).
  */
 typedef int (*vk_progress_fn)(uint64_t done, uint64_t total, void *user_data);
 
