@@ -101,8 +101,8 @@ typedef enum vk_boolean {
 } vk_boolean;
 
 /*
- * Progress of a long call: `done` of `total` work items (some methods estimate `total`; the
- * last call always reports done == total). Called from worker threads, never two at a time;
+ * Progress of a long call: `done` of `total` work items (some methods estimate `total`; a
+ * call that succeeds reports done == total last). Called from worker threads, never two at a time;
  * it must not throw or longjmp. Return 0 to go on, anything else to cancel (the call then
  * returns VK_ERROR_CANCELLED).
  */
