@@ -44,7 +44,7 @@ pub struct ProjectiveBenchArgs {
 }
 
 /// The closed meshes of the data folder.
-const CLOSED_MESHES: &str = "bunny-closed,armadillo,cow,fandisk,horse,igea,ogre,rocker-arm,scorpion,skull,sphere,spot_triangulated,spot_quadrangulated,torus";
+const CLOSED_MESHES: &str = "bunny-closed,armadillo,cow,fandisk,horse,igea,rocker-arm,scorpion,skull,sphere,spot_triangulated,spot_quadrangulated,torus";
 
 fn load(name: &str, data: &std::path::Path) -> Result<Mesh> {
     if name == "beast" {
