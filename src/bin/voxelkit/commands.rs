@@ -133,6 +133,28 @@ fn stats_json(s: &SeparatingStats) -> Json {
         .int("degenerate_faces", s.degenerate_faces as u64)
 }
 
+/// Refuses voxelizing `mesh` on `transform` when `estimate` bytes exceed `max_memory_mib`
+/// (default: the available memory), naming the mesh and the grid size.
+pub fn check_memory(
+    mesh: &Mesh,
+    transform: &Transform,
+    estimate: u64,
+    max_memory_mib: Option<u64>,
+) -> Result<()> {
+    let extent = mesh.bbox().extent() / transform.voxel_size;
+    voxelkit::system::check_fits(
+        estimate,
+        max_memory_mib.map(|m| m << 20),
+        &format!(
+            "{} at {:.0}x{:.0}x{:.0} voxels; lower --resolution or raise --max-memory",
+            mesh.source.display(),
+            extent.x,
+            extent.y,
+            extent.z
+        ),
+    )
+}
+
 /// Loads, fits, checks memory and voxelizes a mesh with a progress bar.
 fn voxelize_file(
     mesh: &Mesh,
@@ -147,18 +169,7 @@ fn voxelize_file(
         normals: surface.normals,
     };
     let estimate = estimate_bytes(mesh, &transform, &opts);
-    let extent = mesh.bbox().extent() / transform.voxel_size;
-    voxelkit::system::check_fits(
-        estimate,
-        surface.max_memory.map(|m| m << 20),
-        &format!(
-            "{} at {:.0}x{:.0}x{:.0} voxels; lower --resolution or raise --max-memory",
-            mesh.source.display(),
-            extent.x,
-            extent.y,
-            extent.z
-        ),
-    )?;
+    check_memory(mesh, &transform, estimate, surface.max_memory)?;
     let bar = progress_bar(work_items(mesh), "voxelizing", quiet);
     let start = Instant::now();
     let (grid, stats) = voxelize_mesh(mesh, transform, &opts, &|n| bar.inc(n))?;

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use voxelkit::Result;
 use voxelkit::grid::{SparseGrid, Transform};
-use voxelkit::io::vdb::{write_vdb, write_vdb_with_masks};
+use voxelkit::io::vdb::write_vdb;
 use voxelkit::mesh::{Mesh, fit_transform};
 use voxelkit::voxelize::projective::{
     Coloring, LineSource, ProjectiveStats, beam::beam_solid, estimate_bytes, line_segments,
@@ -91,17 +91,11 @@ fn fitted(
     max_memory: Option<u64>,
 ) -> Result<Transform> {
     let transform = fit_transform(&mesh.bbox(), fit.grid_fit())?;
-    let extent = mesh.bbox().extent() / transform.voxel_size;
-    voxelkit::system::check_fits(
+    crate::commands::check_memory(
+        mesh,
+        &transform,
         estimate_bytes(mesh, &transform, coloring, lines),
-        max_memory.map(|m| m << 20),
-        &format!(
-            "{} at {:.0}x{:.0}x{:.0} voxels; lower --resolution or raise --max-memory",
-            mesh.source.display(),
-            extent.x,
-            extent.y,
-            extent.z
-        ),
+        max_memory,
     )?;
     Ok(transform)
 }
@@ -247,29 +241,13 @@ pub fn beam(args: &crate::solids::SolidArgs, json: bool) -> Result<()> {
     let bar = progress_bar(mesh.face_count() as u64, "faces", json);
     let (surface, solid, _) = beam_solid(&mesh, transform, &|n| bar.inc(n))?;
     bar.finish_and_clear();
-    let mut whole = surface.clone();
-    whole.union(&solid.inside);
-    write_vdb_with_masks(
-        &args.output,
-        &whole,
-        &[("boundary", &surface), ("interior", &solid.inside)],
-        &metadata("projective-beam", &args.input, fit, Coloring::None),
-    )?;
-    let extra = Json::default()
-        .str("output", args.output.display().to_string())
-        .num("mesh_signed_volume", mesh.signed_volume());
-    let what = format!(
-        "{} (mesh signed volume {:.6})",
-        args.output.display(),
-        mesh.signed_volume()
-    );
-    crate::solids::report(
-        &what,
+    crate::solids::write_and_report(
+        args,
+        &mesh,
         &surface,
         &solid,
+        &metadata("projective-beam", &args.input, fit, Coloring::None),
         "inside = the beams between front and back faces along z (centres between crossings 1-2, 3-4, ...)",
-        args.fill.density,
-        extra,
         start,
         json,
     )

@@ -179,7 +179,7 @@ const FLOOD_RULE: &str =
     "inside = what the exterior flood (from the box corner, no normals needed) cannot reach";
 
 #[allow(clippy::too_many_arguments)]
-pub fn report(
+fn report(
     what: &str,
     surface: &SparseGrid,
     solid: &Solid,
@@ -273,9 +273,6 @@ pub fn solid(args: &SolidArgs, json: bool) -> Result<()> {
     mesh.require_closed(FLOOD_NEEDS_CLOSED)?;
     let surface = mesh_surface(&mesh, args.fill.fit, json)?;
     let solid = solid_from_surface(&surface, args.fill.flood.method())?;
-    let mut whole = SparseGrid::new(surface.transform, voxelkit::grid::Channels::NONE);
-    whole.union(&surface);
-    whole.union(&solid.inside);
     let meta = vec![
         (
             "method",
@@ -284,11 +281,33 @@ pub fn solid(args: &SolidArgs, json: bool) -> Result<()> {
         ("source_file", args.input.display().to_string()),
         ("resolution", args.fill.fit.describe()),
     ];
+    write_and_report(
+        args, &mesh, &surface, &solid, &meta, FLOOD_RULE, start, json,
+    )
+}
+
+/// Writes a solid made of a surface and the voxels inside it (`surface` and `density` on
+/// both, `boundary` and `interior` apart) and prints its summary, `rule` saying what inside
+/// means.
+#[allow(clippy::too_many_arguments)]
+pub fn write_and_report(
+    args: &SolidArgs,
+    mesh: &Mesh,
+    surface: &SparseGrid,
+    solid: &Solid,
+    meta: &[(&str, String)],
+    rule: &str,
+    start: Instant,
+    json: bool,
+) -> Result<()> {
+    let mut whole = SparseGrid::new(surface.transform, voxelkit::grid::Channels::NONE);
+    whole.union(surface);
+    whole.union(&solid.inside);
     write_vdb_with_masks(
         &args.output,
         &whole,
-        &[("boundary", &surface), ("interior", &solid.inside)],
-        &meta,
+        &[("boundary", surface), ("interior", &solid.inside)],
+        meta,
     )?;
     let extra = Json::default()
         .str("output", args.output.display().to_string())
@@ -300,9 +319,9 @@ pub fn solid(args: &SolidArgs, json: bool) -> Result<()> {
     );
     report(
         &what,
-        &surface,
-        &solid,
-        FLOOD_RULE,
+        surface,
+        solid,
+        rule,
         args.fill.density,
         extra,
         start,
