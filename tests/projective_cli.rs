@@ -5,30 +5,17 @@
 
 mod cli_support;
 
-use cli_support::{json_field, text, voxelkit};
+use cli_support::{json_field, run_pyopenvdb, text, voxelkit};
 use glam::{DVec3, Vec3};
 use std::collections::HashMap;
 use std::path::Path;
-use std::process::Command;
 use voxelkit::grid::{SparseGrid, offset_coord};
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
 use voxelkit::voxelize::projective::{Coloring, LineSource, voxelize_lines, voxelize_triangles};
 
-const PYTHON: &str = "/usr/bin/python3";
-
 /// Every active voxel of the `Cd` grid and the `surface` count, through pyopenvdb; `None`
 /// (loudly) when pyopenvdb is missing.
 fn read_cd(path: &Path) -> Option<(HashMap<[i64; 3], Vec3>, u64)> {
-    let probe = Command::new(PYTHON)
-        .args(["-c", "import pyopenvdb"])
-        .output();
-    if !probe.map(|o| o.status.success()).unwrap_or(false) {
-        let _ = std::io::Write::write_all(
-            &mut std::io::stderr(),
-            b"\n!!! python3-openvdb (pyopenvdb) is not installed: the Cd read-back is SKIPPED\n",
-        );
-        return None;
-    }
     let script = r#"
 import sys, pyopenvdb as vdb
 print(vdb.read(sys.argv[1], "surface").activeVoxelCount())
@@ -40,16 +27,7 @@ for item in g.citerOnValues():
             for z in range(lo[2], hi[2] + 1):
                 print(x, y, z, repr(c[0]), repr(c[1]), repr(c[2]))
 "#;
-    let out = Command::new(PYTHON)
-        .args(["-c", script, path.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = run_pyopenvdb(script, path, "the Cd read-back")?;
     let mut lines = text.lines();
     let surface = lines.next().unwrap().parse().unwrap();
     let cd = lines

@@ -3,14 +3,16 @@
 #![cfg(feature = "vdb")]
 
 use glam::DVec3;
-use std::process::Command;
 use voxelkit::grid::SparseGrid;
 use voxelkit::io::vdb::{read_vdb_grid, read_vdb_info, write_vdb};
 use voxelkit::mesh::generate;
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::SeparatingOptions;
 
+mod cli_support;
 mod common;
+
+use cli_support::run_pyopenvdb;
 
 fn sorted_voxels(g: &SparseGrid) -> Vec<[i64; 3]> {
     let mut v: Vec<_> = g.voxels().collect();
@@ -90,17 +92,6 @@ fn openvdb_reads_back_the_same_voxels_transform_and_metadata() {
 
 #[test]
 fn pyopenvdb_reads_back_the_same_voxels_and_transform() {
-    let python = "/usr/bin/python3";
-    let probe = Command::new(python)
-        .args(["-c", "import pyopenvdb"])
-        .output();
-    if !probe.map(|o| o.status.success()).unwrap_or(false) {
-        let _ = std::io::Write::write_all(
-            &mut std::io::stderr(),
-            b"\n!!! python3-openvdb (pyopenvdb) is not installed: the independent-reader test is SKIPPED\n",
-        );
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let (grid, path) = written_example(dir.path());
     let script = r#"
@@ -116,16 +107,9 @@ for name in ("surface", "density"):
                 for z in range(lo[2], hi[2] + 1):
                     print(x, y, z)
 "#;
-    let out = Command::new(python)
-        .args(["-c", script, path.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
+    let Some(text) = run_pyopenvdb(script, &path, "the independent-reader test") else {
+        return;
+    };
     let mut sections = text.split("grid ").filter(|s| !s.is_empty());
     let expected = sorted_voxels(&grid);
     for _ in 0..2 {

@@ -34,3 +34,30 @@ pub fn json_field(out: &str, key: &str) -> f64 {
         .parse()
         .unwrap()
 }
+
+/// Runs a Python `script` with pyopenvdb on `path` and returns its stdout; `None`, with a loud
+/// warning naming `what` is skipped, when pyopenvdb is not installed.
+pub fn run_pyopenvdb(script: &str, path: &std::path::Path, what: &str) -> Option<String> {
+    let python = "/usr/bin/python3";
+    let probe = Command::new(python)
+        .args(["-c", "import pyopenvdb"])
+        .output();
+    if !probe.map(|o| o.status.success()).unwrap_or(false) {
+        let _ = std::io::Write::write_all(
+            &mut std::io::stderr(),
+            format!("\n!!! python3-openvdb (pyopenvdb) is not installed: {what} is SKIPPED\n")
+                .as_bytes(),
+        );
+        return None;
+    }
+    let out = Command::new(python)
+        .args(["-c", script, path.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Some(String::from_utf8(out.stdout).unwrap())
+}

@@ -13,7 +13,9 @@ use voxelkit::mesh::{GridFit, Mesh, fit_transform};
 use voxelkit::ops::separability::check_mesh_separation;
 use voxelkit::subd::{ControlMesh, LimitSurface};
 use voxelkit::voxelize::Separability;
-use voxelkit::voxelize::projective::{Coloring, LineSource, voxelize_lines, voxelize_triangles};
+use voxelkit::voxelize::projective::{
+    Coloring, LineSource, line_segments, voxelize_lines, voxelize_triangles,
+};
 use voxelkit::voxelize::separating::{Criterion, SeparatingOptions, voxelize_mesh};
 
 /// Segments per patch side when `beast` is tessellated: 6x6 quads per patch, about 2.3M
@@ -104,19 +106,9 @@ pub fn run(args: &ProjectiveBenchArgs, json: bool) -> Result<()> {
                     time(&|| Ok(voxelize_triangles(&mesh, t, Coloring::None, &|_| {})?.0))?;
                 let (line_s, line_grid) =
                     time(&|| Ok(voxelize_lines(&mesh, t, edges, Coloring::None, &|_| {})?.0))?;
-                let segments = voxelize_lines(&mesh, t, edges, Coloring::None, &|_| {})?
-                    .1
-                    .segments;
-                let separating = |sep| {
-                    let opts = SeparatingOptions {
-                        separability: sep,
-                        criterion: Criterion::Clipped,
-                        normals: false,
-                    };
-                    time(&|| Ok(voxelize_mesh(&mesh, t, &opts, &|_| {})?.0))
-                };
-                let (sep6_s, sep6) = separating(Separability::Six)?;
-                let (sep26_s, _) = separating(Separability::TwentySix)?;
+                let segments = line_segments(&mesh, edges).len() as u64;
+                let (sep6_s, sep6) = time(&|| separating(&mesh, t, Separability::Six))?;
+                let (sep26_s, _) = time(&|| separating(&mesh, t, Separability::TwentySix))?;
                 let (tri_rate, line_rate) = (triangles as f64 / tri_s, segments as f64 / line_s);
                 if json {
                     rows.push(
@@ -168,6 +160,16 @@ pub fn run(args: &ProjectiveBenchArgs, json: bool) -> Result<()> {
     Ok(())
 }
 
+/// Our separating surface (clipped criterion) of `mesh` on `t`.
+fn separating(mesh: &Mesh, t: Transform, separability: Separability) -> Result<SparseGrid> {
+    let opts = SeparatingOptions {
+        separability,
+        criterion: Criterion::Clipped,
+        normals: false,
+    };
+    Ok(voxelize_mesh(mesh, t, &opts, &|_| {})?.0)
+}
+
 /// Inside voxels reached by the exterior flood through `surface`, with 6 and with 26.
 fn leaked(surface: &SparseGrid, mesh: &Mesh) -> Result<[u64; 2]> {
     let six = check_mesh_separation(surface, mesh, Adjacency::Six)?.leaked;
@@ -203,17 +205,9 @@ fn leaks(args: &ProjectiveBenchArgs, json: bool) -> Result<()> {
         for &res in &resolutions {
             let t: Transform = fit_transform(&mesh.bbox(), GridFit::Resolution(res))?;
             let (proj, _) = voxelize_triangles(&mesh, t, Coloring::None, &|_| {})?;
-            let separating = |sep| {
-                let opts = SeparatingOptions {
-                    separability: sep,
-                    criterion: Criterion::Clipped,
-                    normals: false,
-                };
-                voxelize_mesh(&mesh, t, &opts, &|_| {}).map(|(g, _)| g)
-            };
             let (sep6, sep26) = (
-                separating(Separability::Six)?,
-                separating(Separability::TwentySix)?,
+                separating(&mesh, t, Separability::Six)?,
+                separating(&mesh, t, Separability::TwentySix)?,
             );
             let (p, s6, s26) = (
                 leaked(&proj, &mesh)?,

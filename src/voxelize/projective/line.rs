@@ -45,7 +45,7 @@ pub fn dominant_axis(d: DVec3) -> usize {
 
 /// Emits the voxel holding `p` with its distance from `p`.
 #[inline]
-pub fn emit_point<A>(emit: &mut impl FnMut([i64; 3], f64, A), p: DVec3, c: A) {
+fn emit_point<A>(emit: &mut impl FnMut([i64; 3], f64, A), p: DVec3, c: A) {
     let v = voxel_of(p);
     emit(v, (p - DVec3::from_array(v.map(|x| x as f64))).length(), c);
 }
