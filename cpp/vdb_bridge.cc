@@ -7,6 +7,9 @@
 #include <openvdb/tools/MeshToVolume.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
 #include <mutex>
 #include <stdexcept>
 
@@ -99,11 +102,26 @@ void VdbWriter::add_grid(rust::Str kind, rust::Str name, double voxel_size, std:
     grids_.push_back(grid);
 }
 
-void VdbWriter::write(rust::Str path) const {
-    openvdb::io::File file{std::string(path)};
-    file.write(grids_);
-    file.close();
-}
+namespace {
+
+// io::File writes through a stream whose errors it never checks, so a full disk gives a
+// truncated file; this archive writes the same seekable format to a stream we check.
+class CheckedArchive : public openvdb::io::Archive {
+public:
+    void write_to(const std::string& path, const openvdb::GridPtrVec& grids) const {
+        std::ofstream out(path, std::ios_base::out | std::ios_base::binary | std::ios_base::trunc);
+        if (!out) throw std::runtime_error("cannot open for writing: " + std::string(std::strerror(errno)));
+        Archive::write(out, grids, /*seekable=*/true);
+        out.flush();
+        if (!out) throw std::runtime_error("writing failed: " + std::string(std::strerror(errno)));
+        out.close();
+        if (out.fail()) throw std::runtime_error("closing failed: " + std::string(std::strerror(errno)));
+    }
+};
+
+}  // namespace
+
+void VdbWriter::write(rust::Str path) const { CheckedArchive().write_to(std::string(path), grids_); }
 
 std::unique_ptr<VdbFile> open_vdb(rust::Str path) {
     ensure_initialized();

@@ -171,6 +171,9 @@ vk_status vk_options_set_depth_layers(vk_options *options, uint32_t directions, 
 vk_status vk_options_set_subdivision(vk_options *options, uint32_t presplit, int enclose);
 /* Worker threads for calls with these options; 0 means all cores. */
 vk_status vk_options_set_threads(vk_options *options, uint32_t threads);
+/* Refuse work whose estimated memory exceeds `mib` MiB (0: the memory available, the
+ * default) with VK_ERROR_TOO_LARGE before anything large is allocated. */
+vk_status vk_options_set_max_memory(vk_options *options, uint64_t mib);
 /* Progress callback (NULL to remove) and the pointer it receives. */
 vk_status vk_options_set_progress(vk_options *options, vk_progress_fn callback, void *user_data);
 /*

@@ -3,33 +3,35 @@
 //!
 //! Every export runs its body under `catch_unwind`. Handles are registered in a table of live
 //! objects and looked up (with their kind) before any dereference, so NULL, freed and
-//! mistyped handles and double frees are errors, not undefined behaviour. Cancellation (the
-//! flag, or a progress callback that returns non-zero) unwinds out of the worker threads with
-//! a private payload that the export turns into `VK_ERROR_CANCELLED`; everything the call
-//! built is dropped on the way out. No algorithm lives here.
+//! mistyped handles and double frees are errors, not undefined behaviour. Every computation
+//! is a `pipeline::Job`, like the CLI's: cancellation (the flag, or a progress callback that
+//! returns non-zero) is the observer's answer, the workers skip what is left and the call
+//! returns `VK_ERROR_CANCELLED`. No algorithm and no orchestration lives here.
 
 use crate::error::Error;
-use crate::grid::{DenseMask, LEAF_VOXELS, SparseGrid};
-use crate::implicit::{Coordinates, Formula};
+use crate::grid::{LEAF_VOXELS, SparseGrid};
+use crate::implicit::Coordinates;
 use crate::io::vdb::{read_vdb_grid, write_vdb};
-use crate::mesh::{GridFit, Mesh, fit_transform, index_box};
+use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::{BooleanOp, combine};
 use crate::ops::measure::SolidMeasures;
 use crate::ops::solid::{FloodMethod, solid_from_surface};
-use crate::ops::solid_leaves::{ALL_DIRECTIONS, mesh_solid};
-use crate::subd::ControlMesh;
+use crate::ops::solid_leaves::ALL_DIRECTIONS;
+use crate::pipeline::{
+    ColorChoice, Details, Fill, Job, Limits, MeshSource, Outcome, SurfaceMethod as PipelineSurface,
+    Task,
+};
+use crate::progress::Observer;
 use crate::voxelize::Separability;
 use crate::voxelize::depth_layers::{DIRECTIONS, DepthLayerOptions, Layers};
-use crate::voxelize::interval_octree::{OctreeOptions, progress_total, voxelize_implicit};
-use crate::voxelize::parametric::{ParametricOptions, voxelize_subdivision};
-use crate::voxelize::projective::beam::beam_solid;
-use crate::voxelize::projective::{self, Coloring, LineSource};
-use crate::voxelize::separating::{self, Criterion, SeparatingOptions, voxelize_mesh, work_items};
+use crate::voxelize::parametric::ParametricOptions;
+use crate::voxelize::separating::{Criterion, SeparatingOptions};
 use glam::DVec3;
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::ffi::{CStr, CString, c_char, c_int, c_void};
-use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
+use std::ops::ControlFlow;
+use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicI32, AtomicU64, Ordering};
 use std::sync::{LazyLock, Mutex};
@@ -77,8 +79,20 @@ pub type VkProgressFn = extern "C" fn(done: u64, total: u64, user_data: *mut c_v
 
 /// `vk_mesh`.
 pub struct VkMesh(Mesh);
-/// `vk_grid`.
-pub struct VkGrid(SparseGrid);
+/// `vk_grid`: a grid and the `.vdb` metadata of the job that made it.
+pub struct VkGrid {
+    grid: SparseGrid,
+    metadata: Vec<(String, String)>,
+}
+
+impl From<Outcome> for VkGrid {
+    fn from(outcome: Outcome) -> Self {
+        VkGrid {
+            grid: outcome.grid,
+            metadata: outcome.metadata,
+        }
+    }
+}
 /// `vk_options`.
 pub struct VkOptions(Options);
 
@@ -107,6 +121,7 @@ struct Options {
     depth: DepthLayerOptions,
     subdivision: ParametricOptions,
     threads: u32,
+    max_memory: Option<u64>,
     progress: Option<(VkProgressFn, *mut c_void)>,
     cancel: *const AtomicI32,
 }
@@ -124,6 +139,7 @@ impl Default for Options {
             depth: ALL_DIRECTIONS,
             subdivision: ParametricOptions::default(),
             threads: 0,
+            max_memory: None,
             progress: None,
             cancel: std::ptr::null(),
         }
@@ -155,13 +171,14 @@ impl From<Error> for Failure {
             Error::BadFace { .. } | Error::EmptyMesh { .. } => VkStatus::BadMesh,
             Error::TooLarge { .. } => VkStatus::TooLarge,
             Error::Vdb { .. } => VkStatus::Vdb,
+            Error::Cancelled => VkStatus::Cancelled,
             _ => VkStatus::InvalidArgument,
         };
         Failure::new(status, e.to_string())
     }
 }
 
-type Outcome = std::result::Result<(), Failure>;
+type Status = std::result::Result<(), Failure>;
 
 thread_local! {
     static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
@@ -172,25 +189,18 @@ fn set_last_error(message: &str) {
     LAST_ERROR.with(|e| *e.borrow_mut() = text);
 }
 
-/// The payload of a cancelled call's unwind.
-struct Cancelled;
-
 /// Runs an export's body: no panic escapes, the message is kept, the status returned.
-fn guard(body: impl FnOnce() -> Outcome) -> VkStatus {
+fn guard(body: impl FnOnce() -> Status) -> VkStatus {
     let outcome = catch_unwind(AssertUnwindSafe(body)).unwrap_or_else(|payload| {
-        Err(if payload.is::<Cancelled>() {
-            Failure::new(VkStatus::Cancelled, "cancelled")
-        } else {
-            let what = payload
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "unknown panic".into());
-            Failure::new(
-                VkStatus::Internal,
-                format!("internal error (a bug in voxelkit, please report it): {what}"),
-            )
-        })
+        let what = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".into());
+        Err(Failure::new(
+            VkStatus::Internal,
+            format!("internal error (a bug in voxelkit, please report it): {what}"),
+        ))
     });
     match outcome {
         Ok(()) => {
@@ -231,7 +241,7 @@ fn live() -> std::sync::MutexGuard<'static, HashMap<usize, Kind>> {
 }
 
 /// Moves `value` to the heap, registers it and writes the handle to `out`.
-fn hand_out<T>(value: T, kind: Kind, out: *mut *mut T) -> Outcome {
+fn hand_out<T>(value: T, kind: Kind, out: *mut *mut T) -> Status {
     let out = non_null_out(out)?;
     let p = Box::into_raw(Box::new(value));
     live().insert(p as usize, kind);
@@ -270,7 +280,7 @@ fn borrow<'a, T>(p: *const T, kind: Kind) -> std::result::Result<&'a T, Failure>
 }
 
 /// Releases a handle of `kind`; NULL is fine, anything not live is an error.
-fn release<T>(p: *mut T, kind: Kind) -> Outcome {
+fn release<T>(p: *mut T, kind: Kind) -> Status {
     if p.is_null() {
         return Ok(());
     }
@@ -301,7 +311,7 @@ fn non_null_out<T>(out: *mut T) -> std::result::Result<*mut T, Failure> {
 }
 
 /// Writes `value` through a non-null output pointer.
-fn put<T>(out: *mut T, value: T) -> Outcome {
+fn put<T>(out: *mut T, value: T) -> Status {
     let out = non_null_out(out)?;
     // SAFETY: non-null and writable by the header's contract.
     unsafe { out.write(value) };
@@ -358,9 +368,10 @@ fn invalid(message: impl Into<String>) -> Failure {
     Failure::new(VkStatus::InvalidArgument, message)
 }
 
-/// Progress reporting and cancellation for one call.
+/// Progress reporting and cancellation for one call: the caller's callback and cancel flag
+/// as an observer, so that cancelling stops the workers without unwinding.
 struct Reporter {
-    total: u64,
+    total: AtomicU64,
     done: AtomicU64,
     callback: Option<(VkProgressFn, *mut c_void)>,
     cancel: *const AtomicI32,
@@ -375,9 +386,9 @@ struct Reporter {
 unsafe impl Sync for Reporter {}
 
 impl Reporter {
-    fn new(options: &Options, total: u64) -> Self {
+    fn new(options: &Options) -> Self {
         Reporter {
-            total,
+            total: AtomicU64::new(0),
             done: AtomicU64::new(0),
             callback: options.progress,
             cancel: options.cancel,
@@ -395,78 +406,76 @@ impl Reporter {
     /// Tells the callback the work is done (item counts are estimates for some methods).
     fn finish(&self) {
         if let Some((callback, user)) = self.callback {
-            callback(self.total, self.total, user);
-        }
-    }
-
-    fn advance(&self, n: u64) {
-        let done = self.done.fetch_add(n, Ordering::Relaxed) + n;
-        if let Some((callback, user)) = self.callback
-            && let Ok(_one_at_a_time) = self.calling.try_lock()
-            && callback(done.min(self.total), self.total, user) != 0
-        {
-            self.stop.store(true, Ordering::Relaxed);
-        }
-        if self.cancelled() {
-            resume_unwind(Box::new(Cancelled));
+            let total = self.total.load(Ordering::Relaxed);
+            let _one_at_a_time = self.calling.lock();
+            callback(total, total, user);
         }
     }
 }
 
-/// Runs `work` with the options' threads, progress and cancel flag.
-fn run<T: Send>(
-    options: &Options,
-    total: u64,
-    work: impl FnOnce(&(dyn Fn(u64) + Sync)) -> crate::Result<T> + Send,
-) -> std::result::Result<T, Failure> {
-    let reporter = Reporter::new(options, total);
+impl Observer for Reporter {
+    fn stage(&self, _name: &str, total: u64) {
+        self.total.store(total, Ordering::Relaxed);
+        self.done.store(0, Ordering::Relaxed);
+    }
+
+    fn advance(&self, n: u64) -> ControlFlow<()> {
+        let done = self.done.fetch_add(n, Ordering::Relaxed) + n;
+        let total = self.total.load(Ordering::Relaxed);
+        if let Some((callback, user)) = self.callback
+            && let Ok(_one_at_a_time) = self.calling.try_lock()
+            && callback(done.min(total), total, user) != 0
+        {
+            self.stop.store(true, Ordering::Relaxed);
+        }
+        if self.cancelled() {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+}
+
+/// Runs `task` as a job with the options' grid, threads, memory limit, progress and cancel
+/// flag.
+fn run_job(options: &Options, task: Task) -> std::result::Result<Outcome, Failure> {
+    let reporter = Reporter::new(options);
     if reporter.cancelled() {
         return Err(Failure::new(
             VkStatus::Cancelled,
             "cancelled before it started",
         ));
     }
-    let advance = |n: u64| reporter.advance(n);
-    let result = if options.threads == 0 {
-        work(&advance)
-    } else {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(options.threads as usize)
-            .build()
-            .map_err(|e| invalid(format!("cannot start {} threads: {e}", options.threads)))?
-            .install(|| work(&advance))
-    }?;
+    let job = Job {
+        task,
+        fit: options.fit,
+        limits: Limits {
+            threads: (options.threads > 0).then_some(options.threads as usize),
+            max_memory: options.max_memory,
+        },
+    };
+    let outcome = job.run(&reporter)?;
     reporter.finish();
-    Ok(result)
+    Ok(outcome)
 }
 
-fn fitted(mesh: &Mesh, options: &Options) -> std::result::Result<crate::grid::Transform, Failure> {
-    Ok(fit_transform(&mesh.bbox(), options.fit)?)
+/// The mesh of a handle, as a job's source.
+fn mesh_source(mesh: *const VkMesh) -> std::result::Result<MeshSource, Failure> {
+    Ok(MeshSource::Mesh(borrow(mesh, Kind::Mesh)?.0.clone()))
 }
 
-/// Refuses work whose estimated memory exceeds what is available.
-fn check_memory(mesh: &Mesh, bytes: u64) -> Outcome {
-    Ok(crate::system::check_fits(
-        bytes,
-        None,
-        &format!("{}; lower the resolution", mesh.source.display()),
-    )?)
-}
-
-/// The common shape of an export that makes a grid from a mesh: checked handles and output,
-/// then `make`.
-fn grid_from_mesh(
-    mesh: *const VkMesh,
+/// The common shape of an export that makes a grid: checked options and output, then the
+/// job `task` makes.
+fn grid_from_job(
     options: *const VkOptions,
     out: *mut *mut VkGrid,
-    make: impl FnOnce(&Mesh, &Options) -> std::result::Result<SparseGrid, Failure>,
+    task: impl FnOnce(&Options) -> std::result::Result<Task, Failure>,
 ) -> VkStatus {
     guard(|| {
-        let m = &borrow(mesh, Kind::Mesh)?.0;
         let o = &borrow(options, Kind::Options)?.0;
         non_null_out(out)?;
-        let grid = make(m, o)?;
-        hand_out(VkGrid(grid), Kind::Grid, out)
+        let outcome = run_job(o, task(o)?)?;
+        hand_out(VkGrid::from(outcome), Kind::Grid, out)
     })
 }
 
@@ -713,6 +722,14 @@ pub extern "C" fn vk_options_set_threads(options: *mut VkOptions, threads: u32) 
 }
 
 #[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_max_memory(options: *mut VkOptions, mib: u64) -> VkStatus {
+    guard(|| {
+        options_mut(options)?.max_memory = (mib > 0).then(|| mib.saturating_mul(1 << 20));
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_progress(
     options: *mut VkOptions,
     callback: Option<VkProgressFn>,
@@ -742,28 +759,18 @@ pub extern "C" fn vk_voxelize_mesh(
     options: *const VkOptions,
     out: *mut *mut VkGrid,
 ) -> VkStatus {
-    grid_from_mesh(mesh, options, out, |m, o| {
-        m.validate()?;
-        let t = fitted(m, o)?;
-        Ok(match o.surface {
-            SurfaceMethod::Separating => {
-                let opts = SeparatingOptions {
-                    separability: o.separability,
-                    criterion: o.criterion,
-                    normals: o.normals,
-                };
-                check_memory(m, separating::estimate_bytes(m, &t, &opts))?;
-                run(o, work_items(m), |p| voxelize_mesh(m, t, &opts, p))?.0
-            }
-            SurfaceMethod::Projective => {
-                let coloring = Coloring::of(m);
-                check_memory(m, projective::estimate_bytes(m, &t, coloring, None))?;
-                let faces = m.face_count() as u64;
-                run(o, faces, |p| {
-                    projective::voxelize_triangles(m, t, coloring, p)
-                })?
-                .0
-            }
+    grid_from_job(options, out, |o| {
+        let method = match o.surface {
+            SurfaceMethod::Separating => PipelineSurface::Separating(SeparatingOptions {
+                separability: o.separability,
+                criterion: o.criterion,
+                normals: o.normals,
+            }),
+            SurfaceMethod::Projective => PipelineSurface::Projective(ColorChoice::FromMesh),
+        };
+        Ok(Task::MeshSurface {
+            mesh: mesh_source(mesh)?,
+            method,
         })
     })
 }
@@ -774,19 +781,12 @@ pub extern "C" fn vk_voxelize_lines(
     options: *const VkOptions,
     out: *mut *mut VkGrid,
 ) -> VkStatus {
-    grid_from_mesh(mesh, options, out, |m, o| {
-        let source = LineSource {
-            polylines: true,
-            edges: m.polylines.is_empty(),
-        };
-        let coloring = Coloring::of(m);
-        let t = fitted(m, o)?;
-        check_memory(m, projective::estimate_bytes(m, &t, coloring, Some(source)))?;
-        let total = projective::line_segments(m, source).len() as u64;
-        let (grid, _) = run(o, total, |p| {
-            projective::voxelize_lines(m, t, source, coloring, p)
-        })?;
-        Ok(grid)
+    grid_from_job(options, out, |_| {
+        Ok(Task::Lines {
+            mesh: mesh_source(mesh)?,
+            edges: false,
+            color: ColorChoice::FromMesh,
+        })
     })
 }
 
@@ -796,16 +796,14 @@ pub extern "C" fn vk_voxelize_subdivision(
     options: *const VkOptions,
     out: *mut *mut VkGrid,
 ) -> VkStatus {
-    grid_from_mesh(mesh, options, out, |m, o| {
-        let control = ControlMesh::from_mesh(m)?;
-        let t = fit_transform(&control.bbox(), o.fit)?;
-        check_memory(m, crate::voxelize::parametric::estimate_bytes(&control, &t))?;
-        let opts = ParametricOptions {
-            adjacency: o.separability.flood_adjacency(),
-            ..o.subdivision
-        };
-        let total = control.patch_count() as u64;
-        Ok(run(o, total, |p| voxelize_subdivision(&control, t, &opts, p))?.surface)
+    grid_from_job(options, out, |o| {
+        Ok(Task::Subdivision {
+            mesh: mesh_source(mesh)?,
+            options: ParametricOptions {
+                adjacency: o.separability.flood_adjacency(),
+                ..o.subdivision
+            },
+        })
     })
 }
 
@@ -818,30 +816,28 @@ pub extern "C" fn vk_voxelize_formula(
     options: *const VkOptions,
     out: *mut *mut VkGrid,
 ) -> VkStatus {
-    guard(|| {
-        let o = &borrow(options, Kind::Options)?.0;
-        non_null_out(out)?;
+    grid_from_job(options, out, |_| {
         let coordinates = match coordinates {
             0 => Coordinates::Cartesian,
             1 => Coordinates::Spherical,
             2 => Coordinates::Cylindrical,
             _ => return Err(invalid(format!("unknown vk_coordinates {coordinates}"))),
         };
-        let formula = Formula::parse(c_str(formula, "formula")?, coordinates)?;
         let min = DVec3::from_slice(slice(bounds_min, 3, "bounds_min")?);
         let max = DVec3::from_slice(slice(bounds_max, 3, "bounds_max")?);
-        let resolution = match o.fit {
-            GridFit::Resolution(r) => r,
-            GridFit::VoxelSize(h) => ((max - min).max_element() / h).ceil().min(65536.0) as u32,
-        };
-        let opts = OctreeOptions {
-            resolution,
-            ..Default::default()
-        };
-        let output = run(o, progress_total(&opts), |p| {
-            voxelize_implicit(&formula, min, max, &opts, p)
-        })?;
-        hand_out(VkGrid(output.surface), Kind::Grid, out)
+        if !(min.is_finite() && max.is_finite()) {
+            return Err(invalid(format!(
+                "the bounds {min} .. {max} must be finite numbers"
+            )));
+        }
+        Ok(Task::Implicit {
+            formula: c_str(formula, "formula")?.to_string(),
+            coordinates,
+            min,
+            max,
+            levels: false,
+            negative_r: false,
+        })
     })
 }
 
@@ -853,56 +849,45 @@ pub extern "C" fn vk_fill_mesh(
     measures: *mut VkMeasures,
 ) -> VkStatus {
     guard(|| {
-        let m = &borrow(mesh, Kind::Mesh)?.0;
         let o = &borrow(options, Kind::Options)?.0;
         non_null_out(solid)?;
-        m.validate()?;
-        let t = fitted(m, o)?;
-        let (grid, found) = match o.fill {
-            FillMethod::Flood => {
-                m.require_closed("the exterior flood would leak through it")?;
-                let opts = SeparatingOptions {
-                    separability: Separability::TwentySix,
-                    ..Default::default()
-                };
-                check_memory(m, separating::estimate_bytes(m, &t, &opts))?;
-                let flood = o.flood;
-                let (surface, inside) = run(o, work_items(m), |p| {
-                    let (surface, _) = voxelize_mesh(m, t, &opts, p)?;
-                    let solid = solid_from_surface(&surface, flood)?;
-                    Ok((surface, solid))
-                })?;
-                let mut whole = surface;
-                whole.union(&inside.inside);
-                (whole, inside.measures.into())
+        let fill = match o.fill {
+            FillMethod::Flood => Fill::Flood(o.flood),
+            FillMethod::DepthLayers => Fill::DepthLayers(o.depth),
+            FillMethod::Beam => Fill::Beam,
+        };
+        let task = Task::Solid {
+            mesh: mesh_source(mesh)?,
+            fill,
+            density: 1.0,
+        };
+        let outcome = run_job(o, task)?;
+        let found = match &outcome.report.details {
+            Details::Solid(s) => VkMeasures {
+                inside_voxels: s.inside_voxels,
+                surface_voxels: s.surface_voxels,
+                volume_inside: s.volume_inside,
+                volume_with_surface: s.volume_with_surface,
+            },
+            Details::DepthLayers(d) if d.unclassified_voxels > 0 => {
+                return Err(invalid(format!(
+                    "{} voxels cannot be classified by depth layers (crossed more than four times \
+                     along every direction, or on rays that cross an open mesh an odd number of times)",
+                    d.unclassified_voxels
+                )));
             }
-            FillMethod::Beam => {
-                let faces = m.face_count() as u64;
-                let (surface, inside, _) = run(o, faces, |p| beam_solid(m, t, p))?;
-                let mut whole = surface;
-                whole.union(&inside.inside);
-                (whole, inside.measures.into())
-            }
-            FillMethod::DepthLayers => {
-                let depth = o.depth;
-                let inside: DenseMask = run(o, 0, |_| {
-                    mesh_solid(m, &t, index_box(&m.bbox(), &t), &depth)
-                })?;
-                let count = inside.count();
-                let volume = count as f64 * t.voxel_size.powi(3);
-                let found = VkMeasures {
-                    inside_voxels: count,
-                    surface_voxels: 0,
-                    volume_inside: volume,
-                    volume_with_surface: volume,
-                };
-                (inside.to_grid(t), found)
-            }
+            Details::DepthLayers(d) => VkMeasures {
+                inside_voxels: d.inside_voxels,
+                surface_voxels: 0,
+                volume_inside: d.volume,
+                volume_with_surface: d.volume,
+            },
+            _ => unreachable!("a solid job reports a solid"),
         };
         if !measures.is_null() {
             put(measures, found)?;
         }
-        hand_out(VkGrid(grid), Kind::Grid, solid)
+        hand_out(VkGrid::from(outcome), Kind::Grid, solid)
     })
 }
 
@@ -912,7 +897,7 @@ pub extern "C" fn vk_measure_surface(
     measures: *mut VkMeasures,
 ) -> VkStatus {
     guard(|| {
-        let g = &borrow(surface, Kind::Grid)?.0;
+        let g = &borrow(surface, Kind::Grid)?.grid;
         non_null_out(measures)?;
         let solid = solid_from_surface(g, FloodMethod::Spans)?;
         put(measures, solid.measures.into())
@@ -928,7 +913,7 @@ pub extern "C" fn vk_grid_combine(
     out: *mut *mut VkGrid,
 ) -> VkStatus {
     guard(|| {
-        let (a, b) = (&borrow(a, Kind::Grid)?.0, &borrow(b, Kind::Grid)?.0);
+        let (a, b) = (&borrow(a, Kind::Grid)?.grid, &borrow(b, Kind::Grid)?.grid);
         non_null_out(out)?;
         let op = match op {
             0 => BooleanOp::Union,
@@ -937,7 +922,8 @@ pub extern "C" fn vk_grid_combine(
             _ => return Err(invalid(format!("unknown vk_boolean {op}"))),
         };
         let grid = combine(a, b, op, resample != 0)?;
-        hand_out(VkGrid(grid), Kind::Grid, out)
+        let metadata = vec![("method".to_string(), format!("{op:?}").to_lowercase())];
+        hand_out(VkGrid { grid, metadata }, Kind::Grid, out)
     })
 }
 
@@ -954,25 +940,31 @@ pub extern "C" fn vk_grid_read_vdb(
         } else {
             Some(c_str(name, "name")?)
         };
-        let grid = read_vdb_grid(&PathBuf::from(c_str(path, "path")?), name)?;
-        hand_out(VkGrid(grid), Kind::Grid, out)
+        let path = PathBuf::from(c_str(path, "path")?);
+        let grid = read_vdb_grid(&path, name)?;
+        let metadata = vec![("source_file".to_string(), path.display().to_string())];
+        hand_out(VkGrid { grid, metadata }, Kind::Grid, out)
     })
 }
 
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_grid_write_vdb(grid: *const VkGrid, path: *const c_char) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.0;
+        let g = borrow(grid, Kind::Grid)?;
         let path = PathBuf::from(c_str(path, "path")?);
-        let meta = [("source", "voxelkit C API".to_string())];
-        Ok(write_vdb(&path, g, &meta)?)
+        let meta: Vec<(&str, String)> = g
+            .metadata
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.clone()))
+            .collect();
+        Ok(write_vdb(&path, &g.grid, &meta)?)
     })
 }
 
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_grid_voxel_count(grid: *const VkGrid, count: *mut u64) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.0;
+        let g = &borrow(grid, Kind::Grid)?.grid;
         put(count, g.voxel_count())
     })
 }
@@ -980,7 +972,7 @@ pub extern "C" fn vk_grid_voxel_count(grid: *const VkGrid, count: *mut u64) -> V
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_grid_leaf_count(grid: *const VkGrid, count: *mut usize) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.0;
+        let g = &borrow(grid, Kind::Grid)?.grid;
         put(count, g.leaf_count())
     })
 }
@@ -992,7 +984,7 @@ pub extern "C" fn vk_grid_transform(
     origin: *mut f64,
 ) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.0;
+        let g = &borrow(grid, Kind::Grid)?.grid;
         non_null_out(voxel_size)?;
         let o = slice_mut(origin, 3, "origin")?;
         o.copy_from_slice(&g.transform.origin.to_array());
@@ -1024,7 +1016,7 @@ pub extern "C" fn vk_grid_copy_leaves(
     masks: *mut u64,
 ) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.0;
+        let g = &borrow(grid, Kind::Grid)?.grid;
         let leaves = leaf_range(g, first, count)?;
         let origins = slice_mut(origins, 3 * count, "origins")?;
         let masks = slice_mut(masks, 8 * count, "masks")?;
@@ -1057,7 +1049,7 @@ fn copy_channel(
     channel: fn(&crate::grid::Leaf) -> Option<&[[f32; 3]; LEAF_VOXELS]>,
 ) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.0;
+        let g = &borrow(grid, Kind::Grid)?.grid;
         let leaves = leaf_range(g, first, count)?;
         let out = slice_mut(out, 3 * LEAF_VOXELS * count, name)?;
         for (k, leaf) in leaves.iter().enumerate() {
@@ -1103,7 +1095,7 @@ pub extern "C" fn vk_grid_copy_voxels(
     written: *mut usize,
 ) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.0;
+        let g = &borrow(grid, Kind::Grid)?.grid;
         non_null_out(written)?;
         let n = g.voxel_count() as usize;
         put(written, n)?;

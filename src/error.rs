@@ -55,11 +55,25 @@ pub enum Error {
     },
     #[error("{0}")]
     Unsupported(String),
+    /// The observer asked the work to stop; nothing was kept.
+    #[error("cancelled")]
+    Cancelled,
 }
 
 pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {
+    /// The file and the line (or face) the error is about, where it has them.
+    pub fn location(&self) -> (Option<&std::path::Path>, Option<usize>) {
+        match self {
+            Error::Io { path, .. } | Error::Vdb { path, .. } => (Some(path), None),
+            Error::EmptyMesh { path, .. } | Error::UnsupportedFormat { path } => (Some(path), None),
+            Error::Parse { path, line, .. } => (Some(path), (*line > 0).then_some(*line)),
+            Error::BadFace { path, .. } => (Some(path), None),
+            _ => (None, None),
+        }
+    }
+
     pub(crate) fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {
             path: path.into(),

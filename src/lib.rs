@@ -9,6 +9,9 @@ pub mod implicit;
 pub mod io;
 pub mod mesh;
 pub mod ops;
+#[cfg(feature = "vdb")]
+pub mod pipeline;
+pub mod progress;
 pub mod subd;
 pub mod system;
 pub mod voxelize;

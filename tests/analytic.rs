@@ -13,7 +13,14 @@ use voxelkit::voxelize::separating_analytic::{
 fn check(surface: &dyn AnalyticSurface, transform: Transform, pad: i64) {
     for sep in [Separability::Six, Separability::TwentySix] {
         let adjacency = sep.flood_adjacency();
-        let grid = voxelize_surface(surface, transform, sep, true, &|_| {});
+        let grid = voxelize_surface(
+            surface,
+            transform,
+            sep,
+            true,
+            &voxelkit::progress::Progress::none(),
+        )
+        .unwrap();
         let b = surface.bbox();
         let bbox = CoordBox {
             min: transform.world_to_voxel(b.min).map(|v| v - pad),

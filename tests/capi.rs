@@ -28,13 +28,6 @@ fn run(cmd: &mut Command) -> Output {
     out
 }
 
-fn loud_skip(what: &str) {
-    let _ = std::io::Write::write_all(
-        &mut std::io::stderr(),
-        format!("\n!!! {what}: SKIPPED\n").as_bytes(),
-    );
-}
-
 fn have(tool: &str) -> bool {
     Command::new(tool)
         .arg("--version")
@@ -77,17 +70,22 @@ fn field(text: &str, key: &str) -> u64 {
 #[test]
 fn the_cpp_example_builds_with_werror_static_and_shared_and_matches_the_rust_api() {
     if !have("cmake") {
-        return loud_skip("cmake is not installed: the C++ example test");
+        return common::skip_or_fail("cmake is not installed: the C++ example test");
     }
     let work = tempfile::tempdir().unwrap();
     let mesh_path = test_mesh(work.path());
     let resolution = 128;
     let mesh = Mesh::load(&mesh_path).unwrap();
     let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
-    let expected = voxelize_mesh(&mesh, t, &SeparatingOptions::default(), &|_| {})
-        .unwrap()
-        .0
-        .voxel_count();
+    let expected = voxelize_mesh(
+        &mesh,
+        t,
+        &SeparatingOptions::default(),
+        &voxelkit::progress::Progress::none(),
+    )
+    .unwrap()
+    .0
+    .voxel_count();
     for (static_link, name) in [(false, "shared"), (true, "static")] {
         let build = work.path().join(name);
         run(Command::new("cmake")
@@ -128,14 +126,14 @@ fn the_cpp_example_builds_with_werror_static_and_shared_and_matches_the_rust_api
 #[test]
 fn the_c_smoke_test_passes_static_and_shared_and_runs_clean_under_valgrind() {
     if !have("pkg-config") || !have("gcc") {
-        return loud_skip("gcc or pkg-config is missing: the C smoke test");
+        return common::skip_or_fail("gcc or pkg-config is missing: the C smoke test");
     }
     let work = tempfile::tempdir().unwrap();
     let mesh_path = test_mesh(work.path());
     let pkg_config_path = prefix().join("lib/pkgconfig");
     let valgrind = have("valgrind");
     if !valgrind {
-        loud_skip("valgrind is not installed: the leak and invalid-read check");
+        common::skip_or_fail("valgrind is not installed: the leak and invalid-read check");
     }
     for package in ["voxelkit", "voxelkit-static"] {
         let flags = run(Command::new("pkg-config")

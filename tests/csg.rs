@@ -38,9 +38,14 @@ fn on_one_grid(meshes: &[Mesh], resolution: u32) -> (Vec<SparseGrid>, Transform)
     let grids = meshes
         .iter()
         .map(|m| {
-            voxelize_mesh(m, t, &SeparatingOptions::default(), &|_| {})
-                .unwrap()
-                .0
+            voxelize_mesh(
+                m,
+                t,
+                &SeparatingOptions::default(),
+                &voxelkit::progress::Progress::none(),
+            )
+            .unwrap()
+            .0
         })
         .collect();
     (grids, t)

@@ -24,7 +24,9 @@ fn surface(mesh: &Mesh, t: Transform) -> SparseGrid {
         separability: Separability::TwentySix,
         ..Default::default()
     };
-    voxelize_mesh(mesh, t, &options, &|_| {}).unwrap().0
+    voxelize_mesh(mesh, t, &options, &voxelkit::progress::Progress::none())
+        .unwrap()
+        .0
 }
 
 /// (classified voxels off the surface that disagree with the exact test, unclassified ones).

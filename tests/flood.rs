@@ -89,8 +89,13 @@ fn seeds_from_normals_fill_the_inside_of_a_voxelized_solid() {
     }
     for control in controls {
         let t = fit_transform(&control.polygon_mesh().bbox(), GridFit::Resolution(96)).unwrap();
-        let out =
-            voxelize_subdivision(&control, t, &ParametricOptions::default(), &|_| {}).unwrap();
+        let out = voxelize_subdivision(
+            &control,
+            t,
+            &ParametricOptions::default(),
+            &voxelkit::progress::Progress::none(),
+        )
+        .unwrap();
         let choice = seed_from_normals(&out.surface, &out.opposite, false).expect("a seed");
         let bbox = padded(out.surface.bbox().unwrap(), 2);
         let blocked = DenseMask::from_grid(&out.surface, bbox).unwrap();

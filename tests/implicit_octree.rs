@@ -81,8 +81,14 @@ fn surface_points_lie_in_output_voxels_at_every_resolution() {
                 both_signs: true,
                 ..Default::default()
             };
-            let out =
-                voxelize_implicit(&f, DVec3::splat(-1.0), DVec3::ONE, &options, &|_| {}).unwrap();
+            let out = voxelize_implicit(
+                &f,
+                DVec3::splat(-1.0),
+                DVec3::ONE,
+                &options,
+                &voxelkit::progress::Progress::none(),
+            )
+            .unwrap();
             let t = out.surface.transform;
             let missed: Vec<&DVec3> = points
                 .iter()
@@ -114,7 +120,14 @@ fn every_level_envelops_and_every_cell_has_its_parent() {
             levels: true,
             ..Default::default()
         };
-        let out = voxelize_implicit(&f, DVec3::splat(-1.0), DVec3::ONE, &options, &|_| {}).unwrap();
+        let out = voxelize_implicit(
+            &f,
+            DVec3::splat(-1.0),
+            DVec3::ONE,
+            &options,
+            &voxelkit::progress::Progress::none(),
+        )
+        .unwrap();
         assert_eq!(out.levels.len(), 8, "{name}: levels 0..=7");
         assert_eq!(out.levels[0].voxel_count(), 1);
         let finest = out.levels.last().unwrap();
@@ -145,7 +158,7 @@ fn normals_are_unit_gradients() {
         DVec3::splat(-1.0),
         DVec3::ONE,
         &OctreeOptions::default(),
-        &|_| {},
+        &voxelkit::progress::Progress::none(),
     )
     .unwrap();
     let t = out.surface.transform;

@@ -8,9 +8,8 @@ use voxelkit::grid::{Adjacency, DenseMask};
 use voxelkit::implicit::reference::reference_solids;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
 use voxelkit::ops::flood::{flood_from_border, padded};
-use voxelkit::ops::measure::{
-    components, euler_characteristic, measure_formula_solid, measure_solid,
-};
+use voxelkit::ops::measure::{measure_formula_solid, measure_solid};
+use voxelkit::ops::topology::{components, euler_characteristic};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 
@@ -21,7 +20,8 @@ fn solid(mesh: &Mesh, resolution: u32) -> (DenseMask, DenseMask, f64) {
         separability: Separability::TwentySix,
         ..Default::default()
     };
-    let (grid, _) = voxelize_mesh(mesh, t, &options, &|_| {}).unwrap();
+    let (grid, _) =
+        voxelize_mesh(mesh, t, &options, &voxelkit::progress::Progress::none()).unwrap();
     let bbox = padded(grid.bbox().unwrap(), 2);
     let surface = DenseMask::from_grid(&grid, bbox).unwrap();
     let exterior = flood_from_border(&surface, Adjacency::TwentySix).unwrap();
@@ -113,6 +113,72 @@ fn volume_and_area_of_exact_solids_converge() {
                 "{} {resolution}: area",
                 shape.name
             );
+        }
+    }
+}
+
+/// The definition, voxel by voxel: the lattice elements of every cube in hash sets.
+fn euler_by_elements(set: &DenseMask) -> i64 {
+    let mut elements: [std::collections::HashSet<[i64; 3]>; 4] = Default::default();
+    for i in set.ones() {
+        let at = set.coord(i);
+        for d in 0..27 {
+            let e = [2 * at[0] + d / 9, 2 * at[1] + d / 3 % 3, 2 * at[2] + d % 3];
+            elements[e.iter().filter(|&&v| v % 2 != 0).count()].insert(e);
+        }
+    }
+    elements[0].len() as i64 - elements[1].len() as i64 + elements[2].len() as i64
+        - elements[3].len() as i64
+}
+
+/// The definition of components: a flood per component through the adjacency's offsets.
+fn components_by_flood(set: &DenseMask, adjacency: Adjacency) -> u64 {
+    let mut seen = DenseMask::new(set.bbox).unwrap();
+    let mut count = 0;
+    for start in set.ones() {
+        if seen.get_index(start) {
+            continue;
+        }
+        count += 1;
+        seen.set_index(start);
+        let mut stack = vec![set.coord(start)];
+        while let Some(c) = stack.pop() {
+            for d in adjacency.offsets() {
+                let n = [c[0] + d[0], c[1] + d[1], c[2] + d[2]];
+                if set.bbox.contains(n) && set.get(n) && !seen.get(n) {
+                    seen.set(n);
+                    stack.push(n);
+                }
+            }
+        }
+    }
+    count
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+    /// The word-wise topology equals the definitions on random volumes, rows longer than a
+    /// word included.
+    #[test]
+    fn topology_matches_its_definition(
+        seed in 0u64..u64::MAX,
+        density in 0.05f64..0.95,
+        dims in (1i64..7, 1i64..7, 1i64..140),
+    ) {
+        let bbox = voxelkit::grid::CoordBox { min: [-3, 2, -70], max: [dims.0 - 4, dims.1 + 1, dims.2 - 71] };
+        let mut set = DenseMask::new(bbox).unwrap();
+        let mut state = seed | 1;
+        for i in 0..set.len() {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            if (state % 1000) as f64 / 1000.0 < density {
+                set.set_index(i);
+            }
+        }
+        proptest::prop_assert_eq!(euler_characteristic(&set), euler_by_elements(&set));
+        for adjacency in [Adjacency::Six, Adjacency::TwentySix] {
+            proptest::prop_assert_eq!(components(&set, adjacency), components_by_flood(&set, adjacency));
         }
     }
 }

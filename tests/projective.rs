@@ -264,7 +264,13 @@ fn mesh_voxels_are_the_union_of_the_triangles_with_the_nearest_sample_colour() {
         .map(|p| (p.as_vec3() + 1.0) * 0.5)
         .collect();
     let t = fit_transform(&mesh.bbox(), GridFit::Resolution(48)).unwrap();
-    let (grid, stats) = voxelize_triangles(&mesh, t, Coloring::Vertex, &|_| {}).unwrap();
+    let (grid, stats) = voxelize_triangles(
+        &mesh,
+        t,
+        Coloring::Vertex,
+        &voxelkit::progress::Progress::none(),
+    )
+    .unwrap();
     assert_eq!(stats.triangles, mesh.triangle_count() as u64);
     // The nearest sample of every voxel, scanned triangle by triangle.
     let mut nearest: HashMap<Voxel, (f64, Vec3)> = HashMap::new();
@@ -304,7 +310,8 @@ fn the_beam_solid_holds_the_exact_volume_of_spheres_tori_and_real_meshes() {
         let volume = mesh.signed_volume().abs();
         for res in [48, 128] {
             let t = fit_transform(&mesh.bbox(), GridFit::Resolution(res)).unwrap();
-            let (surface, solid, _) = beam_solid(mesh, t, &|_| {}).unwrap();
+            let (surface, solid, _) =
+                beam_solid(mesh, t, &voxelkit::progress::Progress::none()).unwrap();
             let m = solid.measures;
             assert_eq!(m.surface_voxels, surface.voxel_count());
             assert!(
@@ -331,7 +338,10 @@ fn the_beam_refuses_an_open_mesh() {
     };
     let mesh = Mesh::load(&data.join("meshes/cube_no_bottom.obj")).unwrap();
     let t = fit_transform(&mesh.bbox(), GridFit::Resolution(32)).unwrap();
-    let err = beam_solid(&mesh, t, &|_| {}).err().unwrap().to_string();
+    let err = beam_solid(&mesh, t, &voxelkit::progress::Progress::none())
+        .err()
+        .unwrap()
+        .to_string();
     assert!(
         err.contains("cube_no_bottom.obj") && err.contains("boundary edge"),
         "{err}"
@@ -356,7 +366,13 @@ fn the_projective_surface_separates_under_6_flooding_and_leaks_under_26() {
         let name = mesh.source.display().to_string();
         for res in [64, 128] {
             let t = fit_transform(&mesh.bbox(), GridFit::Resolution(res)).unwrap();
-            let (surface, _) = voxelize_triangles(&mesh, t, Coloring::None, &|_| {}).unwrap();
+            let (surface, _) = voxelize_triangles(
+                &mesh,
+                t,
+                Coloring::None,
+                &voxelkit::progress::Progress::none(),
+            )
+            .unwrap();
             let six = check_mesh_separation(&surface, &mesh, Adjacency::Six).unwrap();
             let all = check_mesh_separation(&surface, &mesh, Adjacency::TwentySix).unwrap();
             eprintln!(

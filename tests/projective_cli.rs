@@ -97,7 +97,14 @@ fn lines_and_projective_meshes_write_the_library_colours() {
         polylines: true,
         edges: false,
     };
-    let (grid, _) = voxelize_lines(&mesh, t, source, Coloring::Vertex, &|_| {}).unwrap();
+    let (grid, _) = voxelize_lines(
+        &mesh,
+        t,
+        source,
+        Coloring::Vertex,
+        &voxelkit::progress::Progress::none(),
+    )
+    .unwrap();
     assert_eq!(json_field(&out, "voxels"), grid.voxel_count() as f64);
     assert_same_colours(&p("helix.vdb"), &grid);
 
@@ -124,7 +131,13 @@ fn lines_and_projective_meshes_write_the_library_colours() {
     assert!(out.contains("vertex colours interpolated"), "{out}");
     let mesh = Mesh::load(&p("ball.obj")).unwrap();
     let t = fit_transform(&mesh.bbox(), GridFit::Resolution(80)).unwrap();
-    let (grid, _) = voxelize_triangles(&mesh, t, Coloring::Vertex, &|_| {}).unwrap();
+    let (grid, _) = voxelize_triangles(
+        &mesh,
+        t,
+        Coloring::Vertex,
+        &voxelkit::progress::Progress::none(),
+    )
+    .unwrap();
     assert_same_colours(&p("ball.vdb"), &grid);
 
     // A constant colour on every voxel; the edges of the same sphere as lines.

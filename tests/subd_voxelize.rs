@@ -43,7 +43,7 @@ fn voxelize(
         ..Default::default()
     };
     (
-        voxelize_subdivision(control, t, &options, &|_| {}).unwrap(),
+        voxelize_subdivision(control, t, &options, &voxelkit::progress::Progress::none()).unwrap(),
         t,
     )
 }
@@ -261,12 +261,24 @@ fn sheets_with_opposite_normals_in_one_voxel_are_marked() {
     let slab = generate::cuboid(DVec3::new(-1.0, -1.0, -0.004), DVec3::new(1.0, 1.0, 0.004));
     let control = ControlMesh::from_mesh(&slab).unwrap();
     let t = fit_transform(&slab.bbox(), GridFit::Resolution(32)).unwrap();
-    let thin = voxelize_subdivision(&control, t, &ParametricOptions::default(), &|_| {}).unwrap();
+    let thin = voxelize_subdivision(
+        &control,
+        t,
+        &ParametricOptions::default(),
+        &voxelkit::progress::Progress::none(),
+    )
+    .unwrap();
     assert!(thin.stats.opposite_voxels > 100, "{:?}", thin.stats);
     let thick = generate::cuboid(DVec3::splat(-1.0), DVec3::splat(1.0));
     let control = ControlMesh::from_mesh(&thick).unwrap();
     let t = fit_transform(&thick.bbox(), GridFit::Resolution(64)).unwrap();
-    let out = voxelize_subdivision(&control, t, &ParametricOptions::default(), &|_| {}).unwrap();
+    let out = voxelize_subdivision(
+        &control,
+        t,
+        &ParametricOptions::default(),
+        &voxelkit::progress::Progress::none(),
+    )
+    .unwrap();
     assert_eq!(out.stats.opposite_voxels, 0);
     // Normals point out of the cube: at the +x face the normal's x is near 1.
     let leaf_normals = out.surface.leaves().iter().flat_map(|l| {

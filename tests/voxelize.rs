@@ -83,7 +83,7 @@ fn class_counts_of_a_box_on_voxel_centres_are_exact() {
         normals: false,
         ..Default::default()
     };
-    let (g, stats) = voxelize_mesh(&mesh, t, &opts, &|_| {}).unwrap();
+    let (g, stats) = voxelize_mesh(&mesh, t, &opts, &voxelkit::progress::Progress::none()).unwrap();
     assert_eq!((stats.vertices, stats.edges, stats.triangles), (8, 12, 12));
     assert_eq!(stats.vertex_voxels, 8);
     assert_eq!(stats.edge_voxels, 12 * 39);

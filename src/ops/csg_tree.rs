@@ -55,6 +55,36 @@ pub struct CsgTree {
     pub source: PathBuf,
 }
 
+impl CsgTree {
+    /// Nodes of the tree: leaves and Booleans.
+    pub fn node_count(&self) -> usize {
+        fn count(node: &CsgNode) -> usize {
+            match node {
+                CsgNode::Boolean { operands, .. } => 1 + operands.iter().map(count).sum::<usize>(),
+                _ => 1,
+            }
+        }
+        count(&self.root)
+    }
+
+    /// The files the tree was read from: the tree file, its meshes and its grids.
+    pub fn input_files(&self) -> Vec<PathBuf> {
+        fn collect(node: &CsgNode, files: &mut Vec<PathBuf>) {
+            match node {
+                CsgNode::Boolean { operands, .. } => {
+                    operands.iter().for_each(|n| collect(n, files));
+                }
+                CsgNode::Mesh(mesh) => files.push(mesh.source.clone()),
+                CsgNode::Grid { source, .. } => files.push(source.clone()),
+                CsgNode::Primitive(_) | CsgNode::Formula { .. } => {}
+            }
+        }
+        let mut files = vec![self.source.clone()];
+        collect(&self.root, &mut files);
+        files
+    }
+}
+
 /// A leaf's share of the result, for the summary.
 pub struct LeafReport {
     pub what: String,

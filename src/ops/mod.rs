@@ -15,3 +15,4 @@ pub mod separability;
 pub mod solid;
 pub mod solid_leaves;
 pub mod surface_area;
+pub mod topology;

@@ -9,7 +9,7 @@
 //! before being bounded with θ in [-π, π]. Normals are the normalized Cartesian gradient of F at
 //! voxel centres (forward-mode through the coordinate conversion).
 
-use super::sink::Progress;
+use super::Progress;
 use crate::error::{Error, Result};
 use crate::grid::{Channels, Coord, SparseGrid, Transform};
 use crate::implicit::{BoxTest, Dual, Formula, Interval, test_box};
@@ -65,7 +65,7 @@ pub fn voxelize_implicit(
     min: DVec3,
     max: DVec3,
     options: &OctreeOptions,
-    progress: Progress,
+    progress: &Progress,
 ) -> Result<OctreeOutput> {
     let extent = (max - min).max_element();
     if !(extent.is_finite() && extent > 0.0 && (max - min).min_element() > 0.0) {
@@ -101,18 +101,22 @@ pub fn voxelize_implicit(
         }
         frontier = next;
     }
-    progress(8u64.pow(top_level) - frontier.len() as u64);
+    progress.advance(8u64.pow(top_level) - frontier.len() as u64);
     let parts = frontier
         .par_iter()
         .fold(
             || Partial::new(&run),
             |mut part, &(level, c)| {
-                run.descend(level, c, &mut part);
-                progress(1);
+                // Once cancelled, the remaining subtrees are skipped.
+                if !progress.stopped() {
+                    run.descend(level, c, &mut part);
+                    progress.advance(1);
+                }
                 part
             },
         )
         .reduce(|| Partial::new(&run), Partial::merge);
+    progress.check()?;
     let mut all = top.merge(parts);
     all.stats.depth = depth;
     all.stats.voxels = all.surface.voxel_count();

@@ -9,7 +9,7 @@ pub mod separating_analytic;
 pub mod sign_change;
 mod sink;
 
-pub use sink::Progress;
+pub use crate::progress::Progress;
 
 use glam::DVec3;
 

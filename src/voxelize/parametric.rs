@@ -24,7 +24,7 @@
 //! whatever N; every output voxel holds an evaluated surface point (eq. 4) or lies within
 //! `ENCLOSE_TOLERANCE` of one. The result blocks 26-paths.
 
-use super::sink::Progress;
+use super::Progress;
 use crate::error::Result;
 use crate::grid::{Adjacency, Channels, Coord, Leaf, SparseGrid, Transform};
 use crate::subd::{ControlMesh, LimitSample, LimitSurface};
@@ -100,7 +100,7 @@ pub fn voxelize_subdivision(
     control: &ControlMesh,
     transform: Transform,
     options: &ParametricOptions,
-    progress: Progress,
+    progress: &Progress,
 ) -> Result<ParametricOutput> {
     if options.presplit == 0 {
         return Err(crate::Error::InvalidArgument(
@@ -128,8 +128,11 @@ pub fn voxelize_subdivision(
         .fold(
             || Partial::new(transform, channels),
             |mut part, pid| {
-                run.patch(pid, &mut part);
-                progress(1);
+                // Once cancelled, the remaining patches are skipped.
+                if !progress.stopped() {
+                    run.patch(pid, &mut part);
+                    progress.advance(1);
+                }
                 part
             },
         )
@@ -144,6 +147,7 @@ pub fn voxelize_subdivision(
             },
             merge_partials,
         );
+    progress.check()?;
     stats.area *= transform.voxel_size * transform.voxel_size;
     stats.patches = surface.patch_count() as u64;
     stats.voxels = grid.voxel_count();

@@ -157,7 +157,7 @@ pub fn voxelize_triangles(
     mesh: &Mesh,
     transform: Transform,
     coloring: Coloring,
-    progress: Progress,
+    progress: &Progress,
 ) -> Result<(SparseGrid, ProjectiveStats)> {
     let pos = index_positions(mesh, &transform);
     let degenerate = AtomicU64::new(0);
@@ -172,6 +172,7 @@ pub fn voxelize_triangles(
         ),
         Some(colors) => scan_faces(mesh, &pos, &colors, transform, &degenerate, progress),
     };
+    progress.check()?;
     let stats = ProjectiveStats {
         triangles: mesh.triangle_count() as u64,
         degenerate_triangles: degenerate.into_inner(),
@@ -188,7 +189,7 @@ fn scan_faces<A: Deposit>(
     attrs: &[A],
     transform: Transform,
     degenerate: &AtomicU64,
-    progress: Progress,
+    progress: &Progress,
 ) -> SparseGrid {
     voxelize_indexed(
         mesh.face_count(),
@@ -245,7 +246,7 @@ pub fn voxelize_lines(
     transform: Transform,
     source: LineSource,
     coloring: Coloring,
-    progress: Progress,
+    progress: &Progress,
 ) -> Result<(SparseGrid, ProjectiveStats)> {
     let segments = line_segments(mesh, source);
     if segments.is_empty() {
@@ -267,6 +268,7 @@ pub fn voxelize_lines(
         None => scan_segments(&segments, &pos, &vec![(); pos.len()], transform, progress),
         Some(colors) => scan_segments(&segments, &pos, &colors, transform, progress),
     };
+    progress.check()?;
     Ok((grid, stats))
 }
 
@@ -275,7 +277,7 @@ fn scan_segments<A: Deposit>(
     pos: &[DVec3],
     attrs: &[A],
     transform: Transform,
-    progress: Progress,
+    progress: &Progress,
 ) -> SparseGrid {
     voxelize_parallel(
         segments,

@@ -29,8 +29,9 @@
 //! - Class counts follow the paper's order: vertex first, then edge, then body; each voxel
 //!   is counted once, so the three counts add up to the total.
 
+use super::Progress;
 use super::Separability;
-use super::sink::{Progress, Sink, merge_grids, nearest_channels, voxelize_parallel};
+use super::sink::{Sink, merge_grids, nearest_channels, voxelize_parallel};
 use crate::error::{Error, Result};
 use crate::grid::{SparseGrid, Transform};
 use crate::mesh::Mesh;
@@ -165,7 +166,7 @@ pub fn voxelize_mesh(
     mesh: &Mesh,
     transform: Transform,
     opts: &SeparatingOptions,
-    progress: Progress,
+    progress: &Progress,
 ) -> Result<(SparseGrid, SeparatingStats)> {
     mesh.validate()?;
     if !(transform.voxel_size > 0.0 && transform.voxel_size.is_finite()) {
@@ -208,6 +209,7 @@ pub fn voxelize_mesh(
     let body_grid = voxelize_parallel(&triangles, transform, channels, progress, |t, s| {
         face_body(t, sep, s)
     });
+    progress.check()?;
 
     let vertex_voxels = vertex_grid.voxel_count();
     let edge_only = count_outside(&edge_grid, &[&vertex_grid]);

@@ -19,8 +19,9 @@
 //! centre exceeds the block's radius plus `Rc`: the distance is 1-Lipschitz, so no voxel
 //! is lost by the culling.
 
+use super::Progress;
 use super::Separability;
-use super::sink::{Progress, nearest_channels, voxelize_parallel};
+use super::sink::{nearest_channels, voxelize_parallel};
 use crate::grid::{SparseGrid, Transform};
 use crate::mesh::Aabb;
 use glam::DVec3;
@@ -232,8 +233,8 @@ pub fn voxelize_surface(
     transform: Transform,
     separability: Separability,
     normals: bool,
-    progress: Progress,
-) -> SparseGrid {
+    progress: &Progress,
+) -> crate::Result<SparseGrid> {
     let bbox = surface.bbox();
     // The surface's voxels reach up to Rc < 1 voxel beyond its box.
     let lo = transform.world_to_voxel(bbox.min).map(|v| v - 1);
@@ -248,7 +249,7 @@ pub fn voxelize_surface(
         Separability::Six => 0.5 * turn,
         Separability::TwentySix => 1.5 * turn,
     };
-    voxelize_parallel(
+    let grid = voxelize_parallel(
         &blocks,
         transform,
         nearest_channels(normals),
@@ -275,7 +276,9 @@ pub fn voxelize_surface(
                 }
             }
         },
-    )
+    );
+    progress.check()?;
+    Ok(grid)
 }
 
 /// Origins of the 8^3 blocks covering `lo..=hi`.

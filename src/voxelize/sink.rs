@@ -3,11 +3,9 @@
 //! fold/merge that turns many such grids into one.
 
 use crate::grid::{Channels, Coord, Leaf, SparseGrid, Transform};
+use crate::progress::Progress;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-
-/// Called with the number of work items just finished (for progress bars).
-pub type Progress<'a> = &'a (dyn Fn(u64) + Sync);
 
 /// Channels a distance-criterion voxelizer produces: distance as value, plus the normal.
 pub(crate) fn nearest_channels(normals: bool) -> Channels {
@@ -111,7 +109,7 @@ pub(crate) fn voxelize_parallel<T: Sync>(
     items: &[T],
     transform: Transform,
     channels: Channels,
-    progress: Progress,
+    progress: &Progress,
     emit: impl Fn(&T, &mut Sink) + Sync,
 ) -> SparseGrid {
     voxelize_indexed(items.len(), transform, channels, progress, |i, sink| {
@@ -124,7 +122,7 @@ pub(crate) fn voxelize_indexed(
     count: usize,
     transform: Transform,
     channels: Channels,
-    progress: Progress,
+    progress: &Progress,
     emit: impl Fn(usize, &mut Sink) + Sync,
 ) -> SparseGrid {
     const CHUNK: usize = 1024;
@@ -135,11 +133,14 @@ pub(crate) fn voxelize_indexed(
             |mut grid, chunk| {
                 let items = chunk * CHUNK..((chunk + 1) * CHUNK).min(count);
                 let done = items.len() as u64;
-                let mut sink = Sink::new(&mut grid);
-                for i in items {
-                    emit(i, &mut sink);
+                // Once cancelled, the remaining chunks are skipped (the caller checks).
+                if !progress.stopped() {
+                    let mut sink = Sink::new(&mut grid);
+                    for i in items {
+                        emit(i, &mut sink);
+                    }
+                    progress.advance(done);
                 }
-                progress(done);
                 grid
             },
         )

@@ -3,6 +3,12 @@
 
 use std::process::{Command, Output};
 
+// Tests that use both helpers get two copies of this small module; that is harmless.
+#[allow(clippy::duplicate_mod)]
+#[path = "../common/skip.rs"]
+mod skip;
+pub use skip::skip_or_fail;
+
 pub fn voxelkit(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_voxelkit"))
         .args(args)
@@ -43,11 +49,9 @@ pub fn run_pyopenvdb(script: &str, path: &std::path::Path, what: &str) -> Option
         .args(["-c", "import pyopenvdb"])
         .output();
     if !probe.map(|o| o.status.success()).unwrap_or(false) {
-        let _ = std::io::Write::write_all(
-            &mut std::io::stderr(),
-            format!("\n!!! python3-openvdb (pyopenvdb) is not installed: {what} is SKIPPED\n")
-                .as_bytes(),
-        );
+        skip_or_fail(&format!(
+            "python3-openvdb (pyopenvdb) is not installed: {what}"
+        ));
         return None;
     }
     let out = Command::new(python)

@@ -3,6 +3,10 @@
 
 use std::path::PathBuf;
 
+#[path = "skip.rs"]
+mod skip;
+pub use skip::skip_or_fail;
+
 /// The shared test data folder: `$VOXELKIT_DATA`, or `../shared/data` beside the crate.
 /// `None` (with a loud warning) when it is missing, so a clean clone still passes; CI
 /// (`.ci/run`) refuses to run without it.
@@ -13,14 +17,10 @@ pub fn data_dir() -> Option<PathBuf> {
     if dir.join("meshes").is_dir() {
         Some(dir)
     } else {
-        // Straight to the stderr handle: libtest captures eprintln! of passing tests.
-        use std::io::Write as _;
-        let _ = writeln!(
-            std::io::stderr(),
-            "\n!!! VOXELKIT_DATA: test data not found at {} — tests on the real meshes are SKIPPED.\n\
-             !!! Set VOXELKIT_DATA to the shared data folder to run them.\n",
+        skip_or_fail(&format!(
+            "VOXELKIT_DATA: the shared test data is not at {} (set VOXELKIT_DATA to the shared data folder)",
             dir.display()
-        );
+        ));
         None
     }
 }
@@ -50,7 +50,13 @@ pub fn voxelize_at(
 ) {
     use voxelkit::mesh::{GridFit, fit_transform};
     let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
-    voxelkit::voxelize::separating::voxelize_mesh(mesh, t, &opts, &|_| {}).unwrap()
+    voxelkit::voxelize::separating::voxelize_mesh(
+        mesh,
+        t,
+        &opts,
+        &voxelkit::progress::Progress::none(),
+    )
+    .unwrap()
 }
 
 /// Asserts that the evaluator matches expected limit points: positions to 1e-9 of the bbox

@@ -1,14 +1,12 @@
 //! `voxelkit implicit`: a typed formula voxelized by interval octree (Stolte & Kaufman).
 
-use crate::report::{Json, peak_mib, progress_bar};
+use crate::run::{Global, run_and_report};
 use clap::Args;
 use glam::DVec3;
 use std::path::PathBuf;
-use std::time::Instant;
-use voxelkit::grid::SparseGrid;
-use voxelkit::implicit::{Coordinates, Formula};
-use voxelkit::io::vdb::write_vdb_with_masks;
-use voxelkit::voxelize::interval_octree::{OctreeOptions, progress_total, voxelize_implicit};
+use voxelkit::implicit::Coordinates;
+use voxelkit::mesh::GridFit;
+use voxelkit::pipeline::{Job, Task};
 use voxelkit::{Error, Result};
 
 /// Named examples: (name, coordinates, formula, what it is).
@@ -108,8 +106,8 @@ fn parse_bounds(s: &str) -> Result<(DVec3, DVec3)> {
     }
 }
 
-pub fn run(args: &ImplicitArgs, json: bool) -> Result<()> {
-    let (text, coords) = match &args.example {
+pub fn run(args: &ImplicitArgs, global: &Global) -> Result<()> {
+    let (text, coordinates) = match &args.example {
         Some(name) => {
             let (_, c, f, _) = EXAMPLES.iter().find(|e| e.0 == name).ok_or_else(|| {
                 let names: Vec<&str> = EXAMPLES.iter().map(|e| e.0).collect();
@@ -125,62 +123,15 @@ pub fn run(args: &ImplicitArgs, json: bool) -> Result<()> {
             args.coords,
         ),
     };
-    let formula = Formula::parse(&text, coords)?;
     let (min, max) = parse_bounds(&args.bounds)?;
-    let options = OctreeOptions {
-        resolution: args.resolution,
-        both_signs: args.negative_r,
+    let task = Task::Implicit {
+        formula: text,
+        coordinates,
+        min,
+        max,
         levels: args.levels,
+        negative_r: args.negative_r,
     };
-    let start = Instant::now();
-    let bar = progress_bar(progress_total(&options), "octree", json);
-    let out = voxelize_implicit(&formula, min, max, &options, &|n| bar.inc(n))?;
-    bar.finish_and_clear();
-    let voxelize_s = start.elapsed().as_secs_f64();
-    let names: Vec<String> = (0..out.levels.len())
-        .map(|l| format!("level_{l}"))
-        .collect();
-    let masks: Vec<(&str, &SparseGrid)> = names
-        .iter()
-        .map(|n| n.as_str())
-        .zip(out.levels.iter())
-        .collect();
-    let meta = vec![
-        ("method", "stolte-kaufman-interval-octree".to_string()),
-        ("formula", text.clone()),
-        ("coordinates", format!("{coords:?}").to_lowercase()),
-        ("resolution", args.resolution.to_string()),
-    ];
-    write_vdb_with_masks(&args.output, &out.surface, &masks, &meta)?;
-    let s = out.stats;
-    let total_s = start.elapsed().as_secs_f64();
-    if json {
-        let j = Json::default()
-            .str("output", args.output.display().to_string())
-            .int("voxels", s.voxels)
-            .int("cells_tested", s.cells_tested)
-            .int("axis_cells", s.axis_cells)
-            .int("levels", out.levels.len() as u64)
-            .int("depth", s.depth as u64)
-            .timings(voxelize_s, total_s);
-        println!("{}", j.render());
-    } else {
-        println!(
-            "{}: {} voxels at depth {} ({} cells tested, {} on the axis){}; voxelized in {:.2} s, {:.2} s in all, peak {:.0} MiB",
-            args.output.display(),
-            s.voxels,
-            s.depth,
-            s.cells_tested,
-            s.axis_cells,
-            if out.levels.is_empty() {
-                String::new()
-            } else {
-                format!(", {} levels written", out.levels.len())
-            },
-            voxelize_s,
-            total_s,
-            peak_mib()
-        );
-    }
-    Ok(())
+    let job = Job::new(task, GridFit::Resolution(args.resolution));
+    run_and_report(job, &args.output, global)
 }

@@ -1,16 +1,9 @@
 //! The `voxelkit` command line: a thin shell over the library.
 
-mod bench;
-mod bench_implicit;
-mod bench_measure;
-mod bench_projective;
-mod bench_solid;
-mod bench_subdiv;
 mod commands;
-mod csg_tree;
 mod implicit;
 mod projective;
-mod report;
+mod run;
 mod solid_depth;
 mod solids;
 mod subdiv;
@@ -32,12 +25,17 @@ use voxelkit::voxelize::separating::Criterion;
                   `density` (fog volume) and, with --normals, `normal` (Vec3)."
 )]
 struct Cli {
-    /// Worker threads (default: all cores).
+    /// Worker threads (default: all cores; at most 256).
     #[arg(long, global = true)]
     threads: Option<usize>,
-    /// Print one JSON object instead of the human summary (no progress bars).
+    /// Print one JSON object instead of the human summary (no progress bars); errors too are
+    /// one JSON object, on stderr.
     #[arg(long, global = true)]
     json: bool,
+    /// Refuse work whose estimated memory exceeds this many MiB, before it starts
+    /// [default: the memory available].
+    #[arg(long, global = true, value_name = "MIB")]
+    max_memory: Option<u64>,
     #[command(subcommand)]
     command: Command,
 }
@@ -64,9 +62,6 @@ pub struct SurfaceArgs {
     /// Also write a `normal` grid (nearest face/edge/vertex normal per voxel).
     #[arg(long)]
     normals: bool,
-    /// Refuse work whose estimated memory exceeds this many MiB [default: available memory].
-    #[arg(long, value_name = "MIB")]
-    pub max_memory: Option<u64>,
 }
 
 fn parse_separability(s: &str) -> Result<Separability, String> {
@@ -138,9 +133,6 @@ enum Command {
     /// Voxelize a Catmull-Clark control mesh from its exact limit surface (Lai & Cheng), or
     /// check the limit-surface evaluator against OpenSubdiv (`subdiv check`, `subdiv eval`).
     Subdiv(subdiv::SubdivArgs),
-    /// Benchmark against OpenVDB's meshToVolume with a one-voxel band, in the same run
-    /// (`bench subdiv`: the Catmull-Clark voxelizer; `bench implicit`: the interval octree; `bench solid`: filled solids).
-    Bench(bench::BenchArgs),
 }
 
 /// How `voxelkit mesh` voxelizes.
@@ -157,15 +149,14 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+    // An interrupted run leaves no temporary file behind.
+    voxelkit::io::atomic::remove_temporaries_on_signals();
     let cli = Cli::parse();
-    if let Some(n) = cli.threads
-        && let Err(e) = rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-    {
-        eprintln!("error: cannot start {n} threads: {e}");
-        return ExitCode::FAILURE;
-    }
+    let global = run::Global {
+        threads: cli.threads,
+        max_memory_mib: cli.max_memory,
+        json: cli.json,
+    };
     let result = match cli.command {
         Command::Mesh {
             method: MeshMethod::Separating,
@@ -179,39 +170,41 @@ fn main() -> ExitCode {
             method: MeshMethod::Separating,
             args,
             ..
-        } => commands::mesh(&input, &args, cli.json),
+        } => commands::mesh(&input, &args, &global),
         Command::Mesh {
             input,
             method: MeshMethod::Projective,
             color,
             args,
-        } => projective::mesh(
-            &input,
-            args.fit,
-            &color,
-            args.surface.max_memory,
-            &args.output,
-            cli.json,
-        ),
-        Command::Lines(args) => projective::lines(&args, cli.json),
-        Command::Shape { shape } => commands::shape(&shape, cli.json),
-        Command::Info { file } => commands::info(&file, cli.json),
+        } => projective::mesh(&input, args.fit, &color, &args.output, &global),
+        Command::Lines(args) => projective::lines(&args, &global),
+        Command::Shape { shape } => commands::shape(&shape, &global),
+        Command::Info { file } => commands::info(&file, &global),
         Command::Check {
             input,
             fit,
             surface,
-        } => commands::check(&input, fit, surface, cli.json),
-        Command::Demo { output, resolution } => commands::demo(&output, resolution, cli.json),
-        Command::Subdiv(args) => subdiv::run(&args, cli.json),
-        Command::Implicit(args) => implicit::run(&args, cli.json),
-        Command::Solid(args) => solids::solid(&args, cli.json),
-        Command::Csg(args) => solids::csg(&args, cli.json),
-        Command::Intersect(args) => solids::intersect(&args, cli.json),
-        Command::Measure(args) => solids::measure(&args, cli.json),
-        Command::Bench(args) => bench::run(&args, cli.json),
+        } => commands::check(&input, fit, surface, &global),
+        Command::Demo { output, resolution } => commands::demo(&output, resolution, &global),
+        Command::Subdiv(args) => subdiv::run(&args, &global),
+        Command::Implicit(args) => implicit::run(&args, &global),
+        Command::Solid(args) => solids::solid(&args, &global),
+        Command::Csg(args) => solids::csg(&args, &global),
+        Command::Intersect(args) => solids::intersect(&args, &global),
+        Command::Measure(args) => solids::measure(&args, &global),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if cli.json => {
+            let (file, line) = e.location();
+            let j = serde_json::json!({
+                "error": e.to_string(),
+                "file": file.map(|f| f.display().to_string()),
+                "line": line,
+            });
+            eprintln!("{j}");
+            ExitCode::FAILURE
+        }
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE

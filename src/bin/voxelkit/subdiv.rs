@@ -2,15 +2,13 @@
 //! and the evaluator checked against OpenSubdiv.
 
 use crate::FitArgs;
-use crate::report::{Json, peak_mib, progress_bar};
+use crate::run::{Global, run_and_report};
 use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 use voxelkit::grid::Adjacency;
-use voxelkit::io::vdb::write_vdb_with_masks;
-use voxelkit::mesh::fit_transform;
+use voxelkit::pipeline::{Job, MeshSource, Task};
 use voxelkit::subd::{ControlMesh, LimitSurface, compare_points, limit_area, read_points};
-use voxelkit::voxelize::parametric::{ParametricOptions, estimate_bytes, voxelize_subdivision};
+use voxelkit::voxelize::parametric::ParametricOptions;
 use voxelkit::{Error, Result};
 
 #[derive(Args)]
@@ -42,9 +40,6 @@ pub struct SubdivVoxelizeArgs {
     /// paper's test alone misses voxels the surface passes through).
     #[arg(long)]
     enclose: bool,
-    /// Refuse work whose estimated memory exceeds this many MiB [default: available memory].
-    #[arg(long, value_name = "MIB")]
-    max_memory: Option<u64>,
     /// Output .vdb file: `surface`, `density`, `normal` and `opposite_normals` grids.
     #[arg(short, long, required = true)]
     output: Option<PathBuf>,
@@ -86,7 +81,8 @@ fn parse_adjacency(s: &str) -> std::result::Result<Adjacency, String> {
     }
 }
 
-pub fn run(args: &SubdivArgs, json: bool) -> Result<()> {
+pub fn run(args: &SubdivArgs, global: &Global) -> Result<()> {
+    let json = global.json;
     match &args.action {
         Some(SubdivAction::Check {
             input,
@@ -96,98 +92,22 @@ pub fn run(args: &SubdivArgs, json: bool) -> Result<()> {
         Some(SubdivAction::Eval { input, points }) => eval(input, points),
         None => {
             let input = args.input.as_deref().expect("clap requires the input");
-            voxelize(input, &args.voxelize, json)
+            voxelize(input, &args.voxelize, global)
         }
     }
 }
 
-fn voxelize(input: &Path, args: &SubdivVoxelizeArgs, json: bool) -> Result<()> {
+fn voxelize(input: &Path, args: &SubdivVoxelizeArgs, global: &Global) -> Result<()> {
     let output = args.output.as_deref().expect("clap requires the output");
-    let start = Instant::now();
-    let control = ControlMesh::load(input)?;
-    let mesh = control.polygon_mesh();
-    let transform = fit_transform(&mesh.bbox(), args.fit.grid_fit())?;
-    let extent = mesh.bbox().extent() / transform.voxel_size;
-    voxelkit::system::check_fits(
-        estimate_bytes(&control, &transform),
-        args.max_memory.map(|m| m << 20),
-        &format!(
-            "{} at {:.0}x{:.0}x{:.0} voxels; lower --resolution or raise --max-memory",
-            input.display(),
-            extent.x,
-            extent.y,
-            extent.z
-        ),
-    )?;
-    let options = ParametricOptions {
-        adjacency: args.adjacency,
-        presplit: args.presplit,
-        enclose: args.enclose,
+    let task = Task::Subdivision {
+        mesh: MeshSource::File(input.to_path_buf()),
+        options: ParametricOptions {
+            adjacency: args.adjacency,
+            presplit: args.presplit,
+            enclose: args.enclose,
+        },
     };
-    let bar = progress_bar(control.patch_count() as u64, "voxelizing", json);
-    let voxelize_start = Instant::now();
-    let out = voxelize_subdivision(&control, transform, &options, &|n| bar.inc(n))?;
-    bar.finish_and_clear();
-    let voxelize_s = voxelize_start.elapsed().as_secs_f64();
-    let s = out.stats;
-    let method = if options.enclose {
-        "lai-cheng-parametric-enclosed"
-    } else {
-        "lai-cheng-parametric"
-    };
-    let meta = vec![
-        ("method", method.to_string()),
-        ("adjacency", args.adjacency.number().to_string()),
-        ("source_file", input.display().to_string()),
-        ("resolution", args.fit.describe()),
-        ("presplit", args.presplit.to_string()),
-        ("surface_area", s.area.to_string()),
-    ];
-    write_vdb_with_masks(
-        output,
-        &out.surface,
-        &[("opposite_normals", &out.opposite)],
-        &meta,
-    )?;
-    let total_s = start.elapsed().as_secs_f64();
-    if json {
-        let j = Json::default()
-            .str("output", output.display().to_string())
-            .int("voxels", s.voxels)
-            .int("opposite_normal_voxels", s.opposite_voxels)
-            .int("patches", s.patches)
-            .int("evaluations", s.evaluations)
-            .int("uniform_evaluations", s.uniform_evaluations)
-            .int("subpatches", s.subpatches)
-            .int("depth_guard_stops", s.depth_guard_stops)
-            .int("enclose_splits", s.enclose_splits)
-            .int("tolerance_voxels", s.guard_voxels)
-            .num("area", s.area)
-            .num("voxel_size", transform.voxel_size)
-            .int("adjacency", args.adjacency.number() as u64)
-            .timings(voxelize_s, total_s);
-        println!("{}", j.render());
-    } else {
-        println!(
-            "{}: {} voxels ({} crossed by opposite sheets) from {} patches; {} evaluations \
-             (a uniform grid at the same density: {}), {} sub-patches, {} depth-guard stops; \
-             area {:.6}; {}-adjacent; voxelized in {:.2} s, {:.2} s in all, peak {:.0} MiB",
-            output.display(),
-            s.voxels,
-            s.opposite_voxels,
-            s.patches,
-            s.evaluations,
-            s.uniform_evaluations,
-            s.subpatches,
-            s.depth_guard_stops,
-            s.area,
-            args.adjacency.number(),
-            voxelize_s,
-            total_s,
-            peak_mib()
-        );
-    }
-    Ok(())
+    run_and_report(Job::new(task, args.fit.grid_fit()), output, global)
 }
 
 #[cfg(feature = "osd")]
@@ -211,28 +131,26 @@ fn check(input: &Path, per_patch: usize, reference: Option<&Path>, json: bool) -
         ("reference file", reference),
     ];
     if json {
-        let mut j = Json::default()
-            .str("input", input.display().to_string())
-            .int("faces", stats.faces as u64)
-            .int("patches", surface.patch_count() as u64)
-            .num("limit_area", area);
-        for (key, c) in [
-            ("dyadic", Some(live.dyadic)),
-            ("random", Some(live.random)),
-            ("reference", reference),
-        ] {
-            if let Some(c) = c {
-                j = j.obj(
-                    key,
-                    Json::default()
-                        .int("points", c.points as u64)
-                        .num("max_position_error", c.max_position_error)
-                        .num("max_relative_position_error", c.max_relative_position_error)
-                        .num("max_normal_angle_rad", c.max_normal_angle),
-                );
-            }
-        }
-        println!("{}", j.render());
+        let comparison = |c: Option<voxelkit::subd::Comparison>| {
+            c.map(|c| {
+                serde_json::json!({
+                    "points": c.points,
+                    "max_position_error": c.max_position_error,
+                    "max_relative_position_error": c.max_relative_position_error,
+                    "max_normal_angle_rad": c.max_normal_angle,
+                })
+            })
+        };
+        let j = serde_json::json!({
+            "input": input.display().to_string(),
+            "faces": stats.faces,
+            "patches": surface.patch_count(),
+            "limit_area": area,
+            "dyadic": comparison(Some(live.dyadic)),
+            "random": comparison(Some(live.random)),
+            "reference": comparison(reference),
+        });
+        println!("{j}");
         return Ok(());
     }
     println!(

@@ -29,7 +29,7 @@ const BEAM_NEEDS_CLOSED: &str = "a column through an open surface can enter with
 pub fn beam_solid(
     mesh: &Mesh,
     transform: Transform,
-    progress: Progress,
+    progress: &Progress,
 ) -> Result<(SparseGrid, Solid, ProjectiveStats)> {
     mesh.require_closed(BEAM_NEEDS_CLOSED)?;
     let (surface, stats) = voxelize_triangles(mesh, transform, Coloring::None, progress)?;

@@ -4,7 +4,7 @@
 //! and thread count, in the same process.
 
 use crate::bench::{best_of, data_folder};
-use crate::report::Json;
+use crate::json::Json;
 use clap::Args;
 use std::path::PathBuf;
 use voxelkit::Result;
@@ -70,7 +70,8 @@ pub fn run(args: &SolidBenchArgs, json: bool) -> Result<()> {
             };
             let (surface_s, surface) = pool.install(|| {
                 best_of(args.repeat, || {
-                    voxelize_mesh(&mesh, t, &options, &|_| {}).map(|r| r.0)
+                    voxelize_mesh(&mesh, t, &options, &voxelkit::progress::Progress::none())
+                        .map(|r| r.0)
                 })
             })?;
             let (spans_s, solid) = best_of(args.repeat, || {

@@ -3,7 +3,7 @@
 //! meshes against each mesh's own signed volume.
 
 use crate::bench::{data_folder, resolve, thread_pool};
-use crate::report::Json;
+use crate::json::Json;
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;

@@ -1,24 +1,6 @@
-//! How the CLI talks back: progress bars, the one-line summary and `--json` objects.
+//! The benchmarks' `--json` objects: ordered keys, as the tables print them.
 
-use indicatif::{ProgressBar, ProgressStyle};
 use std::fmt::Write as _;
-
-/// A progress bar on stderr (hidden when `quiet` or when stderr is not a terminal).
-pub fn progress_bar(total: u64, what: &str, quiet: bool) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(total);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{msg:>12} [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}",
-        )
-        .expect("valid template")
-        .progress_chars("=> "),
-    );
-    bar.set_message(what.to_string());
-    bar
-}
 
 /// A JSON value rendered as text.
 pub enum Value {
@@ -46,19 +28,9 @@ impl Json {
     pub fn str(self, key: &str, v: impl Into<String>) -> Self {
         self.put(key, Value::Str(v.into()))
     }
-    pub fn obj(self, key: &str, v: Json) -> Self {
-        self.put(key, Value::Raw(v.render()))
-    }
     pub fn arr(self, key: &str, items: Vec<Json>) -> Self {
         let inner: Vec<String> = items.iter().map(Json::render).collect();
         self.put(key, Value::Raw(format!("[{}]", inner.join(","))))
-    }
-
-    /// The closing fields of every voxelizing command.
-    pub fn timings(self, voxelize_seconds: f64, seconds: f64) -> Self {
-        self.num("voxelize_seconds", voxelize_seconds)
-            .num("seconds", seconds)
-            .num("peak_mib", peak_mib())
     }
 
     pub fn render(&self) -> String {
@@ -100,9 +72,4 @@ fn quote(s: &str) -> String {
     }
     out.push('"');
     out
-}
-
-/// Peak resident memory in MiB (0 when unknown).
-pub fn peak_mib() -> f64 {
-    voxelkit::system::peak_memory_bytes().unwrap_or(0) as f64 / (1 << 20) as f64
 }

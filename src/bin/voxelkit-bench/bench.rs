@@ -1,7 +1,7 @@
 //! `voxelkit bench`: our separating voxelizer against OpenVDB's `tools::meshToVolume` with a
 //! one-voxel band, on the same mesh, voxel size and thread count, in the same process.
 
-use crate::report::Json;
+use crate::json::Json;
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -157,8 +157,13 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
                     };
                     let (ours_s, voxels) = pool.install(|| {
                         best_of(args.repeat, || {
-                            voxelize_mesh(&mesh, transform, &opts, &|_| {})
-                                .map(|(g, _)| g.voxel_count())
+                            voxelize_mesh(
+                                &mesh,
+                                transform,
+                                &opts,
+                                &voxelkit::progress::Progress::none(),
+                            )
+                            .map(|(g, _)| g.voxel_count())
                         })
                     })?;
                     let speedup = vdb_s / ours_s;

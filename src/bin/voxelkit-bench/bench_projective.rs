@@ -4,7 +4,7 @@
 //! each surface.
 
 use crate::bench::{best_of, data_folder, resolve, thread_pool};
-use crate::report::Json;
+use crate::json::Json;
 use clap::Args;
 use std::path::PathBuf;
 use voxelkit::Result;
@@ -102,10 +102,25 @@ pub fn run(args: &ProjectiveBenchArgs, json: bool) -> Result<()> {
                 let time = |f: &(dyn Fn() -> Result<SparseGrid> + Sync)| {
                     pool.install(|| best_of(args.repeat, f))
                 };
-                let (tri_s, tri_grid) =
-                    time(&|| Ok(voxelize_triangles(&mesh, t, Coloring::None, &|_| {})?.0))?;
-                let (line_s, line_grid) =
-                    time(&|| Ok(voxelize_lines(&mesh, t, edges, Coloring::None, &|_| {})?.0))?;
+                let (tri_s, tri_grid) = time(&|| {
+                    Ok(voxelize_triangles(
+                        &mesh,
+                        t,
+                        Coloring::None,
+                        &voxelkit::progress::Progress::none(),
+                    )?
+                    .0)
+                })?;
+                let (line_s, line_grid) = time(&|| {
+                    Ok(voxelize_lines(
+                        &mesh,
+                        t,
+                        edges,
+                        Coloring::None,
+                        &voxelkit::progress::Progress::none(),
+                    )?
+                    .0)
+                })?;
                 let segments = line_segments(&mesh, edges).len() as u64;
                 let (sep6_s, sep6) = time(&|| separating(&mesh, t, Separability::Six))?;
                 let (sep26_s, _) = time(&|| separating(&mesh, t, Separability::TwentySix))?;
@@ -167,7 +182,7 @@ fn separating(mesh: &Mesh, t: Transform, separability: Separability) -> Result<S
         criterion: Criterion::Clipped,
         normals: false,
     };
-    Ok(voxelize_mesh(mesh, t, &opts, &|_| {})?.0)
+    Ok(voxelize_mesh(mesh, t, &opts, &voxelkit::progress::Progress::none())?.0)
 }
 
 /// Inside voxels reached by the exterior flood through `surface`, with 6 and with 26.
@@ -204,7 +219,12 @@ fn leaks(args: &ProjectiveBenchArgs, json: bool) -> Result<()> {
         let mesh = load(name, &data)?;
         for &res in &resolutions {
             let t: Transform = fit_transform(&mesh.bbox(), GridFit::Resolution(res))?;
-            let (proj, _) = voxelize_triangles(&mesh, t, Coloring::None, &|_| {})?;
+            let (proj, _) = voxelize_triangles(
+                &mesh,
+                t,
+                Coloring::None,
+                &voxelkit::progress::Progress::none(),
+            )?;
             let (sep6, sep26) = (
                 separating(&mesh, t, Separability::Six)?,
                 separating(&mesh, t, Separability::TwentySix)?,

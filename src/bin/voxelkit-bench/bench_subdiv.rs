@@ -6,7 +6,7 @@
 //! is not timed).
 
 use crate::bench::{best_of, data_folder};
-use crate::report::Json;
+use crate::json::Json;
 use clap::Args;
 use std::path::PathBuf;
 use voxelkit::grid::Adjacency;
@@ -100,7 +100,12 @@ pub fn run(args: &SubdivBenchArgs, json: bool) -> Result<()> {
                 };
                 let (seconds, out) = pool.install(|| {
                     best_of(args.repeat, || {
-                        voxelize_subdivision(&control, transform, &options, &|_| {})
+                        voxelize_subdivision(
+                            &control,
+                            transform,
+                            &options,
+                            &voxelkit::progress::Progress::none(),
+                        )
                     })
                 })?;
                 let s = out.stats;

@@ -3,7 +3,7 @@
 //! the naive reference in the same process: F at every voxel corner, voxels with a sign change.
 
 use crate::bench::best_of;
-use crate::report::Json;
+use crate::json::Json;
 use clap::Args;
 use glam::DVec3;
 use voxelkit::implicit::{Coordinates, Formula};
@@ -74,7 +74,13 @@ pub fn run(args: &ImplicitBenchArgs, json: bool) -> Result<()> {
             };
             let (seconds, out) = pool.install(|| {
                 best_of(args.repeat, || {
-                    voxelize_implicit(&formula, min, max, &options, &|_| {})
+                    voxelize_implicit(
+                        &formula,
+                        min,
+                        max,
+                        &options,
+                        &voxelkit::progress::Progress::none(),
+                    )
                 })
             })?;
             let growth = previous.map(|p| seconds / p);

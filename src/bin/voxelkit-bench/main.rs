@@ -1,0 +1,46 @@
+//! `voxelkit-bench`: voxelkit against OpenVDB (and the papers' figures) on the same meshes,
+//! voxel sizes and thread counts, in the same process. Kept out of the `voxelkit` binary so
+//! that the command line stays a thin front end.
+
+mod bench;
+mod bench_implicit;
+mod bench_measure;
+mod bench_projective;
+mod bench_solid;
+mod bench_subdiv;
+mod json;
+
+use clap::Parser;
+use std::process::ExitCode;
+use voxelkit::voxelize::separating::Criterion;
+
+#[derive(Parser)]
+#[command(
+    name = "voxelkit-bench",
+    version,
+    about = "Benchmark voxelkit against OpenVDB's meshToVolume with a one-voxel band, in the same run \
+             (`subdiv`: the Catmull-Clark voxelizer; `implicit`: the interval octree; `solid`: filled \
+             solids; `measure`: volume convergence; `projective`: triangles/s)"
+)]
+struct Cli {
+    /// Print one JSON object instead of the tables.
+    #[arg(long, global = true)]
+    json: bool,
+    #[command(flatten)]
+    args: bench::BenchArgs,
+}
+
+pub fn parse_criterion(s: &str) -> Result<Criterion, String> {
+    s.parse()
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match bench::run(&cli.args, cli.json) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

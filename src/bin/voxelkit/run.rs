@@ -1,0 +1,114 @@
+//! Running a job from the command line: the output checked before any work, progress bars
+//! as the observer, the outcome written, and the report printed (summary or `--json`).
+
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::Write as _;
+use std::ops::ControlFlow;
+use std::path::Path;
+use std::sync::Mutex;
+use std::time::Instant;
+use voxelkit::Result;
+use voxelkit::pipeline::{Job, Limits, Outcome, check_output_path};
+use voxelkit::progress::Observer;
+
+/// What every command shares: threads, memory limit, output style.
+#[derive(Clone, Copy)]
+pub struct Global {
+    pub threads: Option<usize>,
+    pub max_memory_mib: Option<u64>,
+    pub json: bool,
+}
+
+impl Global {
+    pub fn limits(&self) -> Limits {
+        Limits {
+            threads: self.threads,
+            max_memory: self.max_memory_mib.map(|m| m.saturating_mul(1 << 20)),
+        }
+    }
+}
+
+/// A progress bar per stage on stderr (none under `--json` or off a terminal).
+pub struct Bars {
+    bar: Mutex<ProgressBar>,
+    quiet: bool,
+}
+
+impl Bars {
+    pub fn new(quiet: bool) -> Bars {
+        Bars {
+            bar: Mutex::new(ProgressBar::hidden()),
+            quiet,
+        }
+    }
+
+    pub fn finish(&self) {
+        self.bar
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .finish_and_clear();
+    }
+}
+
+impl Observer for Bars {
+    fn stage(&self, name: &str, total: u64) {
+        let mut bar = self.bar.lock().unwrap_or_else(|e| e.into_inner());
+        bar.finish_and_clear();
+        if self.quiet {
+            return;
+        }
+        // No eta: the first items of most methods are not typical of the rest.
+        *bar = ProgressBar::new(total).with_style(
+            ProgressStyle::with_template("{msg:>12} [{bar:40}] {percent:>3}% {elapsed_precise}")
+                .expect("valid template")
+                .progress_chars("=> "),
+        );
+        bar.set_message(name.to_string());
+    }
+
+    fn advance(&self, n: u64) -> ControlFlow<()> {
+        self.bar.lock().unwrap_or_else(|e| e.into_inner()).inc(n);
+        ControlFlow::Continue(())
+    }
+}
+
+/// Plans `job`, refuses an `output` that cannot be written (or is an input) before any
+/// work, runs it, writes the outcome to `output` and returns it with the whole run timed.
+pub fn run_job(job: Job, output: Option<&Path>, global: &Global) -> Result<Outcome> {
+    let start = Instant::now();
+    let job = Job {
+        limits: global.limits(),
+        ..job
+    };
+    let planned = job.plan()?;
+    let inputs = planned.input_files();
+    let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
+    if let Some(out) = output {
+        check_output_path(out, &inputs)?;
+    }
+    let bars = Bars::new(global.json);
+    let result = planned.run(&bars);
+    bars.finish();
+    let mut outcome = result?;
+    if let Some(out) = output {
+        outcome.write(out, &inputs)?;
+    }
+    outcome.report.finish(start);
+    Ok(outcome)
+}
+
+/// Runs `job` and prints its report: on stdout, or on stderr when the `.vdb` goes to stdout.
+pub fn run_and_report(job: Job, output: &Path, global: &Global) -> Result<()> {
+    let outcome = run_job(job, Some(output), global)?;
+    let text = if global.json {
+        outcome.report.to_json()
+    } else {
+        outcome.report.summary()
+    };
+    if output == Path::new("-") {
+        let _ = writeln!(std::io::stderr(), "{text}");
+    } else {
+        println!("{text}");
+    }
+    Ok(())
+}

@@ -1,0 +1,275 @@
+//! Planning: read the inputs, place the grid, and estimate the peak memory and the work
+//! items of every task, so that a job that cannot fit is refused before it allocates.
+//!
+//! The estimates are deliberately generous (the memory check refuses, it never aborts):
+//! surfaces assume 16 voxels per 8^3 leaf, solids half of their box inside, and writing
+//! counts OpenVDB's own leaves (a float leaf holds 512 values whether or not they are on).
+
+use super::{Job, Loaded, MeasureSource, Plan, Task, lines_source};
+use crate::error::{Error, Result};
+use crate::grid::{CoordBox, SparseGrid, Transform};
+use crate::implicit::Formula;
+use crate::io::vdb::read_vdb_grid;
+use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
+use crate::ops::csg_tree::read_csg_tree;
+use crate::ops::flood::padded;
+use crate::subd::ControlMesh;
+use crate::voxelize::projective;
+use crate::voxelize::{parametric, separating};
+use glam::DVec3;
+
+/// A sparse leaf in memory: mask, origin, map entry.
+const LEAF_BYTES: f64 = 160.0;
+/// A per-voxel vector channel of a leaf (normal or colour: 512 x 3 floats) with its distance.
+const VECTOR_CHANNEL_BYTES: f64 = 512.0 * 16.0;
+/// Writing one leaf of a voxel set: OpenVDB's bool and float leaves and the flat arrays.
+const WRITE_LEAF_BYTES: f64 = 2600.0;
+/// Writing one vector leaf: the flat array and OpenVDB's Vec3s leaf.
+const WRITE_VECTOR_LEAF_BYTES: f64 = 2.0 * 512.0 * 12.0;
+/// Voxels per leaf of a surface (a plane through a leaf crosses 64 of its 512 voxels).
+const SURFACE_VOXELS_PER_LEAF: f64 = 16.0;
+/// The share of its box a solid is assumed to fill (a ball fills 52%).
+const SOLID_FILL: f64 = 0.5;
+
+/// Bytes to hold and write a surface of `voxels` voxels with `vector_channels` channels.
+fn surface_bytes(voxels: f64, vector_channels: u32) -> f64 {
+    let leaves = voxels / SURFACE_VOXELS_PER_LEAF + 1.0;
+    let channels = f64::from(vector_channels);
+    leaves
+        * (2.0 * (LEAF_BYTES + channels * VECTOR_CHANNEL_BYTES)
+            + WRITE_LEAF_BYTES
+            + channels * WRITE_VECTOR_LEAF_BYTES)
+}
+
+/// Bytes to fill and write a solid over `cells` voxels of a box, with `masks` dense bit
+/// volumes over it at once.
+fn solid_bytes(cells: f64, masks: u32) -> f64 {
+    let solid_leaves = cells * SOLID_FILL / 512.0;
+    f64::from(masks) * cells / 8.0 + solid_leaves * (3.0 * LEAF_BYTES + WRITE_LEAF_BYTES)
+}
+
+/// Voxels of a box, as a float (boxes past 2^64 voxels must still be refused, not wrap).
+fn cells(b: &CoordBox) -> f64 {
+    (0..3).map(|a| (b.max[a] - b.min[a] + 1) as f64).product()
+}
+
+fn extent(bbox: &Aabb, t: &Transform) -> [f64; 3] {
+    (bbox.extent() / t.voxel_size).to_array()
+}
+
+/// A box's surface in voxels: the voxels of a surface inside it, generously.
+fn box_area(e: [f64; 3]) -> f64 {
+    let [x, y, z] = e.map(|v| v.max(1.0));
+    2.0 * (x * y + y * z + z * x)
+}
+
+/// The index box of `bbox`, refused before any arithmetic overflows i64.
+fn checked_box(bbox: &Aabb, t: &Transform) -> Result<CoordBox> {
+    let e = extent(bbox, t);
+    let far = (bbox.min.abs().max(bbox.max.abs()) / t.voxel_size).max_element();
+    if !(e.iter().all(|v| v.is_finite() && *v < 1e15) && far < 1e15) {
+        return Err(Error::TooLarge {
+            estimated_mib: u64::MAX >> 20,
+            available_mib: crate::system::available_memory_bytes().unwrap_or(0) >> 20,
+            detail: format!(
+                "{:.3e} x {:.3e} x {:.3e} voxels cannot be indexed; raise the voxel size",
+                e[0], e[1], e[2]
+            ),
+        });
+    }
+    Ok(index_box(bbox, t))
+}
+
+/// The octree's resolution: voxels along the longest side of the bounds.
+pub(super) fn octree_resolution(fit: GridFit, min: DVec3, max: DVec3) -> Result<u32> {
+    match fit {
+        GridFit::Resolution(r) => Ok(r),
+        GridFit::VoxelSize(h) if h.is_finite() && h > 0.0 => {
+            let r = ((max - min).max_element() / h).ceil();
+            if r > f64::from(1u32 << 16) {
+                Err(Error::InvalidArgument(format!(
+                    "voxel size {h} gives {r:.3e} voxels along the bounds; the octree takes at most 65536"
+                )))
+            } else {
+                Ok(r.max(1.0) as u32)
+            }
+        }
+        GridFit::VoxelSize(h) => Err(Error::InvalidArgument(format!(
+            "voxel size must be a positive number, got {h}"
+        ))),
+    }
+}
+
+/// The plan of a surface of `mesh`.
+fn mesh_plan(mesh: &Mesh, fit: GridFit) -> Result<(Transform, CoordBox)> {
+    let t = fit_transform(&mesh.bbox(), fit)?;
+    let b = checked_box(&mesh.bbox(), &t)?;
+    Ok((t, b))
+}
+
+pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
+    let fit = job.fit;
+    let plan = |transform: Transform, bbox: &Aabb, bytes: f64, work_items: u64| Plan {
+        transform,
+        extent: extent(bbox, &transform),
+        estimated_bytes: bytes.min(u64::MAX as f64) as u64,
+        work_items,
+    };
+    Ok(match &job.task {
+        Task::MeshSurface { mesh, method } => {
+            let mesh = mesh.load(false)?;
+            let (t, _) = mesh_plan(&mesh, fit)?;
+            let (bytes, items) = match method {
+                super::SurfaceMethod::Separating(o) => (
+                    separating::estimate_bytes(&mesh, &t, o) as f64
+                        + surface_bytes(2.0 * mesh.area() / (t.voxel_size * t.voxel_size), 0),
+                    separating::work_items(&mesh),
+                ),
+                super::SurfaceMethod::Projective(c) => (
+                    projective::estimate_bytes(&mesh, &t, c.coloring(&mesh), None) as f64
+                        + surface_bytes(2.0 * mesh.area() / (t.voxel_size * t.voxel_size), 0),
+                    mesh.face_count() as u64,
+                ),
+            };
+            let p = plan(t, &mesh.bbox(), bytes, items);
+            (Loaded::Mesh(mesh), p)
+        }
+        Task::Lines { mesh, edges, color } => {
+            let mesh = mesh.load(true)?;
+            let (t, _) = mesh_plan(&mesh, fit)?;
+            let source = lines_source(&mesh, *edges);
+            let coloring = color.coloring(&mesh);
+            let bytes = projective::estimate_bytes(&mesh, &t, coloring, Some(source)) as f64;
+            let items = projective::line_segments(&mesh, source).len() as u64;
+            let p = plan(t, &mesh.bbox(), bytes, items);
+            (Loaded::Mesh(mesh), p)
+        }
+        Task::Shape { shape, normals, .. } => {
+            let bbox = shape.surface().bbox();
+            let t = fit_transform(&bbox, fit)?;
+            let b = checked_box(&bbox, &t)?;
+            let voxels = box_area(extent(&bbox, &t));
+            let bytes = surface_bytes(voxels, u32::from(*normals));
+            let p = plan(t, &bbox, bytes, (cells(&b) / 512.0).ceil() as u64);
+            (Loaded::Shape, p)
+        }
+        Task::Subdivision { mesh, .. } => {
+            let control = match mesh {
+                super::MeshSource::File(path) => ControlMesh::load(path)?,
+                super::MeshSource::Mesh(m) => ControlMesh::from_mesh(m)?,
+            };
+            let bbox = control.bbox();
+            let t = fit_transform(&bbox, fit)?;
+            checked_box(&bbox, &t)?;
+            let area = control.polygon_mesh().area() / (t.voxel_size * t.voxel_size);
+            let bytes = parametric::estimate_bytes(&control, &t) as f64 + surface_bytes(area, 1);
+            let p = plan(t, &bbox, bytes, control.patch_count() as u64);
+            (Loaded::Control(control), p)
+        }
+        Task::Implicit {
+            formula,
+            coordinates,
+            min,
+            max,
+            levels,
+            ..
+        } => {
+            let parsed = Formula::parse(formula, *coordinates)?;
+            let resolution = octree_resolution(fit, *min, *max)?;
+            let bbox = Aabb {
+                min: *min,
+                max: *max,
+            };
+            let longest = (*max - *min).max_element();
+            if !(longest.is_finite() && longest > 0.0 && (*max - *min).min_element() > 0.0) {
+                return Err(Error::InvalidArgument(format!(
+                    "the bounds {min} .. {max} must be a box with positive size on every axis"
+                )));
+            }
+            let t = Transform::new(
+                *min + 0.5 * longest / f64::from(resolution.max(1)),
+                longest / f64::from(resolution.max(1)),
+            );
+            let voxels = box_area(extent(&bbox, &t));
+            // Every level holds about a quarter of the one below it.
+            let levels = if *levels { 4.0 / 3.0 } else { 1.0 };
+            let bytes = surface_bytes(voxels * levels, 1);
+            let options = crate::voxelize::interval_octree::OctreeOptions {
+                resolution,
+                ..Default::default()
+            };
+            let items = crate::voxelize::interval_octree::progress_total(&options);
+            let p = plan(t, &bbox, bytes, items);
+            (Loaded::Formula(parsed), p)
+        }
+        Task::Solid { mesh, fill, .. } => {
+            let mesh = mesh.load(false)?;
+            let (t, b) = mesh_plan(&mesh, fit)?;
+            let surface = 2.0 * mesh.area() / (t.voxel_size * t.voxel_size);
+            let (masks, items) = match fill {
+                super::Fill::Flood(_) => (6, separating::work_items(&mesh)),
+                super::Fill::DepthLayers(_) => (6, 1),
+                super::Fill::Beam => (5, mesh.face_count() as u64),
+            };
+            let bytes = surface_bytes(surface, 0) + solid_bytes(cells(&padded(b, 2)), masks);
+            let p = plan(t, &mesh.bbox(), bytes, items);
+            (Loaded::Mesh(mesh), p)
+        }
+        Task::Measure { source, .. } => match source {
+            MeasureSource::Mesh(mesh) => {
+                let mesh = mesh.load(false)?;
+                let (t, b) = mesh_plan(&mesh, fit)?;
+                let surface = 2.0 * mesh.area() / (t.voxel_size * t.voxel_size);
+                let bytes = surface_bytes(surface, 0) + solid_bytes(cells(&padded(b, 2)), 6);
+                let p = plan(t, &mesh.bbox(), bytes, separating::work_items(&mesh));
+                (Loaded::Mesh(mesh), p)
+            }
+            MeasureSource::Vdb(path) => {
+                let grid = read_surface(path)?;
+                let b = grid.bbox().unwrap_or(CoordBox {
+                    min: [0; 3],
+                    max: [0; 3],
+                });
+                let t = grid.transform;
+                let bbox = Aabb {
+                    min: t.index_to_world(b.min),
+                    max: t.index_to_world(b.max),
+                };
+                let bytes = solid_bytes(cells(&padded(b, 2)), 6);
+                let p = plan(t, &bbox, bytes, 1);
+                (Loaded::Vdb(grid), p)
+            }
+        },
+        Task::CsgTree(path) => {
+            let tree = read_csg_tree(path)?;
+            let (t, bounds) = tree.transform()?;
+            let b = checked_box(&bounds, &t)?;
+            // One mask per leaf and Boolean level at most, and the result's boundary.
+            let masks = tree.node_count() as u32 + 3;
+            let bytes = solid_bytes(cells(&b), masks);
+            let p = plan(t, &bounds, bytes, tree.node_count() as u64);
+            (Loaded::Tree(Box::new(tree)), p)
+        }
+        Task::Combine { a, b, grid, .. } => {
+            let ga = read_vdb_grid(a, Some(grid))?;
+            let gb = read_vdb_grid(b, Some(grid))?;
+            let leaves = (ga.leaf_count() + gb.leaf_count()) as f64;
+            let t = ga.transform;
+            let bx = ga.bbox().unwrap_or(CoordBox {
+                min: [0; 3],
+                max: [0; 3],
+            });
+            let bbox = Aabb {
+                min: t.index_to_world(bx.min),
+                max: t.index_to_world(bx.max),
+            };
+            let p = plan(t, &bbox, leaves * (LEAF_BYTES + WRITE_LEAF_BYTES), 1);
+            (Loaded::Grids(ga, gb), p)
+        }
+    })
+}
+
+/// The surface of a `.vdb` to measure: a solid's `boundary` when it is one, else `surface`.
+fn read_surface(path: &std::path::Path) -> Result<SparseGrid> {
+    read_vdb_grid(path, Some("boundary")).or_else(|_| read_vdb_grid(path, Some("surface")))
+}

@@ -1,0 +1,495 @@
+//! The one way to run any method, behind every front end (the CLI, the C API, the Python
+//! module): a `Job` says what to make from what; `Job::plan` reads the inputs, places the
+//! grid and estimates memory and work, refusing what does not fit before anything big is
+//! allocated; `PlannedJob::run` does the work under an `Observer` (progress, cancellation)
+//! and returns an `Outcome`: the grids, their `.vdb` metadata and the report.
+
+mod estimate;
+mod outcome;
+mod report;
+mod solid;
+
+pub use outcome::{Outcome, check_output_path};
+pub use report::*;
+
+use crate::error::{Error, Result};
+use crate::grid::Transform;
+use crate::implicit::{Coordinates, Formula};
+use crate::mesh::{GridFit, Mesh};
+use crate::ops::csg::BooleanOp;
+use crate::ops::csg_tree::CsgTree;
+use crate::ops::solid::FloodMethod;
+use crate::progress::{Observer, Progress};
+use crate::subd::ControlMesh;
+use crate::voxelize::Separability;
+use crate::voxelize::depth_layers::DepthLayerOptions;
+use crate::voxelize::parametric::ParametricOptions;
+use crate::voxelize::projective::{Coloring, LineSource};
+use crate::voxelize::separating::SeparatingOptions;
+use crate::voxelize::separating_analytic::{AnalyticSurface, Cylinder, Quadric, Sphere};
+use glam::{DVec3, Vec3};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Most worker threads a job starts; more are clamped with a warning.
+pub const MAX_THREADS: usize = 256;
+
+/// A mesh given as a file or already in memory (arrays from C or Python).
+#[derive(Clone, Debug)]
+pub enum MeshSource {
+    File(PathBuf),
+    Mesh(Mesh),
+}
+
+/// Where the voxels' colours come from (projective methods).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum ColorChoice {
+    /// The mesh's vertex colours when it has them.
+    #[default]
+    FromMesh,
+    /// One colour for everything.
+    Constant(Vec3),
+    /// No `Cd` grid.
+    None,
+}
+
+/// How a polygon mesh becomes a surface.
+#[derive(Clone, Copy, Debug)]
+pub enum SurfaceMethod {
+    /// Huang et al.'s 6/26-separating surface.
+    Separating(SeparatingOptions),
+    /// Jegathese et al.'s scan-lines in each triangle's dominant plane.
+    Projective(ColorChoice),
+}
+
+/// An analytic surface of Huang et al. §7.
+#[derive(Clone, Copy, Debug)]
+pub enum Shape {
+    Sphere(Sphere),
+    Cylinder(Cylinder),
+    Quadric(Quadric),
+}
+
+/// How a mesh's solid is found.
+#[derive(Clone, Copy, Debug)]
+pub enum Fill {
+    /// The 26-separating surface plus what the exterior flood cannot reach.
+    Flood(FloodMethod),
+    /// Passalis et al.'s depth layers with a stencil count.
+    DepthLayers(DepthLayerOptions),
+    /// The projective surface plus beams between front and back faces along z.
+    Beam,
+}
+
+/// What `measure` measures: a mesh (its flooded 26-separating surface) or a `.vdb` surface.
+#[derive(Clone, Debug)]
+pub enum MeasureSource {
+    Mesh(MeshSource),
+    Vdb(PathBuf),
+}
+
+/// What to make.
+#[derive(Clone, Debug)]
+pub enum Task {
+    MeshSurface {
+        mesh: MeshSource,
+        method: SurfaceMethod,
+    },
+    /// Polylines (OBJ `l`) and, with `edges` or when there are none, the faces' edges.
+    Lines {
+        mesh: MeshSource,
+        edges: bool,
+        color: ColorChoice,
+    },
+    Shape {
+        shape: Shape,
+        separability: Separability,
+        normals: bool,
+    },
+    /// A Catmull-Clark limit surface from its control mesh.
+    Subdivision {
+        mesh: MeshSource,
+        options: ParametricOptions,
+    },
+    /// F = 0 inside `[min, max]`, by interval octree.
+    Implicit {
+        formula: String,
+        coordinates: Coordinates,
+        min: DVec3,
+        max: DVec3,
+        levels: bool,
+        negative_r: bool,
+    },
+    Solid {
+        mesh: MeshSource,
+        fill: Fill,
+        density: f64,
+    },
+    Measure {
+        source: MeasureSource,
+        flood: FloodMethod,
+        density: f64,
+    },
+    /// A CSG tree in JSON (see `ops::csg_tree`); its file sets the grid.
+    CsgTree(PathBuf),
+    /// A Boolean of grid `grid` of two `.vdb` files (`curve`: the intersection of two surfaces).
+    Combine {
+        a: PathBuf,
+        b: PathBuf,
+        grid: String,
+        op: BooleanOp,
+        resample: bool,
+        curve: bool,
+    },
+}
+
+/// Limits the work must respect.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Limits {
+    /// Worker threads (default: all cores; at most `MAX_THREADS`).
+    pub threads: Option<usize>,
+    /// Refuse work estimated above this many bytes (default: the memory available).
+    pub max_memory: Option<u64>,
+}
+
+/// One job: a task, how the grid is fitted and the limits.
+#[derive(Clone, Debug)]
+pub struct Job {
+    pub task: Task,
+    pub fit: GridFit,
+    pub limits: Limits,
+}
+
+/// What planning found: where the grid lies and what the work will cost.
+#[derive(Clone, Copy, Debug)]
+pub struct Plan {
+    pub transform: Transform,
+    /// Voxels along x, y and z of the region the work covers.
+    pub extent: [f64; 3],
+    pub estimated_bytes: u64,
+    /// Work items the observer will hear about (an estimate for some methods).
+    pub work_items: u64,
+}
+
+/// The inputs a task reads, loaded during planning.
+pub(crate) enum Loaded {
+    Mesh(Mesh),
+    Control(ControlMesh),
+    Formula(Formula),
+    Shape,
+    Tree(Box<CsgTree>),
+    Grids(crate::grid::SparseGrid, crate::grid::SparseGrid),
+    Vdb(crate::grid::SparseGrid),
+}
+
+/// A job whose inputs are read and whose plan fits.
+pub struct PlannedJob {
+    job: Job,
+    loaded: Loaded,
+    plan: Plan,
+    warnings: Vec<String>,
+    start: Instant,
+}
+
+impl GridFit {
+    /// The `resolution` metadata: `256`, or `voxel size 0.1`.
+    pub fn describe(&self) -> String {
+        match self {
+            GridFit::Resolution(r) => r.to_string(),
+            GridFit::VoxelSize(h) => format!("voxel size {h}"),
+        }
+    }
+}
+
+impl MeshSource {
+    fn load(&self, lines: bool) -> Result<Mesh> {
+        match self {
+            MeshSource::File(path) if lines => Mesh::load_lines(path),
+            MeshSource::File(path) => Mesh::load(path),
+            MeshSource::Mesh(mesh) => {
+                if !lines {
+                    mesh.validate()?;
+                }
+                Ok(mesh.clone())
+            }
+        }
+    }
+
+    /// The file, when it is one.
+    fn path(&self) -> Option<&Path> {
+        match self {
+            MeshSource::File(p) => Some(p),
+            MeshSource::Mesh(_) => None,
+        }
+    }
+}
+
+impl ColorChoice {
+    fn coloring(self, mesh: &Mesh) -> Coloring {
+        match self {
+            ColorChoice::FromMesh => Coloring::of(mesh),
+            ColorChoice::Constant(c) => Coloring::Constant(c),
+            ColorChoice::None => Coloring::None,
+        }
+    }
+}
+
+impl Shape {
+    pub fn surface(&self) -> &dyn AnalyticSurface {
+        match self {
+            Shape::Sphere(s) => s,
+            Shape::Cylinder(c) => c,
+            Shape::Quadric(q) => q,
+        }
+    }
+
+    /// The shape in words, for the report and the `source_file` metadata.
+    pub fn describe(&self) -> String {
+        match self {
+            Shape::Sphere(s) => format!("sphere r={} c={}", s.radius, s.center),
+            Shape::Cylinder(c) => format!(
+                "cylinder r={} h={} c={} axis={}",
+                c.radius, c.height, c.center, c.axis
+            ),
+            Shape::Quadric(q) => format!(
+                "x^2 + {k} y + {k} z = 0 in [-{e},{e}]^3",
+                k = q.k,
+                e = q.half_extent
+            ),
+        }
+    }
+}
+
+impl Task {
+    /// The files the task reads (an output must not be one of them).
+    pub fn input_files(&self) -> Vec<PathBuf> {
+        let mesh = |m: &MeshSource| m.path().map(Path::to_path_buf).into_iter().collect();
+        match self {
+            Task::MeshSurface { mesh: m, .. }
+            | Task::Lines { mesh: m, .. }
+            | Task::Subdivision { mesh: m, .. }
+            | Task::Solid { mesh: m, .. } => mesh(m),
+            Task::Measure {
+                source: MeasureSource::Mesh(m),
+                ..
+            } => mesh(m),
+            Task::Measure {
+                source: MeasureSource::Vdb(p),
+                ..
+            } => vec![p.clone()],
+            Task::CsgTree(p) => vec![p.clone()],
+            Task::Combine { a, b, .. } => vec![a.clone(), b.clone()],
+            Task::Shape { .. } | Task::Implicit { .. } => vec![],
+        }
+    }
+}
+
+impl Job {
+    pub fn new(task: Task, fit: GridFit) -> Job {
+        Job {
+            task,
+            fit,
+            limits: Limits::default(),
+        }
+    }
+
+    /// Reads the inputs, places the grid, estimates memory and work; refuses work that does
+    /// not fit in `limits.max_memory` (or the memory available) with the estimate.
+    pub fn plan(self) -> Result<PlannedJob> {
+        let start = Instant::now();
+        let mut warnings = Vec::new();
+        if let Some(n) = self.limits.threads {
+            if n == 0 {
+                return Err(Error::InvalidArgument(
+                    "the thread count must be at least 1".into(),
+                ));
+            }
+            if n > MAX_THREADS {
+                warnings.push(format!("{n} threads asked for; using {MAX_THREADS}"));
+            }
+        }
+        let (loaded, plan) = estimate::plan(&self)?;
+        let limit = self.limits.max_memory;
+        crate::system::check_fits(
+            plan.estimated_bytes,
+            limit,
+            &format!(
+                "{} at {:.0}x{:.0}x{:.0} voxels; lower the resolution or raise the memory limit",
+                self.describe_input(),
+                plan.extent[0],
+                plan.extent[1],
+                plan.extent[2]
+            ),
+        )?;
+        Ok(PlannedJob {
+            job: self,
+            loaded,
+            plan,
+            warnings,
+            start,
+        })
+    }
+
+    /// Plans and runs.
+    pub fn run(self, observer: &dyn Observer) -> Result<Outcome> {
+        self.plan()?.run(observer)
+    }
+
+    /// The input in words: the file, or what the task makes.
+    fn describe_input(&self) -> String {
+        match &self.task {
+            Task::Shape { shape, .. } => shape.describe(),
+            Task::Implicit { formula, .. } => formula.clone(),
+            Task::MeshSurface {
+                mesh: MeshSource::Mesh(m),
+                ..
+            }
+            | Task::Lines {
+                mesh: MeshSource::Mesh(m),
+                ..
+            }
+            | Task::Subdivision {
+                mesh: MeshSource::Mesh(m),
+                ..
+            }
+            | Task::Solid {
+                mesh: MeshSource::Mesh(m),
+                ..
+            }
+            | Task::Measure {
+                source: MeasureSource::Mesh(MeshSource::Mesh(m)),
+                ..
+            } => m.source.display().to_string(),
+            Task::Combine { a, b, .. } => format!("{} {}", a.display(), b.display()),
+            other => other
+                .input_files()
+                .first()
+                .map(|p| p.display().to_string())
+                .unwrap_or_default(),
+        }
+    }
+}
+
+impl PlannedJob {
+    pub fn plan(&self) -> &Plan {
+        &self.plan
+    }
+
+    pub fn job(&self) -> &Job {
+        &self.job
+    }
+
+    /// Every file the job reads, those a CSG tree names included.
+    pub fn input_files(&self) -> Vec<PathBuf> {
+        match &self.loaded {
+            Loaded::Tree(tree) => tree.input_files(),
+            _ => self.job.task.input_files(),
+        }
+    }
+
+    /// Does the work on the job's threads; the observer's `Break` ends it with
+    /// `Error::Cancelled`.
+    pub fn run(self, observer: &dyn Observer) -> Result<Outcome> {
+        let progress = Progress::new(observer);
+        progress.stage(self.stage_name(), self.plan.work_items);
+        let threads = self.job.limits.threads.map(|n| n.min(MAX_THREADS));
+        let mut outcome = match threads {
+            None => self.run_here(&progress),
+            Some(n) => rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| Error::InvalidArgument(format!("cannot start {n} threads: {e}")))?
+                .install(|| self.run_here(&progress)),
+        }?;
+        progress.check()?;
+        outcome.report.warnings.splice(0..0, self.warnings);
+        outcome.report.input = self.job.describe_input();
+        outcome.report.finish(self.start);
+        Ok(outcome)
+    }
+
+    fn stage_name(&self) -> &'static str {
+        match &self.job.task {
+            Task::MeshSurface { .. } | Task::Shape { .. } | Task::Subdivision { .. } => {
+                "voxelizing"
+            }
+            Task::Lines { .. } => "lines",
+            Task::Implicit { .. } => "octree",
+            Task::Solid { .. } | Task::Measure { .. } => "surface",
+            Task::CsgTree(_) | Task::Combine { .. } => "combining",
+        }
+    }
+
+    fn run_here(&self, progress: &Progress) -> Result<Outcome> {
+        let t = self.plan.transform;
+        let fit = self.job.fit.describe();
+        let source = self.job.describe_input();
+        match (&self.job.task, &self.loaded) {
+            (Task::MeshSurface { method, .. }, Loaded::Mesh(mesh)) => {
+                outcome::mesh_surface(mesh, t, *method, &fit, progress)
+            }
+            (Task::Lines { edges, color, .. }, Loaded::Mesh(mesh)) => {
+                let source = lines_source(mesh, *edges);
+                outcome::lines(mesh, t, source, color.coloring(mesh), &fit, progress)
+            }
+            (
+                Task::Shape {
+                    shape,
+                    separability,
+                    normals,
+                },
+                Loaded::Shape,
+            ) => outcome::shape(shape, t, *separability, *normals, &fit, progress),
+            (Task::Subdivision { options, .. }, Loaded::Control(control)) => {
+                outcome::subdivision(control, t, options, &fit, progress)
+            }
+            (
+                Task::Implicit {
+                    min,
+                    max,
+                    levels,
+                    negative_r,
+                    formula: text,
+                    ..
+                },
+                Loaded::Formula(formula),
+            ) => {
+                let options = crate::voxelize::interval_octree::OctreeOptions {
+                    resolution: estimate::octree_resolution(self.job.fit, *min, *max)?,
+                    both_signs: *negative_r,
+                    levels: *levels,
+                };
+                outcome::implicit(formula, text, *min, *max, &options, progress)
+            }
+            (Task::Solid { fill, density, .. }, Loaded::Mesh(mesh)) => {
+                solid::mesh_solid(mesh, t, *fill, *density, &fit, progress)
+            }
+            (Task::Measure { flood, density, .. }, Loaded::Mesh(mesh)) => {
+                solid::measure_mesh(mesh, t, *flood, *density, progress)
+            }
+            (Task::Measure { flood, density, .. }, Loaded::Vdb(surface)) => {
+                solid::measure_surface(surface, &source, *flood, *density, progress)
+            }
+            (Task::CsgTree(_), Loaded::Tree(tree)) => solid::csg_tree(tree, progress),
+            (
+                Task::Combine {
+                    op,
+                    resample,
+                    curve,
+                    ..
+                },
+                Loaded::Grids(a, b),
+            ) => outcome::combine(a, b, *op, *resample, *curve, &source),
+            _ => unreachable!("planning loads what the task needs"),
+        }
+    }
+}
+
+/// The segments `lines` voxelizes: the polylines, and the edges when asked or when there are
+/// no polylines.
+fn lines_source(mesh: &Mesh, edges: bool) -> LineSource {
+    LineSource {
+        polylines: true,
+        edges: edges || mesh.polylines.is_empty(),
+    }
+}

@@ -1,0 +1,364 @@
+//! What a job returns: the main grid, the grids written beside it, the `.vdb` metadata and
+//! the report; and the surface tasks that make them.
+
+use super::report::{
+    Details, ImplicitDetails, ProjectiveDetails, Report, SeparatingClasses, SubdivisionDetails,
+};
+use super::{Shape, SurfaceMethod};
+use crate::error::{Error, Result};
+use crate::grid::{SparseGrid, Transform};
+use crate::implicit::Formula;
+use crate::io::atomic::check_output;
+use crate::mesh::Mesh;
+use crate::ops::csg::{BooleanOp, combine as combine_grids};
+use crate::progress::Progress;
+use crate::subd::ControlMesh;
+use crate::voxelize::Separability;
+use crate::voxelize::interval_octree::{OctreeOptions, voxelize_implicit};
+use crate::voxelize::parametric::{ParametricOptions, voxelize_subdivision};
+use crate::voxelize::projective::{self, Coloring, LineSource};
+use crate::voxelize::separating::{Criterion, voxelize_mesh};
+use crate::voxelize::separating_analytic::voxelize_surface;
+use glam::DVec3;
+use std::path::Path;
+use std::time::Instant;
+
+/// The result of a job.
+pub struct Outcome {
+    /// The voxel set: a surface (with its normal or colour channel) or a whole solid.
+    pub grid: SparseGrid,
+    /// Bool grids written beside it (`boundary`, `interior`, `unclassified`,
+    /// `opposite_normals`, `level_0` ..), by name.
+    pub extra: Vec<(String, SparseGrid)>,
+    /// The metadata every written grid carries (`method`, `source_file`, ...).
+    pub metadata: Vec<(String, String)>,
+    pub report: Report,
+}
+
+/// Output formats by extension; `-` is standard output (as `.vdb`).
+const FORMATS: &str = ".vdb (or - for standard output)";
+
+/// Refuses an output voxelkit cannot write, or one that is an input, before any work.
+pub fn check_output_path(path: &Path, inputs: &[&Path]) -> Result<()> {
+    if path == Path::new("-") {
+        return Ok(());
+    }
+    check_output(path, inputs)?;
+    let vdb = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("vdb"));
+    if !vdb {
+        return Err(Error::InvalidArgument(format!(
+            "{}: voxelkit cannot write this format; it writes {FORMATS}",
+            path.display()
+        )));
+    }
+    Ok(())
+}
+
+impl Outcome {
+    pub(super) fn new(
+        grid: SparseGrid,
+        metadata: Vec<(&str, String)>,
+        details: Details,
+    ) -> Outcome {
+        let method = metadata
+            .iter()
+            .find(|(k, _)| *k == "method")
+            .map(|(_, v)| v.clone())
+            .unwrap_or_default();
+        let report = Report {
+            method,
+            voxels: grid.voxel_count(),
+            leaves: grid.leaf_count() as u64,
+            voxel_size: grid.transform.voxel_size,
+            origin: grid.transform.origin.to_array(),
+            details,
+            ..Default::default()
+        };
+        Outcome {
+            grid,
+            extra: Vec::new(),
+            metadata: metadata
+                .into_iter()
+                .map(|(k, v)| (k.to_string(), v))
+                .collect(),
+            report,
+        }
+    }
+
+    /// Adds a bool grid written beside the main one.
+    pub(super) fn with(mut self, name: &str, grid: SparseGrid) -> Outcome {
+        self.extra.push((name.to_string(), grid));
+        self
+    }
+
+    pub(super) fn timed(mut self, start: Instant) -> Outcome {
+        self.report.voxelize_seconds = start.elapsed().as_secs_f64();
+        self
+    }
+
+    /// Writes every grid to `path` (`.vdb`; `-` for standard output), atomically, refusing
+    /// to replace any of `inputs`; records the output in the report.
+    pub fn write(&mut self, path: &Path, inputs: &[&Path]) -> Result<()> {
+        check_output_path(path, inputs)?;
+        let meta: Vec<(&str, String)> = self
+            .metadata
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.clone()))
+            .collect();
+        let extra: Vec<(&str, &SparseGrid)> =
+            self.extra.iter().map(|(n, g)| (n.as_str(), g)).collect();
+        if path == Path::new("-") {
+            write_to_stdout(&self.grid, &extra, &meta)?;
+        } else {
+            crate::io::vdb::write_vdb_with_masks(path, &self.grid, &extra, &meta)?;
+        }
+        self.report.output = Some(path.display().to_string());
+        Ok(())
+    }
+}
+
+/// OpenVDB writes to files: write a private temporary file, then copy it to stdout.
+fn write_to_stdout(
+    grid: &SparseGrid,
+    extra: &[(&str, &SparseGrid)],
+    meta: &[(&str, String)],
+) -> Result<()> {
+    let dir = std::env::temp_dir().join(format!("voxelkit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let file = dir.join("stdout.vdb");
+    let result = crate::io::vdb::write_vdb_with_masks(&file, grid, extra, meta).and_then(|()| {
+        let mut bytes = std::fs::File::open(&file).map_err(|e| Error::io(&file, e))?;
+        let mut out = std::io::stdout().lock();
+        std::io::copy(&mut bytes, &mut out)
+            .and_then(|_| std::io::Write::flush(&mut out))
+            .map_err(|e| Error::io("standard output", e))
+            .map(|_| ())
+    });
+    let _ = std::fs::remove_dir_all(&dir);
+    result
+}
+
+/// `method`, `source_file` and `resolution`, the metadata every output carries.
+fn provenance(method: &str, source: &str, resolution: &str) -> Vec<(&'static str, String)> {
+    vec![
+        ("method", method.to_string()),
+        ("source_file", source.to_string()),
+        ("resolution", resolution.to_string()),
+    ]
+}
+
+fn describe(coloring: Coloring) -> String {
+    match coloring {
+        Coloring::None => "none".into(),
+        Coloring::Vertex => "vertex colours interpolated".into(),
+        Coloring::Constant(c) => format!("constant {},{},{}", c.x, c.y, c.z),
+    }
+}
+
+/// A projective surface or line set, with its colouring in the metadata and the report.
+fn projective_outcome(
+    grid: SparseGrid,
+    mut meta: Vec<(&str, String)>,
+    s: &projective::ProjectiveStats,
+    coloring: Coloring,
+) -> Outcome {
+    meta.push(("color", describe(coloring)));
+    let details = ProjectiveDetails {
+        triangles: s.triangles,
+        degenerate_triangles: s.degenerate_triangles,
+        segments: s.segments,
+        color: describe(coloring),
+    };
+    Outcome::new(grid, meta, Details::Projective(details))
+}
+
+pub(super) fn mesh_surface(
+    mesh: &Mesh,
+    t: Transform,
+    method: SurfaceMethod,
+    resolution: &str,
+    progress: &Progress,
+) -> Result<Outcome> {
+    let start = Instant::now();
+    let source = mesh.source.display().to_string();
+    match method {
+        SurfaceMethod::Separating(options) => {
+            let (grid, s) = voxelize_mesh(mesh, t, &options, progress)?;
+            let method = match options.criterion {
+                Criterion::Huang => "huang-separating",
+                Criterion::Clipped => "huang-separating-clipped",
+            };
+            let sep = options.separability.adjacency();
+            let mut meta = provenance(method, &source, resolution);
+            meta.insert(1, ("separability", sep.to_string()));
+            let classes = SeparatingClasses {
+                vertex_voxels: s.vertex_voxels,
+                edge_voxels: s.edge_voxels,
+                body_voxels: s.body_voxels,
+                triangles: s.triangles as u64,
+                edges: s.edges as u64,
+                vertices: s.vertices as u64,
+                degenerate_faces: s.degenerate_faces as u64,
+            };
+            let mut out = Outcome::new(
+                grid,
+                meta,
+                Details::Separating {
+                    separability: sep,
+                    classes,
+                },
+            );
+            if s.degenerate_faces > 0 {
+                out.report.warnings.push(format!(
+                    "{source}: {} degenerate faces (zero area or repeated vertex) voxelized by their edges only",
+                    s.degenerate_faces
+                ));
+            }
+            Ok(out.timed(start))
+        }
+        SurfaceMethod::Projective(color) => {
+            let coloring = color.coloring(mesh);
+            let (grid, s) = projective::voxelize_triangles(mesh, t, coloring, progress)?;
+            let meta = provenance("projective-triangles", &source, resolution);
+            Ok(projective_outcome(grid, meta, &s, coloring).timed(start))
+        }
+    }
+}
+
+pub(super) fn lines(
+    mesh: &Mesh,
+    t: Transform,
+    source: LineSource,
+    coloring: Coloring,
+    resolution: &str,
+    progress: &Progress,
+) -> Result<Outcome> {
+    let start = Instant::now();
+    let (grid, s) = projective::voxelize_lines(mesh, t, source, coloring, progress)?;
+    let method = if source.edges && !mesh.polylines.is_empty() {
+        "projective-lines+edges"
+    } else if source.edges {
+        "projective-edges"
+    } else {
+        "projective-lines"
+    };
+    let meta = provenance(method, &mesh.source.display().to_string(), resolution);
+    Ok(projective_outcome(grid, meta, &s, coloring).timed(start))
+}
+
+pub(super) fn shape(
+    shape: &Shape,
+    t: Transform,
+    separability: Separability,
+    normals: bool,
+    resolution: &str,
+    progress: &Progress,
+) -> Result<Outcome> {
+    let start = Instant::now();
+    let grid = voxelize_surface(shape.surface(), t, separability, normals, progress)?;
+    let name = shape.describe();
+    let sep = separability.adjacency();
+    let mut meta = provenance("huang-separating-analytic", &name, resolution);
+    meta.insert(1, ("separability", sep.to_string()));
+    let details = Details::Shape {
+        shape: name,
+        separability: sep,
+    };
+    Ok(Outcome::new(grid, meta, details).timed(start))
+}
+
+pub(super) fn subdivision(
+    control: &ControlMesh,
+    t: Transform,
+    options: &ParametricOptions,
+    resolution: &str,
+    progress: &Progress,
+) -> Result<Outcome> {
+    let start = Instant::now();
+    let out = voxelize_subdivision(control, t, options, progress)?;
+    let s = out.stats;
+    let method = if options.enclose {
+        "lai-cheng-parametric-enclosed"
+    } else {
+        "lai-cheng-parametric"
+    };
+    let adjacency = options.adjacency.number();
+    let mut meta = provenance(method, &control.source.display().to_string(), resolution);
+    meta.insert(1, ("adjacency", adjacency.to_string()));
+    meta.push(("presplit", options.presplit.to_string()));
+    meta.push(("surface_area", s.area.to_string()));
+    let details = SubdivisionDetails {
+        adjacency,
+        opposite_normal_voxels: s.opposite_voxels,
+        patches: s.patches,
+        evaluations: s.evaluations,
+        uniform_evaluations: s.uniform_evaluations,
+        subpatches: s.subpatches,
+        depth_guard_stops: s.depth_guard_stops,
+        enclose_splits: s.enclose_splits,
+        tolerance_voxels: s.guard_voxels,
+        area: s.area,
+    };
+    Ok(
+        Outcome::new(out.surface, meta, Details::Subdivision(details))
+            .with("opposite_normals", out.opposite)
+            .timed(start),
+    )
+}
+
+pub(super) fn implicit(
+    formula: &Formula,
+    text: &str,
+    min: DVec3,
+    max: DVec3,
+    options: &OctreeOptions,
+    progress: &Progress,
+) -> Result<Outcome> {
+    let start = Instant::now();
+    let out = voxelize_implicit(formula, min, max, options, progress)?;
+    let s = out.stats;
+    let coordinates = format!("{:?}", formula.coordinates).to_lowercase();
+    let meta = vec![
+        ("method", "stolte-kaufman-interval-octree".to_string()),
+        ("formula", text.to_string()),
+        ("coordinates", coordinates.clone()),
+        ("resolution", options.resolution.to_string()),
+    ];
+    let details = ImplicitDetails {
+        formula: text.to_string(),
+        coordinates,
+        cells_tested: s.cells_tested,
+        axis_cells: s.axis_cells,
+        levels: out.levels.len() as u64,
+        depth: s.depth,
+    };
+    let mut outcome = Outcome::new(out.surface, meta, Details::Implicit(details));
+    for (l, level) in out.levels.into_iter().enumerate() {
+        outcome = outcome.with(&format!("level_{l}"), level);
+    }
+    Ok(outcome.timed(start))
+}
+
+pub(super) fn combine(
+    a: &SparseGrid,
+    b: &SparseGrid,
+    op: BooleanOp,
+    resample: bool,
+    curve: bool,
+    source: &str,
+) -> Result<Outcome> {
+    let start = Instant::now();
+    let grid = combine_grids(a, b, op, resample).map_err(|e| match e {
+        Error::InvalidArgument(m) => Error::InvalidArgument(format!("{source}: {m}")),
+        other => other,
+    })?;
+    let method = if curve {
+        "intersection-curve".to_string()
+    } else {
+        format!("{op:?}").to_lowercase()
+    };
+    let meta = vec![("method", method), ("source_file", source.to_string())];
+    Ok(Outcome::new(grid, meta, Details::None).timed(start))
+}

@@ -1,0 +1,365 @@
+//! What a job reports: one serde struct, printed as JSON (`--json`, the Python module's
+//! `report` dict) or as the human summary, so both always say the same.
+
+use serde::Serialize;
+
+/// The report of one job. Every number is a number; `seconds` is the whole run.
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct Report {
+    /// The file written, once written (`-` for standard output).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub output: Option<String>,
+    /// The input file or a description of the input (shape, formula, arrays).
+    pub input: String,
+    /// The method, as written to the `.vdb` metadata.
+    pub method: String,
+    /// Voxels of the main grid (the surface, or the whole solid).
+    pub voxels: u64,
+    /// 8x8x8 leaves holding them.
+    pub leaves: u64,
+    pub voxel_size: f64,
+    /// World position of the centre of voxel (0,0,0).
+    pub origin: [f64; 3],
+    #[serde(flatten)]
+    pub details: Details,
+    /// What the user should know although the job succeeded.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
+    /// Time in the voxelization (or classification) itself.
+    pub voxelize_seconds: f64,
+    /// The whole run: reading, planning, voxelizing, measuring and writing.
+    pub seconds: f64,
+    /// Peak resident memory of the process.
+    pub peak_mib: f64,
+}
+
+/// What each kind of job adds to the report.
+#[derive(Serialize, Debug, Clone, Default)]
+#[serde(untagged)]
+pub enum Details {
+    #[default]
+    None,
+    Separating {
+        separability: u32,
+        classes: SeparatingClasses,
+    },
+    Projective(ProjectiveDetails),
+    Shape {
+        shape: String,
+        separability: u32,
+    },
+    Subdivision(SubdivisionDetails),
+    Implicit(ImplicitDetails),
+    Solid(SolidDetails),
+    DepthLayers(DepthLayerDetails),
+    Csg(CsgDetails),
+}
+
+/// Voxels by the part of Huang et al.'s criterion that first produced them.
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct SeparatingClasses {
+    pub vertex_voxels: u64,
+    pub edge_voxels: u64,
+    pub body_voxels: u64,
+    pub triangles: u64,
+    pub edges: u64,
+    pub vertices: u64,
+    /// Faces without area (or with a repeated vertex), voxelized by their edges only.
+    pub degenerate_faces: u64,
+}
+
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct ProjectiveDetails {
+    pub triangles: u64,
+    /// Triangles without area, voxelized as their longest edge.
+    pub degenerate_triangles: u64,
+    pub segments: u64,
+    pub color: String,
+}
+
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct SubdivisionDetails {
+    pub adjacency: u32,
+    /// Voxels crossed by two sheets of the surface with opposite normals.
+    pub opposite_normal_voxels: u64,
+    pub patches: u64,
+    /// Limit-surface evaluations, and what a uniform grid at the same density would need.
+    pub evaluations: u64,
+    pub uniform_evaluations: u64,
+    pub subpatches: u64,
+    /// Sub-patches no longer split because they had reached the depth guard (a sub-patch
+    /// smaller than 1/extent of the mesh): their corner voxels are output as they are.
+    pub depth_guard_stops: u64,
+    /// Splits made only by `enclose` (a sub-patch not yet inside its corner voxels).
+    pub enclose_splits: u64,
+    /// Voxels added at depth-guard stops (the tolerance of the adjacency test).
+    pub tolerance_voxels: u64,
+    /// Limit-surface area summed over the final sub-patches, world units.
+    pub area: f64,
+}
+
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct ImplicitDetails {
+    pub formula: String,
+    pub coordinates: String,
+    /// Octree cells whose interval test was evaluated.
+    pub cells_tested: u64,
+    /// Cells on the axis of spherical or cylindrical coordinates (tested as a whole).
+    pub axis_cells: u64,
+    /// Levels written with `levels` (0 when only the finest is kept).
+    pub levels: u64,
+    pub depth: u32,
+}
+
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct SolidDetails {
+    pub inside_voxels: u64,
+    pub surface_voxels: u64,
+    pub volume_inside: f64,
+    pub volume_with_surface: f64,
+    pub density: f64,
+    pub mass_inside: f64,
+    pub mass_with_surface: f64,
+    /// 26-connected components of surface plus inside.
+    pub components: u64,
+    /// Genus of the boundary, for solids without cavities: components - Euler characteristic.
+    pub genus: i64,
+    pub inside_rule: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mesh_signed_volume: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mesh_area: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none", flatten)]
+    pub flooding_xyz: Option<FloodingXyzDetails>,
+}
+
+/// Lai & Cheng's FloodingXYZ at work.
+#[derive(Serialize, Debug, Clone, Copy, Default)]
+pub struct FloodingXyzDetails {
+    pub line_floods: u64,
+    pub sweeps: u64,
+    pub graystack_overflows: u64,
+}
+
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct DepthLayerDetails {
+    pub inside_voxels: u64,
+    /// Voxels no direction could decide (written as `unclassified`).
+    pub unclassified_voxels: u64,
+    /// Of those, the voxels on rays crossed an odd number of times (an open mesh).
+    pub unclassified_on_odd_rays: u64,
+    pub odd_rays: u64,
+    pub boundary_edges: u64,
+    pub non_manifold_edges: u64,
+    pub volume: f64,
+    pub volume_with_unclassified: f64,
+    pub density: f64,
+    pub mass: f64,
+    pub mesh_signed_volume: f64,
+    pub directions: Vec<DirectionCounts>,
+}
+
+/// One direction's rays by how often they cross the mesh.
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct DirectionCounts {
+    pub direction: [i64; 3],
+    pub rays: u64,
+    pub crossed_0: u64,
+    pub crossed_2: u64,
+    pub crossed_4: u64,
+    pub crossed_more: u64,
+    pub crossed_odd: u64,
+}
+
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct CsgDetails {
+    pub volume: f64,
+    pub leaves_of_tree: Vec<CsgLeafCount>,
+}
+
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct CsgLeafCount {
+    pub leaf: String,
+    pub voxels: u64,
+}
+
+impl Report {
+    /// Sets the whole run's time and the peak memory: the last thing before printing.
+    pub fn finish(&mut self, start: std::time::Instant) {
+        self.seconds = start.elapsed().as_secs_f64();
+        self.peak_mib = crate::system::peak_memory_bytes().unwrap_or(0) as f64 / (1 << 20) as f64;
+    }
+
+    /// The report as one JSON object.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).expect("a report serializes")
+    }
+
+    /// The human summary: a first line with what was made, then details.
+    pub fn summary(&self) -> String {
+        let place = self.output.as_deref().unwrap_or(&self.input);
+        let timing = format!(
+            "{:.2} s (voxelize {:.2} s), peak {:.0} MiB",
+            self.seconds, self.voxelize_seconds, self.peak_mib
+        );
+        let mut text = match &self.details {
+            Details::None => format!(
+                "{place}: {} voxels in {} leaves ({}), voxel size {:.6}, {timing}",
+                self.voxels, self.leaves, self.method, self.voxel_size
+            ),
+            Details::Separating {
+                separability,
+                classes: c,
+            } => format!(
+                "{place}: {} voxels ({} vertex, {} edge, {} body) in {} leaves, {separability}-separating, voxel size {:.6}, {timing}",
+                self.voxels,
+                c.vertex_voxels,
+                c.edge_voxels,
+                c.body_voxels,
+                self.leaves,
+                self.voxel_size
+            ),
+            Details::Projective(p) => {
+                let rate = |n: u64| n as f64 / self.voxelize_seconds.max(1e-9) / 1e6;
+                let primitives = if p.segments > 0 {
+                    format!("{} segments ({:.2}M lines/s)", p.segments, rate(p.segments))
+                } else {
+                    format!(
+                        "{} triangles ({} without area, voxelized as their longest edge; {:.2}M triangles/s)",
+                        p.triangles,
+                        p.degenerate_triangles,
+                        rate(p.triangles)
+                    )
+                };
+                format!(
+                    "{place}: {} voxels in {} leaves from {primitives}, colour {}, voxel size {:.6}, {timing}",
+                    self.voxels, self.leaves, p.color, self.voxel_size
+                )
+            }
+            Details::Shape {
+                shape,
+                separability,
+            } => format!(
+                "{place}: {shape}: {} voxels in {} leaves, {separability}-separating, voxel size {:.6}, {timing}",
+                self.voxels, self.leaves, self.voxel_size
+            ),
+            Details::Subdivision(s) => format!(
+                "{place}: {} voxels ({} crossed by opposite sheets) from {} patches; {} evaluations \
+                 (a uniform grid at the same density: {}), {} sub-patches, {} depth-guard stops \
+                 ({} voxels added there); area {:.6}; {}-adjacent; voxel size {:.6}, {timing}",
+                self.voxels,
+                s.opposite_normal_voxels,
+                s.patches,
+                s.evaluations,
+                s.uniform_evaluations,
+                s.subpatches,
+                s.depth_guard_stops,
+                s.tolerance_voxels,
+                s.area,
+                s.adjacency,
+                self.voxel_size
+            ),
+            Details::Implicit(s) => format!(
+                "{place}: {} voxels at depth {} ({} cells tested, {} on the axis){}; voxel size {:.6}, {timing}",
+                self.voxels,
+                s.depth,
+                s.cells_tested,
+                s.axis_cells,
+                if s.levels == 0 {
+                    String::new()
+                } else {
+                    format!(", {} levels", s.levels)
+                },
+                self.voxel_size
+            ),
+            Details::Solid(s) => solid_summary(place, s, &timing),
+            Details::DepthLayers(d) => depth_layer_summary(place, &self.method, d, &timing),
+            Details::Csg(c) => {
+                let mut t = format!(
+                    "{place}: {} voxels (volume {:.6}) at voxel size {:.6} from {} leaves; {timing}",
+                    self.voxels,
+                    c.volume,
+                    self.voxel_size,
+                    c.leaves_of_tree.len()
+                );
+                for l in &c.leaves_of_tree {
+                    t.push_str(&format!("\n  {:>12} voxels  {}", l.voxels, l.leaf));
+                }
+                t
+            }
+        };
+        for w in &self.warnings {
+            text.push_str(&format!("\nwarning: {w}"));
+        }
+        text
+    }
+}
+
+fn solid_summary(place: &str, s: &SolidDetails, timing: &str) -> String {
+    let mesh = match (s.mesh_signed_volume, s.mesh_area) {
+        (Some(v), Some(a)) => format!(" (faces: area {a:.6}, signed volume {v:.6})"),
+        (Some(v), None) => format!(" (mesh signed volume {v:.6})"),
+        _ => String::new(),
+    };
+    let xyz = s.flooding_xyz.map_or(String::new(), |x| {
+        format!(
+            " (FloodingXYZ: {} line floods, {} sweeps, {} stack overflows)",
+            x.line_floods, x.sweeps, x.graystack_overflows
+        )
+    });
+    format!(
+        "{place}{mesh}: {} inside + {} surface voxels; volume {:.6} (inside) .. {:.6} (with surface); \
+         mass {:.6} .. {:.6} at density {}; {} component(s), genus {}; {}{xyz}; {timing}",
+        s.inside_voxels,
+        s.surface_voxels,
+        s.volume_inside,
+        s.volume_with_surface,
+        s.mass_inside,
+        s.mass_with_surface,
+        s.density,
+        s.components,
+        s.genus,
+        s.inside_rule
+    )
+}
+
+fn depth_layer_summary(place: &str, method: &str, d: &DepthLayerDetails, timing: &str) -> String {
+    let mut t = format!(
+        "{place}: {method}: {} inside, {} unclassifiable voxels; volume {:.6} (inside centres){}; mass {:.6} at density {}; mesh signed volume {:.6}",
+        d.inside_voxels,
+        d.unclassified_voxels,
+        d.volume,
+        if d.unclassified_voxels > 0 {
+            format!(
+                ", {:.6} with the unclassifiable voxels",
+                d.volume_with_unclassified
+            )
+        } else {
+            String::new()
+        },
+        d.mass,
+        d.density,
+        d.mesh_signed_volume
+    );
+    t.push_str("\n  rays by crossings     0          2          4         >4        odd");
+    for c in &d.directions {
+        let name = format!("({},{},{})", c.direction[0], c.direction[1], c.direction[2]);
+        t.push_str(&format!(
+            "\n  {name:<12} {:>10} {:>10} {:>10} {:>10} {:>10}",
+            c.crossed_0, c.crossed_2, c.crossed_4, c.crossed_more, c.crossed_odd
+        ));
+    }
+    if d.odd_rays > 0 {
+        t.push_str(&format!(
+            "\n  the input is not closed ({} boundary and {} non-manifold edges): {} rays cross it an odd number of times, and the {} voxels on them are unclassifiable (written as `unclassified`, neither filled nor left empty)",
+            d.boundary_edges, d.non_manifold_edges, d.odd_rays, d.unclassified_on_odd_rays
+        ));
+    } else if d.unclassified_voxels > 0 {
+        t.push_str(&format!(
+            "\n  {} voxels are crossed more than four times along every direction and are written as `unclassified` (more --directions may decide some)",
+            d.unclassified_voxels
+        ));
+    }
+    t.push_str(&format!("\n  {timing}"));
+    t
+}

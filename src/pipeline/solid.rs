@@ -1,0 +1,266 @@
+//! The solid tasks: fill a mesh (exterior flood, depth layers, beams), measure a mesh or a
+//! `.vdb` surface, evaluate a CSG tree; with volumes, mass, components and genus.
+
+use super::Fill;
+use super::outcome::Outcome;
+use super::report::{
+    CsgDetails, CsgLeafCount, DepthLayerDetails, Details, DirectionCounts, FloodingXyzDetails,
+    SolidDetails,
+};
+use crate::error::Result;
+use crate::grid::{Adjacency, Channels, DenseMask, SparseGrid, Transform};
+use crate::mesh::{Mesh, index_box};
+use crate::ops::csg_tree::CsgTree;
+use crate::ops::flood::padded;
+use crate::ops::solid::{FloodMethod, Solid, solid_from_surface};
+use crate::ops::topology::{components, euler_characteristic};
+use crate::progress::Progress;
+use crate::voxelize::Separability;
+use crate::voxelize::depth_layers::{Layers, depth_layer_solid};
+use crate::voxelize::projective::beam::beam_solid;
+use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
+use std::time::Instant;
+
+/// Why the flood needs a closed mesh, for the error that refuses an open one.
+const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it and leave the solid hollow \
+     (--method depth-layers reports which voxels an open mesh leaves undecidable)";
+
+/// What inside means for the exterior flood.
+const FLOOD_RULE: &str =
+    "inside = what the exterior flood (from the box corner, no normals needed) cannot reach";
+
+/// What inside means for the beams.
+const BEAM_RULE: &str = "inside = the beams between front and back faces along z (centres between crossings 1-2, 3-4, ...)";
+
+/// The 26-separating surface a flood fills.
+fn flood_surface(mesh: &Mesh, t: Transform, progress: &Progress) -> Result<SparseGrid> {
+    mesh.require_closed(FLOOD_NEEDS_CLOSED)?;
+    let options = SeparatingOptions {
+        separability: Separability::TwentySix,
+        ..Default::default()
+    };
+    Ok(voxelize_mesh(mesh, t, &options, progress)?.0)
+}
+
+/// Components (26-connected) and genus (components - Euler characteristic) of surface plus
+/// inside.
+fn topology(surface: &SparseGrid, inside: &SparseGrid) -> Result<(u64, i64)> {
+    let Some(bbox) = surface.bbox() else {
+        return Ok((0, 0));
+    };
+    let mut all = DenseMask::from_grid(surface, padded(bbox, 1))?;
+    all.combine_words(&DenseMask::from_grid(inside, padded(bbox, 1))?, |a, b| {
+        a | b
+    });
+    let parts = components(&all, Adjacency::TwentySix);
+    Ok((parts, parts as i64 - euler_characteristic(&all)))
+}
+
+/// The report of a surface and the solid inside it.
+fn solid_details(
+    surface: &SparseGrid,
+    solid: &Solid,
+    density: f64,
+    rule: &str,
+    mesh: Option<&Mesh>,
+) -> Result<SolidDetails> {
+    let m = solid.measures;
+    let (components, genus) = topology(surface, &solid.inside)?;
+    let (mass_inside, mass_with_surface) = m.mass(density);
+    Ok(SolidDetails {
+        inside_voxels: m.inside_voxels,
+        surface_voxels: m.surface_voxels,
+        volume_inside: m.volume_inside,
+        volume_with_surface: m.volume_with_surface,
+        density,
+        mass_inside,
+        mass_with_surface,
+        components,
+        genus,
+        inside_rule: rule.to_string(),
+        mesh_signed_volume: mesh.map(Mesh::signed_volume),
+        mesh_area: None,
+        flooding_xyz: solid.xyz_stats.map(|s| FloodingXyzDetails {
+            line_floods: s.line_floods,
+            sweeps: s.sweeps,
+            graystack_overflows: s.overflows,
+        }),
+    })
+}
+
+/// A surface plus the voxels inside it: `surface` and `density` on both, `boundary` and
+/// `interior` apart.
+fn surface_and_inside(
+    surface: SparseGrid,
+    solid: Solid,
+    meta: Vec<(&str, String)>,
+    details: SolidDetails,
+) -> Outcome {
+    let mut whole = SparseGrid::new(surface.transform, Channels::NONE);
+    whole.union(&surface);
+    whole.union(&solid.inside);
+    Outcome::new(whole, meta, Details::Solid(details))
+        .with("boundary", surface)
+        .with("interior", solid.inside)
+}
+
+/// A solid classified at voxel centres: `boundary` (voxels with a face towards the
+/// outside) and `interior` beside the whole.
+fn centre_solid(
+    solid: &DenseMask,
+    t: Transform,
+    meta: Vec<(&str, String)>,
+    details: Details,
+) -> Outcome {
+    let outer = solid.boundary();
+    let interior = solid.minus(&outer).to_grid(t);
+    Outcome::new(solid.to_grid(t), meta, details)
+        .with("boundary", outer.to_grid(t))
+        .with("interior", interior)
+}
+
+pub(super) fn mesh_solid(
+    mesh: &Mesh,
+    t: Transform,
+    fill: Fill,
+    density: f64,
+    resolution: &str,
+    progress: &Progress,
+) -> Result<Outcome> {
+    let start = Instant::now();
+    let source = mesh.source.display().to_string();
+    let meta = |method: &str| {
+        vec![
+            ("method", method.to_string()),
+            ("source_file", source.clone()),
+            ("resolution", resolution.to_string()),
+        ]
+    };
+    let outcome = match fill {
+        Fill::Flood(flood) => {
+            let surface = flood_surface(mesh, t, progress)?;
+            let solid = solid_from_surface(&surface, flood)?;
+            let details = solid_details(&surface, &solid, density, FLOOD_RULE, Some(mesh))?;
+            let method = meta("huang-26-separating-surface+exterior-flood");
+            surface_and_inside(surface, solid, method, details)
+        }
+        Fill::Beam => {
+            let (surface, solid, _) = beam_solid(mesh, t, progress)?;
+            let details = solid_details(&surface, &solid, density, BEAM_RULE, Some(mesh))?;
+            let mut method = meta("projective-beam");
+            method.push(("color", "none".into()));
+            surface_and_inside(surface, solid, method, details)
+        }
+        Fill::DepthLayers(options) => {
+            let edges = mesh.edge_counts();
+            let solid = depth_layer_solid(mesh, &t, index_box(&mesh.bbox(), &t), &options)?;
+            progress.advance(1);
+            let s = &solid.stats;
+            let cell = t.voxel_size.powi(3);
+            let volume = s.inside_voxels as f64 * cell;
+            let details = DepthLayerDetails {
+                inside_voxels: s.inside_voxels,
+                unclassified_voxels: s.unclassified_voxels,
+                unclassified_on_odd_rays: s.open_voxels,
+                odd_rays: s.odd_rays(),
+                boundary_edges: edges.boundary,
+                non_manifold_edges: edges.non_manifold,
+                volume,
+                volume_with_unclassified: (s.inside_voxels + s.unclassified_voxels) as f64 * cell,
+                density,
+                mass: volume * density,
+                mesh_signed_volume: mesh.signed_volume(),
+                directions: s
+                    .per_direction
+                    .iter()
+                    .map(|c| DirectionCounts {
+                        direction: c.direction,
+                        rays: c.rays,
+                        crossed_0: c.none,
+                        crossed_2: c.two,
+                        crossed_4: c.four,
+                        crossed_more: c.more,
+                        crossed_odd: c.odd,
+                    })
+                    .collect(),
+            };
+            let method = format!(
+                "depth-layers ({}, {} directions)",
+                match options.layers {
+                    Layers::Double => "double layers + stencil",
+                    Layers::Single => "single layer",
+                },
+                options.directions
+            );
+            centre_solid(
+                &solid.inside,
+                t,
+                meta(&method),
+                Details::DepthLayers(details),
+            )
+            .with("unclassified", solid.unclassified.to_grid(t))
+        }
+    };
+    Ok(outcome.timed(start))
+}
+
+pub(super) fn measure_mesh(
+    mesh: &Mesh,
+    t: Transform,
+    flood: FloodMethod,
+    density: f64,
+    progress: &Progress,
+) -> Result<Outcome> {
+    let start = Instant::now();
+    let surface = flood_surface(mesh, t, progress)?;
+    let solid = solid_from_surface(&surface, flood)?;
+    let mut details = solid_details(&surface, &solid, density, FLOOD_RULE, Some(mesh))?;
+    details.mesh_area = Some(mesh.area());
+    let meta = vec![
+        (
+            "method",
+            "huang-26-separating-surface+exterior-flood".to_string(),
+        ),
+        ("source_file", mesh.source.display().to_string()),
+    ];
+    Ok(surface_and_inside(surface, solid, meta, details).timed(start))
+}
+
+pub(super) fn measure_surface(
+    surface: &SparseGrid,
+    source: &str,
+    flood: FloodMethod,
+    density: f64,
+    progress: &Progress,
+) -> Result<Outcome> {
+    let start = Instant::now();
+    let solid = solid_from_surface(surface, flood)?;
+    progress.advance(1);
+    let details = solid_details(surface, &solid, density, FLOOD_RULE, None)?;
+    let meta = vec![
+        ("method", "exterior-flood".to_string()),
+        ("source_file", source.to_string()),
+    ];
+    Ok(surface_and_inside(surface.clone(), solid, meta, details).timed(start))
+}
+
+pub(super) fn csg_tree(tree: &CsgTree, progress: &Progress) -> Result<Outcome> {
+    let start = Instant::now();
+    let (t, solid, leaves) = tree.evaluate()?;
+    progress.advance(tree.node_count() as u64);
+    let details = CsgDetails {
+        volume: solid.count() as f64 * t.voxel_size.powi(3),
+        leaves_of_tree: leaves
+            .into_iter()
+            .map(|l| CsgLeafCount {
+                leaf: l.what,
+                voxels: l.voxels,
+            })
+            .collect(),
+    };
+    let meta = vec![
+        ("method", "csg-tree (voxel centres)".to_string()),
+        ("source_file", tree.source.display().to_string()),
+    ];
+    Ok(centre_solid(&solid, t, meta, Details::Csg(details)).timed(start))
+}
