@@ -34,6 +34,22 @@ fn flatten<'g>(path: &Path, grid: &'g SparseGrid) -> Result<(Vec<i32>, Vec<u64>,
     Ok((origins, masks, leaves))
 }
 
+/// OpenVDB refuses transforms whose voxel volume is within 1e-15 of zero.
+pub const SMALLEST_VOXEL_SIZE: f64 = 1.0001e-5;
+
+/// Refuses a voxel size OpenVDB cannot store, before any work is done for `path`.
+pub fn check_voxel_size(path: &Path, voxel_size: f64) -> Result<()> {
+    if voxel_size >= SMALLEST_VOXEL_SIZE {
+        return Ok(());
+    }
+    Err(vdb_error(
+        path,
+        format!(
+            "OpenVDB cannot store voxel size {voxel_size:.3e} (its transforms need at least              {SMALLEST_VOXEL_SIZE:.0e}); scale the input up (for example to millimetres) or              raise the voxel size"
+        ),
+    ))
+}
+
 fn vdb_error(path: &Path, e: impl std::fmt::Display) -> Error {
     Error::Vdb {
         path: path.to_path_buf(),
@@ -54,6 +70,7 @@ pub fn write_vdb_with_masks(
     masks_to_add: &[(&str, &SparseGrid)],
     metadata: &[(&str, String)],
 ) -> Result<()> {
+    check_voxel_size(path, grid.transform.voxel_size)?;
     let (origins, masks, leaves) = flatten(path, grid)?;
     let mut meta: Vec<MetaEntry> = metadata
         .iter()

@@ -1,9 +1,12 @@
 //! Planning: read the inputs, place the grid, and estimate the peak memory and the work
 //! items of every task, so that a job that cannot fit is refused before it allocates.
 //!
-//! The estimates are deliberately generous (the memory check refuses, it never aborts):
-//! surfaces assume 16 voxels per 8^3 leaf, solids half of their box inside, and writing
-//! counts OpenVDB's own leaves (a float leaf holds 512 values whether or not they are on).
+//! Peak memory is counted in 8^3 leaves, calibrated on the shared meshes (bunny-closed at
+//! 512..4096, spot, the sphere and torus formulas): a leaf of a voxel set costs about 3.5 KB
+//! at the peak (the thread-local grids before their merge, OpenVDB's bool and float leaves
+//! and the flat arrays when writing), one with a normal or colour channel about 20 KB more.
+//! A surface of area A (in voxels) crosses about A/32 leaves, a line of length L about L/4;
+//! a solid is assumed to fill half its box.
 
 use super::{Job, Loaded, MeasureSource, Plan, Task, lines_source};
 use crate::error::{Error, Result};
@@ -14,38 +17,39 @@ use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
 use crate::ops::csg_tree::read_csg_tree;
 use crate::ops::flood::padded;
 use crate::subd::ControlMesh;
-use crate::voxelize::projective;
-use crate::voxelize::{parametric, separating};
+use crate::voxelize::{projective, separating};
 use glam::DVec3;
 
-/// A sparse leaf in memory: mask, origin, map entry.
-const LEAF_BYTES: f64 = 160.0;
-/// A per-voxel vector channel of a leaf (normal or colour: 512 x 3 floats) with its distance.
-const VECTOR_CHANNEL_BYTES: f64 = 512.0 * 16.0;
-/// Writing one leaf of a voxel set: OpenVDB's bool and float leaves and the flat arrays.
-const WRITE_LEAF_BYTES: f64 = 2600.0;
-/// Writing one vector leaf: the flat array and OpenVDB's Vec3s leaf.
-const WRITE_VECTOR_LEAF_BYTES: f64 = 2.0 * 512.0 * 12.0;
-/// Voxels per leaf of a surface (a plane through a leaf crosses 64 of its 512 voxels).
-const SURFACE_VOXELS_PER_LEAF: f64 = 16.0;
+/// Peak bytes per leaf of a voxel set, and per leaf of a normal or colour channel.
+const LEAF_BYTES: f64 = 3500.0;
+const VECTOR_LEAF_BYTES: f64 = 20000.0;
+/// Voxels of surface area, and of line length, per leaf they cross.
+const AREA_PER_LEAF: f64 = 32.0;
+const LENGTH_PER_LEAF: f64 = 4.0;
 /// The share of its box a solid is assumed to fill (a ball fills 52%).
 const SOLID_FILL: f64 = 0.5;
+/// The process itself: code, OpenVDB's and the allocator's own memory.
+const BASE_BYTES: f64 = 48.0 * (1 << 20) as f64;
 
-/// Bytes to hold and write a surface of `voxels` voxels with `vector_channels` channels.
-fn surface_bytes(voxels: f64, vector_channels: u32) -> f64 {
-    let leaves = voxels / SURFACE_VOXELS_PER_LEAF + 1.0;
-    let channels = f64::from(vector_channels);
-    leaves
-        * (2.0 * (LEAF_BYTES + channels * VECTOR_CHANNEL_BYTES)
-            + WRITE_LEAF_BYTES
-            + channels * WRITE_VECTOR_LEAF_BYTES)
+/// Peak bytes of a set of `leaves` leaves with `vector_channels` normal or colour channels.
+fn leaf_bytes(leaves: f64, vector_channels: u32) -> f64 {
+    (leaves + 1.0) * (LEAF_BYTES + f64::from(vector_channels) * VECTOR_LEAF_BYTES)
+}
+
+/// Peak bytes of a surface of `area` voxels^2.
+fn surface_bytes(area: f64, vector_channels: u32) -> f64 {
+    leaf_bytes(area / AREA_PER_LEAF, vector_channels)
 }
 
 /// Bytes to fill and write a solid over `cells` voxels of a box, with `masks` dense bit
 /// volumes over it at once.
 fn solid_bytes(cells: f64, masks: u32) -> f64 {
-    let solid_leaves = cells * SOLID_FILL / 512.0;
-    f64::from(masks) * cells / 8.0 + solid_leaves * (3.0 * LEAF_BYTES + WRITE_LEAF_BYTES)
+    f64::from(masks) * cells / 8.0 + leaf_bytes(cells * SOLID_FILL / 512.0, 0)
+}
+
+/// A mesh's area in voxels^2.
+fn area_in_voxels(mesh: &Mesh, t: &Transform) -> f64 {
+    mesh.area() / (t.voxel_size * t.voxel_size)
 }
 
 /// Voxels of a box, as a float (boxes past 2^64 voxels must still be refused, not wrap).
@@ -112,25 +116,23 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
     let plan = |transform: Transform, bbox: &Aabb, bytes: f64, work_items: u64| Plan {
         transform,
         extent: extent(bbox, &transform),
-        estimated_bytes: bytes.min(u64::MAX as f64) as u64,
+        estimated_bytes: (BASE_BYTES + bytes).min(u64::MAX as f64) as u64,
         work_items,
     };
     Ok(match &job.task {
         Task::MeshSurface { mesh, method } => {
             let mesh = mesh.load(false)?;
             let (t, _) = mesh_plan(&mesh, fit)?;
-            let (bytes, items) = match method {
-                super::SurfaceMethod::Separating(o) => (
-                    separating::estimate_bytes(&mesh, &t, o) as f64
-                        + surface_bytes(2.0 * mesh.area() / (t.voxel_size * t.voxel_size), 0),
-                    separating::work_items(&mesh),
-                ),
-                super::SurfaceMethod::Projective(c) => (
-                    projective::estimate_bytes(&mesh, &t, c.coloring(&mesh), None) as f64
-                        + surface_bytes(2.0 * mesh.area() / (t.voxel_size * t.voxel_size), 0),
-                    mesh.face_count() as u64,
-                ),
+            let (channels, items) = match method {
+                super::SurfaceMethod::Separating(o) => {
+                    (u32::from(o.normals), separating::work_items(&mesh))
+                }
+                super::SurfaceMethod::Projective(c) => {
+                    let colour = c.coloring(&mesh) != projective::Coloring::None;
+                    (u32::from(colour), mesh.face_count() as u64)
+                }
             };
+            let bytes = surface_bytes(area_in_voxels(&mesh, &t), channels);
             let p = plan(t, &mesh.bbox(), bytes, items);
             (Loaded::Mesh(mesh), p)
         }
@@ -138,18 +140,22 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             let mesh = mesh.load(true)?;
             let (t, _) = mesh_plan(&mesh, fit)?;
             let source = lines_source(&mesh, *edges);
-            let coloring = color.coloring(&mesh);
-            let bytes = projective::estimate_bytes(&mesh, &t, coloring, Some(source)) as f64;
-            let items = projective::line_segments(&mesh, source).len() as u64;
-            let p = plan(t, &mesh.bbox(), bytes, items);
+            let segments = projective::line_segments(&mesh, source);
+            let length: f64 = segments
+                .iter()
+                .map(|&[a, b]| mesh.p(a).distance(mesh.p(b)))
+                .sum();
+            let leaves = (length / t.voxel_size + mesh.positions.len() as f64) / LENGTH_PER_LEAF;
+            let colour = color.coloring(&mesh) != projective::Coloring::None;
+            let bytes = leaf_bytes(leaves, u32::from(colour));
+            let p = plan(t, &mesh.bbox(), bytes, segments.len() as u64);
             (Loaded::Mesh(mesh), p)
         }
         Task::Shape { shape, normals, .. } => {
             let bbox = shape.surface().bbox();
             let t = fit_transform(&bbox, fit)?;
             let b = checked_box(&bbox, &t)?;
-            let voxels = box_area(extent(&bbox, &t));
-            let bytes = surface_bytes(voxels, u32::from(*normals));
+            let bytes = surface_bytes(box_area(extent(&bbox, &t)), u32::from(*normals));
             let p = plan(t, &bbox, bytes, (cells(&b) / 512.0).ceil() as u64);
             (Loaded::Shape, p)
         }
@@ -161,8 +167,7 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             let bbox = control.bbox();
             let t = fit_transform(&bbox, fit)?;
             checked_box(&bbox, &t)?;
-            let area = control.polygon_mesh().area() / (t.voxel_size * t.voxel_size);
-            let bytes = parametric::estimate_bytes(&control, &t) as f64 + surface_bytes(area, 1);
+            let bytes = surface_bytes(area_in_voxels(&control.polygon_mesh(), &t), 1);
             let p = plan(t, &bbox, bytes, control.patch_count() as u64);
             (Loaded::Control(control), p)
         }
@@ -190,10 +195,9 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
                 *min + 0.5 * longest / f64::from(resolution.max(1)),
                 longest / f64::from(resolution.max(1)),
             );
-            let voxels = box_area(extent(&bbox, &t));
             // Every level holds about a quarter of the one below it.
             let levels = if *levels { 4.0 / 3.0 } else { 1.0 };
-            let bytes = surface_bytes(voxels * levels, 1);
+            let bytes = surface_bytes(box_area(extent(&bbox, &t)) * levels, 1);
             let options = crate::voxelize::interval_octree::OctreeOptions {
                 resolution,
                 ..Default::default()
@@ -205,7 +209,7 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
         Task::Solid { mesh, fill, .. } => {
             let mesh = mesh.load(false)?;
             let (t, b) = mesh_plan(&mesh, fit)?;
-            let surface = 2.0 * mesh.area() / (t.voxel_size * t.voxel_size);
+            let surface = area_in_voxels(&mesh, &t);
             let (masks, items) = match fill {
                 super::Fill::Flood(_) => (6, separating::work_items(&mesh)),
                 super::Fill::DepthLayers(_) => (6, 1),
@@ -219,7 +223,7 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             MeasureSource::Mesh(mesh) => {
                 let mesh = mesh.load(false)?;
                 let (t, b) = mesh_plan(&mesh, fit)?;
-                let surface = 2.0 * mesh.area() / (t.voxel_size * t.voxel_size);
+                let surface = area_in_voxels(&mesh, &t);
                 let bytes = surface_bytes(surface, 0) + solid_bytes(cells(&padded(b, 2)), 6);
                 let p = plan(t, &mesh.bbox(), bytes, separating::work_items(&mesh));
                 (Loaded::Mesh(mesh), p)
@@ -244,8 +248,8 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             let tree = read_csg_tree(path)?;
             let (t, bounds) = tree.transform()?;
             let b = checked_box(&bounds, &t)?;
-            // One mask per leaf and Boolean level at most, and the result's boundary.
-            let masks = tree.node_count() as u32 + 3;
+            // Two masks per node at most (its own and its result), and the result's boundary.
+            let masks = 2 * tree.node_count() as u32 + 3;
             let bytes = solid_bytes(cells(&b), masks);
             let p = plan(t, &bounds, bytes, tree.node_count() as u64);
             (Loaded::Tree(Box::new(tree)), p)
@@ -263,7 +267,7 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
                 min: t.index_to_world(bx.min),
                 max: t.index_to_world(bx.max),
             };
-            let p = plan(t, &bbox, leaves * (LEAF_BYTES + WRITE_LEAF_BYTES), 1);
+            let p = plan(t, &bbox, leaf_bytes(leaves, 0), 1);
             (Loaded::Grids(ga, gb), p)
         }
     })

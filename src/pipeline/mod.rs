@@ -404,6 +404,7 @@ impl PlannedJob {
         progress.check()?;
         outcome.report.warnings.splice(0..0, self.warnings);
         outcome.report.input = self.job.describe_input();
+        outcome.report.estimated_mib = self.plan.estimated_bytes as f64 / (1 << 20) as f64;
         outcome.report.finish(self.start);
         Ok(outcome)
     }

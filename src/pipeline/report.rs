@@ -29,8 +29,9 @@ pub struct Report {
     pub voxelize_seconds: f64,
     /// The whole run: reading, planning, voxelizing, measuring and writing.
     pub seconds: f64,
-    /// Peak resident memory of the process.
+    /// Peak resident memory of the process, and what planning estimated.
     pub peak_mib: f64,
+    pub estimated_mib: f64,
 }
 
 /// What each kind of job adds to the report.

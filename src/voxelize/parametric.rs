@@ -84,16 +84,6 @@ pub struct ParametricOutput {
     pub stats: ParametricStats,
 }
 
-/// A generous estimate of the memory the voxelization needs: the control mesh's area (which
-/// the limit surface does not exceed by much) in voxels, about a hundred bytes per surface
-/// voxel in leaves with normals, and a copy per worker thread before the merge.
-pub fn estimate_bytes(control: &ControlMesh, transform: &Transform) -> u64 {
-    let mesh = control.polygon_mesh();
-    let area_voxels = mesh.area() / (transform.voxel_size * transform.voxel_size);
-    let threads = rayon::current_num_threads() as f64;
-    (area_voxels * 100.0 * (1.0 + threads)) as u64
-}
-
 /// Voxelizes the limit surface of `control` on the grid of `transform`; `progress` receives
 /// the number of patches finished (`control.patch_count()` in all).
 pub fn voxelize_subdivision(

@@ -113,37 +113,6 @@ fn vertex_colors(mesh: &Mesh, coloring: Coloring) -> Result<Option<Vec<DVec3>>> 
     }
 }
 
-/// Rough peak bytes of a projective voxelization of `mesh`'s faces, or of the lines `lines`
-/// selects, for refusing work that cannot fit: a naive plane holds at most sqrt(3) voxels per
-/// unit of area, a line one per unit of length.
-pub fn estimate_bytes(
-    mesh: &Mesh,
-    transform: &Transform,
-    coloring: Coloring,
-    lines: Option<LineSource>,
-) -> u64 {
-    let h = transform.voxel_size;
-    let voxels = match lines {
-        None => 3f64.sqrt() * mesh.area() / (h * h),
-        Some(source) => {
-            let length: f64 = line_segments(mesh, source)
-                .iter()
-                .map(|&[a, b]| mesh.p(a).distance(mesh.p(b)))
-                .sum();
-            length / h + mesh.positions.len() as f64
-        }
-    };
-    // A surface fills a leaf with ~8x8 voxels per layer; assume a quarter of that.
-    let leaves = voxels / 16.0 + 1.0;
-    let leaf_bytes = 160.0
-        + if coloring == Coloring::None {
-            0.0
-        } else {
-            512.0 * 16.0
-        };
-    (3.0 * leaves * leaf_bytes + mesh.indices.len() as f64 * 40.0) as u64
-}
-
 fn index_positions(mesh: &Mesh, transform: &Transform) -> Vec<DVec3> {
     mesh.positions
         .par_iter()

@@ -150,17 +150,6 @@ pub fn work_items(mesh: &Mesh) -> u64 {
     (mesh.positions.len() + mesh.indices.len() / 2 + mesh.triangle_count()) as u64
 }
 
-/// Rough peak memory for voxelizing `mesh` with `transform`, in bytes, from its area in
-/// voxels (the surface is at most ~2 voxels thick; three class grids live at once).
-pub fn estimate_bytes(mesh: &Mesh, transform: &Transform, opts: &SeparatingOptions) -> u64 {
-    let area = mesh.area() / (transform.voxel_size * transform.voxel_size);
-    let voxels = area * 2.0 + mesh.positions.len() as f64 * 8.0;
-    // A surface fills a leaf with ~8x8 voxels per layer; assume a quarter of that.
-    let leaves = voxels / 16.0 + 1.0;
-    let leaf_bytes = 160.0 + if opts.normals { 512.0 * 16.0 } else { 0.0 };
-    (3.0 * leaves * leaf_bytes + mesh.indices.len() as f64 * 120.0) as u64
-}
-
 /// Voxelizes `mesh` (world units) into a grid with `transform`.
 pub fn voxelize_mesh(
     mesh: &Mesh,

@@ -8,6 +8,7 @@ use std::path::Path;
 use std::sync::Mutex;
 use std::time::Instant;
 use voxelkit::Result;
+use voxelkit::io::vdb::check_voxel_size;
 use voxelkit::pipeline::{Job, Limits, Outcome, check_output_path};
 use voxelkit::progress::Observer;
 
@@ -85,6 +86,7 @@ pub fn run_job(job: Job, output: Option<&Path>, global: &Global) -> Result<Outco
     let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
     if let Some(out) = output {
         check_output_path(out, &inputs)?;
+        check_voxel_size(out, planned.plan().transform.voxel_size)?;
     }
     let bars = Bars::new(global.json);
     let result = planned.run(&bars);

@@ -1,0 +1,170 @@
+//! The command line as a front end of the pipeline: every command refuses an impossible grid
+//! at once with the estimate and writes nothing; `--json` reports are typed JSON and errors
+//! are one JSON object; outputs are `.vdb` files or standard output, nothing else.
+#![cfg(feature = "vdb")]
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+mod cli_support;
+
+use cli_support::{text, voxelkit};
+
+const TETRA: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+const CUBE_QUADS: &str = "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\n\
+                          v 1 1 1\nv -1 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\n\
+                          f 3 4 8 7\nf 4 1 5 8\n";
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn every_command_refuses_an_impossible_grid_at_once_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("tetra.obj");
+    std::fs::write(&obj, TETRA).unwrap();
+    let cube = dir.path().join("cube.obj");
+    std::fs::write(&cube, CUBE_QUADS).unwrap();
+    let tree = dir.path().join("tree.json");
+    std::fs::write(
+        &tree,
+        r#"{"resolution": 500000, "tree": {"sphere": {"center": [0, 0, 0], "radius": 1}}}"#,
+    )
+    .unwrap();
+    let out = dir.path().join("out.vdb");
+    let (o, c, t, v) = (s(&obj), s(&cube), s(&tree), s(&out));
+    let cases: Vec<Vec<&str>> = vec![
+        vec!["mesh", o, "-r", "1000000", "-o", v],
+        vec!["mesh", o, "--voxel-size", "1e-30", "-o", v],
+        vec![
+            "mesh",
+            o,
+            "--method",
+            "projective",
+            "-r",
+            "1000000",
+            "-o",
+            v,
+        ],
+        vec!["lines", o, "-r", "100000000", "-o", v],
+        vec!["shape", "sphere", "-r", "1000000", "-o", v],
+        vec!["subdiv", c, "-r", "1000000", "-o", v],
+        vec!["implicit", "x^2 + y^2 + z^2 - 0.5", "-r", "65536", "-o", v],
+        vec!["solid", o, "-r", "60000", "-o", v],
+        vec!["solid", o, "--voxel-size", "1e-30", "-o", v],
+        vec![
+            "solid",
+            o,
+            "--method",
+            "depth-layers",
+            "-r",
+            "60000",
+            "-o",
+            v,
+        ],
+        vec!["solid", o, "--method", "beam", "-r", "60000", "-o", v],
+        vec!["measure", o, "-r", "60000"],
+        vec!["check", o, "-r", "1000000"],
+        vec!["csg", "--tree", t, "-o", v],
+        vec!["mesh", o, "-r", "64", "--max-memory", "1", "-o", v],
+    ];
+    // OpenVDB cannot store a voxel this small: refused before the work, not after it.
+    let tiny = voxelkit(&["lines", o, "--voxel-size", "1e-6", "-o", v]);
+    let msg = text(&tiny);
+    assert!(
+        !tiny.status.success() && msg.contains("OpenVDB cannot store"),
+        "{msg}"
+    );
+    for args in cases {
+        let start = Instant::now();
+        let result = voxelkit(&args);
+        let elapsed = start.elapsed();
+        let msg = text(&result);
+        assert!(!result.status.success(), "{args:?} succeeded: {msg}");
+        assert!(
+            msg.contains("an estimated") && msg.contains("MiB"),
+            "{args:?}: no estimate in: {msg}"
+        );
+        assert!(
+            elapsed < Duration::from_secs(1),
+            "{args:?}: refusing took {elapsed:?}"
+        );
+        assert!(!out.exists(), "{args:?} wrote a file");
+    }
+}
+
+#[test]
+fn json_reports_are_typed_and_errors_are_json_objects() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("tetra.obj");
+    std::fs::write(&obj, TETRA).unwrap();
+    let out = dir.path().join("out.vdb");
+    let run = voxelkit(&["--json", "mesh", s(&obj), "-r", "16", "-o", s(&out)]);
+    assert!(run.status.success(), "{}", text(&run));
+    let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert!(report["voxels"].as_u64().unwrap() > 0);
+    assert!(report["seconds"].as_f64().unwrap() >= report["voxelize_seconds"].as_f64().unwrap());
+    assert_eq!(report["origin"].as_array().unwrap().len(), 3);
+    assert_eq!(report["method"], "huang-separating");
+
+    let info = voxelkit(&["--json", "info", s(&out)]);
+    let info: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    let grid = &info["grids"][0];
+    assert!(
+        grid["origin"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|v| v.is_f64())
+    );
+    assert!(
+        grid["bbox_min"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|v| v.is_i64())
+    );
+    assert_eq!(grid["metadata"]["method"], "huang-separating");
+
+    let bad = dir.path().join("bad.obj");
+    std::fs::write(&bad, "v 0 0 0\nv 1 0 zero\n").unwrap();
+    let failed = voxelkit(&["--json", "mesh", s(&bad), "-o", s(&out)]);
+    assert!(!failed.status.success());
+    assert!(failed.stdout.is_empty());
+    let error: serde_json::Value = serde_json::from_slice(&failed.stderr)
+        .unwrap_or_else(|_| panic!("not JSON: {}", text(&failed)));
+    assert_eq!(error["line"], 2);
+    assert!(error["file"].as_str().unwrap().ends_with("bad.obj"));
+    assert!(error["error"].as_str().unwrap().contains("bad.obj:2"));
+}
+
+#[test]
+fn outputs_are_vdb_files_or_standard_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("tetra.obj");
+    std::fs::write(&obj, TETRA).unwrap();
+    for name in ["out.npy", "out.binvox", "out"] {
+        let out = dir.path().join(name);
+        let refused = voxelkit(&["mesh", s(&obj), "-r", "16", "-o", s(&out)]);
+        let msg = text(&refused);
+        assert!(!refused.status.success(), "{name}: {msg}");
+        assert!(
+            msg.contains(".vdb") && msg.contains("standard output"),
+            "{msg}"
+        );
+        assert!(!out.exists());
+    }
+    let piped = voxelkit(&["mesh", s(&obj), "-r", "16", "-o", "-"]);
+    assert!(piped.status.success(), "{}", text(&piped));
+    assert!(!dir.path().join("-").exists());
+    let copy = dir.path().join("copy.vdb");
+    std::fs::write(&copy, &piped.stdout).unwrap();
+    let grids = voxelkit::io::vdb::read_vdb_info(&copy).unwrap();
+    assert!(
+        grids
+            .iter()
+            .any(|g| g.name == "surface" && g.active_voxels > 0)
+    );
+    // The summary went to stderr, leaving stdout to the file.
+    assert!(String::from_utf8_lossy(&piped.stderr).contains("voxels"));
+}

@@ -1,0 +1,226 @@
+//! The library pipeline: every task refuses an impossible grid at planning, before anything
+//! large is allocated, and stops promptly with `Error::Cancelled` when its observer answers
+//! `Break` half-way, without unwinding.
+#![cfg(feature = "vdb")]
+
+use glam::DVec3;
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+use voxelkit::Error;
+use voxelkit::implicit::Coordinates;
+use voxelkit::mesh::{GridFit, generate};
+use voxelkit::ops::solid::FloodMethod;
+use voxelkit::pipeline::{
+    ColorChoice, Fill, Job, MeasureSource, MeshSource, Shape, SurfaceMethod, Task,
+};
+use voxelkit::progress::Observer;
+use voxelkit::voxelize::Separability;
+use voxelkit::voxelize::depth_layers::DepthLayerOptions;
+use voxelkit::voxelize::parametric::ParametricOptions;
+use voxelkit::voxelize::separating::SeparatingOptions;
+use voxelkit::voxelize::separating_analytic::Sphere;
+
+/// Fixtures written by the test: a closed torus (triangles) and a cube control mesh (quads).
+fn fixtures(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
+    let torus = dir.join("torus.obj");
+    generate::torus(DVec3::ZERO, 1.0, 0.35, 96, 48)
+        .write_obj(&torus)
+        .unwrap();
+    let cube = dir.join("cube.obj");
+    std::fs::write(
+        &cube,
+        "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
+         f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+    )
+    .unwrap();
+    let tree = dir.join("tree.json");
+    std::fs::write(
+        &tree,
+        r#"{"resolution": 200000, "tree": {"difference": [
+            {"box": {"min": [-1, -1, -1], "max": [1, 1, 1]}},
+            {"sphere": {"center": [0, 0, 0], "radius": 0.8}}]}}"#,
+    )
+    .unwrap();
+    (torus, cube, tree)
+}
+
+/// Every kind of task on the fixtures.
+fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
+    let mesh = || MeshSource::File(torus.to_path_buf());
+    vec![
+        (
+            "separating",
+            Task::MeshSurface {
+                mesh: mesh(),
+                method: SurfaceMethod::Separating(SeparatingOptions::default()),
+            },
+        ),
+        (
+            "projective",
+            Task::MeshSurface {
+                mesh: mesh(),
+                method: SurfaceMethod::Projective(ColorChoice::FromMesh),
+            },
+        ),
+        (
+            "lines",
+            Task::Lines {
+                mesh: mesh(),
+                edges: true,
+                color: ColorChoice::None,
+            },
+        ),
+        (
+            "shape",
+            Task::Shape {
+                shape: Shape::Sphere(Sphere {
+                    center: DVec3::ZERO,
+                    radius: 1.0,
+                }),
+                separability: Separability::TwentySix,
+                normals: false,
+            },
+        ),
+        (
+            "subdivision",
+            Task::Subdivision {
+                mesh: MeshSource::File(cube.to_path_buf()),
+                options: ParametricOptions::default(),
+            },
+        ),
+        (
+            "implicit",
+            Task::Implicit {
+                formula: "x^2 + y^2 + z^2 - 0.5".into(),
+                coordinates: Coordinates::Cartesian,
+                min: DVec3::splat(-1.0),
+                max: DVec3::splat(1.0),
+                levels: false,
+                negative_r: false,
+            },
+        ),
+        (
+            "solid flood",
+            Task::Solid {
+                mesh: mesh(),
+                fill: Fill::Flood(FloodMethod::Spans),
+                density: 1.0,
+            },
+        ),
+        (
+            "solid depth layers",
+            Task::Solid {
+                mesh: mesh(),
+                fill: Fill::DepthLayers(DepthLayerOptions::default()),
+                density: 1.0,
+            },
+        ),
+        (
+            "solid beam",
+            Task::Solid {
+                mesh: mesh(),
+                fill: Fill::Beam,
+                density: 1.0,
+            },
+        ),
+        (
+            "measure",
+            Task::Measure {
+                source: MeasureSource::Mesh(mesh()),
+                flood: FloodMethod::Spans,
+                density: 1.0,
+            },
+        ),
+    ]
+}
+
+#[test]
+fn every_task_refuses_an_impossible_grid_at_planning() {
+    let dir = tempfile::tempdir().unwrap();
+    let (torus, cube, tree) = fixtures(dir.path());
+    let mut all = tasks(&torus, &cube);
+    all.push(("csg tree", Task::CsgTree(tree)));
+    for (name, task) in all {
+        for fit in [GridFit::Resolution(1 << 20), GridFit::VoxelSize(1e-30)] {
+            let start = Instant::now();
+            let refused = Job::new(task.clone(), fit).plan();
+            let elapsed = start.elapsed();
+            match refused {
+                Err(e @ Error::TooLarge { .. }) => {
+                    assert!(e.to_string().contains("MiB"), "{name}: {e}")
+                }
+                Err(Error::InvalidArgument(m)) if name == "implicit" => {
+                    assert!(m.contains("65536"), "{name}: {m}")
+                }
+                Err(e) => panic!("{name} at {fit:?}: refused with the wrong error: {e}"),
+                Ok(p) => panic!("{name} at {fit:?}: planned {:?}", p.plan()),
+            }
+            assert!(
+                elapsed < Duration::from_secs(1),
+                "{name} at {fit:?}: refusing took {elapsed:?}"
+            );
+        }
+    }
+}
+
+/// Stops the work once half of the stage's items are done.
+struct StopHalfWay {
+    total: AtomicU64,
+    done: AtomicU64,
+}
+
+impl Observer for StopHalfWay {
+    fn stage(&self, _name: &str, total: u64) {
+        self.total.store(total, Ordering::SeqCst);
+    }
+    fn advance(&self, n: u64) -> ControlFlow<()> {
+        let done = self.done.fetch_add(n, Ordering::SeqCst) + n;
+        if 2 * done >= self.total.load(Ordering::SeqCst) {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+}
+
+#[test]
+fn a_break_half_way_cancels_promptly_without_unwinding() {
+    let dir = tempfile::tempdir().unwrap();
+    let (torus, cube, _) = fixtures(dir.path());
+    for (name, task) in tasks(&torus, &cube) {
+        // Depth layers and measuring a given surface report once, at the end.
+        if name == "solid depth layers" {
+            continue;
+        }
+        let fit = if name == "implicit" || name == "shape" {
+            GridFit::Resolution(512)
+        } else {
+            GridFit::Resolution(256)
+        };
+        let start = Instant::now();
+        let full = Job::new(task.clone(), fit)
+            .run(&voxelkit::progress::Unobserved)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let whole = start.elapsed();
+        assert!(full.grid.voxel_count() > 0, "{name}");
+        let observer = StopHalfWay {
+            total: AtomicU64::new(0),
+            done: AtomicU64::new(0),
+        };
+        let start = Instant::now();
+        let cancelled = Job::new(task, fit).run(&observer);
+        let took = start.elapsed();
+        assert!(
+            matches!(cancelled, Err(Error::Cancelled)),
+            "{name}: expected Cancelled, got {:?}",
+            cancelled.map(|o| o.grid.voxel_count())
+        );
+        assert!(
+            observer.done.load(Ordering::SeqCst) < observer.total.load(Ordering::SeqCst),
+            "{name}: the work ran to the end"
+        );
+        eprintln!("{name}: whole run {whole:?}, cancelled half-way after {took:?}");
+    }
+}
