@@ -172,3 +172,105 @@ fn the_c_smoke_test_passes_static_and_shared_and_runs_clean_under_valgrind() {
         }
     }
 }
+
+/// The voxels and the metadata of grid `surface` in a `.vdb` file.
+fn surface_of(path: &Path) -> (Vec<[i64; 3]>, std::collections::BTreeMap<String, String>) {
+    let mut voxels: Vec<[i64; 3]> = read_vdb_grid(path, Some("surface"))
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .voxels()
+        .collect();
+    voxels.sort_unstable();
+    let info = voxelkit::io::vdb::read_vdb_info(path).unwrap();
+    let surface = info.iter().find(|g| g.name == "surface").unwrap();
+    let meta = surface
+        .metadata
+        .iter()
+        .map(|m| (m.key.clone(), m.value.clone()))
+        .collect();
+    (voxels, meta)
+}
+
+#[test]
+fn the_c_interface_and_the_command_line_give_the_same_voxels_and_metadata() {
+    if !have("pkg-config") || !have("gcc") {
+        return common::skip_or_fail("gcc or pkg-config is missing: the C/CLI equality test");
+    }
+    let work = tempfile::tempdir().unwrap();
+    let dir = work.path();
+    let mesh = dir.join("torus.obj");
+    generate::torus(glam::DVec3::ZERO, 1.0, 0.35, 48, 24)
+        .write_obj(&mesh)
+        .unwrap();
+    let control = dir.join("cube.obj");
+    std::fs::write(
+        &control,
+        "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
+         f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+    )
+    .unwrap();
+    let flags = run(Command::new("pkg-config")
+        .env("PKG_CONFIG_PATH", prefix().join("lib/pkgconfig"))
+        .args(["--cflags", "--libs", "voxelkit-static"]));
+    let exe = dir.join("equality");
+    run(Command::new("gcc")
+        .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-pedantic"])
+        .arg(repo().join("tests/c/equality.c"))
+        .args(String::from_utf8_lossy(&flags.stdout).split_whitespace())
+        .arg("-o")
+        .arg(&exe));
+    let from_c = dir.join("c");
+    std::fs::create_dir(&from_c).unwrap();
+    run(Command::new(&exe).arg(&mesh).arg(&control).arg(&from_c));
+
+    let cli = |args: &[&str], name: &str| -> PathBuf {
+        let out = dir.join(format!("cli-{name}.vdb"));
+        run(Command::new(env!("CARGO_BIN_EXE_voxelkit"))
+            .args(args)
+            .args(["-r", "64", "-o"])
+            .arg(&out));
+        out
+    };
+    let (m, c) = (mesh.to_str().unwrap(), control.to_str().unwrap());
+    let c_mesh = from_c.join("mesh.vdb");
+    let c_lines = from_c.join("lines.vdb");
+    let pairs = [
+        ("mesh", cli(&["mesh", m], "mesh")),
+        (
+            "projective",
+            cli(&["mesh", m, "--method", "projective"], "projective"),
+        ),
+        ("lines", cli(&["lines", m], "lines")),
+        ("solid", cli(&["solid", m], "solid")),
+        ("subdiv", cli(&["subdiv", c], "subdiv")),
+        (
+            "implicit",
+            cli(&["implicit", "x^2 + y^2 + z^2 - 0.5"], "implicit"),
+        ),
+    ];
+    for (name, from_cli) in &pairs {
+        let (c_voxels, c_meta) = surface_of(&from_c.join(format!("{name}.vdb")));
+        let (cli_voxels, cli_meta) = surface_of(from_cli);
+        assert!(!c_voxels.is_empty(), "{name}");
+        assert_eq!(c_voxels, cli_voxels, "{name}: the voxels differ");
+        assert_eq!(c_meta, cli_meta, "{name}: the metadata differs");
+        assert!(
+            c_meta.contains_key("method") && c_meta.contains_key("resolution"),
+            "{name}"
+        );
+    }
+    // CSG: the CLI combines the C interface's own files, the C interface the grids in memory.
+    let out = dir.join("cli-csg.vdb");
+    run(Command::new(env!("CARGO_BIN_EXE_voxelkit"))
+        .args(["csg", "union"])
+        .arg(&c_mesh)
+        .arg(&c_lines)
+        .arg("-o")
+        .arg(&out));
+    let (c_voxels, c_meta) = surface_of(&from_c.join("csg.vdb"));
+    let (cli_voxels, cli_meta) = surface_of(&out);
+    assert_eq!(c_voxels, cli_voxels, "csg: the voxels differ");
+    assert_eq!(
+        c_meta["method"], cli_meta["method"],
+        "csg: the method differs"
+    );
+}

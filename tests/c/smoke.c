@@ -30,6 +30,11 @@ static int stop_at_once(uint64_t done, uint64_t total, void *user_data) {
     return 1;
 }
 
+static int stop_half_way(uint64_t done, uint64_t total, void *user_data) {
+    *(uint64_t *)user_data = done;
+    return 2 * done >= total;
+}
+
 static int count_calls(uint64_t done, uint64_t total, void *user_data) {
     (void)total;
     if (done > 0) *(int *)user_data += 1;
@@ -163,7 +168,36 @@ int main(int argc, char **argv) {
     OK(vk_options_set_progress(opts, stop_at_once, &stops));
     CHECK(vk_voxelize_mesh(mesh, opts, &g) == VK_ERROR_CANCELLED);
     CHECK(stops >= 1);
+
+    /* Cancelled half-way by the callback: every long call stops, returns nothing, leaks
+     * nothing (valgrind checks that). */
+    uint64_t reached = 0;
+    OK(vk_options_set_progress(opts, stop_half_way, &reached));
+    g = NULL;
+    CHECK(vk_voxelize_mesh(mesh, opts, &g) == VK_ERROR_CANCELLED && g == NULL);
+    CHECK(vk_voxelize_lines(mesh, opts, &g) == VK_ERROR_CANCELLED && g == NULL);
+    CHECK(vk_voxelize_subdivision(box, opts, &g) == VK_ERROR_CANCELLED && g == NULL);
+    CHECK(vk_voxelize_formula("x^2 + y^2 + z^2 - 0.5", VK_CARTESIAN, lo, hi, opts, &g) ==
+          VK_ERROR_CANCELLED && g == NULL);
+    OK(vk_options_set_fill_method(opts, VK_FILL_FLOOD));
+    CHECK(vk_fill_mesh(mesh, opts, &g, NULL) == VK_ERROR_CANCELLED && g == NULL);
+    CHECK(reached > 0);
     OK(vk_options_set_progress(opts, NULL, NULL));
+
+    /* An impossible grid: every call refuses it at once, with the estimate. */
+    OK(vk_options_set_voxel_size(opts, 1e-9));
+    CHECK(vk_voxelize_mesh(mesh, opts, &g) == VK_ERROR_TOO_LARGE);
+    CHECK(strstr(vk_last_error(), "MiB") != NULL);
+    CHECK(vk_voxelize_lines(mesh, opts, &g) == VK_ERROR_TOO_LARGE);
+    CHECK(vk_voxelize_subdivision(box, opts, &g) == VK_ERROR_TOO_LARGE);
+    CHECK(vk_fill_mesh(mesh, opts, &g, NULL) == VK_ERROR_TOO_LARGE);
+    OK(vk_options_set_resolution(opts, 65536));
+    CHECK(vk_voxelize_formula("x^2 + y^2 + z^2 - 0.5", VK_CARTESIAN, lo, hi, opts, &g) ==
+          VK_ERROR_TOO_LARGE);
+    OK(vk_options_set_resolution(opts, 40));
+    OK(vk_options_set_max_memory(opts, 1));
+    CHECK(vk_voxelize_mesh(mesh, opts, &g) == VK_ERROR_TOO_LARGE);
+    OK(vk_options_set_max_memory(opts, 0));
 
     /* Misuse: NULL, wrong kinds, bad values, bad files, double frees, panics. */
     CHECK(vk_voxelize_mesh(NULL, opts, &g) == VK_ERROR_INVALID_HANDLE);
