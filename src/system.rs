@@ -9,9 +9,64 @@ fn proc_kib(file: &str, key: &str) -> Option<u64> {
     line[key.len()..].split_whitespace().next()?.parse().ok()
 }
 
-/// Memory the kernel says is available to new allocations, in bytes.
+/// Memory this process may still allocate, in bytes: the least of what the kernel says is
+/// available, what the process's cgroup (v2 or v1) still allows, and what its address-space
+/// limit (`ulimit -v`) leaves.
 pub fn available_memory_bytes() -> Option<u64> {
-    proc_kib("/proc/meminfo", "MemAvailable:").map(|k| k * 1024)
+    let kernel = proc_kib("/proc/meminfo", "MemAvailable:").map(|k| k * 1024);
+    [kernel, cgroup_headroom(), address_space_headroom()]
+        .into_iter()
+        .flatten()
+        .min()
+}
+
+fn read_u64(path: &str) -> Option<u64> {
+    std::fs::read_to_string(path).ok()?.trim().parse().ok()
+}
+
+/// The cgroup's limit minus its usage (no limit: `None`).
+fn cgroup_headroom() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    for line in text.lines() {
+        let mut parts = line.splitn(3, ':');
+        let (_, controllers, path) = (parts.next()?, parts.next()?, parts.next()?);
+        let (limit, usage) = if controllers.is_empty() {
+            let dir = format!("/sys/fs/cgroup{path}");
+            (
+                read_u64(&format!("{dir}/memory.max")),
+                read_u64(&format!("{dir}/memory.current")),
+            )
+        } else if controllers.split(',').any(|c| c == "memory") {
+            let dir = format!("/sys/fs/cgroup/memory{path}");
+            (
+                read_u64(&format!("{dir}/memory.limit_in_bytes")),
+                read_u64(&format!("{dir}/memory.usage_in_bytes")),
+            )
+        } else {
+            continue;
+        };
+        // "max" (v2) does not parse; v1 reports no limit as a huge number.
+        if let Some(limit) = limit.filter(|&l| l < 1 << 60) {
+            return Some(limit.saturating_sub(usage.unwrap_or(0)));
+        }
+    }
+    None
+}
+
+/// `RLIMIT_AS` minus the address space in use.
+fn address_space_headroom() -> Option<u64> {
+    let mut limit = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    // SAFETY: getrlimit writes the struct it is given.
+    if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut limit) } != 0
+        || limit.rlim_cur == libc::RLIM_INFINITY
+    {
+        return None;
+    }
+    let used = proc_kib("/proc/self/status", "VmSize:").map_or(0, |k| k * 1024);
+    Some((limit.rlim_cur as u64).saturating_sub(used))
 }
 
 /// Peak resident memory of this process so far, in bytes.

@@ -68,6 +68,21 @@ fn every_command_refuses_an_impossible_grid_at_once_and_writes_nothing() {
         vec!["csg", "--tree", t, "-o", v],
         vec!["mesh", o, "-r", "64", "--max-memory", "1", "-o", v],
     ];
+    // An address-space limit (`ulimit -v`, as a cgroup limit) is what is available.
+    let limited = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 400000; exec {} shape sphere --normals -r 1024 -o {v}",
+            env!("CARGO_BIN_EXE_voxelkit")
+        ))
+        .output()
+        .unwrap();
+    let msg = text(&limited);
+    assert!(
+        !limited.status.success() && msg.contains("an estimated"),
+        "{msg}"
+    );
+    assert!(!out.exists());
     // OpenVDB cannot store a voxel this small: refused before the work, not after it.
     let tiny = voxelkit(&["lines", o, "--voxel-size", "1e-6", "-o", v]);
     let msg = text(&tiny);

@@ -88,12 +88,14 @@ pub struct SubdivisionDetails {
     pub evaluations: u64,
     pub uniform_evaluations: u64,
     pub subpatches: u64,
-    /// Sub-patches no longer split because they had reached the depth guard (a sub-patch
-    /// smaller than 1/extent of the mesh): their corner voxels are output as they are.
+    /// Sub-patches whose side fell below the paper's depth guard (1 / the extent in voxels)
+    /// while their corner voxels were still not adjacent: accepted as they are, their corner
+    /// voxels output (a sign of a degenerate patch, not of an error).
     pub depth_guard_stops: u64,
-    /// Splits made only by `enclose` (a sub-patch not yet inside its corner voxels).
+    /// Splits made only by `enclose` (a sub-patch whose bound left its corner voxels).
     pub enclose_splits: u64,
-    /// Voxels added at depth-guard stops (the tolerance of the adjacency test).
+    /// With `enclose`: voxels added from sub-patch bounds smaller than the tolerance, where
+    /// the surface grazes a voxel edge or corner no sample lands in (most hold a sample too).
     pub tolerance_voxels: u64,
     /// Limit-surface area summed over the final sub-patches, world units.
     pub area: f64,
@@ -246,8 +248,8 @@ impl Report {
             ),
             Details::Subdivision(s) => format!(
                 "{place}: {} voxels ({} crossed by opposite sheets) from {} patches; {} evaluations \
-                 (a uniform grid at the same density: {}), {} sub-patches, {} depth-guard stops \
-                 ({} voxels added there); area {:.6}; {}-adjacent; voxel size {:.6}, {timing}",
+                 (a uniform grid at the same density: {}), {} sub-patches ({} stopped by the depth \
+                 guard, {} tolerance voxels); area {:.6}; {}-adjacent; voxel size {:.6}, {timing}",
                 self.voxels,
                 s.opposite_normal_voxels,
                 s.patches,
