@@ -15,15 +15,15 @@ use crate::io::vdb::{read_vdb_grid, write_vdb};
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::{BooleanOp, combine};
 use crate::ops::measure::SolidMeasures;
-use crate::ops::solid::{FloodMethod, solid_from_surface};
-use crate::ops::solid_leaves::ALL_DIRECTIONS;
 use crate::pipeline::{
     ColorChoice, Details, Fill, Job, Limits, MeshSource, Outcome, SurfaceMethod as PipelineSurface,
     Task,
 };
 use crate::progress::Observer;
+use crate::solids::csg_leaves::ALL_DIRECTIONS;
+use crate::solids::depth_layers::{DIRECTIONS, DepthLayerOptions, Layers};
+use crate::solids::exterior_flood::{FloodMethod, solid_from_surface};
 use crate::voxelize::Separability;
-use crate::voxelize::depth_layers::{DIRECTIONS, DepthLayerOptions, Layers};
 use crate::voxelize::parametric::ParametricOptions;
 use crate::voxelize::separating::{Criterion, SeparatingOptions};
 use glam::DVec3;

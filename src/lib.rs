@@ -12,6 +12,8 @@ pub mod ops;
 #[cfg(feature = "vdb")]
 pub mod pipeline;
 pub mod progress;
+pub mod random;
+pub mod solids;
 pub mod subd;
 pub mod system;
 pub mod voxelize;

@@ -66,7 +66,7 @@ fn address_space_headroom() -> Option<u64> {
         return None;
     }
     let used = proc_kib("/proc/self/status", "VmSize:").map_or(0, |k| k * 1024);
-    Some((limit.rlim_cur as u64).saturating_sub(used))
+    Some(limit.rlim_cur.saturating_sub(used))
 }
 
 /// Peak resident memory of this process so far, in bytes.

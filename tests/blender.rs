@@ -1,7 +1,7 @@
 //! Blender opens what voxelkit writes: a headless Blender imports the .vdb as a volume
 //! object and sees the `density`, `surface` and `normal` grids at the right place.
 //! Skipped (loudly) where Blender is not installed, outside CI; CI installs it.
-#![cfg(feature = "vdb")]
+#![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 use std::process::Command;
 use voxelkit::io::vdb::write_vdb;

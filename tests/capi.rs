@@ -2,7 +2,7 @@
 //! the C++ example built by CMake with `-Wall -Wextra -Werror` against the static and the
 //! shared library and checked against the Rust API, and the C smoke test (every capability,
 //! every misuse) built through pkg-config and run under valgrind.
-#![cfg(feature = "vdb")]
+#![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 mod common;
 

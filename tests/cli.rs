@@ -1,6 +1,6 @@
 //! The CLI end to end: real files in and out, and every kind of bad input answered with a
 //! clear error naming the file and place, a non-zero exit and no output file.
-#![cfg(feature = "vdb")]
+#![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 use std::path::{Path, PathBuf};
 mod cli_support;

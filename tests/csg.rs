@@ -1,5 +1,6 @@
 //! Booleans on real voxel grids: the identities hold, counts add up, resampling is exact on
 //! aligned grids, and mismatched transforms are refused unless resampling is asked for.
+#![cfg(feature = "fixtures")]
 
 mod common;
 

@@ -1,6 +1,6 @@
 //! `voxelkit csg --tree`: the bundled mechanical part against its exact volume, trees over
 //! meshes and .vdb grids, and errors that name the file and the node.
-#![cfg(feature = "vdb")]
+#![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 mod cli_support;
 

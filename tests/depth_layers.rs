@@ -1,17 +1,18 @@
 //! Depth-layer solids (Passalis et al.) against the exact inside test, on the closed meshes of
 //! the data folder and on generated fixtures: the G whose hollow no axis sees, spheres in a
 //! hollow box (unclassifiable), and open meshes (reported, never filled or left hollow).
+#![cfg(feature = "fixtures")]
 
 mod common;
 
 use glam::DVec3;
 use voxelkit::grid::{DenseMask, SparseGrid, Transform};
+use voxelkit::mesh::inside::inside_centres;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate, index_box};
-use voxelkit::ops::inside::inside_centres;
-use voxelkit::voxelize::Separability;
-use voxelkit::voxelize::depth_layers::{
+use voxelkit::solids::depth_layers::{
     DepthLayerOptions, DepthLayerSolid, Layers, depth_layer_solid,
 };
+use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 
 fn solid(mesh: &Mesh, t: &Transform, directions: usize, layers: Layers) -> DepthLayerSolid {

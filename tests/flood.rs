@@ -1,6 +1,7 @@
 //! Lai & Cheng's volume flooding: FloodingXYZ with a bounded GRAYSTACK and its resume sweep,
 //! their linear baseline, the fast span flood and the plain flood reach exactly the same
 //! voxels; seeds chosen from normals land inside.
+#![cfg(feature = "fixtures")]
 
 mod common;
 

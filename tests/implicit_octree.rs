@@ -1,6 +1,7 @@
 //! The interval octree (Stolte & Kaufman): every level envelops the surface. Points on the
 //! true surface, found by root finding along random rays, all lie in output voxels; every
 //! kept cell's parent is kept.
+#![cfg(feature = "fixtures")]
 
 use glam::DVec3;
 use voxelkit::implicit::{Coordinates, Formula, value_at};

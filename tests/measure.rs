@@ -2,14 +2,16 @@
 //! inside plus surface voxels, and the bracket closes as the resolution grows; genus from the
 //! Euler characteristic of the voxel solid; volume and face-weighted area of exact solids
 //! (formulas) converging to their known values.
+#![cfg(feature = "fixtures")]
 
 use glam::DVec3;
 use voxelkit::grid::{Adjacency, DenseMask};
 use voxelkit::implicit::reference::reference_solids;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
 use voxelkit::ops::flood::{flood_from_border, padded};
-use voxelkit::ops::measure::{measure_formula_solid, measure_solid};
+use voxelkit::ops::measure::measure_solid;
 use voxelkit::ops::topology::{components, euler_characteristic};
+use voxelkit::solids::csg_leaves::measure_formula_solid;
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 

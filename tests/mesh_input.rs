@@ -1,5 +1,6 @@
 //! Mesh input on the real data (counts and volumes against the data README) and STL written
 //! here in both encodings.
+#![cfg(feature = "fixtures")]
 
 mod common;
 

@@ -1,6 +1,7 @@
 //! Minimality (Huang et al. §3): the share of N-simple voxels (removable without opening an
 //! N-hole, local 3x3x3 test). The paper's full spheres and cylinders leave some; the
 //! clipped criterion must leave fewer, and few.
+#![cfg(feature = "fixtures")]
 
 mod common;
 

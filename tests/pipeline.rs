@@ -1,7 +1,7 @@
 //! The library pipeline: every task refuses an impossible grid at planning, before anything
 //! large is allocated, and stops promptly with `Error::Cancelled` when its observer answers
 //! `Break` half-way, without unwinding.
-#![cfg(feature = "vdb")]
+#![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 use glam::DVec3;
 use std::ops::ControlFlow;
@@ -11,13 +11,13 @@ use std::time::{Duration, Instant};
 use voxelkit::Error;
 use voxelkit::implicit::Coordinates;
 use voxelkit::mesh::{GridFit, generate};
-use voxelkit::ops::solid::FloodMethod;
 use voxelkit::pipeline::{
     ColorChoice, Fill, Job, MeasureSource, MeshSource, Shape, SurfaceMethod, Task,
 };
 use voxelkit::progress::Observer;
+use voxelkit::solids::depth_layers::DepthLayerOptions;
+use voxelkit::solids::exterior_flood::FloodMethod;
 use voxelkit::voxelize::Separability;
-use voxelkit::voxelize::depth_layers::DepthLayerOptions;
 use voxelkit::voxelize::parametric::ParametricOptions;
 use voxelkit::voxelize::separating::SeparatingOptions;
 use voxelkit::voxelize::separating_analytic::Sphere;

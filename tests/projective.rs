@@ -2,6 +2,7 @@
 //! paper's Claim 4) on random input and on every real mesh, triangles cover their points,
 //! colours are the exact linear interpolants at the voxel centres, and the beam solid holds
 //! the mesh's volume.
+#![cfg(feature = "fixtures")]
 
 mod common;
 
@@ -9,7 +10,7 @@ use glam::{DVec3, Vec3};
 use std::collections::{HashMap, HashSet};
 use voxelkit::mesh::generate::{SplitMix64, icosphere, torus};
 use voxelkit::mesh::{GridFit, Mesh, fit_transform};
-use voxelkit::voxelize::projective::beam::beam_solid;
+use voxelkit::solids::beam::beam_solid;
 use voxelkit::voxelize::projective::line::{dominant_axis, voxel_of, voxelize_segment};
 use voxelkit::voxelize::projective::triangle::{is_degenerate, voxelize_triangle};
 use voxelkit::voxelize::projective::{Coloring, LineSource, line_segments, voxelize_triangles};

@@ -1,7 +1,7 @@
 //! `voxelkit lines`, `mesh --method projective` and `solid --method beam` end to end: the
 //! `Cd` grid read back by pyopenvdb (an independent reader) holds exactly the library's
 //! colours, the beam's volume holds the exact one, and bad input is refused by name.
-#![cfg(feature = "vdb")]
+#![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 mod cli_support;
 

@@ -2,6 +2,7 @@
 //! random closed meshes, the exterior flood through empty voxels — 6-connected for the
 //! 6-separating surface, 26-connected for the 26-separating one — reaches no voxel whose
 //! centre lies inside the mesh.
+#![cfg(feature = "fixtures")]
 
 mod common;
 

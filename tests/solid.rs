@@ -7,9 +7,9 @@
 mod common;
 
 use voxelkit::mesh::Mesh;
+use voxelkit::mesh::inside::inside_centres;
 use voxelkit::ops::flood::padded;
-use voxelkit::ops::inside::inside_centres;
-use voxelkit::ops::solid::{FloodMethod, solid_from_surface};
+use voxelkit::solids::exterior_flood::{FloodMethod, solid_from_surface};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::SeparatingOptions;
 

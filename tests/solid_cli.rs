@@ -1,5 +1,5 @@
 //! `voxelkit solid`, `measure`, `csg` and `intersect` end to end on generated meshes.
-#![cfg(feature = "vdb")]
+#![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 mod cli_support;
 

@@ -1,6 +1,7 @@
 //! The parametric voxelizer (Lai & Cheng §4) on the closed control meshes of the data folder:
 //! separability by flooding, accuracy (eqs. 3-4) by dense sampling, area against Gauss
 //! quadrature, and the opposite-normal marking of §6.1.
+#![cfg(feature = "fixtures")]
 
 mod common;
 

@@ -1,6 +1,6 @@
 //! A .vdb written by voxelkit reads back with the same active voxels and transform, through
 //! OpenVDB itself (the bridge) and through the independent reader pyopenvdb.
-#![cfg(feature = "vdb")]
+#![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 use glam::DVec3;
 use voxelkit::grid::SparseGrid;

@@ -1,5 +1,6 @@
 //! Properties of the separating voxelizer beyond separability: accuracy (every voxel is
 //! near the surface), nesting of 6 in 26, class counts, normals, and thread independence.
+#![cfg(feature = "fixtures")]
 
 use glam::DVec3;
 use voxelkit::mesh::{Mesh, generate};

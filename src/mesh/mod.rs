@@ -2,8 +2,11 @@
 //! measurement, fitting to a grid, and the project's own generated fixtures.
 
 mod closed;
+pub mod crossings;
 mod fit;
+#[cfg(feature = "fixtures")]
 pub mod generate;
+pub mod inside;
 mod obj;
 mod stl;
 

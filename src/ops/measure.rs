@@ -36,21 +36,3 @@ pub fn measure_solid(inside: &DenseMask, surface: &DenseMask, voxel_size: f64) -
         volume_with_surface: (inside_voxels + surface_voxels) as f64 * cell,
     }
 }
-
-/// Volume (voxel centres where F < 0) and face-weighted area (normals from the gradient of F)
-/// of a formula's solid at `resolution` voxels along the longest side of `bounds`.
-pub fn measure_formula_solid(
-    formula: &crate::implicit::Formula,
-    bounds: &crate::mesh::Aabb,
-    resolution: u32,
-) -> crate::error::Result<(f64, f64)> {
-    use crate::mesh::{GridFit, fit_transform, index_box};
-    let transform = fit_transform(bounds, GridFit::Resolution(resolution))?;
-    let bbox = index_box(bounds, &transform);
-    let solid = super::solid_leaves::formula_solid(formula, bounds, &transform, bbox)?;
-    let volume = solid.count() as f64 * transform.voxel_size.powi(3);
-    let (area, _) = super::surface_area::face_weighted_area(&solid, &transform, |p| {
-        formula.gradient_at(p.to_array(), &mut Vec::new())
-    });
-    Ok((volume, area))
-}

@@ -2,10 +2,10 @@
 //! flood the empty voxels from outside and look for an inside centre the flood reached.
 
 use super::flood::{flood, flood_from_border, padded};
-use super::inside::inside_centres;
 use crate::error::Result;
 use crate::grid::{Adjacency, CoordBox, DenseMask, SparseGrid};
 use crate::mesh::Mesh;
+use crate::mesh::inside::inside_centres;
 
 /// What the exterior flood found.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -10,14 +10,14 @@ use super::report::{
 use crate::error::Result;
 use crate::grid::{Adjacency, Channels, DenseMask, SparseGrid, Transform};
 use crate::mesh::{Mesh, index_box};
-use crate::ops::csg_tree::CsgTree;
 use crate::ops::flood::padded;
-use crate::ops::solid::{FloodMethod, Solid, solid_from_surface};
 use crate::ops::topology::{components, euler_characteristic};
 use crate::progress::Progress;
+use crate::solids::beam::beam_solid;
+use crate::solids::csg_tree::CsgTree;
+use crate::solids::depth_layers::{Layers, depth_layer_solid};
+use crate::solids::exterior_flood::{FloodMethod, Solid, solid_from_surface};
 use crate::voxelize::Separability;
-use crate::voxelize::depth_layers::{Layers, depth_layer_solid};
-use crate::voxelize::projective::beam::beam_solid;
 use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 use std::time::Instant;
 

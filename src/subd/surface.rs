@@ -175,7 +175,7 @@ impl LimitSurface {
 
     /// `per_patch` uniformly random points on every patch, as face `(face, u, v)`.
     pub fn random_parameters(&self, per_patch: usize, seed: u64) -> Vec<(usize, f64, f64)> {
-        let mut rng = crate::mesh::generate::SplitMix64(seed);
+        let mut rng = crate::random::SplitMix64(seed);
         let mut out = Vec::with_capacity(per_patch * self.patch_count());
         for pid in 0..self.patch_count() {
             let d = self.patch_domain(pid);

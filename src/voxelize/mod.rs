@@ -1,6 +1,5 @@
 //! Voxelization methods, one file each, named for what they do.
 
-pub mod depth_layers;
 pub mod interval_octree;
 pub mod parametric;
 pub mod projective;

@@ -13,7 +13,6 @@
 //! the leaks against the separating voxelizer.
 
 pub mod attribute;
-pub mod beam;
 pub mod line;
 pub mod triangle;
 

@@ -10,8 +10,8 @@ use std::time::Instant;
 use voxelkit::Result;
 use voxelkit::implicit::reference::reference_solids;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, index_box};
-use voxelkit::ops::measure::measure_formula_solid;
-use voxelkit::voxelize::depth_layers::{DepthLayerOptions, depth_layer_solid};
+use voxelkit::solids::csg_leaves::measure_formula_solid;
+use voxelkit::solids::depth_layers::{DepthLayerOptions, depth_layer_solid};
 
 #[derive(Args)]
 pub struct MeasureBenchArgs {

@@ -13,7 +13,7 @@ use voxelkit::io::vdb::openvdb_mesh_to_volume;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform};
 use voxelkit::ops::flood::padded;
 use voxelkit::ops::flood_linear::flood_linear;
-use voxelkit::ops::solid::{FloodMethod, solid_from_surface};
+use voxelkit::solids::exterior_flood::{FloodMethod, solid_from_surface};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 

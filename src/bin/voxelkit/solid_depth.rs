@@ -1,7 +1,7 @@
 //! The options of `voxelkit solid --method depth-layers` (Passalis et al.'s depth buffers).
 
 use clap::Args;
-use voxelkit::voxelize::depth_layers::{DepthLayerOptions, Layers};
+use voxelkit::solids::depth_layers::{DepthLayerOptions, Layers};
 
 #[derive(clap::ValueEnum, Clone, Copy)]
 enum LayersKind {

@@ -6,8 +6,8 @@ use clap::Args;
 use std::path::PathBuf;
 use voxelkit::Result;
 use voxelkit::ops::csg::BooleanOp;
-use voxelkit::ops::solid::FloodMethod;
 use voxelkit::pipeline::{Fill, Job, MeasureSource, MeshSource, Task};
+use voxelkit::solids::exterior_flood::FloodMethod;
 
 /// The floods to choose from.
 #[derive(clap::ValueEnum, Clone, Copy)]

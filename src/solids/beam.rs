@@ -10,16 +10,16 @@
 //! - Only closed meshes are accepted: an open one would pair a front face with the wrong back
 //!   face and fill outside.
 
-use super::{Coloring, ProjectiveStats, voxelize_triangles};
 use crate::error::Result;
 use crate::grid::DenseMask;
 use crate::grid::{SparseGrid, Transform};
+use crate::mesh::inside::inside_centres;
 use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
-use crate::ops::inside::inside_centres;
 use crate::ops::measure::measure_solid;
-use crate::ops::solid::Solid;
+use crate::solids::exterior_flood::Solid;
 use crate::voxelize::Progress;
+use crate::voxelize::projective::{Coloring, ProjectiveStats, voxelize_triangles};
 
 /// Why the beam needs a closed mesh, for the error that refuses an open one.
 const BEAM_NEEDS_CLOSED: &str = "a column through an open surface can enter without leaving, and its beam would fill the outside";

@@ -4,12 +4,12 @@
 //! normals, this works for inward-oriented meshes and for surfaces without normals alike. The
 //! flood is 6-connected, which every surface voxelkit makes blocks.
 
-use super::flood::padded;
-use super::flood_spans::flood_spans;
-use super::flood_xyz::{FloodXyzStats, flood_xyz};
-use super::measure::{SolidMeasures, measure_solid};
 use crate::error::Result;
 use crate::grid::{Channels, DenseMask, SparseGrid};
+use crate::ops::flood::padded;
+use crate::ops::flood_spans::flood_spans;
+use crate::ops::flood_xyz::{FloodXyzStats, flood_xyz};
+use crate::ops::measure::{SolidMeasures, measure_solid};
 
 /// Which flood finds the exterior.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -18,8 +18,7 @@
 //! grid's extent, which otherwise covers every leaf (formulas need their own `bounds` then).
 //! Files are found relative to the tree file.
 
-use super::csg::BooleanOp;
-use super::solid_leaves::{
+use super::csg_leaves::{
     ALL_DIRECTIONS, Primitive, formula_solid, grid_bounds, grid_solid, mesh_solid, primitive_solid,
 };
 use crate::error::{Error, Result};
@@ -27,6 +26,7 @@ use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
 use crate::implicit::{Coordinates, Formula};
 use crate::io::vdb::read_vdb_grid;
 use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
+use crate::ops::csg::BooleanOp;
 use glam::DVec3;
 use serde_json::{Map, Value};
 use std::path::{Path, PathBuf};

@@ -3,12 +3,12 @@
 //! F < 0); closed meshes by depth layers (exact ray parity at the centres); voxel grids from
 //! .vdb files as they are, resampled when their transform differs.
 
-use super::csg::{resample, same_transform};
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
 use crate::implicit::{Formula, to_coordinates};
 use crate::mesh::{Aabb, Mesh, index_box};
-use crate::voxelize::depth_layers::{DepthLayerOptions, Layers, depth_layer_solid};
+use crate::ops::csg::{resample, same_transform};
+use crate::solids::depth_layers::{DepthLayerOptions, Layers, depth_layer_solid};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -160,7 +160,7 @@ pub fn formula_solid(
 
 /// Depth layers over all directions, the most that can be decided.
 pub const ALL_DIRECTIONS: DepthLayerOptions = DepthLayerOptions {
-    directions: crate::voxelize::depth_layers::DIRECTIONS.len(),
+    directions: crate::solids::depth_layers::DIRECTIONS.len(),
     layers: Layers::Double,
 };
 
@@ -206,4 +206,22 @@ pub fn grid_bounds(grid: &SparseGrid) -> Option<Aabb> {
         min: grid.transform.index_to_world(b.min) - h,
         max: grid.transform.index_to_world(b.max) + h,
     })
+}
+
+/// Volume (voxel centres where F < 0) and face-weighted area (normals from the gradient of F)
+/// of a formula's solid at `resolution` voxels along the longest side of `bounds`.
+pub fn measure_formula_solid(
+    formula: &crate::implicit::Formula,
+    bounds: &crate::mesh::Aabb,
+    resolution: u32,
+) -> crate::error::Result<(f64, f64)> {
+    use crate::mesh::{GridFit, fit_transform, index_box};
+    let transform = fit_transform(bounds, GridFit::Resolution(resolution))?;
+    let bbox = index_box(bounds, &transform);
+    let solid = formula_solid(formula, bounds, &transform, bbox)?;
+    let volume = solid.count() as f64 * transform.voxel_size.powi(3);
+    let (area, _) = crate::ops::surface_area::face_weighted_area(&solid, &transform, |p| {
+        formula.gradient_at(p.to_array(), &mut Vec::new())
+    });
+    Ok((volume, area))
 }

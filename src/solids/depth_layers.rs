@@ -26,7 +26,7 @@
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, Transform};
 use crate::mesh::Mesh;
-use crate::ops::crossings::{RayWindow, for_each_crossing};
+use crate::mesh::crossings::{RayWindow, for_each_crossing};
 use glam::DVec3;
 use rayon::prelude::*;
 

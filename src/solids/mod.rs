@@ -1,0 +1,10 @@
+//! Solids: the layer above voxelization that fills, classifies and combines (Lai & Cheng's
+//! exterior flood of a separating surface, Passalis et al.'s depth layers, Jegathese et
+//! al.'s beams, CSG trees of shapes, formulas, meshes and grids).
+
+pub mod beam;
+pub mod csg_leaves;
+#[cfg(feature = "vdb")]
+pub mod csg_tree;
+pub mod depth_layers;
+pub mod exterior_flood;
