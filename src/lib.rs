@@ -13,6 +13,7 @@ pub mod ops;
 pub mod pipeline;
 pub mod progress;
 pub mod random;
+pub mod shapes;
 pub mod solids;
 pub mod subd;
 pub mod system;

@@ -5,10 +5,9 @@
 use glam::DVec3;
 use voxelkit::grid::{CoordBox, Transform};
 use voxelkit::ops::separability::check_side_separation;
+use voxelkit::shapes::{Cylinder, Quadric, Sphere};
 use voxelkit::voxelize::Separability;
-use voxelkit::voxelize::separating_analytic::{
-    AnalyticSurface, Cylinder, Quadric, Sphere, voxelize_surface,
-};
+use voxelkit::voxelize::separating_analytic::{AnalyticSurface, voxelize_surface};
 
 fn check(surface: &dyn AnalyticSurface, transform: Transform, pad: i64) {
     for sep in [Separability::Six, Separability::TwentySix] {

@@ -5,13 +5,14 @@
 use std::path::Path;
 
 /// The top-level modules from the bottom up; modules on one rank may not use each other.
-const LAYERS: [&[&str]; 12] = [
+const LAYERS: [&[&str]; 13] = [
     &["error"],
     &["system", "progress", "random"],
     &["grid"],
     &["ffi"],
     &["io"],
     &["mesh"],
+    &["shapes"],
     &["implicit", "subd"],
     &["voxelize"],
     &["ops"],

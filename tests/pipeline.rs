@@ -15,12 +15,12 @@ use voxelkit::pipeline::{
     ColorChoice, Fill, Job, MeasureSource, MeshSource, Shape, SurfaceMethod, Task,
 };
 use voxelkit::progress::Observer;
+use voxelkit::shapes::Sphere;
 use voxelkit::solids::depth_layers::DepthLayerOptions;
 use voxelkit::solids::exterior_flood::FloodMethod;
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::parametric::ParametricOptions;
 use voxelkit::voxelize::separating::SeparatingOptions;
-use voxelkit::voxelize::separating_analytic::Sphere;
 
 /// Fixtures written by the test: a closed torus (triangles) and a cube control mesh (quads).
 fn fixtures(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {

@@ -8,89 +8,49 @@ use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
 use crate::implicit::{Formula, to_coordinates};
 use crate::mesh::{Aabb, Mesh, index_box};
 use crate::ops::csg::{resample, same_transform};
+use crate::shapes::{Cuboid, Cylinder, Sphere};
 use crate::solids::depth_layers::{DepthLayerOptions, Layers, depth_layer_solid};
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// A solid given by its shape parameters, in world units.
+/// A solid leaf given by its shape, in world units.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Primitive {
-    Box {
-        min: DVec3,
-        max: DVec3,
-    },
-    /// From `base` along the unit `axis` for `height`.
-    Cylinder {
-        base: DVec3,
-        axis: DVec3,
-        radius: f64,
-        height: f64,
-    },
-    Sphere {
-        center: DVec3,
-        radius: f64,
-    },
+    Cuboid(Cuboid),
+    Cylinder(Cylinder),
+    Sphere(Sphere),
 }
 
 impl Primitive {
     pub fn contains(&self, p: DVec3) -> bool {
-        match *self {
-            Primitive::Box { min, max } => p.cmpge(min).all() && p.cmple(max).all(),
-            Primitive::Cylinder {
-                base,
-                axis,
-                radius,
-                height,
-            } => {
-                let d = p - base;
-                let along = d.dot(axis);
-                (0.0..=height).contains(&along)
-                    && (d - along * axis).length_squared() <= radius * radius
-            }
-            Primitive::Sphere { center, radius } => p.distance_squared(center) <= radius * radius,
+        match self {
+            Primitive::Cuboid(b) => b.contains(p),
+            Primitive::Cylinder(c) => c.contains(p),
+            Primitive::Sphere(s) => s.contains(p),
         }
     }
 
     /// A short description for summaries.
     pub fn describe(&self) -> String {
         let v = |p: DVec3| format!("({}, {}, {})", p.x, p.y, p.z);
-        match *self {
-            Primitive::Box { min, max } => format!("box {} .. {}", v(min), v(max)),
-            Primitive::Cylinder {
-                base,
-                axis,
-                radius,
-                height,
-            } => format!(
-                "cylinder from {} along {} radius {radius} height {height}",
-                v(base),
-                v(axis)
+        match self {
+            Primitive::Cuboid(b) => format!("box {} .. {}", v(b.min), v(b.max)),
+            Primitive::Cylinder(c) => format!(
+                "cylinder from {} along {} radius {} height {}",
+                v(c.ends()[0]),
+                v(c.axis),
+                c.radius,
+                c.height
             ),
-            Primitive::Sphere { center, radius } => format!("sphere {} radius {radius}", v(center)),
+            Primitive::Sphere(s) => format!("sphere {} radius {}", v(s.center), s.radius),
         }
     }
 
     pub fn bounds(&self) -> Aabb {
-        match *self {
-            Primitive::Box { min, max } => Aabb { min, max },
-            Primitive::Cylinder {
-                base,
-                axis,
-                radius,
-                height,
-            } => {
-                // The disc of radius r about axis a reaches r * sqrt(1 - a_i^2) along axis i.
-                let reach = (DVec3::ONE - axis * axis).max(DVec3::ZERO).powf(0.5) * radius;
-                let top = base + axis * height;
-                Aabb {
-                    min: base.min(top) - reach,
-                    max: base.max(top) + reach,
-                }
-            }
-            Primitive::Sphere { center, radius } => Aabb {
-                min: center - radius,
-                max: center + radius,
-            },
+        match self {
+            Primitive::Cuboid(b) => b.bounds(),
+            Primitive::Cylinder(c) => c.bounds(),
+            Primitive::Sphere(s) => s.bounds(),
         }
     }
 }

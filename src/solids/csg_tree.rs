@@ -27,6 +27,7 @@ use crate::implicit::{Coordinates, Formula};
 use crate::io::vdb::read_vdb_grid;
 use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
 use crate::ops::csg::BooleanOp;
+use crate::shapes::{Cuboid, Cylinder, Sphere};
 use glam::DVec3;
 use serde_json::{Map, Value};
 use std::path::{Path, PathBuf};
@@ -238,10 +239,10 @@ impl Reader<'_> {
             }
             "box" => {
                 let b = self.aabb(value, &at)?;
-                Ok(CsgNode::Primitive(Primitive::Box {
+                Ok(CsgNode::Primitive(Primitive::Cuboid(Cuboid {
                     min: b.min,
                     max: b.max,
-                }))
+                })))
             }
             "cylinder" => {
                 let c = self.object(value, &at)?;
@@ -249,22 +250,22 @@ impl Reader<'_> {
                 if axis.length() == 0.0 {
                     return Err(self.error(&at, "the axis must not be zero"));
                 }
-                Ok(CsgNode::Primitive(Primitive::Cylinder {
-                    base: self.vec3(self.field(c, "base", &at)?, &format!("{at}.base"))?,
-                    axis: axis.normalize(),
-                    radius: self
-                        .positive(self.field(c, "radius", &at)?, &format!("{at}.radius"))?,
-                    height: self
-                        .positive(self.field(c, "height", &at)?, &format!("{at}.height"))?,
-                }))
+                Ok(CsgNode::Primitive(Primitive::Cylinder(
+                    Cylinder::from_base(
+                        self.vec3(self.field(c, "base", &at)?, &format!("{at}.base"))?,
+                        axis.normalize(),
+                        self.positive(self.field(c, "radius", &at)?, &format!("{at}.radius"))?,
+                        self.positive(self.field(c, "height", &at)?, &format!("{at}.height"))?,
+                    ),
+                )))
             }
             "sphere" => {
                 let s = self.object(value, &at)?;
-                Ok(CsgNode::Primitive(Primitive::Sphere {
+                Ok(CsgNode::Primitive(Primitive::Sphere(Sphere {
                     center: self.vec3(self.field(s, "center", &at)?, &format!("{at}.center"))?,
                     radius: self
                         .positive(self.field(s, "radius", &at)?, &format!("{at}.radius"))?,
-                }))
+                })))
             }
             "formula" => {
                 let text = value

@@ -24,6 +24,7 @@ use super::Separability;
 use super::sink::{nearest_channels, voxelize_parallel};
 use crate::grid::{SparseGrid, Transform};
 use crate::mesh::Aabb;
+use crate::shapes::{Cylinder, Quadric, Sphere};
 use glam::DVec3;
 
 /// The nearest point of a surface to a query point.
@@ -48,18 +49,9 @@ pub trait AnalyticSurface: Sync {
     fn max_curvature(&self) -> f64;
 }
 
-#[derive(Clone, Copy, Debug)]
-pub struct Sphere {
-    pub center: DVec3,
-    pub radius: f64,
-}
-
 impl AnalyticSurface for Sphere {
     fn bbox(&self) -> Aabb {
-        Aabb {
-            min: self.center - self.radius,
-            max: self.center + self.radius,
-        }
+        self.bounds()
     }
     fn nearest(&self, p: DVec3) -> Nearest {
         let d = p - self.center;
@@ -78,50 +70,26 @@ impl AnalyticSurface for Sphere {
     }
 }
 
-/// A closed cylinder: side, two caps and two sharp rims.
-#[derive(Clone, Copy, Debug)]
-pub struct Cylinder {
-    /// Centre of the axis segment.
-    pub center: DVec3,
-    /// Unit axis direction.
-    pub axis: DVec3,
-    pub radius: f64,
-    pub height: f64,
-}
-
-impl Cylinder {
-    /// (axial coordinate, radial distance, unit radial direction) of `p`.
-    fn local(&self, p: DVec3) -> (f64, f64, DVec3) {
-        let d = p - self.center;
-        let h = d.dot(self.axis);
-        let radial = d - h * self.axis;
-        let rho = radial.length();
-        let dir = if rho > 0.0 {
-            radial / rho
-        } else {
-            self.axis.any_orthonormal_vector()
-        };
-        (h, rho, dir)
-    }
+/// (axial coordinate, radial distance, unit radial direction) of `p` about `c`'s axis.
+fn cylinder_local(c: &Cylinder, p: DVec3) -> (f64, f64, DVec3) {
+    let d = p - c.center;
+    let h = d.dot(c.axis);
+    let radial = d - h * c.axis;
+    let rho = radial.length();
+    let dir = if rho > 0.0 {
+        radial / rho
+    } else {
+        c.axis.any_orthonormal_vector()
+    };
+    (h, rho, dir)
 }
 
 impl AnalyticSurface for Cylinder {
     fn bbox(&self) -> Aabb {
-        let half = 0.5 * self.height;
-        let ends = [
-            self.center - half * self.axis,
-            self.center + half * self.axis,
-        ];
-        // Per axis, a disc of radius r perpendicular to `axis` reaches r * sqrt(1 - a_i^2).
-        let reach = (DVec3::ONE - self.axis * self.axis).max(DVec3::ZERO);
-        let reach = DVec3::new(reach.x.sqrt(), reach.y.sqrt(), reach.z.sqrt()) * self.radius;
-        Aabb {
-            min: ends[0].min(ends[1]) - reach,
-            max: ends[0].max(ends[1]) + reach,
-        }
+        self.bounds()
     }
     fn nearest(&self, p: DVec3) -> Nearest {
-        let (h, rho, dir) = self.local(p);
+        let (h, rho, dir) = cylinder_local(self, p);
         let half = 0.5 * self.height;
         let (dr, dh) = (rho - self.radius, h.abs() - half);
         let cap = self.axis * h.signum();
@@ -146,20 +114,12 @@ impl AnalyticSurface for Cylinder {
         }
     }
     fn side(&self, p: DVec3) -> f64 {
-        let (h, rho, _) = self.local(p);
+        let (h, rho, _) = cylinder_local(self, p);
         (rho - self.radius).max(h.abs() - 0.5 * self.height)
     }
     fn max_curvature(&self) -> f64 {
         1.0 / self.radius
     }
-}
-
-/// The parabolic cylinder `x^2 + k y + k z = 0` (Huang et al. §7), clipped to a cube of
-/// half edge `half_extent` around the origin.
-#[derive(Clone, Copy, Debug)]
-pub struct Quadric {
-    pub k: f64,
-    pub half_extent: f64,
 }
 
 impl Quadric {
@@ -184,10 +144,7 @@ impl Quadric {
 
 impl AnalyticSurface for Quadric {
     fn bbox(&self) -> Aabb {
-        Aabb {
-            min: DVec3::splat(-self.half_extent),
-            max: DVec3::splat(self.half_extent),
-        }
+        self.bounds()
     }
     fn nearest(&self, p: DVec3) -> Nearest {
         // In the plane spanned by x and s = (y+z)/sqrt2 the surface is s = -a x^2; it is

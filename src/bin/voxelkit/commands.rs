@@ -11,9 +11,9 @@ use voxelkit::mesh::{GridFit, generate};
 use voxelkit::ops::minimality::simple_voxel_count;
 use voxelkit::ops::separability::check_mesh_separation;
 use voxelkit::pipeline::{Job, MeshSource, Shape, SurfaceMethod, Task};
+use voxelkit::shapes::{Cylinder, Quadric, Sphere};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{Criterion, SeparatingOptions};
-use voxelkit::voxelize::separating_analytic::{Cylinder, Quadric, Sphere};
 use voxelkit::{Error, Result};
 
 impl FitArgs {
