@@ -129,7 +129,7 @@ fn bad_trees_are_refused_naming_the_file_and_the_node() {
         (
             "kind.json",
             r#"{ "tree": { "union": [ { "torus": 1 } ] } }"#,
-            "tree.union[0]: needs exactly one of",
+            "tree.union[0]: unknown variant `torus`",
         ),
         (
             "radius.json",
@@ -140,6 +140,12 @@ fn bad_trees_are_refused_naming_the_file_and_the_node() {
             "formula.json",
             r#"{ "bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}, "tree": { "formula": "x^2 + * y" } }"#,
             "tree.formula: formula, column",
+        ),
+        (
+            "cylinder.json",
+            r#"{ "tree": { "difference": [ { "box": { "min": [0, 0, 0], "max": [1, 1, 1] } },
+                 { "cylinder": { "base": [0, 0, 0], "axis": [0, 0, 1], "radius": "wide", "height": 1 } } ] } }"#,
+            "tree.difference[1].cylinder.radius",
         ),
         (
             "nobounds.json",

@@ -7,11 +7,14 @@
 //!       { "union": [ { "box": { "min": [-2, -1, 0], "max": [2, 1, 0.5] } },
 //!                    { "cylinder": { "base": [0, 0, 0.5], "axis": [0, 0, 1],
 //!                                    "radius": 0.8, "height": 1 } } ] },
-//!       { "formula": "(sqrt(x^2 + y^2) - 0.8)^2 + (z - 1)^2 - 0.01",
-//!         "bounds": { "min": [-1, -1, 0.8], "max": [1, 1, 1.2] } },
-//!       { "mesh": "bolt.obj" }, { "vdb": "pocket.vdb", "grid": "surface" } ] } }
+//!       { "formula": { "text": "(sqrt(x^2 + y^2) - 0.8)^2 + (z - 1)^2 - 0.01",
+//!                      "bounds": { "min": [-1, -1, 0.8], "max": [1, 1, 1.2] } } },
+//!       { "mesh": "bolt.obj" }, { "vdb": { "file": "pocket.vdb", "grid": "surface" } } ] } }
 //! ```
 //!
+//! Every node is an object with one key, its kind (serde's externally tagged enum): `union`,
+//! `intersection` and `difference` hold lists of nodes; `formula` holds the text, or an
+//! object with `text`, `coordinates` and `bounds`; `vdb` a file name, or `file` and `grid`.
 //! `union` and `intersection` take any number of operands, `difference` removes all later
 //! operands from the first. A formula's solid is where F < 0. `voxel_size` may replace
 //! `resolution` (voxels along the longest axis of the bounds); `bounds` (top level) fixes the
@@ -29,7 +32,7 @@ use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
 use crate::ops::csg::BooleanOp;
 use crate::shapes::{Cuboid, Cylinder, Sphere};
 use glam::DVec3;
-use serde_json::{Map, Value};
+use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 pub enum CsgNode {
@@ -92,23 +95,104 @@ pub struct LeafReport {
     pub voxels: u64,
 }
 
-/// Reads the tree in `path`, loading its meshes and grids.
+/// The file as written: an externally tagged enum per node, read by serde.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TreeFile {
+    resolution: Option<f64>,
+    voxel_size: Option<f64>,
+    bounds: Option<BoundsSpec>,
+    tree: NodeSpec,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(deny_unknown_fields)]
+struct BoundsSpec {
+    min: [f64; 3],
+    max: [f64; 3],
+}
+
+#[derive(Deserialize)]
+#[serde(rename_all = "lowercase")]
+enum NodeSpec {
+    Union(Vec<NodeSpec>),
+    Intersection(Vec<NodeSpec>),
+    Difference(Vec<NodeSpec>),
+    Box(BoundsSpec),
+    Cylinder(CylinderSpec),
+    Sphere(SphereSpec),
+    Formula(FormulaSpec),
+    Mesh(String),
+    Vdb(VdbSpec),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CylinderSpec {
+    base: [f64; 3],
+    axis: [f64; 3],
+    radius: f64,
+    height: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SphereSpec {
+    center: [f64; 3],
+    radius: f64,
+}
+
+/// `"F"`, or `{"text": "F", "coordinates": "spherical", "bounds": {...}}`.
+#[derive(Deserialize)]
+#[serde(
+    untagged,
+    expecting = "the formula as a string, or {\"text\": ..., \"coordinates\": ..., \"bounds\": ...}"
+)]
+enum FormulaSpec {
+    Text(String),
+    Full {
+        text: String,
+        coordinates: Option<String>,
+        bounds: Option<BoundsSpec>,
+    },
+}
+
+/// `"grid.vdb"`, or `{"file": "grid.vdb", "grid": "surface"}`.
+#[derive(Deserialize)]
+#[serde(
+    untagged,
+    expecting = "a file name, or {\"file\": ..., \"grid\": ...} with the grid's name"
+)]
+enum VdbSpec {
+    File(String),
+    Full { file: String, grid: Option<String> },
+}
+
+/// Reads the tree in `path`, loading its meshes and grids. Errors name the file and the
+/// place in the tree (`tree.difference[1].cylinder.radius`).
 pub fn read_csg_tree(path: &Path) -> Result<CsgTree> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    let json: Value = serde_json::from_str(&text).map_err(|e| Error::Parse {
-        path: path.to_path_buf(),
-        line: e.line(),
-        message: e.to_string(),
+    let mut json = serde_json::Deserializer::from_str(&text);
+    let file: TreeFile = serde_path_to_error::deserialize(&mut json).map_err(|e| {
+        let at = e.path().to_string();
+        let inner = e.into_inner();
+        Error::Parse {
+            path: path.to_path_buf(),
+            line: inner.line(),
+            message: if at == "." {
+                inner.to_string()
+            } else {
+                format!("{at}: {inner}")
+            },
+        }
     })?;
     let reader = Reader {
         file: path,
         folder: path.parent().unwrap_or(Path::new(".")),
     };
-    let top = reader.object(&json, "the file")?;
-    let fit = match (top.get("resolution"), top.get("voxel_size")) {
+    let fit = match (file.resolution, file.voxel_size) {
         (Some(r), None) => {
-            let r = reader.number(r, "resolution")?;
-            if r < 1.0 || r.fract() != 0.0 || r > 1e6 {
+            if !(1.0..=1e6).contains(&r) || r.fract() != 0.0 {
                 return Err(reader.error("resolution", "must be a whole number of voxels"));
             }
             GridFit::Resolution(r as u32)
@@ -119,15 +203,8 @@ pub fn read_csg_tree(path: &Path) -> Result<CsgTree> {
             return Err(reader.error("the file", "give resolution or voxel_size, not both"));
         }
     };
-    let bounds = top
-        .get("bounds")
-        .map(|b| reader.aabb(b, "bounds"))
-        .transpose()?;
-    let root = reader.node(
-        top.get("tree")
-            .ok_or_else(|| reader.error("the file", "has no \"tree\""))?,
-        "tree",
-    )?;
+    let bounds = file.bounds.map(|b| reader.aabb(b, "bounds")).transpose()?;
+    let root = reader.node(file.tree, "tree")?;
     Ok(CsgTree {
         root,
         fit,
@@ -136,6 +213,7 @@ pub fn read_csg_tree(path: &Path) -> Result<CsgTree> {
     })
 }
 
+/// Checks what serde cannot (signs, sizes, files) and builds the nodes, naming the place.
 struct Reader<'a> {
     file: &'a Path,
     folder: &'a Path,
@@ -146,160 +224,114 @@ impl Reader<'_> {
         Error::InvalidArgument(format!("{}: {at}: {message}", self.file.display()))
     }
 
-    fn object<'v>(&self, v: &'v Value, at: &str) -> Result<&'v Map<String, Value>> {
-        v.as_object()
-            .ok_or_else(|| self.error(at, "expected a JSON object"))
-    }
-
-    fn number(&self, v: &Value, at: &str) -> Result<f64> {
-        v.as_f64()
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| self.error(at, "expected a number"))
-    }
-
-    fn positive(&self, v: &Value, at: &str) -> Result<f64> {
-        let x = self.number(v, at)?;
-        if x > 0.0 {
+    fn positive(&self, x: f64, at: &str) -> Result<f64> {
+        if x > 0.0 && x.is_finite() {
             Ok(x)
         } else {
             Err(self.error(at, "must be positive"))
         }
     }
 
-    fn vec3(&self, v: &Value, at: &str) -> Result<DVec3> {
-        match v.as_array().map(|a| a.as_slice()) {
-            Some([x, y, z]) => Ok(DVec3::new(
-                self.number(x, at)?,
-                self.number(y, at)?,
-                self.number(z, at)?,
-            )),
-            _ => Err(self.error(at, "expected [x, y, z]")),
+    fn vec3(&self, v: [f64; 3], at: &str) -> Result<DVec3> {
+        let p = DVec3::from_array(v);
+        if p.is_finite() {
+            Ok(p)
+        } else {
+            Err(self.error(at, "must be finite numbers"))
         }
     }
 
-    fn field<'v>(&self, m: &'v Map<String, Value>, key: &str, at: &str) -> Result<&'v Value> {
-        m.get(key)
-            .ok_or_else(|| self.error(at, &format!("needs \"{key}\"")))
-    }
-
-    fn aabb(&self, v: &Value, at: &str) -> Result<Aabb> {
-        let m = self.object(v, at)?;
-        let min = self.vec3(self.field(m, "min", at)?, &format!("{at}.min"))?;
-        let max = self.vec3(self.field(m, "max", at)?, &format!("{at}.max"))?;
+    fn aabb(&self, b: BoundsSpec, at: &str) -> Result<Aabb> {
+        let min = self.vec3(b.min, &format!("{at}.min"))?;
+        let max = self.vec3(b.max, &format!("{at}.max"))?;
         if !min.cmplt(max).all() {
             return Err(self.error(at, "min must be below max on every axis"));
         }
         Ok(Aabb { min, max })
     }
 
-    fn path(&self, v: &Value, at: &str) -> Result<PathBuf> {
-        v.as_str()
-            .map(|p| self.folder.join(p))
-            .ok_or_else(|| self.error(at, "expected a file name"))
-    }
-
-    fn node(&self, v: &Value, at: &str) -> Result<CsgNode> {
-        let m = self.object(v, at)?;
-        let kinds = [
-            "union",
-            "intersection",
-            "difference",
-            "box",
-            "cylinder",
-            "sphere",
-            "formula",
-            "mesh",
-            "vdb",
-        ];
-        let found: Vec<&str> = kinds
-            .iter()
-            .copied()
-            .filter(|k| m.contains_key(*k))
-            .collect();
-        let [kind] = found[..] else {
-            return Err(self.error(at, &format!("needs exactly one of {}", kinds.join(", "))));
-        };
-        let at = format!("{at}.{kind}");
-        let value = &m[kind];
-        match kind {
-            "union" | "intersection" | "difference" => {
-                let items = value
-                    .as_array()
-                    .filter(|a| !a.is_empty())
-                    .ok_or_else(|| self.error(&at, "expected a list of operands"))?;
-                let operands = items
-                    .iter()
-                    .enumerate()
-                    .map(|(i, item)| self.node(item, &format!("{at}[{i}]")))
-                    .collect::<Result<_>>()?;
-                Ok(CsgNode::Boolean {
-                    op: kind.parse().expect("a Boolean name"),
-                    operands,
-                })
+    fn node(&self, spec: NodeSpec, at: &str) -> Result<CsgNode> {
+        let boolean = |op: BooleanOp, name: &str, items: Vec<NodeSpec>| -> Result<CsgNode> {
+            let at = format!("{at}.{name}");
+            if items.is_empty() {
+                return Err(self.error(&at, "needs at least one operand"));
             }
-            "box" => {
-                let b = self.aabb(value, &at)?;
+            let operands = items
+                .into_iter()
+                .enumerate()
+                .map(|(i, item)| self.node(item, &format!("{at}[{i}]")))
+                .collect::<Result<_>>()?;
+            Ok(CsgNode::Boolean { op, operands })
+        };
+        match spec {
+            NodeSpec::Union(items) => boolean(BooleanOp::Union, "union", items),
+            NodeSpec::Intersection(items) => {
+                boolean(BooleanOp::Intersection, "intersection", items)
+            }
+            NodeSpec::Difference(items) => boolean(BooleanOp::Difference, "difference", items),
+            NodeSpec::Box(b) => {
+                let b = self.aabb(b, &format!("{at}.box"))?;
                 Ok(CsgNode::Primitive(Primitive::Cuboid(Cuboid {
                     min: b.min,
                     max: b.max,
                 })))
             }
-            "cylinder" => {
-                let c = self.object(value, &at)?;
-                let axis = self.vec3(self.field(c, "axis", &at)?, &format!("{at}.axis"))?;
-                if axis.length() == 0.0 {
-                    return Err(self.error(&at, "the axis must not be zero"));
-                }
+            NodeSpec::Cylinder(c) => {
+                let at = format!("{at}.cylinder");
+                let axis = self.vec3(c.axis, &format!("{at}.axis"))?;
+                let axis = axis
+                    .try_normalize()
+                    .ok_or_else(|| self.error(&format!("{at}.axis"), "must not be zero"))?;
                 Ok(CsgNode::Primitive(Primitive::Cylinder(
                     Cylinder::from_base(
-                        self.vec3(self.field(c, "base", &at)?, &format!("{at}.base"))?,
-                        axis.normalize(),
-                        self.positive(self.field(c, "radius", &at)?, &format!("{at}.radius"))?,
-                        self.positive(self.field(c, "height", &at)?, &format!("{at}.height"))?,
+                        self.vec3(c.base, &format!("{at}.base"))?,
+                        axis,
+                        self.positive(c.radius, &format!("{at}.radius"))?,
+                        self.positive(c.height, &format!("{at}.height"))?,
                     ),
                 )))
             }
-            "sphere" => {
-                let s = self.object(value, &at)?;
+            NodeSpec::Sphere(s) => {
+                let at = format!("{at}.sphere");
                 Ok(CsgNode::Primitive(Primitive::Sphere(Sphere {
-                    center: self.vec3(self.field(s, "center", &at)?, &format!("{at}.center"))?,
-                    radius: self
-                        .positive(self.field(s, "radius", &at)?, &format!("{at}.radius"))?,
+                    center: self.vec3(s.center, &format!("{at}.center"))?,
+                    radius: self.positive(s.radius, &format!("{at}.radius"))?,
                 })))
             }
-            "formula" => {
-                let text = value
-                    .as_str()
-                    .ok_or_else(|| self.error(&at, "expected the formula as a string"))?;
-                let coordinates = match m.get("coordinates") {
+            NodeSpec::Formula(f) => {
+                let at = format!("{at}.formula");
+                let (text, coordinates, bounds) = match f {
+                    FormulaSpec::Text(text) => (text, None, None),
+                    FormulaSpec::Full {
+                        text,
+                        coordinates,
+                        bounds,
+                    } => (text, coordinates, bounds),
+                };
+                let coordinates = match coordinates {
                     None => Coordinates::Cartesian,
                     Some(c) => c
-                        .as_str()
-                        .ok_or_else(|| self.error(&at, "coordinates must be a string"))?
                         .parse()
-                        .map_err(|e: String| self.error(&at, &e))?,
+                        .map_err(|e: String| self.error(&format!("{at}.coordinates"), &e))?,
                 };
-                let formula = Formula::parse(text, coordinates)
+                let formula = Formula::parse(&text, coordinates)
                     .map_err(|e| self.error(&at, &e.to_string()))?;
-                let bounds = m
-                    .get("bounds")
+                let bounds = bounds
                     .map(|b| self.aabb(b, &format!("{at}.bounds")))
                     .transpose()?;
                 Ok(CsgNode::Formula { formula, bounds })
             }
-            "mesh" => Mesh::load(&self.path(value, &at)?)
+            NodeSpec::Mesh(file) => Mesh::load(&self.folder.join(file))
                 .map(CsgNode::Mesh)
-                .map_err(|e| self.error(&at, &e.to_string())),
-            _ => {
-                let source = self.path(value, &at)?;
-                let name = match m.get("grid") {
-                    None => "surface",
-                    Some(g) => g
-                        .as_str()
-                        .ok_or_else(|| self.error(&at, "grid must be a string"))?,
+                .map_err(|e| self.error(&format!("{at}.mesh"), &e.to_string())),
+            NodeSpec::Vdb(v) => {
+                let (file, name) = match v {
+                    VdbSpec::File(file) => (file, None),
+                    VdbSpec::Full { file, grid } => (file, grid),
                 };
-                let grid = read_vdb_grid(&source, Some(name))
-                    .map_err(|e| self.error(&at, &e.to_string()))?;
+                let source = self.folder.join(file);
+                let grid = read_vdb_grid(&source, Some(name.as_deref().unwrap_or("surface")))
+                    .map_err(|e| self.error(&format!("{at}.vdb"), &e.to_string()))?;
                 Ok(CsgNode::Grid { grid, source })
             }
         }
