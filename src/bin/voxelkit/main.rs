@@ -22,7 +22,21 @@ use voxelkit::voxelize::separating::Criterion;
     long_about = "Voxelize meshes and analytic surfaces into 6- or 26-separating voxel surfaces \
                   (Huang et al.'s distance criterion) and write OpenVDB .vdb files that Blender, \
                   Houdini and any OpenVDB program open. Each .vdb holds `surface` (bool), \
-                  `density` (fog volume) and, with --normals, `normal` (Vec3)."
+                  `density` (fog volume) and, with --normals, `normal` (Vec3).",
+    after_long_help = "What a summary (or --json) reports:\n  \
+        voxels, leaves: voxels of the main grid (surface or whole solid) and their 8^3 leaves\n  \
+        vertex/edge/body voxels: voxels first made by a vertex sphere, edge cylinder, face slab\n  \
+        degenerate faces: faces without area, voxelized by their edges (a warning)\n  \
+        depth-guard stops (subdiv): sub-patches smaller than the paper's depth guard whose\n    \
+        corner voxels were still not adjacent; accepted as they are\n  \
+        tolerance voxels (subdiv --enclose): voxels added where the surface grazes a voxel\n    \
+        edge or corner no sample lands in\n  \
+        inside/surface voxels, volume inside .. with surface (solids): the true volume lies\n    \
+        between them; components (26-connected) and genus (components - Euler characteristic)\n  \
+        unclassified voxels (depth layers): voxels no direction decides, written as\n    \
+        `unclassified`\n  \
+        voxelize seconds, seconds: the voxelization itself, and the whole run\n  \
+        peak, estimated MiB: the process's peak memory, and what planning estimated"
 )]
 struct Cli {
     /// Worker threads (default: all cores; at most 256).
