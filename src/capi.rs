@@ -13,16 +13,15 @@ use crate::grid::{LEAF_VOXELS, SparseGrid};
 use crate::implicit::Coordinates;
 use crate::io::vdb::{read_vdb_grid, write_vdb};
 use crate::mesh::{GridFit, Mesh};
-use crate::ops::csg::{BooleanOp, combine};
-use crate::ops::measure::SolidMeasures;
+use crate::ops::csg::BooleanOp;
 use crate::pipeline::{
-    ColorChoice, Details, Fill, Job, Limits, MeshSource, Outcome, SurfaceMethod as PipelineSurface,
-    Task,
+    ColorChoice, Details, Fill, GridSource, Job, Limits, MeasureSource, MeshSource, Outcome,
+    SurfaceMethod as PipelineSurface, Task,
 };
 use crate::progress::Observer;
 use crate::solids::csg_leaves::ALL_DIRECTIONS;
 use crate::solids::depth_layers::{DIRECTIONS, DepthLayerOptions, Layers};
-use crate::solids::exterior_flood::{FloodMethod, solid_from_surface};
+use crate::solids::exterior_flood::FloodMethod;
 use crate::voxelize::Separability;
 use crate::voxelize::parametric::ParametricOptions;
 use crate::voxelize::separating::{Criterion, SeparatingOptions};
@@ -61,17 +60,6 @@ pub struct VkMeasures {
     pub surface_voxels: u64,
     pub volume_inside: f64,
     pub volume_with_surface: f64,
-}
-
-impl From<SolidMeasures> for VkMeasures {
-    fn from(m: SolidMeasures) -> Self {
-        VkMeasures {
-            inside_voxels: m.inside_voxels,
-            surface_voxels: m.surface_voxels,
-            volume_inside: m.volume_inside,
-            volume_with_surface: m.volume_with_surface,
-        }
-    }
 }
 
 /// `vk_progress_fn`.
@@ -457,6 +445,22 @@ fn run_job(options: &Options, task: Task) -> std::result::Result<Outcome, Failur
     let outcome = job.run(&reporter)?;
     reporter.finish();
     Ok(outcome)
+}
+
+/// The measures of a solid job's report.
+fn solid_measures(outcome: &Outcome) -> std::result::Result<VkMeasures, Failure> {
+    match &outcome.report.details {
+        Details::Solid(s) => Ok(VkMeasures {
+            inside_voxels: s.inside_voxels,
+            surface_voxels: s.surface_voxels,
+            volume_inside: s.volume_inside,
+            volume_with_surface: s.volume_with_surface,
+        }),
+        _ => Err(Failure::new(
+            VkStatus::Internal,
+            "internal error (a bug in voxelkit, please report it): a solid without measures",
+        )),
+    }
 }
 
 /// The mesh of a handle, as a job's source.
@@ -863,12 +867,6 @@ pub extern "C" fn vk_fill_mesh(
         };
         let outcome = run_job(o, task)?;
         let found = match &outcome.report.details {
-            Details::Solid(s) => VkMeasures {
-                inside_voxels: s.inside_voxels,
-                surface_voxels: s.surface_voxels,
-                volume_inside: s.volume_inside,
-                volume_with_surface: s.volume_with_surface,
-            },
             Details::DepthLayers(d) if d.unclassified_voxels > 0 => {
                 return Err(invalid(format!(
                     "{} voxels cannot be classified by depth layers (crossed more than four times \
@@ -882,7 +880,7 @@ pub extern "C" fn vk_fill_mesh(
                 volume_inside: d.volume,
                 volume_with_surface: d.volume,
             },
-            _ => unreachable!("a solid job reports a solid"),
+            _ => solid_measures(&outcome)?,
         };
         if !measures.is_null() {
             put(measures, found)?;
@@ -899,8 +897,13 @@ pub extern "C" fn vk_measure_surface(
     guard(|| {
         let g = &borrow(surface, Kind::Grid)?.grid;
         non_null_out(measures)?;
-        let solid = solid_from_surface(g, FloodMethod::Spans)?;
-        put(measures, solid.measures.into())
+        let task = Task::Measure {
+            source: MeasureSource::Grid(g.clone()),
+            flood: FloodMethod::Spans,
+            density: 1.0,
+        };
+        let outcome = run_job(&Options::default(), task)?;
+        put(measures, solid_measures(&outcome)?)
     })
 }
 
@@ -921,9 +924,16 @@ pub extern "C" fn vk_grid_combine(
             2 => BooleanOp::Difference,
             _ => return Err(invalid(format!("unknown vk_boolean {op}"))),
         };
-        let grid = combine(a, b, op, resample != 0)?;
-        let metadata = vec![("method".to_string(), format!("{op:?}").to_lowercase())];
-        hand_out(VkGrid { grid, metadata }, Kind::Grid, out)
+        let task = Task::Combine {
+            a: GridSource::Grid(a.clone()),
+            b: GridSource::Grid(b.clone()),
+            grid: "surface".into(),
+            op,
+            resample: resample != 0,
+            curve: false,
+        };
+        let outcome = run_job(&Options::default(), task)?;
+        hand_out(VkGrid::from(outcome), Kind::Grid, out)
     })
 }
 

@@ -230,19 +230,9 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             }
             MeasureSource::Vdb(path) => {
                 let grid = read_surface(path)?;
-                let b = grid.bbox().unwrap_or(CoordBox {
-                    min: [0; 3],
-                    max: [0; 3],
-                });
-                let t = grid.transform;
-                let bbox = Aabb {
-                    min: t.index_to_world(b.min),
-                    max: t.index_to_world(b.max),
-                };
-                let bytes = solid_bytes(cells(&padded(b, 2)), 6);
-                let p = plan(t, &bbox, bytes, 1);
-                (Loaded::Vdb(grid), p)
+                grid_plan(grid)
             }
+            MeasureSource::Grid(grid) => grid_plan(grid.clone()),
         },
         Task::CsgTree(path) => {
             let tree = read_csg_tree(path)?;
@@ -255,18 +245,14 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             (Loaded::Tree(Box::new(tree)), p)
         }
         Task::Combine { a, b, grid, .. } => {
-            let ga = read_vdb_grid(a, Some(grid))?;
-            let gb = read_vdb_grid(b, Some(grid))?;
+            let load = |g: &super::GridSource| match g {
+                super::GridSource::File(path) => read_vdb_grid(path, Some(grid)),
+                super::GridSource::Grid(g) => Ok(g.clone()),
+            };
+            let (ga, gb) = (load(a)?, load(b)?);
             let leaves = (ga.leaf_count() + gb.leaf_count()) as f64;
             let t = ga.transform;
-            let bx = ga.bbox().unwrap_or(CoordBox {
-                min: [0; 3],
-                max: [0; 3],
-            });
-            let bbox = Aabb {
-                min: t.index_to_world(bx.min),
-                max: t.index_to_world(bx.max),
-            };
+            let bbox = world_box(&ga);
             let p = plan(t, &bbox, leaf_bytes(leaves, 0), 1);
             (Loaded::Grids(ga, gb), p)
         }
@@ -276,4 +262,33 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
 /// The surface of a `.vdb` to measure: a solid's `boundary` when it is one, else `surface`.
 fn read_surface(path: &std::path::Path) -> Result<SparseGrid> {
     read_vdb_grid(path, Some("boundary")).or_else(|_| read_vdb_grid(path, Some("surface")))
+}
+
+/// The world box of a grid's voxel centres (a point at the origin when it is empty).
+fn world_box(grid: &SparseGrid) -> Aabb {
+    let b = grid.bbox().unwrap_or(CoordBox {
+        min: [0; 3],
+        max: [0; 3],
+    });
+    Aabb {
+        min: grid.transform.index_to_world(b.min),
+        max: grid.transform.index_to_world(b.max),
+    }
+}
+
+/// Measuring a surface grid: its box filled.
+fn grid_plan(grid: SparseGrid) -> (Loaded, Plan) {
+    let b = grid.bbox().unwrap_or(CoordBox {
+        min: [0; 3],
+        max: [0; 3],
+    });
+    let bbox = world_box(&grid);
+    let t = grid.transform;
+    let plan = Plan {
+        transform: t,
+        extent: extent(&bbox, &t),
+        estimated_bytes: (BASE_BYTES + solid_bytes(cells(&padded(b, 2)), 6)) as u64,
+        work_items: 1,
+    };
+    (Loaded::Grid(grid), plan)
 }

@@ -13,7 +13,7 @@ pub use outcome::{Outcome, check_output_path};
 pub use report::*;
 
 use crate::error::{Error, Result};
-use crate::grid::Transform;
+use crate::grid::{SparseGrid, Transform};
 use crate::implicit::{Coordinates, Formula};
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::BooleanOp;
@@ -82,11 +82,20 @@ pub enum Fill {
     Beam,
 }
 
-/// What `measure` measures: a mesh (its flooded 26-separating surface) or a `.vdb` surface.
+/// What `measure` measures: a mesh (its flooded 26-separating surface), a `.vdb` surface (a
+/// solid's `boundary`, else its `surface`) or a surface in memory.
 #[derive(Clone, Debug)]
 pub enum MeasureSource {
     Mesh(MeshSource),
     Vdb(PathBuf),
+    Grid(SparseGrid),
+}
+
+/// A voxel grid: a grid of a `.vdb` file (named by the task), or one in memory.
+#[derive(Clone, Debug)]
+pub enum GridSource {
+    File(PathBuf),
+    Grid(SparseGrid),
 }
 
 /// What to make.
@@ -133,10 +142,11 @@ pub enum Task {
     },
     /// A CSG tree in JSON (see `ops::csg_tree`); its file sets the grid.
     CsgTree(PathBuf),
-    /// A Boolean of grid `grid` of two `.vdb` files (`curve`: the intersection of two surfaces).
+    /// A Boolean of two grids (from files: their grid `grid`); `curve`: the intersection of
+    /// two surfaces.
     Combine {
-        a: PathBuf,
-        b: PathBuf,
+        a: GridSource,
+        b: GridSource,
         grid: String,
         op: BooleanOp,
         resample: bool,
@@ -179,8 +189,8 @@ pub(crate) enum Loaded {
     Formula(Formula),
     Shape,
     Tree(Box<CsgTree>),
-    Grids(crate::grid::SparseGrid, crate::grid::SparseGrid),
-    Vdb(crate::grid::SparseGrid),
+    Grids(SparseGrid, SparseGrid),
+    Grid(SparseGrid),
 }
 
 /// A job whose inputs are read and whose plan fits.
@@ -279,8 +289,19 @@ impl Task {
                 ..
             } => vec![p.clone()],
             Task::CsgTree(p) => vec![p.clone()],
-            Task::Combine { a, b, .. } => vec![a.clone(), b.clone()],
-            Task::Shape { .. } | Task::Implicit { .. } => vec![],
+            Task::Combine { a, b, .. } => [a, b]
+                .into_iter()
+                .filter_map(|g| match g {
+                    GridSource::File(p) => Some(p.clone()),
+                    GridSource::Grid(_) => None,
+                })
+                .collect(),
+            Task::Measure {
+                source: MeasureSource::Grid(_),
+                ..
+            }
+            | Task::Shape { .. }
+            | Task::Implicit { .. } => vec![],
         }
     }
 }
@@ -361,7 +382,17 @@ impl Job {
                 source: MeasureSource::Mesh(MeshSource::Mesh(m)),
                 ..
             } => m.source.display().to_string(),
-            Task::Combine { a, b, .. } => format!("{} {}", a.display(), b.display()),
+            Task::Combine { a, b, .. } => {
+                let name = |g: &GridSource| match g {
+                    GridSource::File(p) => p.display().to_string(),
+                    GridSource::Grid(_) => "a grid in memory".to_string(),
+                };
+                format!("{} {}", name(a), name(b))
+            }
+            Task::Measure {
+                source: MeasureSource::Grid(_),
+                ..
+            } => "a grid in memory".to_string(),
             other => other
                 .input_files()
                 .first()
@@ -469,7 +500,7 @@ impl PlannedJob {
             (Task::Measure { flood, density, .. }, Loaded::Mesh(mesh)) => {
                 solid::measure_mesh(mesh, t, *flood, *density, progress)
             }
-            (Task::Measure { flood, density, .. }, Loaded::Vdb(surface)) => {
+            (Task::Measure { flood, density, .. }, Loaded::Grid(surface)) => {
                 solid::measure_surface(surface, &source, *flood, *density, progress)
             }
             (Task::CsgTree(_), Loaded::Tree(tree)) => solid::csg_tree(tree, progress),

@@ -6,7 +6,7 @@ use clap::Args;
 use std::path::PathBuf;
 use voxelkit::Result;
 use voxelkit::ops::csg::BooleanOp;
-use voxelkit::pipeline::{Fill, Job, MeasureSource, MeshSource, Task};
+use voxelkit::pipeline::{Fill, GridSource, Job, MeasureSource, MeshSource, Task};
 use voxelkit::solids::exterior_flood::FloodMethod;
 
 /// The floods to choose from.
@@ -178,8 +178,8 @@ pub fn measure(args: &MeasureArgs, global: &Global) -> Result<()> {
 pub fn csg(args: &CsgArgs, global: &Global) -> Result<()> {
     let task = match (args.operation, &args.a, &args.b, &args.tree) {
         (Some(op), Some(a), Some(b), None) => Task::Combine {
-            a: a.clone(),
-            b: b.clone(),
+            a: GridSource::File(a.clone()),
+            b: GridSource::File(b.clone()),
             grid: args.grid.clone(),
             op,
             resample: args.resample,
@@ -195,8 +195,8 @@ pub fn csg(args: &CsgArgs, global: &Global) -> Result<()> {
 
 pub fn intersect(args: &IntersectArgs, global: &Global) -> Result<()> {
     let task = Task::Combine {
-        a: args.a.clone(),
-        b: args.b.clone(),
+        a: GridSource::File(args.a.clone()),
+        b: GridSource::File(args.b.clone()),
         grid: "surface".into(),
         op: BooleanOp::Intersection,
         resample: args.resample,
