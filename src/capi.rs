@@ -26,14 +26,15 @@ use crate::voxelize::Separability;
 use crate::voxelize::parametric::ParametricOptions;
 use crate::voxelize::separating::{Criterion, SeparatingOptions};
 use glam::DVec3;
+use std::any::Any;
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::ffi::{CStr, CString, c_char, c_int, c_void};
 use std::ops::ControlFlow;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, AtomicI32, AtomicU64, Ordering};
-use std::sync::{LazyLock, Mutex};
+use std::sync::atomic::{AtomicBool, AtomicI32, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, LazyLock, Mutex};
 
 /// `vk_status`.
 #[repr(C)]
@@ -81,8 +82,12 @@ impl From<Outcome> for VkGrid {
         }
     }
 }
-/// `vk_options`.
-pub struct VkOptions(Options);
+/// `vk_options`: changed by the setters, copied by each call.
+pub struct VkOptions(Mutex<Options>);
+
+// SAFETY: the raw pointers in `Options` are the caller's progress user data and cancel flag,
+// which the header lets calls on any thread use (the flag is read atomically).
+unsafe impl Send for Options {}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum SurfaceMethod {
@@ -179,7 +184,13 @@ fn set_last_error(message: &str) {
 
 /// Runs an export's body: no panic escapes, the message is kept, the status returned.
 fn guard(body: impl FnOnce() -> Status) -> VkStatus {
-    let outcome = catch_unwind(AssertUnwindSafe(body)).unwrap_or_else(|payload| {
+    quiet_panics_during_calls();
+    ACTIVE_CALLS.fetch_add(1, Ordering::SeqCst);
+    IN_CALL.with(|c| c.set(true));
+    let caught = catch_unwind(AssertUnwindSafe(body));
+    IN_CALL.with(|c| c.set(false));
+    ACTIVE_CALLS.fetch_sub(1, Ordering::SeqCst);
+    let outcome = caught.unwrap_or_else(|payload| {
         let what = payload
             .downcast_ref::<&str>()
             .map(|s| s.to_string())
@@ -202,6 +213,29 @@ fn guard(body: impl FnOnce() -> Status) -> VkStatus {
     }
 }
 
+thread_local! {
+    static IN_CALL: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+/// Calls into the library in progress, on any thread.
+static ACTIVE_CALLS: AtomicUsize = AtomicUsize::new(0);
+
+/// A panic inside a call becomes its status and message (`vk_last_error`); it is not also
+/// printed on the host's stderr. Panics of the host's own Rust code still print.
+fn quiet_panics_during_calls() {
+    static INSTALLED: std::sync::Once = std::sync::Once::new();
+    INSTALLED.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            let ours = IN_CALL.with(|c| c.get())
+                || (ACTIVE_CALLS.load(Ordering::SeqCst) > 0
+                    && rayon::current_thread_index().is_some());
+            if !ours {
+                previous(info);
+            }
+        }));
+    });
+}
+
 /// What kind of object a live handle points to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Kind {
@@ -220,71 +254,94 @@ impl Kind {
     }
 }
 
-/// Every handle given out and not yet freed, by address.
-static LIVE: LazyLock<Mutex<HashMap<usize, Kind>>> = LazyLock::new(Default::default);
+/// A live object: its kind and the object, shared with the calls using it right now.
+struct Entry {
+    kind: Kind,
+    object: Arc<dyn Any + Send + Sync>,
+}
 
-fn live() -> std::sync::MutexGuard<'static, HashMap<usize, Kind>> {
+/// Every handle given out and not yet freed. A handle is a number, never an address, and
+/// never given out twice: a freed or forged handle finds nothing, even after new objects
+/// were made, and an object freed while another thread still uses it lives until that use
+/// ends.
+static LIVE: LazyLock<Mutex<HashMap<usize, Entry>>> = LazyLock::new(Default::default);
+static NEXT_HANDLE: AtomicUsize = AtomicUsize::new(1);
+
+fn live() -> std::sync::MutexGuard<'static, HashMap<usize, Entry>> {
     // A panic never happens while the table is locked, but do not let one poison it.
     LIVE.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Moves `value` to the heap, registers it and writes the handle to `out`.
-fn hand_out<T>(value: T, kind: Kind, out: *mut *mut T) -> Status {
+/// Registers `value` and writes its new handle to `out`.
+fn hand_out<T: Any + Send + Sync>(value: T, kind: Kind, out: *mut *mut T) -> Status {
     let out = non_null_out(out)?;
-    let p = Box::into_raw(Box::new(value));
-    live().insert(p as usize, kind);
+    // Spaced by 16 so that a handle looks like an aligned address to tools that print it.
+    let id = NEXT_HANDLE.fetch_add(1, Ordering::Relaxed) << 4;
+    let object: Arc<dyn Any + Send + Sync> = Arc::new(value);
+    live().insert(id, Entry { kind, object });
     // SAFETY: `out` is non-null and, by the header's contract, points to writable storage.
-    unsafe { *out = p };
+    unsafe { *out = id as *mut T };
     Ok(())
 }
 
-/// The object behind a live handle of `kind`.
-fn borrow<'a, T>(p: *const T, kind: Kind) -> std::result::Result<&'a T, Failure> {
-    if p.is_null() {
-        return Err(Failure::new(
-            VkStatus::InvalidHandle,
-            format!("{} is NULL", kind.name()),
-        ));
-    }
-    match live().get(&(p as usize)) {
-        // SAFETY: the address was produced by `hand_out` for this kind and is not freed yet.
-        Some(&k) if k == kind => Ok(unsafe { &*p }),
-        Some(&k) => Err(Failure::new(
-            VkStatus::InvalidHandle,
-            format!(
+fn not_live(kind: Kind, p: usize, found: Option<Kind>) -> Failure {
+    Failure::new(
+        VkStatus::InvalidHandle,
+        match found {
+            _ if p == 0 => format!("{} is NULL", kind.name()),
+            Some(k) => format!(
                 "a {} was passed where a {} is expected",
                 k.name(),
                 kind.name()
             ),
-        )),
-        None => Err(Failure::new(
-            VkStatus::InvalidHandle,
-            format!(
-                "{} {p:p} is not a live handle (freed already, or never created)",
+            None => format!(
+                "{} {p:#x} is not a live handle (freed already, or never created)",
                 kind.name()
             ),
-        )),
+        },
+    )
+}
+
+/// The object behind a live handle of `kind`.
+fn borrow<T: Any + Send + Sync>(p: *const T, kind: Kind) -> std::result::Result<Arc<T>, Failure> {
+    let table = live();
+    match table.get(&(p as usize)) {
+        Some(e) if e.kind == kind => Ok(Arc::clone(&e.object)
+            .downcast::<T>()
+            .expect("the table holds each kind's own type")),
+        found => Err(not_live(kind, p as usize, found.map(|e| e.kind))),
     }
 }
 
-/// Releases a handle of `kind`; NULL is fine, anything not live is an error.
+/// Releases a handle of `kind`; NULL is fine, anything not live is an error. Removing it
+/// from the table is the one step, so two threads freeing one handle cannot both succeed.
 fn release<T>(p: *mut T, kind: Kind) -> Status {
     if p.is_null() {
         return Ok(());
     }
-    borrow(p as *const T, kind)?;
-    live().remove(&(p as usize));
-    // SAFETY: the handle was live, so it came from `Box::into_raw` and is freed only here.
-    drop(unsafe { Box::from_raw(p) });
-    Ok(())
+    let mut table = live();
+    match table.get(&(p as usize)) {
+        Some(e) if e.kind == kind => {
+            table.remove(&(p as usize));
+            Ok(())
+        }
+        found => Err(not_live(kind, p as usize, found.map(|e| e.kind))),
+    }
 }
 
-/// Mutable access to the options behind a live handle.
-fn options_mut<'a>(p: *mut VkOptions) -> std::result::Result<&'a mut Options, Failure> {
-    borrow(p as *const VkOptions, Kind::Options)?;
-    // SAFETY: live, and the header forbids using one options object from two threads while
-    // one of them changes it.
-    Ok(unsafe { &mut (*p).0 })
+/// The options behind a live handle, to change them.
+fn options_mut(p: *mut VkOptions) -> std::result::Result<Arc<VkOptions>, Failure> {
+    borrow(p as *const VkOptions, Kind::Options)
+}
+
+fn lock(options: &VkOptions) -> std::sync::MutexGuard<'_, Options> {
+    options.0.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// A copy of the options behind a live handle, for one call.
+fn options_of(p: *const VkOptions) -> std::result::Result<Options, Failure> {
+    let options: Arc<VkOptions> = borrow(p, Kind::Options)?;
+    Ok(*lock(&options))
 }
 
 fn non_null_out<T>(out: *mut T) -> std::result::Result<*mut T, Failure> {
@@ -476,7 +533,7 @@ fn grid_from_job(
     task: impl FnOnce(&Options) -> std::result::Result<Task, Failure>,
 ) -> VkStatus {
     guard(|| {
-        let o = &borrow(options, Kind::Options)?.0;
+        let o = &options_of(options)?;
         non_null_out(out)?;
         let outcome = run_job(o, task(o)?)?;
         hand_out(VkGrid::from(outcome), Kind::Grid, out)
@@ -557,7 +614,13 @@ pub extern "C" fn vk_mesh_free(mesh: *mut VkMesh) -> VkStatus {
 
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_new(out: *mut *mut VkOptions) -> VkStatus {
-    guard(|| hand_out(VkOptions(Options::default()), Kind::Options, out))
+    guard(|| {
+        hand_out(
+            VkOptions(Mutex::new(Options::default())),
+            Kind::Options,
+            out,
+        )
+    })
 }
 
 #[unsafe(no_mangle)]
@@ -568,7 +631,8 @@ pub extern "C" fn vk_options_free(options: *mut VkOptions) -> VkStatus {
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_resolution(options: *mut VkOptions, resolution: u32) -> VkStatus {
     guard(|| {
-        let o = options_mut(options)?;
+        let options = options_mut(options)?;
+        let mut o = lock(&options);
         if !(1..=1 << 16).contains(&resolution) {
             return Err(invalid(format!(
                 "resolution {resolution} must be between 1 and 65536"
@@ -582,7 +646,8 @@ pub extern "C" fn vk_options_set_resolution(options: *mut VkOptions, resolution:
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_voxel_size(options: *mut VkOptions, voxel_size: f64) -> VkStatus {
     guard(|| {
-        let o = options_mut(options)?;
+        let options = options_mut(options)?;
+        let mut o = lock(&options);
         if !(voxel_size > 0.0 && voxel_size.is_finite()) {
             return Err(invalid(format!(
                 "voxel size {voxel_size} must be positive and finite"
@@ -599,7 +664,8 @@ pub extern "C" fn vk_options_set_separability(
     separability: c_int,
 ) -> VkStatus {
     guard(|| {
-        let o = options_mut(options)?;
+        let options = options_mut(options)?;
+        let mut o = lock(&options);
         o.separability = separability.to_string().parse().map_err(invalid)?;
         Ok(())
     })
@@ -608,7 +674,8 @@ pub extern "C" fn vk_options_set_separability(
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_criterion(options: *mut VkOptions, criterion: c_int) -> VkStatus {
     guard(|| {
-        let o = options_mut(options)?;
+        let options = options_mut(options)?;
+        let mut o = lock(&options);
         o.criterion = match criterion {
             0 => Criterion::Huang,
             1 => Criterion::Clipped,
@@ -621,7 +688,8 @@ pub extern "C" fn vk_options_set_criterion(options: *mut VkOptions, criterion: c
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_normals(options: *mut VkOptions, normals: c_int) -> VkStatus {
     guard(|| {
-        options_mut(options)?.normals = normals != 0;
+        let options: Arc<VkOptions> = options_mut(options)?;
+        lock(&options).normals = normals != 0;
         Ok(())
     })
 }
@@ -632,7 +700,8 @@ pub extern "C" fn vk_options_set_surface_method(
     method: c_int,
 ) -> VkStatus {
     guard(|| {
-        let o = options_mut(options)?;
+        let options = options_mut(options)?;
+        let mut o = lock(&options);
         o.surface = match method {
             0 => SurfaceMethod::Separating,
             1 => SurfaceMethod::Projective,
@@ -645,7 +714,8 @@ pub extern "C" fn vk_options_set_surface_method(
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_fill_method(options: *mut VkOptions, method: c_int) -> VkStatus {
     guard(|| {
-        let o = options_mut(options)?;
+        let options = options_mut(options)?;
+        let mut o = lock(&options);
         o.fill = match method {
             0 => FillMethod::Flood,
             1 => FillMethod::DepthLayers,
@@ -663,7 +733,8 @@ pub extern "C" fn vk_options_set_flood(
     graystack: usize,
 ) -> VkStatus {
     guard(|| {
-        options_mut(options)?.flood = if flooding_xyz != 0 {
+        let options: Arc<VkOptions> = options_mut(options)?;
+        lock(&options).flood = if flooding_xyz != 0 {
             FloodMethod::Xyz {
                 capacity: graystack.max(1),
             }
@@ -681,7 +752,8 @@ pub extern "C" fn vk_options_set_depth_layers(
     double_layers: c_int,
 ) -> VkStatus {
     guard(|| {
-        let o = options_mut(options)?;
+        let options = options_mut(options)?;
+        let mut o = lock(&options);
         if !(3..=DIRECTIONS.len() as u32).contains(&directions) {
             return Err(invalid(format!(
                 "depth layers take 3 to {} directions, not {directions}",
@@ -707,7 +779,8 @@ pub extern "C" fn vk_options_set_subdivision(
     enclose: c_int,
 ) -> VkStatus {
     guard(|| {
-        let o = options_mut(options)?;
+        let options = options_mut(options)?;
+        let mut o = lock(&options);
         if presplit == 0 {
             return Err(invalid("the pre-split count must be at least 1"));
         }
@@ -720,7 +793,8 @@ pub extern "C" fn vk_options_set_subdivision(
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_threads(options: *mut VkOptions, threads: u32) -> VkStatus {
     guard(|| {
-        options_mut(options)?.threads = threads;
+        let options: Arc<VkOptions> = options_mut(options)?;
+        lock(&options).threads = threads;
         Ok(())
     })
 }
@@ -728,7 +802,8 @@ pub extern "C" fn vk_options_set_threads(options: *mut VkOptions, threads: u32) 
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_max_memory(options: *mut VkOptions, mib: u64) -> VkStatus {
     guard(|| {
-        options_mut(options)?.max_memory = (mib > 0).then(|| mib.saturating_mul(1 << 20));
+        let options: Arc<VkOptions> = options_mut(options)?;
+        lock(&options).max_memory = (mib > 0).then(|| mib.saturating_mul(1 << 20));
         Ok(())
     })
 }
@@ -740,7 +815,8 @@ pub extern "C" fn vk_options_set_progress(
     user_data: *mut c_void,
 ) -> VkStatus {
     guard(|| {
-        options_mut(options)?.progress = callback.map(|c| (c, user_data));
+        let options: Arc<VkOptions> = options_mut(options)?;
+        lock(&options).progress = callback.map(|c| (c, user_data));
         Ok(())
     })
 }
@@ -752,7 +828,8 @@ pub extern "C" fn vk_options_set_cancel_flag(
 ) -> VkStatus {
     guard(|| {
         // An `int32_t` written atomically by the caller has the layout of an `AtomicI32`.
-        options_mut(options)?.cancel = flag.cast();
+        let options: Arc<VkOptions> = options_mut(options)?;
+        lock(&options).cancel = flag.cast();
         Ok(())
     })
 }
@@ -853,7 +930,7 @@ pub extern "C" fn vk_fill_mesh(
     measures: *mut VkMeasures,
 ) -> VkStatus {
     guard(|| {
-        let o = &borrow(options, Kind::Options)?.0;
+        let o = &options_of(options)?;
         non_null_out(solid)?;
         let fill = match o.fill {
             FillMethod::Flood => Fill::Flood(o.flood),

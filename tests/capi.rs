@@ -274,3 +274,40 @@ fn the_c_interface_and_the_command_line_give_the_same_voxels_and_metadata() {
         "csg: the method differs"
     );
 }
+
+#[test]
+fn handles_survive_racing_frees_and_are_never_reused() {
+    if !have("pkg-config") || !have("gcc") {
+        return common::skip_or_fail("gcc or pkg-config is missing: the handle race test");
+    }
+    let work = tempfile::tempdir().unwrap();
+    let mesh = work.path().join("torus.obj");
+    generate::torus(glam::DVec3::ZERO, 1.0, 0.35, 24, 12)
+        .write_obj(&mesh)
+        .unwrap();
+    let flags = run(Command::new("pkg-config")
+        .env("PKG_CONFIG_PATH", prefix().join("lib/pkgconfig"))
+        .args(["--cflags", "--libs", "voxelkit"]));
+    let exe = work.path().join("race");
+    run(Command::new("gcc")
+        .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-pthread"])
+        .arg(repo().join("tests/c/race.c"))
+        .args(String::from_utf8_lossy(&flags.stdout).split_whitespace())
+        .arg("-o")
+        .arg(&exe));
+    let out = run(Command::new(&exe).arg(&mesh));
+    assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "ok");
+    if !have("valgrind") {
+        return common::skip_or_fail("valgrind is not installed: the handle race under valgrind");
+    }
+    let out = run(Command::new("valgrind")
+        .args([
+            "--error-exitcode=99",
+            "--leak-check=full",
+            "--errors-for-leak-kinds=definite",
+        ])
+        .arg(&exe)
+        .arg(&mesh));
+    let report = String::from_utf8_lossy(&out.stderr);
+    assert!(report.contains("ERROR SUMMARY: 0 errors"), "{report}");
+}

@@ -29,7 +29,13 @@ struct Parser<'a> {
     variables: [&'a str; 3],
     names: Vec<(String, u32)>,
     instrs: Vec<Instr>,
+    /// Nesting of signs, parentheses and function calls: bounded, so that no input can
+    /// exhaust the stack (the evaluation runs a flat tape and does not recurse).
+    depth: usize,
 }
+
+/// Deepest nesting a formula may have.
+const MAX_DEPTH: usize = 100;
 
 /// Compiles `text` over the coordinate `variables` (in slot order).
 pub fn parse(text: &str, variables: [&str; 3]) -> Result<Tape> {
@@ -40,6 +46,7 @@ pub fn parse(text: &str, variables: [&str; 3]) -> Result<Tape> {
         variables,
         names: Vec::new(),
         instrs: Vec::new(),
+        depth: 0,
     };
     let root = p.formula()?;
     // The value is the last instruction: make sure the root is last.
@@ -89,6 +96,13 @@ fn tokenize(text: &str) -> Result<Vec<(Token, usize)>> {
             let value = word
                 .parse::<f64>()
                 .map_err(|_| error(text, column, format!("`{word}` is not a number")))?;
+            if !value.is_finite() {
+                return Err(error(
+                    text,
+                    column,
+                    format!("`{word}` is too large for a double-precision number"),
+                ));
+            }
             tokens.push((Token::Number(value), column));
         } else if c.is_alphabetic() || c == '_' {
             let start = i;
@@ -234,14 +248,21 @@ impl Parser<'_> {
     }
 
     fn unary(&mut self) -> Result<u32> {
-        if self.eat('-') {
-            let a = self.unary()?;
-            Ok(self.push(Instr::Neg(a)))
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return self.fail(format!(
+                "the formula nests more than {MAX_DEPTH} levels deep (signs, parentheses, functions)"
+            ));
+        }
+        let value = if self.eat('-') {
+            self.unary().map(|a| self.push(Instr::Neg(a)))
         } else if self.eat('+') {
             self.unary()
         } else {
             self.power()
-        }
+        };
+        self.depth -= 1;
+        value
     }
 
     fn power(&mut self) -> Result<u32> {

@@ -34,10 +34,11 @@ pub fn fit_transform(bbox: &Aabb, fit: GridFit) -> Result<Transform> {
                 "the mesh has zero extent; give --voxel-size instead of --resolution".into(),
             ));
         }
-        GridFit::VoxelSize(h) if h.is_finite() && h > 0.0 => h,
+        // Volumes and masses need h^3: refuse sizes whose cube overflows.
+        GridFit::VoxelSize(h) if h > 0.0 && h.powi(3).is_finite() => h,
         GridFit::VoxelSize(h) => {
             return Err(Error::InvalidArgument(format!(
-                "voxel size must be a positive number, got {h}"
+                "voxel size must be a positive number whose cube is finite, got {h}"
             )));
         }
     };

@@ -224,9 +224,13 @@ impl Mesh {
     }
 
     /// Signed volume by the divergence theorem (positive for outward-facing normals).
+    /// The volume the faces enclose, signed by their orientation; taken about the centre of
+    /// the bounding box, so that a mesh far from the origin loses no precision.
     pub fn signed_volume(&self) -> f64 {
+        let b = self.bbox();
+        let o = 0.5 * (b.min + b.max);
         self.triangles()
-            .map(|(_, [a, b, c])| self.p(a).dot(self.p(b).cross(self.p(c))) / 6.0)
+            .map(|(_, [a, b, c])| (self.p(a) - o).dot((self.p(b) - o).cross(self.p(c) - o)) / 6.0)
             .sum()
     }
 

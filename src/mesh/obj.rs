@@ -11,7 +11,9 @@ use std::path::Path;
 
 pub(super) fn load_obj(path: &Path) -> Result<Mesh> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    let parsed = parse_obj(&text).map_err(|(line, message)| Error::Parse {
+    // A byte-order mark is not part of the first line.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let parsed = parse_obj(text).map_err(|(line, message)| Error::Parse {
         path: path.to_path_buf(),
         line,
         message,

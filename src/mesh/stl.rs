@@ -9,16 +9,21 @@ use rustc_hash::FxHashMap;
 use std::path::Path;
 
 pub(super) fn load_stl(path: &Path) -> Result<Mesh> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let corners = if is_binary(&bytes) {
-        binary_corners(path, &bytes)?
+    let read = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = match read.strip_prefix(b"\xEF\xBB\xBF") {
+        // A byte-order mark: UTF-8 text, never a binary header.
+        Some(text) => return Ok(weld(path, &ascii_corners(path, text)?)),
+        None => &read,
+    };
+    let corners = if is_binary(bytes) {
+        binary_corners(path, bytes)?
     } else {
-        ascii_corners(path, &bytes)?
+        ascii_corners(path, bytes)?
     };
     Ok(weld(path, &corners))
 }
 
-/// A binary STL is exactly 84 + 50 n bytes; an ASCII one starts with `solid`.
+/// A binary STL is exactly 84 + 50 n bytes; an ASCII one starts with `solid` (any case).
 fn is_binary(bytes: &[u8]) -> bool {
     if bytes.len() >= 84 {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
@@ -26,7 +31,8 @@ fn is_binary(bytes: &[u8]) -> bool {
             return true;
         }
     }
-    !bytes.trim_ascii_start().starts_with(b"solid")
+    let start = bytes.trim_ascii_start();
+    !(start.len() >= 5 && start[..5].eq_ignore_ascii_case(b"solid"))
 }
 
 fn binary_corners(path: &Path, bytes: &[u8]) -> Result<Vec<DVec3>> {
@@ -79,6 +85,7 @@ fn ascii_corners(path: &Path, bytes: &[u8]) -> Result<Vec<DVec3>> {
     })?;
     let mut corners = Vec::new();
     let mut in_facet = 0usize;
+    let mut ended = false;
     for (n, line) in text.lines().enumerate() {
         let err = |message: String| Error::Parse {
             path: path.to_path_buf(),
@@ -86,7 +93,12 @@ fn ascii_corners(path: &Path, bytes: &[u8]) -> Result<Vec<DVec3>> {
             message,
         };
         let mut words = line.split_whitespace();
-        match words.next() {
+        // Keywords in any case (some exporters write `FACET NORMAL`).
+        let keyword = words.next().map(str::to_ascii_lowercase);
+        if ended && keyword.is_some() {
+            return Err(err("text after `endsolid`".into()));
+        }
+        match keyword.as_deref() {
             Some("vertex") => {
                 let mut v = [0.0; 3];
                 for (a, slot) in v.iter_mut().enumerate() {
@@ -109,14 +121,19 @@ fn ascii_corners(path: &Path, bytes: &[u8]) -> Result<Vec<DVec3>> {
                 }
                 in_facet = 0;
             }
+            Some("endsolid") => ended = true,
             _ => {}
         }
     }
-    if corners.len() % 3 != 0 {
+    if corners.len() % 3 != 0 || !ended {
         return Err(Error::Parse {
             path: path.to_path_buf(),
             line: text.lines().count(),
-            message: "file ends inside a facet".into(),
+            message: if corners.len() % 3 != 0 {
+                "file ends inside a facet".into()
+            } else {
+                "file ends without `endsolid` (truncated?)".into()
+            },
         });
     }
     Ok(corners)

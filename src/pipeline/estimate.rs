@@ -71,6 +71,17 @@ fn box_area(e: [f64; 3]) -> f64 {
 fn checked_box(bbox: &Aabb, t: &Transform) -> Result<CoordBox> {
     let e = extent(bbox, t);
     let far = (bbox.min.abs().max(bbox.max.abs()) / t.voxel_size).max_element();
+    // Coordinates this many voxels from the origin keep a thousandth of a voxel in f64.
+    const PRECISE: f64 = 1e-3 * (1u64 << 52) as f64;
+    if e.iter().all(|v| v.is_finite() && *v < 1e15) && far.is_finite() && far > PRECISE {
+        return Err(Error::InvalidArgument(format!(
+            "coordinates up to {:.3e} lie {far:.3e} voxels from the origin: double precision \
+             cannot place them to a thousandth of a voxel of size {:.3e}; move the model nearer \
+             the origin or raise the voxel size",
+            bbox.min.abs().max(bbox.max.abs()).max_element(),
+            t.voxel_size
+        )));
+    }
     if !(e.iter().all(|v| v.is_finite() && *v < 1e15) && far < 1e15) {
         return Err(Error::TooLarge {
             estimated_mib: u64::MAX >> 20,

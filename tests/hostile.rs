@@ -1,0 +1,161 @@
+//! Hostile input, each case a reproduction of a failure once seen: deep formulas that
+//! overflowed the stack, numbers that silently became infinite, a byte-order mark that ate
+//! the first OBJ line, STL files read wrongly, volumes lost to cancellation far from the
+//! origin, voxel sizes whose cube overflows. Every one is now a clear error or a right answer.
+#![cfg(feature = "vdb")]
+
+use std::path::Path;
+mod cli_support;
+
+use cli_support::{json_field, text, voxelkit};
+use voxelkit::Error;
+use voxelkit::implicit::{Coordinates, Formula};
+use voxelkit::mesh::Mesh;
+
+const TETRA: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+
+fn formula_error(text: &str) -> String {
+    match Formula::parse(text, Coordinates::Cartesian) {
+        Err(e @ Error::Formula { .. }) => e.to_string(),
+        Err(e) => panic!("not a formula error: {e}"),
+        Ok(_) => panic!("accepted: {}", &text[..text.len().min(40)]),
+    }
+}
+
+#[test]
+fn deep_formulas_are_refused_on_a_small_stack() {
+    // Run where a host thread of the C interface would: a 256 KiB stack.
+    let worker = std::thread::Builder::new()
+        .stack_size(256 << 10)
+        .spawn(|| {
+            for deep in [
+                format!("{}x{}", "(".repeat(15_000), ")".repeat(15_000)),
+                format!("{}x", "-".repeat(50_000)),
+                format!("{}x{}", "sqrt(".repeat(10_000), ")".repeat(10_000)),
+                format!("{}x{}", "(".repeat(500), ")".repeat(500)),
+            ] {
+                assert!(formula_error(&deep).contains("nests more than"));
+            }
+            // Deep but reasonable formulas still parse.
+            let fine = format!("{}x{}", "(".repeat(60), ")".repeat(60));
+            Formula::parse(&fine, Coordinates::Cartesian).unwrap();
+        })
+        .unwrap();
+    worker
+        .join()
+        .expect("the parser overflowed a 256 KiB stack");
+}
+
+#[test]
+fn numbers_beyond_double_precision_are_refused() {
+    let e = formula_error("x - 1e400");
+    assert!(e.contains("1e400") && e.contains("too large"), "{e}");
+}
+
+#[test]
+fn a_byte_order_mark_is_not_part_of_the_first_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("bom.obj");
+    std::fs::write(&obj, format!("\u{feff}{TETRA}")).unwrap();
+    let mesh = Mesh::load(&obj).unwrap();
+    assert_eq!(mesh.positions.len(), 4);
+    assert!((mesh.signed_volume().abs() - 1.0 / 6.0).abs() < 1e-12);
+}
+
+/// An ASCII STL of the unit tetrahedron, keywords in `case`.
+fn ascii_stl(upper: bool, end: bool) -> String {
+    let p = [[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]];
+    let faces = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+    let mut s = String::from("solid t\n");
+    for f in faces {
+        s.push_str("facet normal 0 0 0\nouter loop\n");
+        for v in f {
+            s.push_str(&format!("vertex {} {} {}\n", p[v][0], p[v][1], p[v][2]));
+        }
+        s.push_str("endloop\nendfacet\n");
+    }
+    if end {
+        s.push_str("endsolid t\n");
+    }
+    if upper { s.to_uppercase() } else { s }
+}
+
+#[test]
+fn stl_in_any_case_with_a_mark_is_read_and_a_cut_one_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, body: &[u8]| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, body).unwrap();
+        p
+    };
+    for (name, body) in [
+        ("upper.stl", ascii_stl(true, true).into_bytes()),
+        (
+            "bom.stl",
+            [
+                b"\xEF\xBB\xBF".as_slice(),
+                ascii_stl(false, true).as_bytes(),
+            ]
+            .concat(),
+        ),
+    ] {
+        let mesh = Mesh::load(&write(name, &body)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(mesh.face_count(), 4, "{name}");
+        assert!(
+            (mesh.signed_volume().abs() - 1.0 / 6.0).abs() < 1e-12,
+            "{name}"
+        );
+    }
+    // Cut at a facet boundary: no `endsolid`.
+    let cut = write("cut.stl", ascii_stl(false, false).as_bytes());
+    let e = Mesh::load(&cut).unwrap_err().to_string();
+    assert!(e.contains("cut.stl") && e.contains("endsolid"), "{e}");
+}
+
+fn tetra_at(dir: &Path, offset: f64) -> std::path::PathBuf {
+    let p = dir.join(format!("tetra{offset}.obj"));
+    let mut s = String::new();
+    for v in [[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]] {
+        s.push_str(&format!(
+            "v {} {} {}\n",
+            v[0] + offset,
+            v[1] + offset,
+            v[2] + offset
+        ));
+    }
+    s.push_str("f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+    std::fs::write(&p, s).unwrap();
+    p
+}
+
+#[test]
+fn far_from_the_origin_the_volume_holds_or_the_grid_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let shifted = tetra_at(dir.path(), 1e8);
+    let o = voxelkit(&["--json", "measure", shifted.to_str().unwrap(), "-r", "32"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let v = json_field(&String::from_utf8_lossy(&o.stdout), "mesh_signed_volume");
+    assert!((v.abs() - 1.0 / 6.0).abs() < 1e-6, "signed volume {v}");
+    // At 1e14 no double places a 1/64 voxel: refused, not wrong.
+    let far = tetra_at(dir.path(), 1e14);
+    let o = voxelkit(&["measure", far.to_str().unwrap(), "-r", "64"]);
+    let msg = text(&o);
+    assert!(
+        !o.status.success() && msg.contains("double precision"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn a_voxel_size_whose_cube_overflows_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("tetra.obj");
+    std::fs::write(&obj, TETRA).unwrap();
+    let o = voxelkit(&["measure", obj.to_str().unwrap(), "--voxel-size", "1e308"]);
+    let msg = text(&o);
+    assert!(!o.status.success(), "{msg}");
+    assert!(
+        msg.contains("cube is finite") && !msg.contains("NaN"),
+        "{msg}"
+    );
+}
