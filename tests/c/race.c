@@ -9,6 +9,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include <voxelkit.h>
 
+#include "check.h"
+
 #include <pthread.h>
 #include <stdio.h>
 #include <string.h>
@@ -25,16 +27,6 @@ static void *free_it(void *arg) {
     results[k] = vk_mesh_free(shared_mesh);
     return NULL;
 }
-
-static int failures = 0;
-#define CHECK(cond)                                                                       \
-    do {                                                                                  \
-        if (!(cond)) {                                                                    \
-            fprintf(stderr, "%s:%d: check failed: %s (last error: %s)\n", __FILE__,       \
-                    __LINE__, #cond, vk_last_error());                                    \
-            failures++;                                                                   \
-        }                                                                                 \
-    } while (0)
 
 int main(int argc, char **argv) {
     if (argc != 2) {

@@ -6,22 +6,11 @@
  */
 #include <voxelkit.h>
 
+#include "check.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static int failures = 0;
-
-#define CHECK(cond)                                                                      \
-    do {                                                                                 \
-        if (!(cond)) {                                                                   \
-            fprintf(stderr, "%s:%d: check failed: %s (last error: %s)\n", __FILE__,      \
-                    __LINE__, #cond, vk_last_error());                                   \
-            failures++;                                                                  \
-        }                                                                                \
-    } while (0)
-
-#define OK(call) CHECK((call) == VK_OK)
 
 static int stop_at_once(uint64_t done, uint64_t total, void *user_data) {
     (void)done;
