@@ -15,6 +15,10 @@ public:
     void add_grid(rust::Str kind, rust::Str name, double voxel_size, std::array<double, 3> origin,
                   rust::Slice<const int32_t> leaf_origins, rust::Slice<const uint64_t> masks,
                   rust::Slice<const float> values, rust::Slice<const MetaEntry> metadata);
+    void add_level_set(rust::Str name, rust::Str density_name, double voxel_size, std::array<double, 3> origin,
+                       rust::Slice<const int32_t> leaf_origins, rust::Slice<const uint64_t> masks,
+                       rust::Slice<const float> values, float background, bool is_signed,
+                       rust::Slice<const MetaEntry> metadata);
     void write(rust::Str path) const;
 
 private:
@@ -36,6 +40,7 @@ private:
 
 std::unique_ptr<VdbWriter> new_vdb_writer();
 std::unique_ptr<VdbFile> open_vdb(rust::Str path);
+double openvdb_level_set_volume(rust::Str path, rust::Str name);
 uint64_t openvdb_mesh_to_volume(rust::Slice<const float> points, rust::Slice<const uint32_t> triangles,
                                 double voxel_size, float exterior_band, float interior_band, size_t threads);
 

@@ -49,6 +49,22 @@ pub mod bridge {
             values: &[f32],
             metadata: &[MetaEntry],
         ) -> Result<()>;
+        /// Adds a narrow-band distance FloatGrid: `values` per active voxel (world units), the
+        /// rest `background`; signed: class LEVEL_SET with the interior flood-filled to
+        /// -background, preceded by its fog volume as `density_name` (unless empty).
+        fn add_level_set(
+            self: Pin<&mut VdbWriter>,
+            name: &str,
+            density_name: &str,
+            voxel_size: f64,
+            origin: [f64; 3],
+            leaf_origins: &[i32],
+            masks: &[u64],
+            values: &[f32],
+            background: f32,
+            is_signed: bool,
+            metadata: &[MetaEntry],
+        ) -> Result<()>;
         /// Writes all grids to `path` (the caller renames it into place).
         fn write(self: &VdbWriter, path: &str) -> Result<()>;
 
@@ -64,6 +80,9 @@ pub mod bridge {
             masks: &mut Vec<u64>,
             values: &mut Vec<f32>,
         ) -> Result<()>;
+
+        /// OpenVDB's `tools::levelSetVolume` of the level set `name` in the file at `path`.
+        fn openvdb_level_set_volume(path: &str, name: &str) -> Result<f64>;
 
         /// OpenVDB's own conversion (`tools::meshToVolume`) of a triangle mesh given in index
         /// space, with `exterior_band` voxels outside and `interior_band` inside (the largest

@@ -41,6 +41,25 @@ impl SparseGrid {
         &self.leaves
     }
 
+    /// Replaces the value of every active voxel by `f(voxel, value)`, leaves in parallel.
+    pub fn map_values(&mut self, f: impl Fn(Coord, f32) -> f32 + Sync) {
+        use rayon::prelude::*;
+        self.leaves.par_iter_mut().for_each(|leaf| {
+            let origin = leaf.origin;
+            let on: Vec<usize> = leaf.offsets().collect();
+            if let Some(values) = leaf.value.as_mut() {
+                for n in on {
+                    let c = [
+                        origin[0] + (n / 64) as i64,
+                        origin[1] + (n / 8 % 8) as i64,
+                        origin[2] + (n % 8) as i64,
+                    ];
+                    values[n] = f(c, values[n]);
+                }
+            }
+        });
+    }
+
     pub fn leaf(&self, origin: Coord) -> Option<&Leaf> {
         self.index.get(&origin).map(|&i| &self.leaves[i as usize])
     }

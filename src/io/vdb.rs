@@ -72,17 +72,7 @@ pub fn write_vdb_with_masks(
 ) -> Result<()> {
     check_voxel_size(path, grid.transform.voxel_size)?;
     let (origins, masks, leaves) = flatten(path, grid)?;
-    let mut meta: Vec<MetaEntry> = metadata
-        .iter()
-        .map(|(k, v)| MetaEntry {
-            key: k.to_string(),
-            value: v.clone(),
-        })
-        .collect();
-    meta.push(MetaEntry {
-        key: "voxelkit_version".into(),
-        value: env!("CARGO_PKG_VERSION").into(),
-    });
+    let meta = meta_entries(metadata);
     let t = grid.transform;
     let origin = t.origin.to_array();
     let mut writer = bridge::new_vdb_writer();
@@ -136,12 +126,95 @@ pub fn write_vdb_with_masks(
             )
             .map_err(|e| vdb_error(path, e))?;
     }
+    write_file(path, &writer)
+}
+
+/// Writes the writer's grids to `path` atomically.
+fn write_file(path: &Path, writer: &bridge::VdbWriter) -> Result<()> {
     write_atomic(path, |tmp| {
         let tmp_str = tmp
             .to_str()
             .ok_or_else(|| vdb_error(path, "path is not UTF-8"))?;
         writer.write(tmp_str).map_err(|e| vdb_error(path, e))
     })
+}
+
+/// The metadata entries of every grid: the caller's plus `voxelkit_version`.
+fn meta_entries(metadata: &[(&str, String)]) -> Vec<MetaEntry> {
+    let mut meta: Vec<MetaEntry> = metadata
+        .iter()
+        .map(|(k, v)| MetaEntry {
+            key: k.to_string(),
+            value: v.clone(),
+        })
+        .collect();
+    meta.push(MetaEntry {
+        key: "voxelkit_version".into(),
+        value: env!("CARGO_PKG_VERSION").into(),
+    });
+    meta
+}
+
+/// How a distance band is written.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DistanceGrid {
+    /// Signed distances: a LEVEL_SET FloatGrid `surface` (Houdini's name) whose interior
+    /// is -background, after its fog volume `density`.
+    LevelSet,
+    /// Unsigned distances: a FloatGrid `distance`.
+    Unsigned,
+}
+
+/// Writes the value channel of `grid` (distances in world units on its active voxels) as a
+/// narrow band with `background` outside it, atomically, with `metadata`.
+pub fn write_distance_band(
+    path: &Path,
+    grid: &SparseGrid,
+    background: f32,
+    kind: DistanceGrid,
+    metadata: &[(&str, String)],
+) -> Result<()> {
+    check_voxel_size(path, grid.transform.voxel_size)?;
+    let (origins, masks, leaves) = flatten(path, grid)?;
+    let mut values = Vec::with_capacity(leaves.len() * LEAF_VOXELS);
+    for leaf in &leaves {
+        let v = leaf
+            .value
+            .as_ref()
+            .ok_or_else(|| vdb_error(path, "a distance band needs distances"))?;
+        values.extend_from_slice(&v[..]);
+    }
+    let meta = meta_entries(metadata);
+    let t = grid.transform;
+    let (name, density, signed) = match kind {
+        DistanceGrid::LevelSet => ("surface", "density", true),
+        DistanceGrid::Unsigned => ("distance", "", false),
+    };
+    let mut writer = bridge::new_vdb_writer();
+    writer
+        .pin_mut()
+        .add_level_set(
+            name,
+            density,
+            t.voxel_size,
+            t.origin.to_array(),
+            &origins,
+            &masks,
+            &values,
+            background,
+            signed,
+            &meta,
+        )
+        .map_err(|e| vdb_error(path, e))?;
+    write_file(path, &writer)
+}
+
+/// OpenVDB's own volume (`tools::levelSetVolume`) of the level set `name` in a file.
+pub fn openvdb_level_set_volume(path: &Path, name: &str) -> Result<f64> {
+    let p = path
+        .to_str()
+        .ok_or_else(|| vdb_error(path, "path is not UTF-8"))?;
+    bridge::openvdb_level_set_volume(p, name).map_err(|e| vdb_error(path, e))
 }
 
 fn open(path: &Path) -> Result<cxx::UniquePtr<bridge::VdbFile>> {

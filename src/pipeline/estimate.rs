@@ -147,6 +147,16 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             let p = plan(t, &mesh.bbox(), bytes, items);
             (Loaded::Mesh(mesh), p)
         }
+        Task::DistanceBand { mesh, band, .. } => {
+            let mesh = mesh.load(false)?;
+            let (t, b) = mesh_plan(&mesh, fit)?;
+            // A band 2w+1 voxels thick crosses about that many eighths of each leaf it meets;
+            // each leaf is held with its values, then twice more by OpenVDB (level set, fog).
+            let leaves = area_in_voxels(&mesh, &t) / AREA_PER_LEAF * (2.0 * band + 1.0) / 4.0;
+            let bytes = leaf_bytes(leaves, 0) * 2.0 + cells(&padded(b, band.ceil() as i64)) / 8.0;
+            let p = plan(t, &mesh.bbox(), bytes, mesh.face_count() as u64);
+            (Loaded::Mesh(mesh), p)
+        }
         Task::Lines { mesh, edges, color } => {
             let mesh = mesh.load(true)?;
             let (t, _) = mesh_plan(&mesh, fit)?;

@@ -140,6 +140,13 @@ pub enum Task {
         flood: FloodMethod,
         density: f64,
     },
+    /// Exact distances to a mesh on every voxel within `band` voxels: signed (a level set,
+    /// closed meshes only) or unsigned.
+    DistanceBand {
+        mesh: MeshSource,
+        band: f64,
+        signed: bool,
+    },
     /// A CSG tree in JSON (see `ops::csg_tree`); its file sets the grid.
     CsgTree(PathBuf),
     /// A Boolean of two grids (from files: their grid `grid`); `curve`: the intersection of
@@ -277,6 +284,7 @@ impl Task {
         let mesh = |m: &MeshSource| m.path().map(Path::to_path_buf).into_iter().collect();
         match self {
             Task::MeshSurface { mesh: m, .. }
+            | Task::DistanceBand { mesh: m, .. }
             | Task::Lines { mesh: m, .. }
             | Task::Subdivision { mesh: m, .. }
             | Task::Solid { mesh: m, .. } => mesh(m),
@@ -370,6 +378,10 @@ impl Job {
                 mesh: MeshSource::Mesh(m),
                 ..
             }
+            | Task::DistanceBand {
+                mesh: MeshSource::Mesh(m),
+                ..
+            }
             | Task::Subdivision {
                 mesh: MeshSource::Mesh(m),
                 ..
@@ -447,6 +459,7 @@ impl PlannedJob {
                 "voxelizing"
             }
             Task::Lines { .. } => "lines",
+            Task::DistanceBand { .. } => "distances",
             Task::Implicit { .. } => "octree",
             Task::Solid { .. } | Task::Measure { .. } => "surface",
             Task::CsgTree(_) | Task::Combine { .. } => "combining",
@@ -493,6 +506,9 @@ impl PlannedJob {
                     levels: *levels,
                 };
                 outcome::implicit(formula, text, *min, *max, &options, progress)
+            }
+            (Task::DistanceBand { band, signed, .. }, Loaded::Mesh(mesh)) => {
+                solid::distance_band(mesh, t, *band, *signed, &fit, progress)
             }
             (Task::Solid { fill, density, .. }, Loaded::Mesh(mesh)) => {
                 solid::mesh_solid(mesh, t, *fill, *density, &fit, progress)

@@ -9,6 +9,7 @@ use crate::error::{Error, Result};
 use crate::grid::{SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::io::atomic::check_output;
+use crate::io::vdb::{DistanceGrid, write_distance_band, write_vdb_with_masks};
 use crate::mesh::Mesh;
 use crate::ops::csg::{BooleanOp, combine as combine_grids};
 use crate::progress::Progress;
@@ -33,6 +34,9 @@ pub struct Outcome {
     /// The metadata every written grid carries (`method`, `source_file`, ...).
     pub metadata: Vec<(String, String)>,
     pub report: Report,
+    /// Set when `grid` holds distances (world units) to write as a narrow band with this
+    /// background, instead of a voxel set.
+    pub distances: Option<(DistanceGrid, f32)>,
 }
 
 /// Output formats by extension; `-` is standard output (as `.vdb`).
@@ -84,6 +88,7 @@ impl Outcome {
                 .map(|(k, v)| (k.to_string(), v))
                 .collect(),
             report,
+            distances: None,
         }
     }
 
@@ -109,26 +114,28 @@ impl Outcome {
             .collect();
         let extra: Vec<(&str, &SparseGrid)> =
             self.extra.iter().map(|(n, g)| (n.as_str(), g)).collect();
+        let write = |file: &Path| match self.distances {
+            Some((kind, background)) => {
+                write_distance_band(file, &self.grid, background, kind, &meta)
+            }
+            None => write_vdb_with_masks(file, &self.grid, &extra, &meta),
+        };
         if path == Path::new("-") {
-            write_to_stdout(&self.grid, &extra, &meta)?;
+            write_to_stdout(write)?;
         } else {
-            crate::io::vdb::write_vdb_with_masks(path, &self.grid, &extra, &meta)?;
+            write(path)?;
         }
         self.report.output = Some(path.display().to_string());
         Ok(())
     }
 }
 
-/// OpenVDB writes to files: write a private temporary file, then copy it to stdout.
-fn write_to_stdout(
-    grid: &SparseGrid,
-    extra: &[(&str, &SparseGrid)],
-    meta: &[(&str, String)],
-) -> Result<()> {
+/// OpenVDB writes to files: `write` a private temporary file, then copy it to stdout.
+fn write_to_stdout(write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     let dir = std::env::temp_dir().join(format!("voxelkit-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
     let file = dir.join("stdout.vdb");
-    let result = crate::io::vdb::write_vdb_with_masks(&file, grid, extra, meta).and_then(|()| {
+    let result = write(&file).and_then(|()| {
         let mut bytes = std::fs::File::open(&file).map_err(|e| Error::io(&file, e))?;
         let mut out = std::io::stdout().lock();
         std::io::copy(&mut bytes, &mut out)

@@ -52,6 +52,7 @@ pub enum Details {
     Subdivision(SubdivisionDetails),
     Implicit(ImplicitDetails),
     Solid(SolidDetails),
+    DistanceBand(DistanceBandDetails),
     DepthLayers(DepthLayerDetails),
     Csg(CsgDetails),
 }
@@ -112,6 +113,16 @@ pub struct ImplicitDetails {
     /// Levels written with `levels` (0 when only the finest is kept).
     pub levels: u64,
     pub depth: u32,
+}
+
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct DistanceBandDetails {
+    /// Half width of the band in voxels; the background is band x voxel size.
+    pub band: f64,
+    pub signed: bool,
+    /// Band voxels whose centre is inside (negative values).
+    pub inside_band_voxels: u64,
+    pub background: f64,
 }
 
 #[derive(Serialize, Debug, Clone, Default)]
@@ -276,6 +287,15 @@ impl Report {
                 self.voxel_size
             ),
             Details::Solid(s) => solid_summary(place, s, &timing),
+            Details::DistanceBand(d) => format!(
+                "{place}: {} {} distances within {} voxels ({} inside), background {:.6}, voxel size {:.6}, {timing}",
+                self.voxels,
+                if d.signed { "signed" } else { "unsigned" },
+                d.band,
+                d.inside_band_voxels,
+                d.background,
+                self.voxel_size
+            ),
             Details::DepthLayers(d) => depth_layer_summary(place, &self.method, d, &timing),
             Details::Csg(c) => {
                 let mut t = format!(

@@ -1,14 +1,16 @@
-//! The solid tasks: fill a mesh (exterior flood, depth layers, beams), measure a mesh or a
-//! `.vdb` surface, evaluate a CSG tree; with volumes, mass, components and genus.
+//! The solid tasks: fill a mesh (exterior flood, depth layers, beams), its level set or
+//! distance band, measure a mesh or a `.vdb` surface, evaluate a CSG tree; with volumes,
+//! mass, components and genus.
 
 use super::Fill;
 use super::outcome::Outcome;
 use super::report::{
-    CsgDetails, CsgLeafCount, DepthLayerDetails, Details, DirectionCounts, FloodingXyzDetails,
-    SolidDetails,
+    CsgDetails, CsgLeafCount, DepthLayerDetails, Details, DirectionCounts, DistanceBandDetails,
+    FloodingXyzDetails, SolidDetails,
 };
 use crate::error::Result;
 use crate::grid::{Adjacency, Channels, DenseMask, SparseGrid, Transform};
+use crate::io::vdb::DistanceGrid;
 use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
 use crate::ops::topology::{components, euler_characteristic};
@@ -17,6 +19,7 @@ use crate::solids::beam::beam_solid;
 use crate::solids::csg_tree::CsgTree;
 use crate::solids::depth_layers::{Layers, depth_layer_solid};
 use crate::solids::exterior_flood::{FloodMethod, Solid, solid_from_surface};
+use crate::solids::level_set::{level_set, unsigned_distance};
 use crate::voxelize::Separability;
 use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 use std::time::Instant;
@@ -201,6 +204,56 @@ pub(super) fn mesh_solid(
             .with("unclassified", solid.unclassified.to_grid(t))
         }
     };
+    Ok(outcome.timed(start))
+}
+
+pub(super) fn distance_band(
+    mesh: &Mesh,
+    t: Transform,
+    band: f64,
+    signed: bool,
+    resolution: &str,
+    progress: &Progress,
+) -> Result<Outcome> {
+    let start = Instant::now();
+    let grid = if signed {
+        level_set(mesh, t, band, progress)?
+    } else {
+        unsigned_distance(mesh, t, band, progress)?
+    };
+    let inside_band_voxels = grid
+        .leaves()
+        .iter()
+        .map(|l| {
+            let values = l.value.as_ref().expect("distances");
+            l.offsets().filter(|&n| values[n] < 0.0).count() as u64
+        })
+        .sum();
+    let background = band * t.voxel_size;
+    let method = if signed {
+        "exact-signed-distance-band"
+    } else {
+        "exact-unsigned-distance-band"
+    };
+    let meta = vec![
+        ("method", method.to_string()),
+        ("source_file", mesh.source.display().to_string()),
+        ("resolution", resolution.to_string()),
+        ("band_voxels", band.to_string()),
+    ];
+    let details = DistanceBandDetails {
+        band,
+        signed,
+        inside_band_voxels,
+        background,
+    };
+    let mut outcome = Outcome::new(grid, meta, Details::DistanceBand(details));
+    let kind = if signed {
+        DistanceGrid::LevelSet
+    } else {
+        DistanceGrid::Unsigned
+    };
+    outcome.distances = Some((kind, background as f32));
     Ok(outcome.timed(start))
 }
 

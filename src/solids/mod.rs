@@ -8,3 +8,4 @@ pub mod csg_leaves;
 pub mod csg_tree;
 pub mod depth_layers;
 pub mod exterior_flood;
+pub mod level_set;

@@ -89,6 +89,46 @@ pub enum ShapeKind {
     },
 }
 
+/// A narrow band of exact distances instead of a voxel set.
+#[derive(Args, Clone, Copy)]
+pub struct DistanceArgs {
+    /// Write a level set instead: exact signed distances (world units, negative inside) on
+    /// every voxel within --band of the mesh, as a FloatGrid of class LEVEL_SET named
+    /// `surface` (Houdini's name) after its fog volume `density`; closed meshes only (the
+    /// sign comes from ray parity, so face orientation does not matter).
+    #[arg(long)]
+    pub sdf: bool,
+    /// Write unsigned distances within --band (a FloatGrid `distance`); open meshes too.
+    #[arg(long, conflicts_with = "sdf")]
+    pub udf: bool,
+    /// Half width of the distance band, in voxels (the background is band x voxel size).
+    #[arg(long, default_value_t = 3.0, value_name = "W")]
+    pub band: f64,
+}
+
+impl DistanceArgs {
+    pub fn given(&self) -> bool {
+        self.sdf || self.udf
+    }
+}
+
+/// `mesh --sdf | --udf` and `solid --sdf`: the distance band of a mesh file.
+pub fn distances(
+    input: &Path,
+    band: f64,
+    signed: bool,
+    fit: FitArgs,
+    output: &Path,
+    global: &Global,
+) -> Result<()> {
+    let task = Task::DistanceBand {
+        mesh: MeshSource::File(input.to_path_buf()),
+        band,
+        signed,
+    };
+    run_and_report(Job::new(task, fit.grid_fit()), output, global)
+}
+
 impl SurfaceArgs {
     pub fn separating(&self) -> SeparatingOptions {
         SeparatingOptions {

@@ -101,6 +101,8 @@ enum Command {
         #[command(flatten)]
         color: projective::ColorArgs,
         #[command(flatten)]
+        distance: commands::DistanceArgs,
+        #[command(flatten)]
         args: commands::VoxelizeArgs,
     },
     /// Voxelize 3D polylines (OBJ `l`) or the edges of a mesh by marching each segment's
@@ -173,6 +175,19 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Mesh {
+            input,
+            distance,
+            args,
+            ..
+        } if distance.given() => commands::distances(
+            &input,
+            distance.band,
+            distance.sdf,
+            args.fit,
+            &args.output,
+            &global,
+        ),
+        Command::Mesh {
             method: MeshMethod::Separating,
             color,
             ..
@@ -190,6 +205,7 @@ fn main() -> ExitCode {
             method: MeshMethod::Projective,
             color,
             args,
+            ..
         } => projective::mesh(&input, args.fit, &color, &args.output, &global),
         Command::Lines(args) => projective::lines(&args, &global),
         Command::Shape { shape } => commands::shape(&shape, &global),

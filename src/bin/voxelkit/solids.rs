@@ -75,6 +75,13 @@ pub struct SolidArgs {
     pub fill: FillArgs,
     #[command(flatten)]
     pub depth: crate::solid_depth::DepthArgs,
+    /// Write the solid as a level set instead (as `mesh --sdf`): exact signed distances
+    /// within --band, class LEVEL_SET, named `surface`, after its fog volume `density`.
+    #[arg(long)]
+    pub sdf: bool,
+    /// Half width of the --sdf band, in voxels.
+    #[arg(long, default_value_t = 3.0, value_name = "W")]
+    pub band: f64,
     /// Output .vdb: `surface` and `density` (1 on the whole solid), `boundary` (its outer
     /// voxels) and `interior`; depth layers add `unclassified`.
     #[arg(short, long)]
@@ -134,6 +141,10 @@ fn parse_op(s: &str) -> std::result::Result<BooleanOp, String> {
 }
 
 pub fn solid(args: &SolidArgs, global: &Global) -> Result<()> {
+    if args.sdf {
+        let fit = args.fill.fit;
+        return crate::commands::distances(&args.input, args.band, true, fit, &args.output, global);
+    }
     let fill = match args.method {
         SolidMethod::Flood => Fill::Flood(args.fill.flood.method()),
         SolidMethod::DepthLayers => Fill::DepthLayers(args.depth.options()),
