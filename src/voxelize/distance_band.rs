@@ -86,21 +86,29 @@ pub fn distance_band(
 fn triangle_band(a: DVec3, b: DVec3, c: DVec3, band: f64, sink: &mut Sink) {
     let lo = (a.min(b).min(c) - band).ceil().as_i64vec3();
     let hi = (a.max(b).max(c) + band).floor().as_i64vec3();
-    let normal = (b - a).cross(c - a);
-    let unit = normal.try_normalize();
+    let unit = (b - a).cross(c - a).try_normalize();
+    // Every point of the triangle lies within `radius` of its centroid: a voxel farther than
+    // band + radius from the centroid, or than the band from its plane, is out of the band.
+    let centroid = (a + b + c) / 3.0;
+    let radius = centroid
+        .distance_squared(a)
+        .max(centroid.distance_squared(b))
+        .max(centroid.distance_squared(c))
+        .sqrt();
+    let reach = (band + radius) * (band + radius);
+    let band2 = band * band;
     for x in lo.x..=hi.x {
         for y in lo.y..=hi.y {
             for z in lo.z..=hi.z {
                 let p = DVec3::new(x as f64, y as f64, z as f64);
-                // Farther from the plane than the band: farther from the triangle too.
-                if let Some(n) = unit
-                    && (p - a).dot(n).abs() > band
+                if p.distance_squared(centroid) > reach
+                    || unit.is_some_and(|n| (p - a).dot(n).abs() > band)
                 {
                     continue;
                 }
-                let d = p.distance(closest_point_on_triangle(p, a, b, c));
-                if d <= band {
-                    sink.add_distance([x, y, z], d);
+                let d2 = p.distance_squared(closest_point_on_triangle(p, a, b, c));
+                if d2 <= band2 {
+                    sink.add_distance([x, y, z], d2.sqrt());
                 }
             }
         }

@@ -51,6 +51,9 @@ enum BenchKind {
     /// The projective voxelizer in triangles/s and lines/s against the separating one;
     /// with --leaks, voxel counts and flood leaks of both.
     Projective(crate::bench_projective::ProjectiveBenchArgs),
+    /// Level sets: `voxelkit mesh --sdf` (the whole process) against OpenVDB's
+    /// meshToLevelSet with the same band.
+    Levelset(crate::bench_level_set::LevelSetBenchArgs),
 }
 
 /// A pool of `threads` workers for one side of a comparison.
@@ -99,6 +102,7 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
         Some(BenchKind::Solid(solid)) => return crate::bench_solid::run(solid, json),
         Some(BenchKind::Measure(m)) => return crate::bench_measure::run(m, json),
         Some(BenchKind::Projective(p)) => return crate::bench_projective::run(p, json),
+        Some(BenchKind::Levelset(l)) => return crate::bench_level_set::run(l, json),
         None => {}
     }
     let data = data_folder(&args.data);

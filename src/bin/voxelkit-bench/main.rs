@@ -4,6 +4,7 @@
 
 mod bench;
 mod bench_implicit;
+mod bench_level_set;
 mod bench_measure;
 mod bench_projective;
 mod bench_solid;
