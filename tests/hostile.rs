@@ -159,3 +159,47 @@ fn a_voxel_size_whose_cube_overflows_is_refused() {
         "{msg}"
     );
 }
+
+#[test]
+fn damaged_vdb_files_are_refused_plainly_and_huge_tiles_before_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("sphere.vdb");
+    let made = voxelkit(&["shape", "sphere", "-r", "48", "-o", good.to_str().unwrap()]);
+    assert!(made.status.success(), "{}", text(&made));
+    let bytes = std::fs::read(&good).unwrap();
+    for (name, cut) in [
+        ("half.vdb", bytes.len() / 2),
+        ("head.vdb", 200),
+        ("empty.vdb", 0),
+    ] {
+        let damaged = dir.path().join(name);
+        std::fs::write(&damaged, &bytes[..cut]).unwrap();
+        for args in [vec!["info"], vec!["measure"]] {
+            let mut args = args.clone();
+            args.push(damaged.to_str().unwrap());
+            let o = voxelkit(&args);
+            let msg = text(&o);
+            assert!(!o.status.success(), "{name} {args:?}: {msg}");
+            assert!(msg.contains(name) && msg.len() < 1000, "{name}: {msg}");
+            assert!(!msg.contains("panicked"), "{msg}");
+        }
+    }
+    // One active tile of 4096^3 voxels in a 545-byte file: refused by the memory plan.
+    let tile = dir.path().join("tile.vdb");
+    let script = "import sys, pyopenvdb as vdb\n\
+                  g = vdb.BoolGrid()\n\
+                  g.fill((0, 0, 0), (4095, 4095, 4095), True, True)\n\
+                  g.name = 'surface'\n\
+                  vdb.write(sys.argv[1], grids=[g])\n";
+    if cli_support::run_pyopenvdb(script, &tile, "the huge-tile file").is_none() {
+        return;
+    }
+    let start = std::time::Instant::now();
+    let o = voxelkit(&["measure", tile.to_str().unwrap()]);
+    let msg = text(&o);
+    assert!(
+        !o.status.success() && msg.contains("68719476736 active voxels"),
+        "{msg}"
+    );
+    assert!(start.elapsed() < std::time::Duration::from_secs(2), "{msg}");
+}

@@ -227,7 +227,25 @@ fn open(path: &Path) -> Result<cxx::UniquePtr<bridge::VdbFile>> {
     let p = path
         .to_str()
         .ok_or_else(|| vdb_error(path, "path is not UTF-8"))?;
-    bridge::open_vdb(p).map_err(|e| vdb_error(path, e))
+    bridge::open_vdb(p).map_err(|e| unreadable(path, e))
+}
+
+/// A file OpenVDB cannot read: say so plainly, with OpenVDB's own words cut short (a damaged
+/// file can make them very long).
+fn unreadable(path: &Path, e: impl std::fmt::Display) -> Error {
+    let mut detail = e.to_string();
+    if detail.len() > 300 {
+        let cut = (0..=300)
+            .rev()
+            .find(|&i| detail.is_char_boundary(i))
+            .unwrap_or(0);
+        detail.truncate(cut);
+        detail.push_str("...");
+    }
+    vdb_error(
+        path,
+        format!("cannot read it: not a .vdb file, or a damaged or truncated one ({detail})"),
+    )
 }
 
 /// Describes every grid in the file.
@@ -263,9 +281,29 @@ pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
             ),
         ));
     }
+    // Tiles are expanded into leaves: plan that before OpenVDB allocates anything.
+    let leaves = info
+        .active_voxels
+        .div_ceil(LEAF_VOXELS as u64)
+        .max(info.leaf_count);
+    let per_leaf = if info.value_type == "float" {
+        3 * 4 * LEAF_VOXELS
+    } else {
+        400
+    } as u64;
+    crate::system::check_fits(
+        leaves.saturating_mul(per_leaf),
+        None,
+        &format!(
+            "{}: grid `{}` holds {} active voxels",
+            path.display(),
+            info.name,
+            info.active_voxels
+        ),
+    )?;
     let (mut origins, mut masks, mut values) = (Vec::new(), Vec::new(), Vec::new());
     file.read_leaves(index, &mut origins, &mut masks, &mut values)
-        .map_err(|e| vdb_error(path, e))?;
+        .map_err(|e| unreadable(path, e))?;
     let has_values = !values.is_empty();
     let channels = Channels {
         value: has_values,
