@@ -203,3 +203,54 @@ fn damaged_vdb_files_are_refused_plainly_and_huge_tiles_before_allocating() {
     );
     assert!(start.elapsed() < std::time::Duration::from_secs(2), "{msg}");
 }
+
+#[test]
+fn huge_faces_and_valences_of_control_meshes_are_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let ngon = dir.path().join("ngon.obj");
+    let mut s = String::new();
+    for k in 0..3000 {
+        let a = std::f64::consts::TAU * k as f64 / 3000.0;
+        s.push_str(&format!("v {} {} 0\n", a.cos(), a.sin()));
+    }
+    s.push_str(&format!(
+        "f {}\n",
+        (1..=3000)
+            .map(|k| k.to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    ));
+    std::fs::write(&ngon, s).unwrap();
+    let repeated = dir.path().join("repeated.obj");
+    let corners: Vec<String> = (0..1_000_000).map(|k| (k % 4 + 1).to_string()).collect();
+    std::fs::write(
+        &repeated,
+        format!(
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf {}\n",
+            corners.join(" ")
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out.vdb");
+    for args in [
+        vec![
+            "subdiv",
+            ngon.to_str().unwrap(),
+            "-r",
+            "64",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        vec!["subdiv", "check", repeated.to_str().unwrap()],
+    ] {
+        let start = std::time::Instant::now();
+        let o = voxelkit(&args);
+        let msg = text(&o);
+        assert!(!o.status.success() && msg.contains("corners"), "{msg}");
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(3),
+            "{args:?}"
+        );
+    }
+    assert!(!out.exists());
+}

@@ -30,6 +30,9 @@ pub struct ControlStats {
     pub max_valence: usize,
 }
 
+/// Most corners of a face, and most faces at a vertex, of a control mesh.
+pub const MAX_CORNERS: usize = 256;
+
 impl ControlMesh {
     /// Loads an OBJ control mesh (tags such as creases are not read).
     pub fn load(path: &Path) -> Result<ControlMesh> {
@@ -47,12 +50,38 @@ impl ControlMesh {
             message,
         };
         let faces: Vec<&[u32]> = (0..mesh.face_count()).map(|f| mesh.face(f)).collect();
+        let mut valence = vec![0usize; mesh.positions.len()];
         for (f, face) in faces.iter().enumerate() {
-            for (k, v) in face.iter().enumerate() {
-                if face[k + 1..].contains(v) {
+            if face.len() > MAX_CORNERS {
+                return Err(bad_face(
+                    f,
+                    format!(
+                        "has {} corners; faces of at most {MAX_CORNERS} are subdivided (each of \
+                         a face's patches keeps the whole face around it, so memory grows with \
+                         the square of its size)",
+                        face.len()
+                    ),
+                ));
+            }
+            let mut sorted = face.to_vec();
+            sorted.sort_unstable();
+            if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+                return Err(bad_face(
+                    f,
+                    format!("uses vertex {} twice (degenerate face)", w[0] + 1),
+                ));
+            }
+            for &v in face.iter() {
+                valence[v as usize] += 1;
+                if valence[v as usize] > MAX_CORNERS {
                     return Err(bad_face(
                         f,
-                        format!("uses vertex {} twice (degenerate face)", v + 1),
+                        format!(
+                            "makes vertex {} shared by more than {MAX_CORNERS} faces; the \
+                             patches around a vertex keep all its neighbours, so memory grows \
+                             with the square of its valence",
+                            v + 1
+                        ),
                     ));
                 }
             }
