@@ -254,3 +254,34 @@ fn huge_faces_and_valences_of_control_meshes_are_refused_at_once() {
     }
     assert!(!out.exists());
 }
+
+#[test]
+fn a_formula_zero_everywhere_stops_at_the_memory_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("zero.vdb");
+    let o = voxelkit(&[
+        "implicit",
+        "0*x",
+        "-r",
+        "256",
+        "--max-memory",
+        "300",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let msg = text(&o);
+    assert!(!o.status.success() && msg.contains("leaves"), "{msg}");
+    assert!(!out.exists());
+    // A real surface at the same settings fits.
+    let sphere = voxelkit(&[
+        "implicit",
+        "x^2 + y^2 + z^2 - 0.5",
+        "-r",
+        "256",
+        "--max-memory",
+        "300",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(sphere.status.success(), "{}", text(&sphere));
+}

@@ -504,6 +504,7 @@ impl PlannedJob {
                     resolution: estimate::octree_resolution(self.job.fit, *min, *max)?,
                     both_signs: *negative_r,
                     levels: *levels,
+                    max_leaves: Some(estimate::leaf_budget(self.job.limits.max_memory, 1)),
                 };
                 outcome::implicit(formula, text, *min, *max, &options, progress)
             }

@@ -15,6 +15,7 @@ use crate::grid::{Channels, Coord, SparseGrid, Transform};
 use crate::implicit::{BoxTest, Dual, Formula, Interval, test_box};
 use glam::DVec3;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Extra halvings of a finest-level cell that contains the axis.
 const AXIS_DEPTH: u32 = 4;
@@ -28,6 +29,10 @@ pub struct OctreeOptions {
     pub both_signs: bool,
     /// Keep every level of the octree, not only the finest.
     pub levels: bool,
+    /// Stop with `Error::TooLarge` once the surface holds more 8^3 leaves than this: how much
+    /// of its box a formula's surface fills is only known while it is voxelized (`0*x` is zero
+    /// everywhere).
+    pub max_leaves: Option<u64>,
 }
 
 impl Default for OctreeOptions {
@@ -36,6 +41,7 @@ impl Default for OctreeOptions {
             resolution: 256,
             both_signs: false,
             levels: false,
+            max_leaves: None,
         }
     }
 }
@@ -102,14 +108,19 @@ pub fn voxelize_implicit(
         frontier = next;
     }
     progress.advance(8u64.pow(top_level) - frontier.len() as u64);
+    let leaves = AtomicU64::new(top.surface.leaf_count() as u64);
+    let budget = options.max_leaves.unwrap_or(u64::MAX);
     let parts = frontier
         .par_iter()
         .fold(
             || Partial::new(&run),
             |mut part, &(level, c)| {
-                // Once cancelled, the remaining subtrees are skipped.
-                if !progress.stopped() {
+                // Once cancelled or over the budget, the remaining subtrees are skipped.
+                if !progress.stopped() && leaves.load(Ordering::Relaxed) <= budget {
+                    let before = part.surface.leaf_count() as u64;
                     run.descend(level, c, &mut part);
+                    let added = part.surface.leaf_count() as u64 - before;
+                    leaves.fetch_add(added, Ordering::Relaxed);
                     progress.advance(1);
                 }
                 part
@@ -117,6 +128,20 @@ pub fn voxelize_implicit(
         )
         .reduce(|| Partial::new(&run), Partial::merge);
     progress.check()?;
+    let leaves = leaves.into_inner();
+    if leaves > budget {
+        // The budget is what the memory allows: the surface so far needs that in proportion.
+        let available_mib = crate::system::available_memory_bytes().unwrap_or(0) >> 20;
+        return Err(Error::TooLarge {
+            estimated_mib: (available_mib as f64 * leaves as f64 / budget.max(1) as f64) as u64,
+            available_mib,
+            detail: format!(
+                "the surface filled {leaves} leaves of 8^3 voxels before it was stopped, more \
+                 than the memory allows ({budget}); the formula is zero on much of the box: \
+                 lower the resolution or raise the memory limit"
+            ),
+        });
+    }
     let mut all = top.merge(parts);
     all.stats.depth = depth;
     all.stats.voxels = all.surface.voxel_count();

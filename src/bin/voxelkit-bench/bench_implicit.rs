@@ -71,6 +71,7 @@ pub fn run(args: &ImplicitBenchArgs, json: bool) -> Result<()> {
                 resolution: res,
                 both_signs: args.negative_r,
                 levels: false,
+                ..Default::default()
             };
             let (seconds, out) = pool.install(|| {
                 best_of(args.repeat, || {
