@@ -265,7 +265,7 @@ fn a_formula_zero_everywhere_stops_at_the_memory_limit() {
         "-r",
         "256",
         "--max-memory",
-        "300",
+        "400",
         "-o",
         out.to_str().unwrap(),
     ]);
@@ -279,7 +279,7 @@ fn a_formula_zero_everywhere_stops_at_the_memory_limit() {
         "-r",
         "256",
         "--max-memory",
-        "300",
+        "400",
         "-o",
         out.to_str().unwrap(),
     ]);
