@@ -17,7 +17,14 @@ use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 
 fn solid(mesh: &Mesh, t: &Transform, directions: usize, layers: Layers) -> DepthLayerSolid {
     let bbox = index_box(&mesh.bbox(), t);
-    depth_layer_solid(mesh, t, bbox, &DepthLayerOptions { directions, layers }).unwrap()
+    depth_layer_solid(
+        mesh,
+        t,
+        bbox,
+        &DepthLayerOptions { directions, layers },
+        &voxelkit::progress::Progress::none(),
+    )
+    .unwrap()
 }
 
 fn surface(mesh: &Mesh, t: Transform) -> SparseGrid {

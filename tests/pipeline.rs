@@ -190,10 +190,6 @@ fn a_break_half_way_cancels_promptly_without_unwinding() {
     let dir = tempfile::tempdir().unwrap();
     let (torus, cube, _) = fixtures(dir.path());
     for (name, task) in tasks(&torus, &cube) {
-        // Depth layers and measuring a given surface report once, at the end.
-        if name == "solid depth layers" {
-            continue;
-        }
         let fit = if name == "implicit" || name == "shape" {
             GridFit::Resolution(512)
         } else {

@@ -243,7 +243,9 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             let surface = area_in_voxels(&mesh, &t);
             let (masks, items) = match fill {
                 super::Fill::Flood(_) => (6, separating::work_items(&mesh)),
-                super::Fill::DepthLayers(_) => (6, 1),
+                super::Fill::DepthLayers(o) => {
+                    (6, o.directions as u64 + (b.max[0] - b.min[0] + 1) as u64)
+                }
                 super::Fill::Beam => (5, mesh.face_count() as u64),
             };
             let bytes = surface_bytes(surface, 0) + solid_bytes(cells(&padded(b, 2)), masks);

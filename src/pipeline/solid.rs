@@ -156,8 +156,8 @@ pub(super) fn mesh_solid(
         }
         Fill::DepthLayers(options) => {
             let edges = mesh.edge_counts();
-            let solid = depth_layer_solid(mesh, &t, index_box(&mesh.bbox(), &t), &options)?;
-            progress.advance(1);
+            let region = index_box(&mesh.bbox(), &t);
+            let solid = depth_layer_solid(mesh, &t, region, &options, progress)?;
             let s = &solid.stats;
             let cell = t.voxel_size.powi(3);
             let volume = s.inside_voxels as f64 * cell;

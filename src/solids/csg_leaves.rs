@@ -8,6 +8,7 @@ use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
 use crate::implicit::{Formula, to_coordinates};
 use crate::mesh::{Aabb, Mesh, index_box};
 use crate::ops::csg::{resample, same_transform};
+use crate::progress::Progress;
 use crate::shapes::{Cuboid, Cylinder, Sphere};
 use crate::solids::depth_layers::{DepthLayerOptions, Layers, depth_layer_solid};
 use glam::DVec3;
@@ -132,7 +133,7 @@ pub fn mesh_solid(
     options: &DepthLayerOptions,
 ) -> Result<DenseMask> {
     mesh.require_closed("a solid must be closed")?;
-    let s = depth_layer_solid(mesh, transform, bbox, options)?;
+    let s = depth_layer_solid(mesh, transform, bbox, options, &Progress::none())?;
     if s.stats.unclassified_voxels > 0 {
         return Err(Error::InvalidArgument(format!(
             "{}: {} voxels cannot be classified by depth layers (crossed more than four times \

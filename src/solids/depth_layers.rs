@@ -27,6 +27,7 @@ use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, Transform};
 use crate::mesh::Mesh;
 use crate::mesh::crossings::{RayWindow, for_each_crossing};
+use crate::progress::Progress;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -332,12 +333,14 @@ fn push_voxel(runs: &mut Vec<(usize, usize)>, index: usize) {
 }
 
 /// The solid of `mesh` on `transform` over `bbox`: depth buffers from `options.directions`
-/// directions, classified with single or double layers.
+/// directions, classified with single or double layers; `progress` counts the directions
+/// rendered, then the x slabs classified.
 pub fn depth_layer_solid(
     mesh: &Mesh,
     transform: &Transform,
     bbox: CoordBox,
     options: &DepthLayerOptions,
+    progress: &Progress,
 ) -> Result<DepthLayerSolid> {
     if !(3..=DIRECTIONS.len()).contains(&options.directions) {
         return Err(Error::InvalidArgument(format!(
@@ -357,8 +360,13 @@ pub fn depth_layer_solid(
         .collect();
     let views = DIRECTIONS[..options.directions]
         .par_iter()
-        .map(|&d| View::render(d, dims, &points, mesh))
+        .map(|&d| {
+            let view = View::render(d, dims, &points, mesh);
+            progress.advance(1);
+            view
+        })
         .collect::<Result<Vec<View>>>()?;
+    progress.check()?;
     let per_direction: Vec<RayCounts> = views.iter().map(View::counts).collect();
     let open_input = per_direction.iter().any(|c| c.odd > 0);
     let [_, ny, nz] = dims;
@@ -367,6 +375,11 @@ pub fn depth_layer_solid(
         .into_par_iter()
         .map(|x| {
             let (mut ins, mut unc, mut open) = (Vec::new(), Vec::new(), 0);
+            // Once cancelled, the remaining slabs are skipped (the call then fails).
+            if progress.stopped() {
+                return (ins, unc, open);
+            }
+            progress.advance(1);
             for y in 0..ny {
                 let row = (x * ny + y) * nz;
                 let (ray, _) = z_view.voxel_ray([x as i64, y as i64, 0]);
@@ -406,6 +419,7 @@ pub fn depth_layer_solid(
             (ins, unc, open)
         })
         .collect();
+    progress.check()?;
     let mut open_voxels = 0;
     for (ins, unc, open) in slabs {
         for (a, b) in ins {

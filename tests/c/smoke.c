@@ -168,8 +168,11 @@ int main(int argc, char **argv) {
     CHECK(vk_voxelize_subdivision(box, opts, &g) == VK_ERROR_CANCELLED && g == NULL);
     CHECK(vk_voxelize_formula("x^2 + y^2 + z^2 - 0.5", VK_CARTESIAN, lo, hi, opts, &g) ==
           VK_ERROR_CANCELLED && g == NULL);
+    for (int method = VK_FILL_FLOOD; method <= VK_FILL_BEAM; method++) {
+        OK(vk_options_set_fill_method(opts, (vk_fill_method)method));
+        CHECK(vk_fill_mesh(mesh, opts, &g, NULL) == VK_ERROR_CANCELLED && g == NULL);
+    }
     OK(vk_options_set_fill_method(opts, VK_FILL_FLOOD));
-    CHECK(vk_fill_mesh(mesh, opts, &g, NULL) == VK_ERROR_CANCELLED && g == NULL);
     CHECK(reached > 0);
     OK(vk_options_set_progress(opts, NULL, NULL));
 

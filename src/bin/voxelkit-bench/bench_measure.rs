@@ -86,8 +86,15 @@ pub fn run(args: &MeasureBenchArgs, json: bool) -> Result<()> {
                 directions: 16,
                 ..Default::default()
             };
-            let s = pool
-                .install(|| depth_layer_solid(&mesh, &t, index_box(&mesh.bbox(), &t), &options))?;
+            let s = pool.install(|| {
+                depth_layer_solid(
+                    &mesh,
+                    &t,
+                    index_box(&mesh.bbox(), &t),
+                    &options,
+                    &voxelkit::progress::Progress::none(),
+                )
+            })?;
             let volume = s.stats.inside_voxels as f64 * t.voxel_size.powi(3);
             let error = (volume - exact) / exact;
             if json {
