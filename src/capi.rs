@@ -586,7 +586,8 @@ pub extern "C" fn vk_mesh_from_triangles(
         let t = slice(triangles, corners, "triangles")?;
         let points: Vec<DVec3> = p.chunks_exact(3).map(DVec3::from_slice).collect();
         let polygons: Vec<Vec<u32>> = t.chunks_exact(3).map(|c| c.to_vec()).collect();
-        let mesh = Mesh::from_polygons("vk_mesh_from_triangles", points, &polygons);
+        let mut mesh = Mesh::from_polygons("vk_mesh_from_triangles", points, &polygons);
+        mesh.numbered_from_zero = true;
         mesh.validate()?;
         hand_out(VkMesh(mesh), Kind::Mesh, out)
     })

@@ -285,3 +285,23 @@ fn a_formula_zero_everywhere_stops_at_the_memory_limit() {
     ]);
     assert!(sphere.status.success(), "{}", text(&sphere));
 }
+
+#[test]
+fn a_formula_at_resolution_one_is_one_voxel() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("one.vdb");
+    let o = voxelkit(&[
+        "--json",
+        "implicit",
+        "x^2 + y^2 + z^2 - 0.5",
+        "-r",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(
+        json_field(&String::from_utf8_lossy(&o.stdout), "voxels"),
+        1.0
+    );
+}

@@ -11,8 +11,8 @@ use rustc_hash::FxHashMap;
 pub struct EdgeCounts {
     pub boundary: u64,
     pub non_manifold: u64,
-    pub first_boundary: Option<[u32; 2]>,
-    pub first_non_manifold: Option<[u32; 2]>,
+    pub first_boundary: Option<[u64; 2]>,
+    pub first_non_manifold: Option<[u64; 2]>,
 }
 
 impl EdgeCounts {
@@ -35,7 +35,7 @@ impl Mesh {
         let mut edges: Vec<_> = uses.into_iter().collect();
         edges.sort_unstable();
         for ((a, b), n) in edges {
-            let edge = Some([a + 1, b + 1]);
+            let edge = Some([a, b].map(|v| self.vertex_number(v)));
             if n == 1 {
                 counts.boundary += 1;
                 counts.first_boundary = counts.first_boundary.or(edge);
@@ -51,7 +51,7 @@ impl Mesh {
     /// `why` says what needs it closed.
     pub fn require_closed(&self, why: &str) -> Result<()> {
         let c = self.edge_counts();
-        let edge = |e: Option<[u32; 2]>| e.map_or(String::new(), |[a, b]| format!("{a}-{b}"));
+        let edge = |e: Option<[u64; 2]>| e.map_or(String::new(), |[a, b]| format!("{a}-{b}"));
         if c.boundary > 0 {
             return Err(Error::InvalidArgument(format!(
                 "{}: the mesh is open: {} boundary edge(s), the first between vertices {}; {why}",

@@ -31,6 +31,9 @@ pub struct Mesh {
     pub colors: Vec<Vec3>,
     /// Polylines (OBJ `l`), as vertex indices.
     pub polylines: Vec<Vec<u32>>,
+    /// Vertices are numbered from 0 in messages (arrays from C or Python) instead of from 1
+    /// (files, as OBJ numbers them).
+    pub numbered_from_zero: bool,
 }
 
 /// Axis-aligned bounding box in world space.
@@ -107,6 +110,11 @@ impl Mesh {
         Ok(mesh)
     }
 
+    /// Vertex `i` as messages number it: from 1 in files, from 0 in arrays.
+    pub fn vertex_number(&self, i: u32) -> u64 {
+        u64::from(i) + u64::from(!self.numbered_from_zero)
+    }
+
     pub fn face_count(&self) -> usize {
         self.face_starts.len().saturating_sub(1)
     }
@@ -145,7 +153,7 @@ impl Mesh {
             return Err(Error::InvalidArgument(format!(
                 "{}: vertex {} has a non-finite coordinate {:?}",
                 self.source.display(),
-                v + 1,
+                self.vertex_number(v as u32),
                 self.positions[v]
             )));
         }
@@ -166,7 +174,7 @@ impl Mesh {
                     f,
                     format!(
                         "vertex index {} is out of range (the mesh has {n} vertices)",
-                        i + 1
+                        self.vertex_number(i)
                     ),
                 ));
             }

@@ -68,7 +68,10 @@ impl ControlMesh {
             if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
                 return Err(bad_face(
                     f,
-                    format!("uses vertex {} twice (degenerate face)", w[0] + 1),
+                    format!(
+                        "uses vertex {} twice (degenerate face)",
+                        mesh.vertex_number(w[0])
+                    ),
                 ));
             }
             for &v in face.iter() {
@@ -80,7 +83,7 @@ impl ControlMesh {
                             "makes vertex {} shared by more than {MAX_CORNERS} faces; the \
                              patches around a vertex keep all its neighbours, so memory grows \
                              with the square of its valence",
-                            v + 1
+                            mesh.vertex_number(v)
                         ),
                     ));
                 }
@@ -103,8 +106,8 @@ impl ControlMesh {
                      oriented: it is used by faces {} (a Catmull-Clark surface needs every \
                      edge shared by at most two faces, traversed in opposite directions)",
                     source.display(),
-                    a + 1,
-                    b + 1,
+                    mesh.vertex_number(a),
+                    mesh.vertex_number(b),
                     users.join(", ")
                 ))
             })?;
@@ -118,7 +121,7 @@ impl ControlMesh {
                 Error::Unsupported(format!(
                     "{}: vertex {} (at {:?}) {what}",
                     source.display(),
-                    v + 1,
+                    mesh.vertex_number(v as u32),
                     poly.points[v]
                 ))
             };

@@ -100,6 +100,10 @@ pub fn voxelize_implicit(
     let top_level = depth.min(TOP_LEVEL);
     let mut frontier = vec![(0u32, [0i64; 3])];
     let mut top = Partial::new(&run);
+    // At resolution 1 the root cell is the finest: it has no parent to test it.
+    if depth == 0 {
+        run.keep(0, [0; 3], &mut top);
+    }
     while frontier.first().is_some_and(|f| f.0 < top_level) {
         let mut next = Vec::new();
         for (level, c) in frontier {

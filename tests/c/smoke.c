@@ -147,6 +147,8 @@ int main(int argc, char **argv) {
     OK(vk_grid_free(g));
     CHECK(vk_voxelize_formula("x^2 +* y", VK_CARTESIAN, lo, hi, opts, &g) == VK_ERROR_PARSE);
     CHECK(strstr(vk_last_error(), "column") != NULL);
+    const double nan_lo[3] = {-1, 0.0 / 0.0, -1};
+    CHECK(vk_voxelize_formula("x", VK_CARTESIAN, nan_lo, hi, opts, &g) == VK_ERROR_INVALID_ARGUMENT);
 
     /* Cancellation: by the flag, and by the progress callback. */
     int32_t cancel = 1;
@@ -209,6 +211,8 @@ int main(int argc, char **argv) {
     static const uint32_t bad_t[] = {0, 1, 7};
     vk_mesh *bad = NULL;
     CHECK(vk_mesh_from_triangles(bad_p, 3, bad_t, 1, &bad) == VK_ERROR_BAD_MESH);
+    /* Arrays count vertices from 0, and so do the messages about them. */
+    CHECK(strstr(vk_last_error(), "vertex index 7 ") != NULL);
     CHECK(vk_mesh_from_triangles(NULL, 3, bad_t, 1, &bad) == VK_ERROR_INVALID_ARGUMENT);
     CHECK(bad == NULL);
     CHECK(vk_grid_write_vdb(surface, "/no/such/dir/out.vdb") != VK_OK);
