@@ -43,6 +43,22 @@ fn all_floods_agree_on_random_volumes() {
         for &s in &seeds {
             seed_mask.set(s);
         }
+        // From the border, for every adjacency: spans against the plain flood.
+        let mut border = DenseMask::new(bbox).unwrap();
+        for i in 0..border.len() {
+            let c = border.coord(i);
+            if (0..3).any(|a| c[a] == bbox.min[a] || c[a] == bbox.max[a]) {
+                border.set_index(i);
+            }
+        }
+        for adjacency in [Adjacency::Six, Adjacency::Eighteen, Adjacency::TwentySix] {
+            let plain = flood(&blocked, &border, adjacency).unwrap();
+            let spans = flood_from_border(&blocked, adjacency).unwrap();
+            assert!(
+                same(&plain, &spans),
+                "round {round}: {adjacency:?} border flood differs"
+            );
+        }
         let reference = flood(&blocked, &seed_mask, Adjacency::Six).unwrap();
         let spans = flood_spans(&blocked, &seeds).unwrap();
         assert!(

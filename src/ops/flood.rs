@@ -5,19 +5,9 @@ use crate::grid::{Adjacency, CoordBox, DenseMask};
 
 /// Empty voxels (not in `blocked`) reachable from the border of `blocked.bbox` through
 /// `adjacency`-paths of empty voxels.
+/// (By z-row spans: no stack entry per voxel.)
 pub fn flood_from_border(blocked: &DenseMask, adjacency: Adjacency) -> Result<DenseMask> {
-    let mut seeds = DenseMask::new(blocked.bbox)?;
-    let [nx, ny, nz] = blocked.dims();
-    for x in 0..nx {
-        for y in 0..ny {
-            for z in 0..nz {
-                if x == 0 || y == 0 || z == 0 || x == nx - 1 || y == ny - 1 || z == nz - 1 {
-                    seeds.set_index((x * ny + y) * nz + z);
-                }
-            }
-        }
-    }
-    flood(blocked, &seeds, adjacency)
+    super::flood_spans::flood_spans_from_border(blocked, adjacency)
 }
 
 /// Empty voxels reachable from the empty voxels of `seeds` through `adjacency`-paths of

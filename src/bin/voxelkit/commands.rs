@@ -320,7 +320,25 @@ struct CheckReport {
 }
 
 pub fn check(input: &Path, fit: FitArgs, surface: SurfaceArgs, global: &Global) -> Result<()> {
-    let outcome = run_job(surface_job(input, fit, surface), None, global)?;
+    // The checks hold four bit volumes over the surface's box besides the surface itself.
+    let job = Job {
+        limits: global.limits(),
+        ..surface_job(input, fit, surface)
+    };
+    let plan = *job.clone().plan()?.plan();
+    let cells: f64 = plan.extent.iter().map(|e| e + 6.0).product();
+    voxelkit::system::check_fits(
+        plan.estimated_bytes + (4.0 * cells / 8.0) as u64,
+        global.limits().max_memory,
+        &format!(
+            "{} at {:.0}x{:.0}x{:.0} voxels, with the flood checks; lower the resolution",
+            input.display(),
+            plan.extent[0],
+            plan.extent[1],
+            plan.extent[2]
+        ),
+    )?;
+    let outcome = run_job(job, None, global)?;
     let mesh = voxelkit::mesh::Mesh::load(input)?;
     let grid = &outcome.grid;
     let adjacency = surface.separability.flood_adjacency();
