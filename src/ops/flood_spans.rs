@@ -61,27 +61,43 @@ fn flood_spans_into(
         Adjacency::Eighteen => (1, Some(0)),
         Adjacency::TwentySix => (1, Some(1)),
     };
-    let free = |reached: &DenseMask, i: usize| !blocked.get_index(i) && !reached.get_index(i);
+    // Walls (blocked or already reached) of row (x, y), 64 voxels at a time from z.
+    let walls = |reached: &DenseMask, x: i64, y: i64, z: usize, n: usize| {
+        blocked.row_bits(x, y, z, n) | reached.row_bits(x, y, z, n)
+    };
     let mut stack: Vec<usize> = seeds
         .iter()
         .filter(|&&s| blocked.bbox.contains(s))
         .map(|&s| blocked.index(s))
         .collect();
     while let Some(i) = stack.pop() {
-        if !free(reached, i) {
+        if blocked.get_index(i) || reached.get_index(i) {
             continue;
         }
-        // Grow to the run [first, last] along z.
         let row = i - i % nz;
-        let (mut first, mut last) = (i, i);
-        while first > row && free(reached, first - 1) {
-            first -= 1;
-        }
-        while last + 1 < row + nz && free(reached, last + 1) {
-            last += 1;
-        }
-        reached.set_index_range(first, last);
         let (x, y) = ((row / (ny * nz)) as i64, ((row / nz) % ny) as i64);
+        // Grow to the run [first, last] along z, a word at a time.
+        let mut last = i - row;
+        while last + 1 < nz {
+            let n = (nz - last - 1).min(64);
+            let w = walls(reached, x, y, last + 1, n);
+            if w != 0 {
+                last += w.trailing_zeros() as usize;
+                break;
+            }
+            last += n;
+        }
+        let mut first = i - row;
+        while first > 0 {
+            let n = first.min(64);
+            let w = walls(reached, x, y, first - n, n);
+            if w != 0 {
+                first -= n - 1 - (63 - w.leading_zeros() as usize);
+                break;
+            }
+            first -= n;
+        }
+        reached.set_index_range(row + first, row + last);
         for dx in -1i64..=1 {
             for dy in -1i64..=1 {
                 let reach = match (dx != 0, dy != 0) {
@@ -97,17 +113,21 @@ fn flood_spans_into(
                     continue;
                 }
                 let other = (ox as usize * ny + oy as usize) * nz;
-                let z0 = (first - row).saturating_sub(reach);
-                let z1 = (last - row + reach).min(nz - 1);
-                // One push per run of free voxels beside [z0, z1].
-                let mut in_run = false;
-                for z in z0..=z1 {
-                    let j = other + z;
-                    let f = free(reached, j);
-                    if f && !in_run {
-                        stack.push(j);
+                // One push per run of free voxels beside [z0, z1]: the first voxel of each.
+                let (z0, z1) = (first.saturating_sub(reach), (last + reach).min(nz - 1));
+                let mut z = z0;
+                let mut before_free = false;
+                while z <= z1 {
+                    let n = (z1 + 1 - z).min(64);
+                    let mask = if n == 64 { u64::MAX } else { (1u64 << n) - 1 };
+                    let free = !walls(reached, ox, oy, z, n) & mask;
+                    let mut starts = free & !((free << 1) | u64::from(before_free));
+                    while starts != 0 {
+                        stack.push(other + z + starts.trailing_zeros() as usize);
+                        starts &= starts - 1;
                     }
-                    in_run = f;
+                    before_free = free >> (n - 1) & 1 == 1;
+                    z += n;
                 }
             }
         }
