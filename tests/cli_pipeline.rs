@@ -183,3 +183,27 @@ fn outputs_are_vdb_files_or_standard_output() {
     // The summary went to stderr, leaving stdout to the file.
     assert!(String::from_utf8_lossy(&piped.stderr).contains("voxels"));
 }
+
+#[test]
+fn an_absurd_thread_count_is_clamped_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("tetra.obj");
+    std::fs::write(&obj, TETRA).unwrap();
+    let out = dir.path().join("out.vdb");
+    let o = voxelkit(&[
+        "--threads",
+        "1000000",
+        "mesh",
+        s(&obj),
+        "-r",
+        "8",
+        "-o",
+        s(&out),
+    ]);
+    let msg = text(&o);
+    assert!(o.status.success(), "{msg}");
+    assert!(
+        msg.contains("1000000 threads asked for; using 256"),
+        "{msg}"
+    );
+}
