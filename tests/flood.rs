@@ -60,7 +60,7 @@ fn all_floods_agree_on_random_volumes() {
             );
         }
         let reference = flood(&blocked, &seed_mask, Adjacency::Six).unwrap();
-        let spans = flood_spans(&blocked, &seeds).unwrap();
+        let spans = flood_spans(&blocked, &seeds, &voxelkit::progress::Progress::none()).unwrap();
         assert!(
             same(&reference, &spans),
             "round {round}: span flood differs"
@@ -125,7 +125,12 @@ fn seeds_from_normals_fill_the_inside_of_a_voxelized_solid() {
             choice.seed
         );
         let (xyz, stats) = flood_xyz(&blocked, &[choice.seed], 4096).unwrap();
-        let spans = flood_spans(&blocked, &[choice.seed]).unwrap();
+        let spans = flood_spans(
+            &blocked,
+            &[choice.seed],
+            &voxelkit::progress::Progress::none(),
+        )
+        .unwrap();
         assert!(same(&xyz, &spans));
         assert_eq!(
             xyz.count(),

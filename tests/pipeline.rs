@@ -220,3 +220,43 @@ fn a_break_half_way_cancels_promptly_without_unwinding() {
         eprintln!("{name}: whole run {whole:?}, cancelled half-way after {took:?}");
     }
 }
+
+/// Lets the surface finish and stops at the first poll of a later stage (the flood).
+struct StopWhenPolled;
+
+impl Observer for StopWhenPolled {
+    fn advance(&self, n: u64) -> ControlFlow<()> {
+        if n == 0 {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+}
+
+#[test]
+fn the_exterior_flood_stops_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let (torus, _, _) = fixtures(dir.path());
+    for measure in [false, true] {
+        let mesh = MeshSource::File(torus.clone());
+        let task = if measure {
+            Task::Measure {
+                source: MeasureSource::Mesh(mesh),
+                flood: FloodMethod::Spans,
+                density: 1.0,
+            }
+        } else {
+            Task::Solid {
+                mesh,
+                fill: Fill::Flood(FloodMethod::Spans),
+                density: 1.0,
+            }
+        };
+        let result = Job::new(task, GridFit::Resolution(256)).run(&StopWhenPolled);
+        assert!(
+            matches!(result, Err(Error::Cancelled)),
+            "measure: {measure}"
+        );
+    }
+}

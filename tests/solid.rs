@@ -32,7 +32,8 @@ fn flooded_solids_match_ray_parity_off_the_surface() {
             } else {
                 FloodMethod::Spans
             };
-            let solid = solid_from_surface(&surface, method).unwrap();
+            let solid = solid_from_surface(&surface, method, &voxelkit::progress::Progress::none())
+                .unwrap();
             let bbox = padded(surface.bbox().unwrap(), 2);
             let exact = inside_centres(&mesh, &surface.transform, bbox).unwrap();
             let mut wrong = 0u64;

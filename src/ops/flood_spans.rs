@@ -8,11 +8,14 @@
 
 use crate::error::Result;
 use crate::grid::{Adjacency, Coord, DenseMask};
+use crate::progress::Progress;
 
-/// Empty voxels 6-connected to the empty voxels among `seeds`.
-pub fn flood_spans(blocked: &DenseMask, seeds: &[Coord]) -> Result<DenseMask> {
+/// Empty voxels 6-connected to the empty voxels among `seeds`; stops with `Cancelled` when
+/// `progress`'s observer asks (it is asked every few thousand runs).
+pub fn flood_spans(blocked: &DenseMask, seeds: &[Coord], progress: &Progress) -> Result<DenseMask> {
     let mut reached = DenseMask::new(blocked.bbox)?;
-    flood_spans_into(blocked, seeds, Adjacency::Six, &mut reached);
+    flood_spans_into(blocked, seeds, Adjacency::Six, &mut reached, progress);
+    progress.check()?;
     Ok(reached)
 }
 
@@ -37,7 +40,7 @@ pub fn flood_spans_from_border(blocked: &DenseMask, adjacency: Adjacency) -> Res
                 let i = blocked.index(c);
                 if !blocked.get_index(i) && !reached.get_index(i) {
                     seeds.push(c);
-                    flood_spans_into(blocked, &seeds, adjacency, &mut reached);
+                    flood_spans_into(blocked, &seeds, adjacency, &mut reached, &Progress::none());
                     seeds.clear();
                 }
             }
@@ -52,6 +55,7 @@ fn flood_spans_into(
     seeds: &[Coord],
     adjacency: Adjacency,
     reached: &mut DenseMask,
+    progress: &Progress,
 ) {
     let [nx, ny, nz] = blocked.dims();
     // Side rows scanned one voxel beyond the run for 18 and 26; diagonal rows for 18 (along
@@ -70,9 +74,17 @@ fn flood_spans_into(
         .filter(|&&s| blocked.bbox.contains(s))
         .map(|&s| blocked.index(s))
         .collect();
+    let mut runs = 0u32;
     while let Some(i) = stack.pop() {
         if blocked.get_index(i) || reached.get_index(i) {
             continue;
+        }
+        runs = runs.wrapping_add(1);
+        if runs % 4096 == 0 {
+            progress.advance(0);
+            if progress.stopped() {
+                return;
+            }
         }
         let row = i - i % nz;
         let (x, y) = ((row / (ny * nz)) as i64, ((row / nz) % ny) as i64);

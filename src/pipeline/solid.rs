@@ -142,7 +142,7 @@ pub(super) fn mesh_solid(
     let outcome = match fill {
         Fill::Flood(flood) => {
             let surface = flood_surface(mesh, t, progress)?;
-            let solid = solid_from_surface(&surface, flood)?;
+            let solid = solid_from_surface(&surface, flood, progress)?;
             let details = solid_details(&surface, &solid, density, FLOOD_RULE, Some(mesh))?;
             let method = meta("huang-26-separating-surface+exterior-flood");
             surface_and_inside(surface, solid, method, details)
@@ -266,7 +266,7 @@ pub(super) fn measure_mesh(
 ) -> Result<Outcome> {
     let start = Instant::now();
     let surface = flood_surface(mesh, t, progress)?;
-    let solid = solid_from_surface(&surface, flood)?;
+    let solid = solid_from_surface(&surface, flood, progress)?;
     let mut details = solid_details(&surface, &solid, density, FLOOD_RULE, Some(mesh))?;
     details.mesh_area = Some(mesh.area());
     let meta = vec![
@@ -287,7 +287,7 @@ pub(super) fn measure_surface(
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
-    let solid = solid_from_surface(surface, flood)?;
+    let solid = solid_from_surface(surface, flood, progress)?;
     progress.advance(1);
     let details = solid_details(surface, &solid, density, FLOOD_RULE, None)?;
     let meta = vec![

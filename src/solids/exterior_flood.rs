@@ -10,6 +10,7 @@ use crate::ops::flood::padded;
 use crate::ops::flood_spans::flood_spans;
 use crate::ops::flood_xyz::{FloodXyzStats, flood_xyz};
 use crate::ops::measure::{SolidMeasures, measure_solid};
+use crate::progress::Progress;
 
 /// Which flood finds the exterior.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,7 +30,11 @@ pub struct Solid {
 }
 
 /// The solid enclosed by `surface` (an empty surface encloses nothing).
-pub fn solid_from_surface(surface: &SparseGrid, method: FloodMethod) -> Result<Solid> {
+pub fn solid_from_surface(
+    surface: &SparseGrid,
+    method: FloodMethod,
+    progress: &Progress,
+) -> Result<Solid> {
     let Some(bbox) = surface.bbox() else {
         return Ok(Solid {
             inside: SparseGrid::new(surface.transform, Channels::NONE),
@@ -41,7 +46,7 @@ pub fn solid_from_surface(surface: &SparseGrid, method: FloodMethod) -> Result<S
     let blocked = DenseMask::from_grid(surface, bbox)?;
     let seed = [bbox.min];
     let (exterior, xyz_stats) = match method {
-        FloodMethod::Spans => (flood_spans(&blocked, &seed)?, None),
+        FloodMethod::Spans => (flood_spans(&blocked, &seed, progress)?, None),
         FloodMethod::Xyz { capacity } => {
             let (reached, stats) = flood_xyz(&blocked, &seed, capacity)?;
             (reached, Some(stats))

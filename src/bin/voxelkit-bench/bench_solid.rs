@@ -75,7 +75,11 @@ pub fn run(args: &SolidBenchArgs, json: bool) -> Result<()> {
                 })
             })?;
             let (spans_s, solid) = best_of(args.repeat, || {
-                solid_from_surface(&surface, FloodMethod::Spans)
+                solid_from_surface(
+                    &surface,
+                    FloodMethod::Spans,
+                    &voxelkit::progress::Progress::none(),
+                )
             })?;
             let (xyz_s, _) = best_of(args.repeat, || {
                 solid_from_surface(
@@ -83,6 +87,7 @@ pub fn run(args: &SolidBenchArgs, json: bool) -> Result<()> {
                     FloodMethod::Xyz {
                         capacity: args.graystack,
                     },
+                    &voxelkit::progress::Progress::none(),
                 )
             })?;
             let linear_s = if res <= args.linear_up_to {
