@@ -80,7 +80,7 @@ fn flood_spans_into(
             continue;
         }
         runs = runs.wrapping_add(1);
-        if runs % 4096 == 0 {
+        if runs.is_multiple_of(4096) {
             progress.advance(0);
             if progress.stopped() {
                 return;
