@@ -22,7 +22,8 @@ use voxelkit::voxelize::separating::Criterion;
     long_about = "Voxelize meshes and analytic surfaces into 6- or 26-separating voxel surfaces \
                   (Huang et al.'s distance criterion) and write OpenVDB .vdb files that Blender, \
                   Houdini and any OpenVDB program open. Each .vdb holds `surface` (bool), \
-                  `density` (fog volume) and, with --normals, `normal` (Vec3).",
+                  `density` (fog volume) and, with --normals, `normal` (Vec3); with --sdf, \
+                  `density` and the level set `surface` (float, class LEVEL_SET).",
     after_long_help = "What a summary (or --json) reports:\n  \
         voxels, leaves: voxels of the main grid (surface or whole solid) and their 8^3 leaves\n  \
         vertex/edge/body voxels: voxels first made by a vertex sphere, edge cylinder, face slab\n  \
@@ -89,7 +90,8 @@ pub fn parse_criterion(s: &str) -> Result<Criterion, String> {
 #[derive(Subcommand)]
 enum Command {
     /// Voxelize a polygon mesh (.obj or .stl) into a separating surface, or by projective
-    /// scan-lines with vertex colours carried into a `Cd` grid.
+    /// scan-lines with vertex colours carried into a `Cd` grid; or write its level set
+    /// (--sdf) or unsigned distances (--udf).
     Mesh {
         /// Input mesh: .obj (polygons kept; `v x y z r g b` colours read) or .stl.
         input: PathBuf,
