@@ -1,5 +1,6 @@
 //! Blender opens what voxelkit writes: a headless Blender imports the .vdb as a volume
-//! object and sees the `density`, `surface` and `normal` grids at the right place.
+//! object and loads the `density`, `surface` and `normal` grids at the right place, and the
+//! `density` and level-set `surface` of `--sdf`.
 //! Skipped (loudly) where Blender is not installed, outside CI; CI installs it.
 #![cfg(all(feature = "vdb", feature = "fixtures"))]
 
@@ -43,9 +44,9 @@ fn blender_imports_the_volume() {
         .unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
     for g in [
-        "GRID density FLOAT",
-        "GRID surface BOOLEAN",
-        "GRID normal VECTOR_FLOAT",
+        "GRID density FLOAT True",
+        "GRID surface BOOLEAN True",
+        "GRID normal VECTOR_FLOAT True",
     ] {
         assert!(text.contains(g), "`{g}` missing: {text}");
     }
@@ -72,5 +73,41 @@ fn blender_imports_the_volume() {
             nums[3 + a] >= hi[a] - 1e-3 && nums[3 + a] <= hi[a] + 8.0 * h,
             "{line} vs {hi}"
         );
+    }
+}
+
+#[test]
+fn blender_imports_the_level_set() {
+    if Command::new("blender").arg("--version").output().is_err() {
+        return common::skip_or_fail("blender is not installed: the Blender level-set test");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("torus.obj");
+    generate::torus(glam::DVec3::ZERO, 1.0, 0.3, 64, 16)
+        .write_obj(&obj)
+        .unwrap();
+    let path = dir.path().join("torus-sdf.vdb");
+    let made = Command::new(env!("CARGO_BIN_EXE_voxelkit"))
+        .args(["mesh", obj.to_str().unwrap(), "--sdf", "-r", "64", "-o"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(
+        made.status.success(),
+        "{}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/blender/inspect_volume.py"
+    );
+    let out = Command::new("blender")
+        .args(["-b", "--factory-startup", "--python", script, "--"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    for g in ["GRID density FLOAT True", "GRID surface FLOAT True"] {
+        assert!(text.contains(g), "`{g}` missing: {text}");
     }
 }
