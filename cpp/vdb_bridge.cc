@@ -10,6 +10,7 @@
 #include <openvdb/tools/SignedFloodFill.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -158,6 +159,7 @@ namespace {
 // truncated file; this archive writes the same seekable format to a stream we check.
 class CheckedArchive : public openvdb::io::Archive {
 public:
+    explicit CheckedArchive(uint32_t compression) { setCompression(compression); }
     void write_to(const std::string& path, const openvdb::GridPtrVec& grids) const {
         std::ofstream out(path, std::ios_base::out | std::ios_base::binary | std::ios_base::trunc);
         if (!out) throw std::runtime_error("cannot open for writing: " + std::string(std::strerror(errno)));
@@ -171,7 +173,33 @@ public:
 
 }  // namespace
 
-void VdbWriter::write(rust::Str path) const { CheckedArchive().write_to(std::string(path), grids_); }
+void VdbWriter::write(rust::Str path, rust::Str compression, bool half, rust::Slice<const rust::String> only) const {
+    const std::string c(compression);
+    uint32_t flags = openvdb::io::COMPRESS_ACTIVE_MASK;
+    if (c == "blosc") flags |= openvdb::io::COMPRESS_BLOSC;
+    else if (c == "zip") flags |= openvdb::io::COMPRESS_ZIP;
+    else if (c != "none") throw std::invalid_argument("unknown compression " + c + " (blosc, zip or none)");
+    openvdb::GridPtrVec chosen;
+    for (const auto& name : only) {
+        const std::string n(name);
+        auto found = std::find_if(grids_.begin(), grids_.end(), [&](const auto& g) { return g->getName() == n; });
+        if (found == grids_.end()) {
+            std::string names;
+            for (const auto& g : grids_) names += (names.empty() ? "" : ", ") + g->getName();
+            throw std::invalid_argument("no grid `" + n + "` to write; this output has " + names);
+        }
+    }
+    for (const auto& g : grids_) {
+        const bool wanted = only.empty() || std::any_of(only.begin(), only.end(), [&](const rust::String& n) {
+                                                return std::string(n) == g->getName();
+                                            });
+        if (!wanted) continue;
+        // Half precision applies to float and vector grids; bool grids have no floats.
+        g->setSaveFloatAsHalf(half);
+        chosen.push_back(g);
+    }
+    CheckedArchive(flags).write_to(std::string(path), chosen);
+}
 
 std::unique_ptr<VdbFile> open_vdb(rust::Str path) {
     ensure_initialized();

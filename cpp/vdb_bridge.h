@@ -19,7 +19,7 @@ public:
                        rust::Slice<const int32_t> leaf_origins, rust::Slice<const uint64_t> masks,
                        rust::Slice<const float> values, float background, bool is_signed,
                        rust::Slice<const MetaEntry> metadata);
-    void write(rust::Str path) const;
+    void write(rust::Str path, rust::Str compression, bool half, rust::Slice<const rust::String> only) const;
 
 private:
     openvdb::GridPtrVec grids_;

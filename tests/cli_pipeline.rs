@@ -1,7 +1,7 @@
 //! The command line as a front end of the pipeline: every command refuses an impossible grid
 //! at once with the estimate and writes nothing; `--json` reports are typed JSON and errors
 //! are one JSON object; outputs are `.vdb` files or standard output, nothing else.
-#![cfg(feature = "vdb")]
+#![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -206,4 +206,66 @@ fn an_absurd_thread_count_is_clamped_with_a_warning() {
         msg.contains("1000000 threads asked for; using 256"),
         "{msg}"
     );
+}
+
+#[test]
+fn grids_compression_and_half_precision_are_chosen_when_writing() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("torus.obj");
+    voxelkit::mesh::generate::torus(glam::DVec3::ZERO, 1.0, 0.35, 48, 24)
+        .write_obj(&obj)
+        .unwrap();
+    let o = s(&obj);
+    let write = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec!["mesh", o, "-r", "96", "-o", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let run = voxelkit(&args);
+        (run, out)
+    };
+    let (run, only) = write("only.vdb", &["--grids", "density"]);
+    assert!(run.status.success(), "{}", text(&run));
+    let grids = voxelkit::io::vdb::read_vdb_info(&only).unwrap();
+    assert_eq!(
+        grids.iter().map(|g| g.name.as_str()).collect::<Vec<_>>(),
+        ["density"]
+    );
+
+    let (run, missing) = write("missing.vdb", &["--grids", "density,nope"]);
+    let msg = text(&run);
+    assert!(
+        !run.status.success() && msg.contains("nope") && msg.contains("surface"),
+        "{msg}"
+    );
+    assert!(!missing.exists());
+
+    let (_, blosc) = write("blosc.vdb", &[]);
+    let (run, plain) = write("plain.vdb", &["--compression", "none"]);
+    assert!(run.status.success(), "{}", text(&run));
+    let size = |p: &Path| std::fs::metadata(p).unwrap().len();
+    assert!(
+        size(&plain) > size(&blosc),
+        "{} vs {}",
+        size(&plain),
+        size(&blosc)
+    );
+
+    let (run, half) = write("half.vdb", &["--sdf", "--half"]);
+    assert!(run.status.success(), "{}", text(&run));
+    let (_, full) = write("full.vdb", &["--sdf"]);
+    let a = voxelkit::io::vdb::read_vdb_grid(&half, Some("surface")).unwrap();
+    let b = voxelkit::io::vdb::read_vdb_grid(&full, Some("surface")).unwrap();
+    assert_eq!(a.voxel_count(), b.voxel_count());
+    let h = b.transform.voxel_size as f32;
+    for (la, lb) in a.leaves().iter().zip(b.leaves()) {
+        let (va, vb) = (la.value.as_ref().unwrap(), lb.value.as_ref().unwrap());
+        for n in lb.offsets() {
+            assert!(
+                (va[n] - vb[n]).abs() <= 1e-3 * 3.0 * h,
+                "{} vs {}",
+                va[n],
+                vb[n]
+            );
+        }
+    }
 }

@@ -65,8 +65,16 @@ pub mod bridge {
             is_signed: bool,
             metadata: &[MetaEntry],
         ) -> Result<()>;
-        /// Writes all grids to `path` (the caller renames it into place).
-        fn write(self: &VdbWriter, path: &str) -> Result<()>;
+        /// Writes the grids named in `only` (all when empty) to `path` (the caller renames it
+        /// into place), compressed by `compression` (blosc, zip or none), floats as 16-bit
+        /// halves when `half`.
+        fn write(
+            self: &VdbWriter,
+            path: &str,
+            compression: &str,
+            half: bool,
+            only: &[String],
+        ) -> Result<()>;
 
         fn open_vdb(path: &str) -> Result<UniquePtr<VdbFile>>;
         fn grid_count(self: &VdbFile) -> usize;

@@ -70,6 +70,17 @@ pub fn write_vdb_with_masks(
     masks_to_add: &[(&str, &SparseGrid)],
     metadata: &[(&str, String)],
 ) -> Result<()> {
+    write_vdb_as(path, grid, masks_to_add, metadata, &WriteOptions::default())
+}
+
+/// `write_vdb_with_masks`, writing as `options` say.
+pub fn write_vdb_as(
+    path: &Path,
+    grid: &SparseGrid,
+    masks_to_add: &[(&str, &SparseGrid)],
+    metadata: &[(&str, String)],
+    options: &WriteOptions,
+) -> Result<()> {
     check_voxel_size(path, grid.transform.voxel_size)?;
     let (origins, masks, leaves) = flatten(path, grid)?;
     let meta = meta_entries(metadata);
@@ -126,16 +137,55 @@ pub fn write_vdb_with_masks(
             )
             .map_err(|e| vdb_error(path, e))?;
     }
-    write_file(path, &writer)
+    write_file(path, &writer, options)
 }
 
-/// Writes the writer's grids to `path` atomically.
-fn write_file(path: &Path, writer: &bridge::VdbWriter) -> Result<()> {
+/// How a `.vdb` is written: which grids, compressed how, floats at what precision.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WriteOptions {
+    /// The grids to write, by name (all when empty).
+    pub grids: Vec<String>,
+    pub compression: Compression,
+    /// Float and vector grids as 16-bit halves (half the size, about 3 decimal digits).
+    pub half: bool,
+}
+
+/// `.vdb` compression.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Compression {
+    /// OpenVDB's default: fast, good ratios.
+    #[default]
+    Blosc,
+    Zip,
+    None,
+}
+
+impl std::str::FromStr for Compression {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "blosc" => Ok(Compression::Blosc),
+            "zip" => Ok(Compression::Zip),
+            "none" => Ok(Compression::None),
+            _ => Err(format!("compression must be blosc, zip or none, not `{s}`")),
+        }
+    }
+}
+
+/// Writes the writer's grids to `path` atomically, as `options` say.
+fn write_file(path: &Path, writer: &bridge::VdbWriter, options: &WriteOptions) -> Result<()> {
+    let compression = match options.compression {
+        Compression::Blosc => "blosc",
+        Compression::Zip => "zip",
+        Compression::None => "none",
+    };
     write_atomic(path, |tmp| {
         let tmp_str = tmp
             .to_str()
             .ok_or_else(|| vdb_error(path, "path is not UTF-8"))?;
-        writer.write(tmp_str).map_err(|e| vdb_error(path, e))
+        writer
+            .write(tmp_str, compression, options.half, &options.grids)
+            .map_err(|e| vdb_error(path, e))
     })
 }
 
@@ -173,6 +223,7 @@ pub fn write_distance_band(
     background: f32,
     kind: DistanceGrid,
     metadata: &[(&str, String)],
+    options: &WriteOptions,
 ) -> Result<()> {
     check_voxel_size(path, grid.transform.voxel_size)?;
     let (origins, masks, leaves) = flatten(path, grid)?;
@@ -206,7 +257,7 @@ pub fn write_distance_band(
             &meta,
         )
         .map_err(|e| vdb_error(path, e))?;
-    write_file(path, &writer)
+    write_file(path, &writer, options)
 }
 
 /// OpenVDB's own volume (`tools::levelSetVolume`) of the level set `name` in a file.

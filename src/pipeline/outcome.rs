@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::grid::{SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::io::atomic::check_output;
-use crate::io::vdb::{DistanceGrid, write_distance_band, write_vdb_with_masks};
+use crate::io::vdb::{DistanceGrid, WriteOptions, write_distance_band, write_vdb_as};
 use crate::mesh::Mesh;
 use crate::ops::csg::{BooleanOp, combine as combine_grids};
 use crate::progress::Progress;
@@ -103,9 +103,9 @@ impl Outcome {
         self
     }
 
-    /// Writes every grid to `path` (`.vdb`; `-` for standard output), atomically, refusing
-    /// to replace any of `inputs`; records the output in the report.
-    pub fn write(&mut self, path: &Path, inputs: &[&Path]) -> Result<()> {
+    /// Writes the grids to `path` (`.vdb`; `-` for standard output) as `options` say,
+    /// atomically, refusing to replace any of `inputs`; records the output in the report.
+    pub fn write(&mut self, path: &Path, inputs: &[&Path], options: &WriteOptions) -> Result<()> {
         check_output_path(path, inputs)?;
         let meta: Vec<(&str, String)> = self
             .metadata
@@ -116,9 +116,9 @@ impl Outcome {
             self.extra.iter().map(|(n, g)| (n.as_str(), g)).collect();
         let write = |file: &Path| match self.distances {
             Some((kind, background)) => {
-                write_distance_band(file, &self.grid, background, kind, &meta)
+                write_distance_band(file, &self.grid, background, kind, &meta, options)
             }
-            None => write_vdb_with_masks(file, &self.grid, &extra, &meta),
+            None => write_vdb_as(file, &self.grid, &extra, &meta, options),
         };
         if path == Path::new("-") {
             write_to_stdout(write)?;

@@ -51,6 +51,15 @@ struct Cli {
     /// [default: the memory available].
     #[arg(long, global = true, value_name = "MIB")]
     max_memory: Option<u64>,
+    /// Write only these grids of the .vdb, by name (e.g. `density,surface`) [default: all].
+    #[arg(long, global = true, value_delimiter = ',', value_name = "NAMES")]
+    grids: Vec<String>,
+    /// .vdb compression: blosc (OpenVDB's default), zip or none.
+    #[arg(long, global = true, default_value = "blosc", value_parser = parse_compression)]
+    compression: voxelkit::io::vdb::Compression,
+    /// Write float and vector grids at half precision (16-bit: half the size).
+    #[arg(long, global = true)]
+    half: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -80,6 +89,10 @@ pub struct SurfaceArgs {
 }
 
 fn parse_separability(s: &str) -> Result<Separability, String> {
+    s.parse()
+}
+
+fn parse_compression(s: &str) -> Result<voxelkit::io::vdb::Compression, String> {
     s.parse()
 }
 
@@ -174,6 +187,11 @@ fn main() -> ExitCode {
         threads: cli.threads,
         max_memory_mib: cli.max_memory,
         json: cli.json,
+        write: voxelkit::io::vdb::WriteOptions {
+            grids: cli.grids,
+            compression: cli.compression,
+            half: cli.half,
+        },
     };
     let result = match cli.command {
         Command::Mesh {

@@ -8,16 +8,17 @@ use std::path::Path;
 use std::sync::Mutex;
 use std::time::Instant;
 use voxelkit::Result;
-use voxelkit::io::vdb::check_voxel_size;
+use voxelkit::io::vdb::{WriteOptions, check_voxel_size};
 use voxelkit::pipeline::{Job, Limits, Outcome, check_output_path};
 use voxelkit::progress::Observer;
 
 /// What every command shares: threads, memory limit, output style.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub struct Global {
     pub threads: Option<usize>,
     pub max_memory_mib: Option<u64>,
     pub json: bool,
+    pub write: WriteOptions,
 }
 
 impl Global {
@@ -93,7 +94,7 @@ pub fn run_job(job: Job, output: Option<&Path>, global: &Global) -> Result<Outco
     bars.finish();
     let mut outcome = result?;
     if let Some(out) = output {
-        outcome.write(out, &inputs)?;
+        outcome.write(out, &inputs, &global.write)?;
     }
     outcome.report.finish(start);
     Ok(outcome)
