@@ -651,7 +651,7 @@ pub extern "C" fn vk_options_set_voxel_size(options: *mut VkOptions, voxel_size:
         let mut o = lock(&options);
         if !(voxel_size > 0.0 && voxel_size.is_finite()) {
             return Err(invalid(format!(
-                "voxel size {voxel_size} must be positive and finite"
+                "voxel size {voxel_size:?} must be positive and finite"
             )));
         }
         o.fit = GridFit::VoxelSize(voxel_size);

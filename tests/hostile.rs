@@ -305,3 +305,24 @@ fn a_formula_at_resolution_one_is_one_voxel() {
         1.0
     );
 }
+
+#[test]
+fn tiny_and_huge_numbers_are_printed_short() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("tetra.obj");
+    std::fs::write(&obj, TETRA).unwrap();
+    let out = dir.path().join("out.vdb");
+    for size in ["1e-300", "-1e-300"] {
+        let o = voxelkit(&[
+            "mesh",
+            obj.to_str().unwrap(),
+            "--voxel-size",
+            size,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let msg = text(&o);
+        assert!(!o.status.success(), "{msg}");
+        assert!(msg.len() < 400 && !msg.contains("00000000"), "{msg}");
+    }
+}

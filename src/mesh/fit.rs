@@ -38,7 +38,7 @@ pub fn fit_transform(bbox: &Aabb, fit: GridFit) -> Result<Transform> {
         GridFit::VoxelSize(h) if h > 0.0 && h.powi(3).is_finite() => h,
         GridFit::VoxelSize(h) => {
             return Err(Error::InvalidArgument(format!(
-                "voxel size must be a positive number whose cube is finite, got {h}"
+                "voxel size must be a positive number whose cube is finite, got {h:?}"
             )));
         }
     };

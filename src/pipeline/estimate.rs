@@ -113,14 +113,14 @@ pub(super) fn octree_resolution(fit: GridFit, min: DVec3, max: DVec3) -> Result<
             let r = ((max - min).max_element() / h).ceil();
             if r > f64::from(1u32 << 16) {
                 Err(Error::InvalidArgument(format!(
-                    "voxel size {h} gives {r:.3e} voxels along the bounds; the octree takes at most 65536"
+                    "voxel size {h:?} gives {r:.3e} voxels along the bounds; the octree takes at most 65536"
                 )))
             } else {
                 Ok(r.max(1.0) as u32)
             }
         }
         GridFit::VoxelSize(h) => Err(Error::InvalidArgument(format!(
-            "voxel size must be a positive number, got {h}"
+            "voxel size must be a positive number, got {h:?}"
         ))),
     }
 }

@@ -189,6 +189,24 @@ pub struct Plan {
     pub work_items: u64,
 }
 
+impl Plan {
+    /// The region in voxels, `1024x1013x789`, in scientific notation when huge.
+    pub fn describe_extent(&self) -> String {
+        let v: Vec<String> = self
+            .extent
+            .iter()
+            .map(|&e| {
+                if e < 1e9 {
+                    format!("{e:.0}")
+                } else {
+                    format!("{e:.3e}")
+                }
+            })
+            .collect();
+        v.join("x")
+    }
+}
+
 /// The inputs a task reads, loaded during planning.
 pub(crate) enum Loaded {
     Mesh(Mesh),
@@ -214,7 +232,7 @@ impl GridFit {
     pub fn describe(&self) -> String {
         match self {
             GridFit::Resolution(r) => r.to_string(),
-            GridFit::VoxelSize(h) => format!("voxel size {h}"),
+            GridFit::VoxelSize(h) => format!("voxel size {h:?}"),
         }
     }
 }
@@ -344,11 +362,9 @@ impl Job {
             plan.estimated_bytes,
             limit,
             &format!(
-                "{} at {:.0}x{:.0}x{:.0} voxels; lower the resolution or raise the memory limit",
+                "{} at {} voxels; lower the resolution or raise the memory limit",
                 self.describe_input(),
-                plan.extent[0],
-                plan.extent[1],
-                plan.extent[2]
+                plan.describe_extent()
             ),
         )?;
         Ok(PlannedJob {

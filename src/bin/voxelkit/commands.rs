@@ -331,11 +331,9 @@ pub fn check(input: &Path, fit: FitArgs, surface: SurfaceArgs, global: &Global) 
         plan.estimated_bytes + (4.0 * cells / 8.0) as u64,
         global.limits().max_memory,
         &format!(
-            "{} at {:.0}x{:.0}x{:.0} voxels, with the flood checks; lower the resolution",
+            "{} at {} voxels, with the flood checks; lower the resolution",
             input.display(),
-            plan.extent[0],
-            plan.extent[1],
-            plan.extent[2]
+            plan.describe_extent()
         ),
     )?;
     let outcome = run_job(job, None, global)?;
