@@ -34,7 +34,8 @@ pub enum Error {
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
     #[error(
-        "resolution too large: an estimated {estimated_mib} MiB is needed but only {available_mib} MiB is available ({detail})"
+        "resolution too large: an estimated {} MiB is needed but only {available_mib} MiB is available ({detail})",
+        short_number(*estimated_mib)
     )]
     TooLarge {
         estimated_mib: u64,
@@ -61,6 +62,15 @@ pub enum Error {
 }
 
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// A count as people read it: digits up to a billion, then scientific notation.
+fn short_number(n: u64) -> String {
+    if n < 1_000_000_000 {
+        n.to_string()
+    } else {
+        format!("{:.2e}", n as f64)
+    }
+}
 
 impl Error {
     /// The file and the line (or face) the error is about, where it has them.

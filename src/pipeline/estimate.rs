@@ -93,8 +93,10 @@ fn checked_box(bbox: &Aabb, t: &Transform) -> Result<CoordBox> {
         )));
     }
     if !(e.iter().all(|v| v.is_finite() && *v < 1e15) && far < 1e15) {
+        // At least a bit per voxel of the box.
+        let bits: f64 = e.iter().map(|v| v.max(1.0)).product();
         return Err(Error::TooLarge {
-            estimated_mib: u64::MAX >> 20,
+            estimated_mib: (bits / 8.0 / (1u64 << 20) as f64).min(u64::MAX as f64) as u64,
             available_mib: crate::system::available_memory_bytes().unwrap_or(0) >> 20,
             detail: format!(
                 "{:.3e} x {:.3e} x {:.3e} voxels cannot be indexed; raise the voxel size",
