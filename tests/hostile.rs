@@ -326,3 +326,36 @@ fn tiny_and_huge_numbers_are_printed_short() {
         assert!(msg.len() < 400 && !msg.contains("00000000"), "{msg}");
     }
 }
+
+#[test]
+fn resampling_onto_a_far_finer_grid_is_planned() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    for (radius, res, name) in [("1", "64", "small.vdb"), ("1000", "16", "big.vdb")] {
+        let o = voxelkit(&[
+            "shape",
+            "sphere",
+            "--radius",
+            radius,
+            "-r",
+            res,
+            "-o",
+            &p(name),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+    }
+    let start = std::time::Instant::now();
+    let o = voxelkit(&[
+        "csg",
+        "union",
+        &p("small.vdb"),
+        &p("big.vdb"),
+        "--resample",
+        "-o",
+        &p("u.vdb"),
+    ]);
+    let msg = text(&o);
+    assert!(!o.status.success() && msg.contains("an estimated"), "{msg}");
+    assert!(start.elapsed() < std::time::Duration::from_secs(2));
+    assert!(!dir.path().join("u.vdb").exists());
+}

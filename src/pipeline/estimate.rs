@@ -279,13 +279,26 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             let p = plan(t, &bounds, bytes, tree.node_count() as u64);
             (Loaded::Tree(Box::new(tree)), p)
         }
-        Task::Combine { a, b, grid, .. } => {
+        Task::Combine {
+            a,
+            b,
+            grid,
+            resample,
+            ..
+        } => {
             let load = |g: &super::GridSource| match g {
                 super::GridSource::File(path) => read_vdb_grid(path, Some(grid)),
                 super::GridSource::Grid(g) => Ok(g.clone()),
             };
             let (ga, gb) = (load(a)?, load(b)?);
-            let leaves = (ga.leaf_count() + gb.leaf_count()) as f64;
+            // Resampled onto the first grid, each voxel of the second becomes (hb/ha)^3.
+            let scale = gb.transform.voxel_size / ga.transform.voxel_size;
+            let second = if *resample {
+                (gb.voxel_count() as f64 * scale.powi(3) / 64.0).max(gb.leaf_count() as f64)
+            } else {
+                gb.leaf_count() as f64
+            };
+            let leaves = ga.leaf_count() as f64 + second;
             let t = ga.transform;
             let bbox = world_box(&ga);
             let p = plan(t, &bbox, leaf_bytes(leaves, 0), 1);
