@@ -359,3 +359,21 @@ fn resampling_onto_a_far_finer_grid_is_planned() {
     assert!(start.elapsed() < std::time::Duration::from_secs(2));
     assert!(!dir.path().join("u.vdb").exists());
 }
+
+#[test]
+fn a_mirrored_grid_is_refused_saying_what_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let mirror = dir.path().join("mirror.vdb");
+    let script = "import sys, pyopenvdb as vdb\n\
+                  g = vdb.BoolGrid()\n\
+                  g.fill((0, 0, 0), (3, 3, 3), True, True)\n\
+                  g.name = 'surface'\n\
+                  g.transform = vdb.createLinearTransform([[-1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])\n\
+                  vdb.write(sys.argv[1], grids=[g])\n";
+    if cli_support::run_pyopenvdb(script, &mirror, "the mirrored-grid file").is_none() {
+        return;
+    }
+    let o = voxelkit(&["measure", mirror.to_str().unwrap()]);
+    let msg = text(&o);
+    assert!(!o.status.success() && msg.contains("mirroring"), "{msg}");
+}

@@ -327,8 +327,10 @@ pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
         return Err(vdb_error(
             path,
             format!(
-                "grid `{}` has a non-uniform or non-linear transform",
-                info.name
+                "grid `{}` has a transform voxelkit cannot use (voxel size {:?}): it reads grids \
+                 placed by one uniform scale and a translation, without rotation, mirroring or \
+                 a different scale per axis",
+                info.name, info.voxel_size
             ),
         ));
     }
