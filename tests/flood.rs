@@ -71,7 +71,13 @@ fn all_floods_agree_on_random_volumes() {
             "round {round}: linear flood differs"
         );
         for capacity in [1, 7, 1 << 20] {
-            let (xyz, stats) = flood_xyz(&blocked, &seeds, capacity).unwrap();
+            let (xyz, stats) = flood_xyz(
+                &blocked,
+                &seeds,
+                capacity,
+                &voxelkit::progress::Progress::none(),
+            )
+            .unwrap();
             assert!(
                 same(&reference, &xyz),
                 "round {round}: FloodingXYZ with capacity {capacity} differs"
@@ -90,7 +96,13 @@ fn a_tiny_stack_needs_sweeps_and_still_fills_everything() {
         max: [40, 40, 40],
     };
     let blocked = DenseMask::new(bbox).unwrap();
-    let (filled, stats) = flood_xyz(&blocked, &[[20, 20, 20]], 4).unwrap();
+    let (filled, stats) = flood_xyz(
+        &blocked,
+        &[[20, 20, 20]],
+        4,
+        &voxelkit::progress::Progress::none(),
+    )
+    .unwrap();
     assert_eq!(filled.count(), 41 * 41 * 41);
     assert!(stats.overflows > 0 && stats.sweeps > 1, "{stats:?}");
 }
@@ -124,7 +136,13 @@ fn seeds_from_normals_fill_the_inside_of_a_voxelized_solid() {
             "the seed {:?} is outside",
             choice.seed
         );
-        let (xyz, stats) = flood_xyz(&blocked, &[choice.seed], 4096).unwrap();
+        let (xyz, stats) = flood_xyz(
+            &blocked,
+            &[choice.seed],
+            4096,
+            &voxelkit::progress::Progress::none(),
+        )
+        .unwrap();
         let spans = flood_spans(
             &blocked,
             &[choice.seed],

@@ -238,25 +238,30 @@ impl Observer for StopWhenPolled {
 fn the_exterior_flood_stops_when_asked() {
     let dir = tempfile::tempdir().unwrap();
     let (torus, _, _) = fixtures(dir.path());
-    for measure in [false, true] {
+    let xyz = FloodMethod::Xyz { capacity: 1 << 20 };
+    for (measure, flood) in [
+        (false, FloodMethod::Spans),
+        (true, FloodMethod::Spans),
+        (false, xyz),
+    ] {
         let mesh = MeshSource::File(torus.clone());
         let task = if measure {
             Task::Measure {
                 source: MeasureSource::Mesh(mesh),
-                flood: FloodMethod::Spans,
+                flood,
                 density: 1.0,
             }
         } else {
             Task::Solid {
                 mesh,
-                fill: Fill::Flood(FloodMethod::Spans),
+                fill: Fill::Flood(flood),
                 density: 1.0,
             }
         };
         let result = Job::new(task, GridFit::Resolution(256)).run(&StopWhenPolled);
         assert!(
             matches!(result, Err(Error::Cancelled)),
-            "measure: {measure}"
+            "measure: {measure}, {flood:?}"
         );
     }
 }

@@ -10,6 +10,7 @@
 
 use crate::error::Result;
 use crate::grid::{Coord, DenseMask};
+use crate::progress::Progress;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FloodXyzStats {
@@ -27,6 +28,7 @@ pub fn flood_xyz(
     blocked: &DenseMask,
     seeds: &[Coord],
     capacity: usize,
+    progress: &Progress,
 ) -> Result<(DenseMask, FloodXyzStats)> {
     let mut run = Run {
         blocked,
@@ -48,6 +50,11 @@ pub fn flood_xyz(
     loop {
         while let Some(i) = run.stack.pop() {
             run.line_flood(i);
+            // Ask the observer now and then; stop when it says so.
+            if run.stats.line_floods.is_multiple_of(4096) {
+                progress.advance(0);
+                progress.check()?;
+            }
         }
         run.stats.sweeps += 1;
         if !run.sweep() {

@@ -48,7 +48,7 @@ pub fn solid_from_surface(
     let (exterior, xyz_stats) = match method {
         FloodMethod::Spans => (flood_spans(&blocked, &seed, progress)?, None),
         FloodMethod::Xyz { capacity } => {
-            let (reached, stats) = flood_xyz(&blocked, &seed, capacity)?;
+            let (reached, stats) = flood_xyz(&blocked, &seed, capacity, progress)?;
             (reached, Some(stats))
         }
     };
