@@ -1,13 +1,13 @@
 //! The subcommands other than `bench`: each is arguments -> `Job` -> report.
 
-use crate::run::{Global, run_and_report, run_job};
+use crate::run::{Global, plan, run_and_report, run_job, run_planned};
 use crate::{FitArgs, SurfaceArgs};
 use clap::{Args, Subcommand};
 use glam::DVec3;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use voxelkit::io::vdb::read_vdb_info;
-use voxelkit::mesh::{GridFit, generate};
+use voxelkit::mesh::{GridFit, Mesh, generate};
 use voxelkit::ops::minimality::simple_voxel_count;
 use voxelkit::ops::separability::check_mesh_separation;
 use voxelkit::pipeline::{Job, MeshSource, Shape, SurfaceMethod, Task};
@@ -139,11 +139,11 @@ impl SurfaceArgs {
     }
 }
 
-/// The separating surface of a mesh file.
-fn surface_job(input: &Path, fit: FitArgs, surface: SurfaceArgs) -> Job {
+/// The separating surface of a mesh.
+fn surface_job(mesh: MeshSource, fit: FitArgs, surface: SurfaceArgs) -> Job {
     Job::new(
         Task::MeshSurface {
-            mesh: MeshSource::File(input.to_path_buf()),
+            mesh,
             method: SurfaceMethod::Separating(surface.separating()),
         },
         fit.grid_fit(),
@@ -152,7 +152,11 @@ fn surface_job(input: &Path, fit: FitArgs, surface: SurfaceArgs) -> Job {
 
 pub fn mesh(input: &Path, args: &VoxelizeArgs, global: &Global) -> Result<()> {
     run_and_report(
-        surface_job(input, args.fit, args.surface),
+        surface_job(
+            MeshSource::File(input.to_path_buf()),
+            args.fit,
+            args.surface,
+        ),
         &args.output,
         global,
     )
@@ -320,12 +324,15 @@ struct CheckReport {
 }
 
 pub fn check(input: &Path, fit: FitArgs, surface: SurfaceArgs, global: &Global) -> Result<()> {
+    let start = std::time::Instant::now();
+    // Read once: the job voxelizes the mesh, the checks then flood around it.
+    let mesh = Mesh::load(input)?;
+    let planned = plan(
+        surface_job(MeshSource::Mesh(mesh.clone()), fit, surface),
+        global,
+    )?;
     // The checks hold four bit volumes over the surface's box besides the surface itself.
-    let job = Job {
-        limits: global.limits(),
-        ..surface_job(input, fit, surface)
-    };
-    let plan = *job.clone().plan()?.plan();
+    let plan = *planned.plan();
     let cells: f64 = plan.extent.iter().map(|e| e + 6.0).product();
     voxelkit::system::check_fits(
         plan.estimated_bytes + (4.0 * cells / 8.0) as u64,
@@ -336,8 +343,7 @@ pub fn check(input: &Path, fit: FitArgs, surface: SurfaceArgs, global: &Global) 
             plan.describe_extent()
         ),
     )?;
-    let outcome = run_job(job, None, global)?;
-    let mesh = voxelkit::mesh::Mesh::load(input)?;
+    let outcome = run_planned(planned, None, global, start)?;
     let grid = &outcome.grid;
     let adjacency = surface.separability.flood_adjacency();
     let found = check_mesh_separation(grid, &mesh, adjacency)?;
@@ -392,9 +398,10 @@ pub fn demo(folder: &Path, resolution: u32, global: &Global) -> Result<()> {
         path: folder.to_path_buf(),
         source: e,
     })?;
-    let mesh = generate::trefoil(1.0, 0.45, 384, 32);
+    let mut mesh = generate::trefoil(1.0, 0.45, 384, 32);
     let obj = folder.join("trefoil.obj");
     mesh.write_obj(&obj)?;
+    mesh.source = obj.clone();
     let mut results = Vec::new();
     for sep in [Separability::Six, Separability::TwentySix] {
         let surface = SurfaceArgs {
@@ -407,9 +414,9 @@ pub fn demo(folder: &Path, resolution: u32, global: &Global) -> Result<()> {
             voxel_size: None,
         };
         let out = folder.join(format!("trefoil-{}.vdb", sep.adjacency()));
-        let outcome = run_job(surface_job(&obj, fit, surface), Some(&out), global)?;
-        let loaded = voxelkit::mesh::Mesh::load(&obj)?;
-        let found = check_mesh_separation(&outcome.grid, &loaded, sep.flood_adjacency())?;
+        let job = surface_job(MeshSource::Mesh(mesh.clone()), fit, surface);
+        let outcome = run_job(job, Some(&out), global)?;
+        let found = check_mesh_separation(&outcome.grid, &mesh, sep.flood_adjacency())?;
         let verdict = if found.separates() {
             format!("{}-separating", sep.adjacency())
         } else {
