@@ -26,6 +26,19 @@ pub fn range(words: &[u64], i: usize, n: usize) -> u64 {
     if n < 64 { v & ((1u64 << n) - 1) } else { v }
 }
 
+/// ORs the low bits of `bits` (at most 64, no others set) into the words from bit `i` on.
+#[inline]
+pub fn or_bits(words: &mut [u64], i: usize, bits: u64) {
+    if bits == 0 {
+        return;
+    }
+    let (w, b) = (i >> 6, i & 63);
+    words[w] |= bits << b;
+    if b > 0 && bits >> (64 - b) != 0 {
+        words[w + 1] |= bits >> (64 - b);
+    }
+}
+
 /// Sets bits `first..=last`.
 pub fn set_range(words: &mut [u64], first: usize, last: usize) {
     let (fw, lw) = (first >> 6, last >> 6);

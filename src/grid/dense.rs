@@ -32,11 +32,33 @@ impl DenseMask {
         }
     }
 
-    /// The active voxels of `grid` inside `bbox`.
+    /// The active voxels of `grid` inside `bbox`, copied 8 voxels (a leaf row along z) at
+    /// a time.
     pub fn from_grid(grid: &SparseGrid, bbox: CoordBox) -> Result<Self> {
         let mut m = DenseMask::new(bbox)?;
-        for c in grid.voxels().filter(|&c| bbox.contains(c)) {
-            m.set(c);
+        for leaf in grid.leaves() {
+            let o = leaf.origin;
+            // The part of the leaf's z row inside the box, as a bit range of the row.
+            let z0 = (bbox.min[2] - o[2]).clamp(0, 8);
+            let z1 = (bbox.max[2] - o[2] + 1).clamp(0, 8);
+            if z0 >= z1 {
+                continue;
+            }
+            let keep = (0xffu64 >> (8 - (z1 - z0))) << z0;
+            for dx in 0..8 {
+                let x = o[0] + dx;
+                if x < bbox.min[0] || x > bbox.max[0] {
+                    continue;
+                }
+                for dy in 0..8 {
+                    let y = o[1] + dy;
+                    let row = (leaf.mask[dx as usize] >> (dy * 8)) & keep;
+                    if row != 0 && y >= bbox.min[1] && y <= bbox.max[1] {
+                        let start = m.index([x, y, o[2] + z0]);
+                        bits::or_bits(&mut m.bits, start, row >> z0);
+                    }
+                }
+            }
         }
         Ok(m)
     }
@@ -242,5 +264,37 @@ impl DenseMask {
                 let bit = (self.bits[w] & other.bits[w]).trailing_zeros() as usize;
                 self.coord(w * 64 + bit)
             })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::{Channels, Transform};
+    use crate::random::SplitMix64;
+
+    #[test]
+    fn from_grid_copies_exactly_the_voxels_inside_the_box() {
+        let mut rng = SplitMix64(9);
+        let mut grid = SparseGrid::new(Transform::default(), Channels::NONE);
+        let mut voxels = Vec::new();
+        for _ in 0..4000 {
+            let c = [0, 1, 2].map(|_| rng.range(-30.0, 30.0).floor() as i64);
+            grid.insert(c);
+            voxels.push(c);
+        }
+        // Boxes cutting leaves at every offset, and one holding everything.
+        for (lo, hi) in [(-30, 29), (-13, 5), (-7, -5), (3, 21), (-31, 40)] {
+            let bbox = CoordBox {
+                min: [lo, lo + 1, lo - 2],
+                max: [hi, hi - 1, hi + 3],
+            };
+            let mask = DenseMask::from_grid(&grid, bbox).unwrap();
+            let mut expected = DenseMask::new(bbox).unwrap();
+            for &c in voxels.iter().filter(|&&c| bbox.contains(c)) {
+                expected.set(c);
+            }
+            assert_eq!(mask.bits, expected.bits, "box {bbox:?}");
+        }
     }
 }
