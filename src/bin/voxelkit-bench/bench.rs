@@ -56,6 +56,17 @@ enum BenchKind {
     Levelset(crate::bench_level_set::LevelSetBenchArgs),
 }
 
+/// `mesh` as OpenVDB's mesher takes it: points in the index space of `t` and triangle
+/// corners (made before any timing starts).
+pub fn openvdb_mesh(mesh: &Mesh, t: &voxelkit::grid::Transform) -> (Vec<f32>, Vec<u32>) {
+    let points = mesh
+        .positions
+        .iter()
+        .flat_map(|&p| t.world_to_index(p).as_vec3().to_array())
+        .collect();
+    (points, mesh.triangles().flat_map(|(_, t)| t).collect())
+}
+
 /// A pool of `threads` workers for one side of a comparison.
 pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
     rayon::ThreadPoolBuilder::new()
@@ -130,14 +141,9 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
     for name in &args.meshes {
         let path = resolve(name, &data, "meshes");
         let mesh = Mesh::load(&path)?;
-        let tris: Vec<u32> = mesh.triangles().flat_map(|(_, t)| t).collect();
         for &res in &args.resolutions {
             let transform = fit_transform(&mesh.bbox(), GridFit::Resolution(res))?;
-            let index_points: Vec<f32> = mesh
-                .positions
-                .iter()
-                .flat_map(|&p| transform.world_to_index(p).as_vec3().to_array())
-                .collect();
+            let (index_points, tris) = openvdb_mesh(&mesh, &transform);
             for &threads in &args.thread_counts {
                 let pool = thread_pool(threads)?;
                 let (vdb_s, vdb_voxels) = best_of(args.repeat, || {

@@ -76,14 +76,9 @@ pub fn run(args: &LevelSetBenchArgs, json: bool) -> Result<()> {
     for name in &args.meshes {
         let path = crate::bench::resolve(name, &data, "meshes");
         let mesh = Mesh::load(&path)?;
-        let tris: Vec<u32> = mesh.triangles().flat_map(|(_, t)| t).collect();
         for &res in &args.resolutions {
             let t = fit_transform(&mesh.bbox(), GridFit::Resolution(res))?;
-            let points: Vec<f32> = mesh
-                .positions
-                .iter()
-                .flat_map(|&p| t.world_to_index(p).as_vec3().to_array())
-                .collect();
+            let (points, tris) = crate::bench::openvdb_mesh(&mesh, &t);
             for &threads in &args.thread_counts {
                 let (ours_s, report) =
                     best_of(args.repeat, || ours(&path, res, threads, args.band))?;

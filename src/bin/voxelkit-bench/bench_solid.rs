@@ -61,7 +61,6 @@ pub fn run(args: &SolidBenchArgs, json: bool) -> Result<()> {
     for name in &args.meshes {
         let path = crate::bench::resolve(name, &data, "meshes");
         let mesh = Mesh::load(&path)?;
-        let tris: Vec<u32> = mesh.triangles().flat_map(|(_, t)| t).collect();
         for &res in &args.resolutions {
             let t = fit_transform(&mesh.bbox(), GridFit::Resolution(res))?;
             let options = SeparatingOptions {
@@ -97,11 +96,7 @@ pub fn run(args: &SolidBenchArgs, json: bool) -> Result<()> {
             } else {
                 None
             };
-            let points: Vec<f32> = mesh
-                .positions
-                .iter()
-                .flat_map(|&p| t.world_to_index(p).as_vec3().to_array())
-                .collect();
+            let (points, tris) = crate::bench::openvdb_mesh(&mesh, &t);
             let (vdb_s, vdb_voxels) = best_of(args.repeat, || {
                 openvdb_mesh_to_volume(&points, &tris, t.voxel_size, 1.0, f32::MAX, args.threads)
             })?;

@@ -182,12 +182,7 @@ fn reference_seconds(
                 .clamp(1.0, 256.0) as usize
         })
     });
-    let points: Vec<f32> = mesh
-        .positions
-        .iter()
-        .flat_map(|&p| transform.world_to_index(p).as_vec3().to_array())
-        .collect();
-    let tris: Vec<u32> = mesh.triangles().flat_map(|(_, t)| t).collect();
+    let (points, tris) = crate::bench::openvdb_mesh(&mesh, &transform);
     let (seconds, _) = best_of(args.repeat, || {
         openvdb_mesh_to_volume(&points, &tris, transform.voxel_size, 1.0, 1.0, args.threads)
     })?;
