@@ -202,12 +202,10 @@ fn the_c_interface_and_the_command_line_give_the_same_voxels_and_metadata() {
         .write_obj(&mesh)
         .unwrap();
     let control = dir.join("cube.obj");
-    std::fs::write(
-        &control,
-        "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
-         f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
-    )
-    .unwrap();
+    // A quad cube: a Catmull-Clark control mesh.
+    generate::cuboid(glam::DVec3::splat(-1.0), glam::DVec3::ONE)
+        .write_obj(&control)
+        .unwrap();
     let flags = run(Command::new("pkg-config")
         .env("PKG_CONFIG_PATH", prefix().join("lib/pkgconfig"))
         .args(["--cflags", "--libs", "voxelkit-static"]));

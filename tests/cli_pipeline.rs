@@ -10,9 +10,6 @@ mod cli_support;
 use cli_support::{text, voxelkit};
 
 const TETRA: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
-const CUBE_QUADS: &str = "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\n\
-                          v 1 1 1\nv -1 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\n\
-                          f 3 4 8 7\nf 4 1 5 8\n";
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -24,7 +21,10 @@ fn every_command_refuses_an_impossible_grid_at_once_and_writes_nothing() {
     let obj = dir.path().join("tetra.obj");
     std::fs::write(&obj, TETRA).unwrap();
     let cube = dir.path().join("cube.obj");
-    std::fs::write(&cube, CUBE_QUADS).unwrap();
+    // A quad cube: a Catmull-Clark control mesh.
+    voxelkit::mesh::generate::cuboid(glam::DVec3::splat(-1.0), glam::DVec3::ONE)
+        .write_obj(&cube)
+        .unwrap();
     let tree = dir.path().join("tree.json");
     std::fs::write(
         &tree,

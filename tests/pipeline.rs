@@ -22,19 +22,17 @@ use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::parametric::ParametricOptions;
 use voxelkit::voxelize::separating::SeparatingOptions;
 
-/// Fixtures written by the test: a closed torus (triangles) and a cube control mesh (quads).
+/// Fixtures written by the test: a closed torus (triangles), a cube control mesh (quads) and
+/// a CSG tree at an impossible resolution.
 fn fixtures(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
     let torus = dir.join("torus.obj");
     generate::torus(DVec3::ZERO, 1.0, 0.35, 96, 48)
         .write_obj(&torus)
         .unwrap();
     let cube = dir.join("cube.obj");
-    std::fs::write(
-        &cube,
-        "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
-         f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
-    )
-    .unwrap();
+    generate::cuboid(DVec3::splat(-1.0), DVec3::ONE)
+        .write_obj(&cube)
+        .unwrap();
     let tree = dir.join("tree.json");
     std::fs::write(
         &tree,
