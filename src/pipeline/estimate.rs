@@ -8,7 +8,7 @@
 //! A surface of area A (in voxels) crosses about A/32 leaves, a line of length L about L/4;
 //! a solid is assumed to fill half its box.
 
-use super::{Job, Loaded, MeasureSource, Plan, Task, lines_source};
+use super::{Job, Loaded, MeasureSource, MeshSource, Plan, Task, lines_source};
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, SparseGrid, Transform};
 use crate::implicit::Formula;
@@ -134,14 +134,8 @@ fn mesh_plan(mesh: &Mesh, fit: GridFit) -> Result<(Transform, CoordBox)> {
     Ok((t, b))
 }
 
-pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
+pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
     let fit = job.fit;
-    let plan = |transform: Transform, bbox: &Aabb, bytes: f64, work_items: u64| Plan {
-        transform,
-        extent: extent(bbox, &transform),
-        estimated_bytes: (BASE_BYTES + bytes).min(u64::MAX as f64) as u64,
-        work_items,
-    };
     Ok(match &job.task {
         Task::MeshSurface { mesh, method } => {
             let mesh = mesh.load(false)?;
@@ -156,7 +150,7 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
                 }
             };
             let bytes = surface_bytes(area_in_voxels(&mesh, &t), channels);
-            let p = plan(t, &mesh.bbox(), bytes, items);
+            let p = plan_of(t, &mesh.bbox(), bytes, items);
             (Loaded::Mesh(mesh), p)
         }
         Task::DistanceBand { mesh, band, .. } => {
@@ -166,7 +160,7 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             // each leaf is held with its values, then twice more by OpenVDB (level set, fog).
             let leaves = area_in_voxels(&mesh, &t) / AREA_PER_LEAF * (2.0 * band + 1.0) / 4.0;
             let bytes = leaf_bytes(leaves, 0) * 2.0 + cells(&padded(b, band.ceil() as i64)) / 8.0;
-            let p = plan(t, &mesh.bbox(), bytes, mesh.face_count() as u64);
+            let p = plan_of(t, &mesh.bbox(), bytes, mesh.face_count() as u64);
             (Loaded::Mesh(mesh), p)
         }
         Task::Lines { mesh, edges, color } => {
@@ -181,7 +175,7 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             let leaves = (length / t.voxel_size + mesh.positions.len() as f64) / LENGTH_PER_LEAF;
             let colour = color.coloring(&mesh) != projective::Coloring::None;
             let bytes = leaf_bytes(leaves, u32::from(colour));
-            let p = plan(t, &mesh.bbox(), bytes, segments.len() as u64);
+            let p = plan_of(t, &mesh.bbox(), bytes, segments.len() as u64);
             (Loaded::Mesh(mesh), p)
         }
         Task::Shape { shape, normals, .. } => {
@@ -189,7 +183,7 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             let t = fit_transform(&bbox, fit)?;
             let b = checked_box(&bbox, &t)?;
             let bytes = surface_bytes(box_area(extent(&bbox, &t)), u32::from(*normals));
-            let p = plan(t, &bbox, bytes, (cells(&b) / 512.0).ceil() as u64);
+            let p = plan_of(t, &bbox, bytes, (cells(&b) / 512.0).ceil() as u64);
             (Loaded::Shape, p)
         }
         Task::Subdivision { mesh, .. } => {
@@ -201,7 +195,7 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             let t = fit_transform(&bbox, fit)?;
             checked_box(&bbox, &t)?;
             let bytes = surface_bytes(area_in_voxels(&control.polygon_mesh(), &t), 1);
-            let p = plan(t, &bbox, bytes, control.patch_count() as u64);
+            let p = plan_of(t, &bbox, bytes, control.patch_count() as u64);
             (Loaded::Control(control), p)
         }
         Task::Implicit {
@@ -236,39 +230,24 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
                 ..Default::default()
             };
             let items = crate::voxelize::interval_octree::progress_total(&options);
-            let p = plan(t, &bbox, bytes, items);
+            let p = plan_of(t, &bbox, bytes, items);
             (Loaded::Formula(parsed), p)
         }
-        Task::Solid { mesh, fill, .. } => {
-            let mesh = mesh.load(false)?;
-            let (t, b) = mesh_plan(&mesh, fit)?;
-            let surface = area_in_voxels(&mesh, &t);
-            let (masks, items) = match fill {
-                super::Fill::Flood(_) => (6, separating::work_items(&mesh)),
-                super::Fill::DepthLayers(o) => {
-                    (6, o.directions as u64 + (b.max[0] - b.min[0] + 1) as u64)
-                }
-                super::Fill::Beam => (5, mesh.face_count() as u64),
-            };
-            let bytes = surface_bytes(surface, 0) + solid_bytes(cells(&padded(b, 2)), masks);
-            let p = plan(t, &mesh.bbox(), bytes, items);
-            (Loaded::Mesh(mesh), p)
-        }
-        Task::Measure { source, .. } => match source {
-            MeasureSource::Mesh(mesh) => {
-                let mesh = mesh.load(false)?;
-                let (t, b) = mesh_plan(&mesh, fit)?;
-                let surface = area_in_voxels(&mesh, &t);
-                let bytes = surface_bytes(surface, 0) + solid_bytes(cells(&padded(b, 2)), 6);
-                let p = plan(t, &mesh.bbox(), bytes, separating::work_items(&mesh));
-                (Loaded::Mesh(mesh), p)
-            }
-            MeasureSource::Vdb(path) => {
-                let grid = read_surface(path)?;
-                grid_plan(grid)
-            }
-            MeasureSource::Grid(grid) => grid_plan(grid.clone()),
-        },
+        Task::Solid { mesh, fill, .. } => solid_plan(mesh, fit, *fill)?,
+        // Measuring a mesh fills its flooded surface.
+        Task::Measure {
+            source: MeasureSource::Mesh(mesh),
+            flood,
+            ..
+        } => solid_plan(mesh, fit, super::Fill::Flood(*flood))?,
+        Task::Measure {
+            source: MeasureSource::Vdb(path),
+            ..
+        } => grid_plan(read_surface(path)?),
+        Task::Measure {
+            source: MeasureSource::Grid(grid),
+            ..
+        } => grid_plan(grid.clone()),
         Task::CsgTree(path) => {
             let tree = read_csg_tree(path)?;
             let (t, bounds) = tree.transform()?;
@@ -276,7 +255,7 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             // Two masks per node at most (its own and its result), and the result's boundary.
             let masks = 2 * tree.node_count() as u32 + 3;
             let bytes = solid_bytes(cells(&b), masks);
-            let p = plan(t, &bounds, bytes, tree.node_count() as u64);
+            let p = plan_of(t, &bounds, bytes, tree.node_count() as u64);
             (Loaded::Tree(Box::new(tree)), p)
         }
         Task::Combine {
@@ -301,10 +280,35 @@ pub(super) fn plan(job: &Job) -> Result<(Loaded, Plan)> {
             let leaves = ga.leaf_count() as f64 + second;
             let t = ga.transform;
             let bbox = world_box(&ga);
-            let p = plan(t, &bbox, leaf_bytes(leaves, 0), 1);
+            let p = plan_of(t, &bbox, leaf_bytes(leaves, 0), 1);
             (Loaded::Grids(ga, gb), p)
         }
     })
+}
+
+/// A plan over `bbox` on `transform` needing `bytes` besides the process itself.
+fn plan_of(transform: Transform, bbox: &Aabb, bytes: f64, work_items: u64) -> Plan {
+    Plan {
+        transform,
+        extent: extent(bbox, &transform),
+        estimated_bytes: (BASE_BYTES + bytes).min(u64::MAX as f64) as u64,
+        work_items,
+    }
+}
+
+/// Filling `mesh` by `fill`: its surface, the bit volumes over its box and the solid.
+fn solid_plan(mesh: &MeshSource, fit: GridFit, fill: super::Fill) -> Result<(Loaded, Plan)> {
+    let mesh = mesh.load(false)?;
+    let (t, b) = mesh_plan(&mesh, fit)?;
+    let (masks, items) = match fill {
+        super::Fill::Flood(_) => (6, separating::work_items(&mesh)),
+        super::Fill::DepthLayers(o) => (6, o.directions as u64 + (b.max[0] - b.min[0] + 1) as u64),
+        super::Fill::Beam => (5, mesh.face_count() as u64),
+    };
+    let bytes =
+        surface_bytes(area_in_voxels(&mesh, &t), 0) + solid_bytes(cells(&padded(b, 2)), masks);
+    let p = plan_of(t, &mesh.bbox(), bytes, items);
+    Ok((Loaded::Mesh(mesh), p))
 }
 
 /// The surface of a `.vdb` to measure: a solid's `boundary` when it is one, else `surface`.
@@ -312,12 +316,17 @@ fn read_surface(path: &std::path::Path) -> Result<SparseGrid> {
     read_vdb_grid(path, Some("boundary")).or_else(|_| read_vdb_grid(path, Some("surface")))
 }
 
-/// The world box of a grid's voxel centres (a point at the origin when it is empty).
-fn world_box(grid: &SparseGrid) -> Aabb {
-    let b = grid.bbox().unwrap_or(CoordBox {
+/// A grid's index box (the voxel at the origin when it is empty).
+fn grid_box(grid: &SparseGrid) -> CoordBox {
+    grid.bbox().unwrap_or(CoordBox {
         min: [0; 3],
         max: [0; 3],
-    });
+    })
+}
+
+/// The world box of a grid's voxel centres.
+fn world_box(grid: &SparseGrid) -> Aabb {
+    let b = grid_box(grid);
     Aabb {
         min: grid.transform.index_to_world(b.min),
         max: grid.transform.index_to_world(b.max),
@@ -326,17 +335,7 @@ fn world_box(grid: &SparseGrid) -> Aabb {
 
 /// Measuring a surface grid: its box filled.
 fn grid_plan(grid: SparseGrid) -> (Loaded, Plan) {
-    let b = grid.bbox().unwrap_or(CoordBox {
-        min: [0; 3],
-        max: [0; 3],
-    });
-    let bbox = world_box(&grid);
-    let t = grid.transform;
-    let plan = Plan {
-        transform: t,
-        extent: extent(&bbox, &t),
-        estimated_bytes: (BASE_BYTES + solid_bytes(cells(&padded(b, 2)), 6)) as u64,
-        work_items: 1,
-    };
-    (Loaded::Grid(grid), plan)
+    let bytes = solid_bytes(cells(&padded(grid_box(&grid), 2)), 6);
+    let p = plan_of(grid.transform, &world_box(&grid), bytes, 1);
+    (Loaded::Grid(grid), p)
 }

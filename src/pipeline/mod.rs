@@ -356,7 +356,7 @@ impl Job {
                 warnings.push(format!("{n} threads asked for; using {MAX_THREADS}"));
             }
         }
-        let (loaded, plan) = estimate::plan(&self)?;
+        let (loaded, plan) = estimate::plan_job(&self)?;
         let limit = self.limits.max_memory;
         crate::system::check_fits(
             plan.estimated_bytes,
