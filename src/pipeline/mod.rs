@@ -298,23 +298,32 @@ impl Shape {
 
 impl Task {
     /// The files the task reads (an output must not be one of them).
-    pub fn input_files(&self) -> Vec<PathBuf> {
-        let mesh = |m: &MeshSource| m.path().map(Path::to_path_buf).into_iter().collect();
+    /// The mesh a mesh-based task reads.
+    fn mesh(&self) -> Option<&MeshSource> {
         match self {
-            Task::MeshSurface { mesh: m, .. }
-            | Task::DistanceBand { mesh: m, .. }
-            | Task::Lines { mesh: m, .. }
-            | Task::Subdivision { mesh: m, .. }
-            | Task::Solid { mesh: m, .. } => mesh(m),
-            Task::Measure {
-                source: MeasureSource::Mesh(m),
+            Task::MeshSurface { mesh, .. }
+            | Task::DistanceBand { mesh, .. }
+            | Task::Lines { mesh, .. }
+            | Task::Subdivision { mesh, .. }
+            | Task::Solid { mesh, .. }
+            | Task::Measure {
+                source: MeasureSource::Mesh(mesh),
                 ..
-            } => mesh(m),
+            } => Some(mesh),
+            _ => None,
+        }
+    }
+
+    pub fn input_files(&self) -> Vec<PathBuf> {
+        if let Some(mesh) = self.mesh() {
+            return mesh.path().map(Path::to_path_buf).into_iter().collect();
+        }
+        match self {
             Task::Measure {
                 source: MeasureSource::Vdb(p),
                 ..
-            } => vec![p.clone()],
-            Task::CsgTree(p) => vec![p.clone()],
+            }
+            | Task::CsgTree(p) => vec![p.clone()],
             Task::Combine { a, b, .. } => [a, b]
                 .into_iter()
                 .filter_map(|g| match g {
@@ -322,12 +331,7 @@ impl Task {
                     GridSource::Grid(_) => None,
                 })
                 .collect(),
-            Task::Measure {
-                source: MeasureSource::Grid(_),
-                ..
-            }
-            | Task::Shape { .. }
-            | Task::Implicit { .. } => vec![],
+            _ => vec![],
         }
     }
 }
@@ -383,45 +387,25 @@ impl Job {
 
     /// The input in words: the file, or what the task makes.
     fn describe_input(&self) -> String {
-        match &self.task {
-            Task::Shape { shape, .. } => shape.describe(),
-            Task::Implicit { formula, .. } => formula.clone(),
-            Task::MeshSurface {
-                mesh: MeshSource::Mesh(m),
-                ..
-            }
-            | Task::Lines {
-                mesh: MeshSource::Mesh(m),
-                ..
-            }
-            | Task::DistanceBand {
-                mesh: MeshSource::Mesh(m),
-                ..
-            }
-            | Task::Subdivision {
-                mesh: MeshSource::Mesh(m),
-                ..
-            }
-            | Task::Solid {
-                mesh: MeshSource::Mesh(m),
-                ..
-            }
-            | Task::Measure {
-                source: MeasureSource::Mesh(MeshSource::Mesh(m)),
-                ..
-            } => m.source.display().to_string(),
-            Task::Combine { a, b, .. } => {
-                let name = |g: &GridSource| match g {
-                    GridSource::File(p) => p.display().to_string(),
-                    GridSource::Grid(_) => "a grid in memory".to_string(),
-                };
-                format!("{} {}", name(a), name(b))
-            }
-            Task::Measure {
-                source: MeasureSource::Grid(_),
-                ..
-            } => "a grid in memory".to_string(),
-            other => other
+        const IN_MEMORY: &str = "a grid in memory";
+        let grid = |g: &GridSource| match g {
+            GridSource::File(p) => p.display().to_string(),
+            GridSource::Grid(_) => IN_MEMORY.to_string(),
+        };
+        match (&self.task, self.task.mesh()) {
+            (_, Some(MeshSource::File(p))) => p.display().to_string(),
+            (_, Some(MeshSource::Mesh(m))) => m.source.display().to_string(),
+            (Task::Shape { shape, .. }, _) => shape.describe(),
+            (Task::Implicit { formula, .. }, _) => formula.clone(),
+            (Task::Combine { a, b, .. }, _) => format!("{} {}", grid(a), grid(b)),
+            (
+                Task::Measure {
+                    source: MeasureSource::Grid(_),
+                    ..
+                },
+                _,
+            ) => IN_MEMORY.to_string(),
+            (other, _) => other
                 .input_files()
                 .first()
                 .map(|p| p.display().to_string())
