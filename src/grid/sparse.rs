@@ -115,13 +115,41 @@ impl SparseGrid {
     /// Bounding box of the active voxels, `None` for an empty grid.
     pub fn bbox(&self) -> Option<CoordBox> {
         let mut b: Option<CoordBox> = None;
-        for leaf in self.leaves.iter().filter(|l| !l.is_empty()) {
-            // Only leaves on the current hull can move it; cheap enough to scan all voxels.
-            for c in leaf.coords() {
-                match b.as_mut() {
-                    Some(b) => b.expand(c),
-                    None => b = Some(CoordBox::point(c)),
+        for leaf in &self.leaves {
+            // A leaf's extent from its mask words: x by the non-empty words, y by the
+            // non-empty bytes of their union, z by the union of those bytes.
+            let Some(x0) = leaf.mask.iter().position(|&w| w != 0) else {
+                continue;
+            };
+            let x1 = leaf
+                .mask
+                .iter()
+                .rposition(|&w| w != 0)
+                .expect("a non-empty word");
+            let rows = leaf.mask.iter().fold(0u64, |a, &w| a | w);
+            let bytes = (0..8).map(|y| rows >> (8 * y) & 0xff);
+            let ys = bytes
+                .clone()
+                .enumerate()
+                .fold(0u64, |a, (y, r)| a | u64::from(r != 0) << y);
+            let zs = bytes.fold(0u64, |a, r| a | r);
+            let o = leaf.origin;
+            let lo = [
+                o[0] + x0 as i64,
+                o[1] + ys.trailing_zeros() as i64,
+                o[2] + zs.trailing_zeros() as i64,
+            ];
+            let hi = [
+                o[0] + x1 as i64,
+                o[1] + 63 - ys.leading_zeros() as i64,
+                o[2] + 63 - zs.leading_zeros() as i64,
+            ];
+            match b.as_mut() {
+                Some(b) => {
+                    b.expand(lo);
+                    b.expand(hi);
                 }
+                None => b = Some(CoordBox { min: lo, max: hi }),
             }
         }
         b
@@ -254,6 +282,23 @@ mod tests {
         let mut all: Vec<_> = g.voxels().collect();
         all.sort();
         assert_eq!(all, vec![[-100, 5, 3000], [0, 0, 0], [9, -3, 2]]);
+    }
+
+    #[test]
+    fn bbox_from_masks_equals_the_voxels_box() {
+        let mut rng = crate::random::SplitMix64(3);
+        for round in 0..50 {
+            let n = 1 + round % 9;
+            let pts: Vec<Coord> = (0..n)
+                .map(|_| [0, 1, 2].map(|_| rng.range(-40.0, 40.0).floor() as i64))
+                .collect();
+            let g = grid(&pts);
+            let mut expected = CoordBox::point(pts[0]);
+            for &p in &pts {
+                expected.expand(p);
+            }
+            assert_eq!(g.bbox(), Some(expected), "{pts:?}");
+        }
     }
 
     #[test]

@@ -45,30 +45,27 @@ fn flood_surface(mesh: &Mesh, t: Transform, progress: &Progress) -> Result<Spars
     Ok(voxelize_mesh(mesh, t, &options, progress)?.0)
 }
 
-/// Components (26-connected) and genus (components - Euler characteristic) of surface plus
-/// inside.
-fn topology(surface: &SparseGrid, inside: &SparseGrid) -> Result<(u64, i64)> {
-    let Some(bbox) = surface.bbox() else {
+/// Components (26-connected) and genus (components - Euler characteristic) of the whole
+/// solid, surface and inside.
+fn topology(whole: &SparseGrid) -> Result<(u64, i64)> {
+    let Some(bbox) = whole.bbox() else {
         return Ok((0, 0));
     };
-    let mut all = DenseMask::from_grid(surface, padded(bbox, 1))?;
-    all.combine_words(&DenseMask::from_grid(inside, padded(bbox, 1))?, |a, b| {
-        a | b
-    });
+    let all = DenseMask::from_grid(whole, padded(bbox, 1))?;
     let parts = components(&all, Adjacency::TwentySix);
     Ok((parts, parts as i64 - euler_characteristic(&all)))
 }
 
 /// The report of a surface and the solid inside it.
 fn solid_details(
-    surface: &SparseGrid,
+    whole: &SparseGrid,
     solid: &Solid,
     density: f64,
     rule: &str,
     mesh: Option<&Mesh>,
 ) -> Result<SolidDetails> {
     let m = solid.measures;
-    let (components, genus) = topology(surface, &solid.inside)?;
+    let (components, genus) = topology(whole)?;
     let (mass_inside, mass_with_surface) = m.mass(density);
     Ok(SolidDetails {
         inside_voxels: m.inside_voxels,
@@ -93,18 +90,20 @@ fn solid_details(
 
 /// A surface plus the voxels inside it: `surface` and `density` on both, `boundary` and
 /// `interior` apart.
+/// `describe` reports on the whole solid.
 fn surface_and_inside(
     surface: SparseGrid,
     solid: Solid,
     meta: Vec<(&str, String)>,
-    details: SolidDetails,
-) -> Outcome {
+    describe: impl FnOnce(&SparseGrid, &Solid) -> Result<SolidDetails>,
+) -> Result<Outcome> {
     let mut whole = SparseGrid::new(surface.transform, Channels::NONE);
     whole.union(&surface);
     whole.union(&solid.inside);
-    Outcome::new(whole, meta, Details::Solid(details))
+    let details = describe(&whole, &solid)?;
+    Ok(Outcome::new(whole, meta, Details::Solid(details))
         .with("boundary", surface)
-        .with("interior", solid.inside)
+        .with("interior", solid.inside))
 }
 
 /// A solid classified at voxel centres: `boundary` (voxels with a face towards the
@@ -143,16 +142,18 @@ pub(super) fn mesh_solid(
         Fill::Flood(flood) => {
             let surface = flood_surface(mesh, t, progress)?;
             let solid = solid_from_surface(&surface, flood, progress)?;
-            let details = solid_details(&surface, &solid, density, FLOOD_RULE, Some(mesh))?;
             let method = meta("huang-26-separating-surface+exterior-flood");
-            surface_and_inside(surface, solid, method, details)
+            surface_and_inside(surface, solid, method, |whole, solid| {
+                solid_details(whole, solid, density, FLOOD_RULE, Some(mesh))
+            })?
         }
         Fill::Beam => {
             let (surface, solid, _) = beam_solid(mesh, t, progress)?;
-            let details = solid_details(&surface, &solid, density, BEAM_RULE, Some(mesh))?;
             let mut method = meta("projective-beam");
             method.push(("color", "none".into()));
-            surface_and_inside(surface, solid, method, details)
+            surface_and_inside(surface, solid, method, |whole, solid| {
+                solid_details(whole, solid, density, BEAM_RULE, Some(mesh))
+            })?
         }
         Fill::DepthLayers(options) => {
             let edges = mesh.edge_counts();
@@ -267,8 +268,6 @@ pub(super) fn measure_mesh(
     let start = Instant::now();
     let surface = flood_surface(mesh, t, progress)?;
     let solid = solid_from_surface(&surface, flood, progress)?;
-    let mut details = solid_details(&surface, &solid, density, FLOOD_RULE, Some(mesh))?;
-    details.mesh_area = Some(mesh.area());
     let meta = vec![
         (
             "method",
@@ -276,7 +275,14 @@ pub(super) fn measure_mesh(
         ),
         ("source_file", mesh.source.display().to_string()),
     ];
-    Ok(surface_and_inside(surface, solid, meta, details).timed(start))
+    let outcome = surface_and_inside(surface, solid, meta, |whole, solid| {
+        let details = solid_details(whole, solid, density, FLOOD_RULE, Some(mesh))?;
+        Ok(SolidDetails {
+            mesh_area: Some(mesh.area()),
+            ..details
+        })
+    })?;
+    Ok(outcome.timed(start))
 }
 
 pub(super) fn measure_surface(
@@ -289,12 +295,14 @@ pub(super) fn measure_surface(
     let start = Instant::now();
     let solid = solid_from_surface(surface, flood, progress)?;
     progress.advance(1);
-    let details = solid_details(surface, &solid, density, FLOOD_RULE, None)?;
     let meta = vec![
         ("method", "exterior-flood".to_string()),
         ("source_file", source.to_string()),
     ];
-    Ok(surface_and_inside(surface.clone(), solid, meta, details).timed(start))
+    let outcome = surface_and_inside(surface.clone(), solid, meta, |whole, solid| {
+        solid_details(whole, solid, density, FLOOD_RULE, None)
+    })?;
+    Ok(outcome.timed(start))
 }
 
 pub(super) fn csg_tree(tree: &CsgTree, progress: &Progress) -> Result<Outcome> {
