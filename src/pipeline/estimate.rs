@@ -163,6 +163,15 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             let p = plan_of(t, &mesh.bbox(), bytes, mesh.face_count() as u64);
             (Loaded::Mesh(mesh), p)
         }
+        Task::SeparationCheck { mesh, options } => {
+            let mesh = mesh.load(false)?;
+            let (t, b) = mesh_plan(&mesh, fit)?;
+            // Four bit volumes over the box: surface, inside centres, flood, minimality.
+            let bytes = surface_bytes(area_in_voxels(&mesh, &t), u32::from(options.normals))
+                + 4.0 * cells(&padded(b, 3)) / 8.0;
+            let p = plan_of(t, &mesh.bbox(), bytes, separating::work_items(&mesh));
+            (Loaded::Mesh(mesh), p)
+        }
         Task::Lines { mesh, edges, color } => {
             let mesh = mesh.load(true)?;
             let (t, _) = mesh_plan(&mesh, fit)?;

@@ -105,6 +105,12 @@ pub enum Task {
         mesh: MeshSource,
         method: SurfaceMethod,
     },
+    /// The separating surface of a closed mesh, checked: the inside centres an exterior flood
+    /// reaches through it (none when it separates) and its simple (removable) voxels.
+    SeparationCheck {
+        mesh: MeshSource,
+        options: SeparatingOptions,
+    },
     /// Polylines (OBJ `l`) and, with `edges` or when there are none, the faces' edges.
     Lines {
         mesh: MeshSource,
@@ -302,6 +308,7 @@ impl Task {
     fn mesh(&self) -> Option<&MeshSource> {
         match self {
             Task::MeshSurface { mesh, .. }
+            | Task::SeparationCheck { mesh, .. }
             | Task::DistanceBand { mesh, .. }
             | Task::Lines { mesh, .. }
             | Task::Subdivision { mesh, .. }
@@ -455,9 +462,10 @@ impl PlannedJob {
 
     fn stage_name(&self) -> &'static str {
         match &self.job.task {
-            Task::MeshSurface { .. } | Task::Shape { .. } | Task::Subdivision { .. } => {
-                "voxelizing"
-            }
+            Task::MeshSurface { .. }
+            | Task::SeparationCheck { .. }
+            | Task::Shape { .. }
+            | Task::Subdivision { .. } => "voxelizing",
             Task::Lines { .. } => "lines",
             Task::DistanceBand { .. } => "distances",
             Task::Implicit { .. } => "octree",
@@ -473,6 +481,9 @@ impl PlannedJob {
         match (&self.job.task, &self.loaded) {
             (Task::MeshSurface { method, .. }, Loaded::Mesh(mesh)) => {
                 outcome::mesh_surface(mesh, t, *method, &fit, progress)
+            }
+            (Task::SeparationCheck { options, .. }, Loaded::Mesh(mesh)) => {
+                outcome::separation_check(mesh, t, *options, &fit, progress)
             }
             (Task::Lines { edges, color, .. }, Loaded::Mesh(mesh)) => {
                 let source = lines_source(mesh, *edges);

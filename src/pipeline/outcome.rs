@@ -2,7 +2,8 @@
 //! the report; and the surface tasks that make them.
 
 use super::report::{
-    Details, ImplicitDetails, ProjectiveDetails, Report, SeparatingClasses, SubdivisionDetails,
+    Details, ImplicitDetails, ProjectiveDetails, Report, SeparatingClasses, SeparationCheckDetails,
+    SubdivisionDetails,
 };
 use super::{Shape, SurfaceMethod};
 use crate::error::{Error, Result};
@@ -12,13 +13,15 @@ use crate::io::atomic::check_output;
 use crate::io::vdb::{DistanceGrid, WriteOptions, write_distance_band, write_vdb_as};
 use crate::mesh::Mesh;
 use crate::ops::csg::{BooleanOp, combine as combine_grids};
+use crate::ops::minimality::simple_voxel_count;
+use crate::ops::separability::check_mesh_separation;
 use crate::progress::Progress;
 use crate::subd::ControlMesh;
 use crate::voxelize::Separability;
 use crate::voxelize::interval_octree::{OctreeOptions, voxelize_implicit};
 use crate::voxelize::parametric::{ParametricOptions, voxelize_subdivision};
 use crate::voxelize::projective::{self, Coloring, LineSource};
-use crate::voxelize::separating::{Criterion, voxelize_mesh};
+use crate::voxelize::separating::{Criterion, SeparatingOptions, voxelize_mesh};
 use crate::voxelize::separating_analytic::voxelize_surface;
 use glam::DVec3;
 use std::path::Path;
@@ -232,6 +235,36 @@ pub(super) fn mesh_surface(
             Ok(projective_outcome(grid, meta, &s, coloring).timed(start))
         }
     }
+}
+
+pub(super) fn separation_check(
+    mesh: &Mesh,
+    t: Transform,
+    options: SeparatingOptions,
+    resolution: &str,
+    progress: &Progress,
+) -> Result<Outcome> {
+    let mut outcome = mesh_surface(
+        mesh,
+        t,
+        SurfaceMethod::Separating(options),
+        resolution,
+        progress,
+    )?;
+    let adjacency = options.separability.flood_adjacency();
+    let found = check_mesh_separation(&outcome.grid, mesh, adjacency)?;
+    let simple = simple_voxel_count(&outcome.grid, adjacency)?;
+    outcome.report.details = Details::SeparationCheck(SeparationCheckDetails {
+        separability: options.separability.adjacency(),
+        inside_centres: found.inside_centres,
+        exterior_voxels: found.exterior,
+        leaked: found.leaked,
+        first_leak: found.first_leak,
+        simple_voxels: simple,
+        simple_share: simple as f64 / outcome.grid.voxel_count().max(1) as f64,
+        resolution: resolution.to_string(),
+    });
+    Ok(outcome)
 }
 
 pub(super) fn lines(

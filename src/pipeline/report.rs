@@ -45,6 +45,7 @@ pub enum Details {
         classes: SeparatingClasses,
     },
     Projective(ProjectiveDetails),
+    SeparationCheck(SeparationCheckDetails),
     Shape {
         shape: String,
         separability: u32,
@@ -68,6 +69,24 @@ pub struct SeparatingClasses {
     pub vertices: u64,
     /// Faces without area (or with a repeated vertex), voxelized by their edges only.
     pub degenerate_faces: u64,
+}
+
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct SeparationCheckDetails {
+    pub separability: u32,
+    /// Voxel centres inside the mesh (by ray parity), the empty voxels the exterior flood
+    /// reached, and the inside centres among them: zero for a separating surface.
+    pub inside_centres: u64,
+    pub exterior_voxels: u64,
+    pub leaked: u64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub first_leak: Option<[i64; 3]>,
+    /// Surface voxels whose removal changes no topology (Huang et al.'s minimality).
+    pub simple_voxels: u64,
+    pub simple_share: f64,
+    /// The resolution, for the summary.
+    #[serde(skip)]
+    pub resolution: String,
 }
 
 #[derive(Serialize, Debug, Clone, Default)]
@@ -250,6 +269,23 @@ impl Report {
                     self.voxels, self.leaves, p.color, self.voxel_size
                 )
             }
+            Details::SeparationCheck(c) => format!(
+                "{} at {}: {} voxels, {}-separating: exterior flood ({}-connected) reached {} inside voxels of {} ({}); {} simple voxels ({:.2}%)",
+                self.input,
+                c.resolution,
+                self.voxels,
+                c.separability,
+                c.separability,
+                c.leaked,
+                c.inside_centres,
+                if c.leaked == 0 {
+                    "separating"
+                } else {
+                    "NOT separating"
+                },
+                c.simple_voxels,
+                100.0 * c.simple_share
+            ),
             Details::Shape {
                 shape,
                 separability,

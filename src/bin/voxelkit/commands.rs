@@ -1,16 +1,15 @@
 //! The subcommands other than `bench`: each is arguments -> `Job` -> report.
 
-use crate::run::{Global, plan, run_and_report, run_job, run_planned};
+use crate::run::{Global, run_and_report, run_job};
 use crate::{FitArgs, SurfaceArgs};
 use clap::{Args, Subcommand};
 use glam::DVec3;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use voxelkit::io::vdb::read_vdb_info;
-use voxelkit::mesh::{GridFit, Mesh, generate};
-use voxelkit::ops::minimality::simple_voxel_count;
+use voxelkit::mesh::{GridFit, generate};
 use voxelkit::ops::separability::check_mesh_separation;
-use voxelkit::pipeline::{Job, MeshSource, Shape, SurfaceMethod, Task};
+use voxelkit::pipeline::{Details, Job, MeshSource, Shape, SurfaceMethod, Task};
 use voxelkit::shapes::{Cylinder, Quadric, Sphere};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{Criterion, SeparatingOptions};
@@ -305,91 +304,33 @@ pub fn info(file: &Path, global: &Global) -> Result<()> {
     Ok(())
 }
 
-/// What `voxelkit check` found.
-#[derive(Serialize)]
-struct CheckReport {
-    input: String,
-    separability: u32,
-    voxels: u64,
-    /// Voxel centres inside the mesh (by ray parity), and how many the exterior flood reached.
-    inside_centres: u64,
-    exterior_voxels: u64,
-    leaked: u64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    first_leak: Option<[i64; 3]>,
-    /// Surface voxels whose removal changes no topology (Huang et al.'s minimality).
-    simple_voxels: u64,
-    simple_share: f64,
-    voxelize_seconds: f64,
-}
-
 pub fn check(input: &Path, fit: FitArgs, surface: SurfaceArgs, global: &Global) -> Result<()> {
-    let start = std::time::Instant::now();
-    // Read once: the job voxelizes the mesh, the checks then flood around it.
-    let mesh = Mesh::load(input)?;
-    let planned = plan(
-        surface_job(MeshSource::Mesh(mesh.clone()), fit, surface),
-        global,
-    )?;
-    // The checks hold four bit volumes over the surface's box besides the surface itself.
-    let plan = *planned.plan();
-    let cells: f64 = plan.extent.iter().map(|e| e + 6.0).product();
-    voxelkit::system::check_fits(
-        plan.estimated_bytes + (4.0 * cells / 8.0) as u64,
-        global.limits().max_memory,
-        &format!(
-            "{} at {} voxels, with the flood checks; lower the resolution",
-            input.display(),
-            plan.describe_extent()
-        ),
-    )?;
-    let outcome = run_planned(planned, None, global, start)?;
-    let grid = &outcome.grid;
-    let adjacency = surface.separability.flood_adjacency();
-    let found = check_mesh_separation(grid, &mesh, adjacency)?;
-    let simple = simple_voxel_count(grid, adjacency)?;
-    let report = CheckReport {
-        input: input.display().to_string(),
-        separability: surface.separability.adjacency(),
-        voxels: grid.voxel_count(),
-        inside_centres: found.inside_centres,
-        exterior_voxels: found.exterior,
-        leaked: found.leaked,
-        first_leak: found.first_leak,
-        simple_voxels: simple,
-        simple_share: simple as f64 / grid.voxel_count().max(1) as f64,
-        voxelize_seconds: outcome.report.voxelize_seconds,
+    let task = Task::SeparationCheck {
+        mesh: MeshSource::File(input.to_path_buf()),
+        options: surface.separating(),
     };
-    if global.json {
-        println!("{}", serde_json::to_string(&report).expect("serializable"));
-    } else {
-        println!(
-            "{} at {}: {} voxels, {}-separating: exterior flood ({}-connected) reached {} inside voxels of {} ({}); {} simple voxels ({:.2}%)",
-            report.input,
-            fit.grid_fit().describe(),
-            report.voxels,
-            report.separability,
-            adjacency.number(),
-            report.leaked,
-            report.inside_centres,
-            if found.separates() {
-                "separating"
-            } else {
-                "NOT separating"
-            },
-            simple,
-            100.0 * report.simple_share
-        );
-    }
-    match found.first_leak {
-        None => Ok(()),
-        Some(v) => Err(Error::Unsupported(format!(
-            "{}: the surface leaks: the exterior flood reaches the inside voxel ({}, {}, {})",
-            input.display(),
-            v[0],
-            v[1],
-            v[2]
-        ))),
+    let outcome = run_job(Job::new(task, fit.grid_fit()), None, global)?;
+    let report = &outcome.report;
+    println!(
+        "{}",
+        if global.json {
+            report.to_json()
+        } else {
+            report.summary()
+        }
+    );
+    match &report.details {
+        Details::SeparationCheck(c) if c.leaked > 0 => {
+            let v = c.first_leak.unwrap_or_default();
+            Err(Error::Unsupported(format!(
+                "{}: the surface leaks: the exterior flood reaches the inside voxel ({}, {}, {})",
+                input.display(),
+                v[0],
+                v[1],
+                v[2]
+            )))
+        }
+        _ => Ok(()),
     }
 }
 

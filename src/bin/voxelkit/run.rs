@@ -9,7 +9,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 use voxelkit::Result;
 use voxelkit::io::vdb::{WriteOptions, check_voxel_size};
-use voxelkit::pipeline::{Job, Limits, Outcome, PlannedJob, check_output_path};
+use voxelkit::pipeline::{Job, Limits, Outcome, check_output_path};
 use voxelkit::progress::Observer;
 
 /// What every command shares: threads, memory limit, output style.
@@ -74,29 +74,15 @@ impl Observer for Bars {
     }
 }
 
-/// Plans `job` with the command line's limits.
-pub fn plan(job: Job, global: &Global) -> Result<PlannedJob> {
-    Job {
-        limits: global.limits(),
-        ..job
-    }
-    .plan()
-}
-
 /// Plans `job`, refuses an `output` that cannot be written (or is an input) before any
 /// work, runs it, writes the outcome to `output` and returns it with the whole run timed.
 pub fn run_job(job: Job, output: Option<&Path>, global: &Global) -> Result<Outcome> {
     let start = Instant::now();
-    run_planned(plan(job, global)?, output, global, start)
-}
-
-/// `run_job` for a job already planned; `start` is when the command began.
-pub fn run_planned(
-    planned: PlannedJob,
-    output: Option<&Path>,
-    global: &Global,
-    start: Instant,
-) -> Result<Outcome> {
+    let planned = Job {
+        limits: global.limits(),
+        ..job
+    }
+    .plan()?;
     let inputs = planned.input_files();
     let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
     if let Some(out) = output {
