@@ -1,5 +1,5 @@
 // OpenVDB side of the bridge: builds LeafNodes from bulk leaf arrays in parallel, writes and
-// reads .vdb files, and runs tools::meshToVolume for benchmarks. Every exception becomes a
+// reads .vdb files, and runs OpenVDB's own mesh conversions for benchmarks. Every exception becomes a
 // Rust Err through cxx (see the trycatch override in vdb_bridge.h).
 #include "voxelkit/cpp/vdb_bridge.h"
 #include "voxelkit/src/ffi/vdb.rs.h"
@@ -11,6 +11,7 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <algorithm>
+#include <limits>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -70,7 +71,8 @@ std::unique_ptr<VdbWriter> new_vdb_writer() {
 
 void VdbWriter::add_grid(rust::Str kind, rust::Str name, double voxel_size, std::array<double, 3> origin,
                          rust::Slice<const int32_t> leaf_origins, rust::Slice<const uint64_t> masks,
-                         rust::Slice<const float> values, rust::Slice<const MetaEntry> metadata) {
+                         rust::Slice<const float> values, rust::Slice<const int32_t> leaf_tiles,
+                         rust::Slice<const int32_t> node_tiles, rust::Slice<const MetaEntry> metadata) {
     const std::string k(kind);
     const size_t count = leaf_origins.size() / 3;
     openvdb::GridBase::Ptr grid;
@@ -99,6 +101,20 @@ void VdbWriter::add_grid(rust::Str kind, rust::Str name, double voxel_size, std:
     } else {
         throw std::invalid_argument("unknown grid kind " + k);
     }
+    // Whole blocks as active tiles: level 1 holds 8^3, level 2 holds 128^3.
+    auto add_tiles = [&](auto& typed, typename std::decay_t<decltype(typed)>::ValueType on) {
+        if (leaf_tiles.size() % 3 != 0 || node_tiles.size() % 3 != 0)
+            throw std::invalid_argument("tile origins of inconsistent length");
+        auto& tree = typed.tree();
+        for (size_t i = 0; i < leaf_tiles.size(); i += 3)
+            tree.addTile(1, openvdb::Coord(leaf_tiles[i], leaf_tiles[i + 1], leaf_tiles[i + 2]), on, true);
+        for (size_t i = 0; i < node_tiles.size(); i += 3)
+            tree.addTile(2, openvdb::Coord(node_tiles[i], node_tiles[i + 1], node_tiles[i + 2]), on, true);
+    };
+    if (auto b = openvdb::gridPtrCast<openvdb::BoolGrid>(grid)) add_tiles(*b, true);
+    else if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(grid)) add_tiles(*f, 1.0f);
+    else if (!leaf_tiles.empty() || !node_tiles.empty())
+        throw std::invalid_argument(k + " grid: tiles carry no " + k);
     grid->setName(std::string(name));
     grid->setTransform(make_transform(voxel_size, origin));
     for (const auto& m : metadata)
@@ -244,7 +260,15 @@ GridInfo VdbFile::grid_info(size_t index) const {
         if (it->first.rfind("file_", 0) == 0) continue;  // OpenVDB's own bookkeeping
         info.metadata.push_back(MetaEntry{rust::String(it->first), rust::String(it->second->str())});
     }
-    auto count_leaves = [&](auto typed) { info.leaf_count = typed->tree().leafCount(); };
+    info.tile_count = 0;
+    auto count_leaves = [&](auto typed) {
+        info.leaf_count = typed->tree().leafCount();
+        for (auto it = typed->tree().cbeginValueOn(); it; ++it) {
+            if (it.isVoxelValue()) continue;
+            const auto dim = it.getBoundingBox().dim().x();
+            info.tile_count += dim <= 128 ? 1 : uint64_t(dim / 128) * (dim / 128) * (dim / 128);
+        }
+    };
     if (auto b = openvdb::gridConstPtrCast<openvdb::BoolGrid>(g)) count_leaves(b);
     else if (auto m = openvdb::gridConstPtrCast<openvdb::MaskGrid>(g)) count_leaves(m);
     else if (auto f = openvdb::gridConstPtrCast<openvdb::FloatGrid>(g)) count_leaves(f);
@@ -255,9 +279,8 @@ GridInfo VdbFile::grid_info(size_t index) const {
 namespace {
 template <typename GridT>
 void copy_leaves(const GridT& src, rust::Vec<int32_t>& origins, rust::Vec<uint64_t>& masks,
-                 rust::Vec<float>* values) {
-    typename GridT::TreeType tree(src.tree());  // tiles become leaves on a copy, never on the file's grid
-    tree.voxelizeActiveTiles();
+                 rust::Vec<float>* values, rust::Vec<int32_t>& tiles) {
+    const auto& tree = src.tree();
     for (auto it = tree.cbeginLeaf(); it; ++it) {
         const auto& mask = it->getValueMask();
         if (mask.isOff()) continue;
@@ -270,32 +293,70 @@ void copy_leaves(const GridT& src, rust::Vec<int32_t>& origins, rust::Vec<uint64
             for (openvdb::Index n = 0; n < 512; ++n) values->push_back(float(it->getValue(n)));
         }
     }
+    auto push_tile = [&](const openvdb::Coord& o, int32_t edge) {
+        tiles.push_back(o.x());
+        tiles.push_back(o.y());
+        tiles.push_back(o.z());
+        tiles.push_back(edge);
+    };
+    for (auto it = tree.cbeginValueOn(); it; ++it) {
+        if (it.isVoxelValue()) continue;
+        const auto box = it.getBoundingBox();
+        const int32_t edge = box.dim().x();
+        if (edge <= 128) {
+            push_tile(box.min(), edge);
+            continue;
+        }
+        // A root tile (4096^3): its 128^3 blocks.
+        for (int32_t x = 0; x < edge; x += 128)
+            for (int32_t y = 0; y < edge; y += 128)
+                for (int32_t z = 0; z < edge; z += 128) push_tile(box.min().offsetBy(x, y, z), 128);
+    }
 }
 }  // namespace
 
 void VdbFile::read_leaves(size_t index, rust::Vec<int32_t>& leaf_origins, rust::Vec<uint64_t>& masks,
-                          rust::Vec<float>& values) const {
+                          rust::Vec<float>& values, rust::Vec<int32_t>& tiles) const {
     auto g = grid(index);
-    if (auto b = openvdb::gridConstPtrCast<openvdb::BoolGrid>(g)) copy_leaves(*b, leaf_origins, masks, nullptr);
-    else if (auto m = openvdb::gridConstPtrCast<openvdb::MaskGrid>(g)) copy_leaves(*m, leaf_origins, masks, nullptr);
-    else if (auto f = openvdb::gridConstPtrCast<openvdb::FloatGrid>(g)) copy_leaves(*f, leaf_origins, masks, &values);
+    if (auto b = openvdb::gridConstPtrCast<openvdb::BoolGrid>(g)) copy_leaves(*b, leaf_origins, masks, nullptr, tiles);
+    else if (auto m = openvdb::gridConstPtrCast<openvdb::MaskGrid>(g))
+        copy_leaves(*m, leaf_origins, masks, nullptr, tiles);
+    else if (auto f = openvdb::gridConstPtrCast<openvdb::FloatGrid>(g))
+        copy_leaves(*f, leaf_origins, masks, &values, tiles);
     else throw std::invalid_argument("grid '" + g->getName() + "' has value type " + g->valueType() +
                                      "; only bool, mask and float grids can be read");
 }
 
-uint64_t openvdb_mesh_to_volume(rust::Slice<const float> points, rust::Slice<const uint32_t> triangles,
-                                double voxel_size, float exterior_band, float interior_band, size_t threads) {
+uint64_t openvdb_reference(rust::Str kind, rust::Slice<const float> points, rust::Slice<const uint32_t> triangles,
+                           double voxel_size, float band, size_t threads) {
     ensure_initialized();
+    const std::string k(kind);
     std::vector<openvdb::Vec3s> pts(points.size() / 3);
     for (size_t i = 0; i < pts.size(); ++i) pts[i] = openvdb::Vec3s(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
     std::vector<openvdb::Vec3I> tris(triangles.size() / 3);
     for (size_t i = 0; i < tris.size(); ++i)
         tris[i] = openvdb::Vec3I(triangles[3 * i], triangles[3 * i + 1], triangles[3 * i + 2]);
+    const std::vector<openvdb::Vec4I> no_quads;
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     auto xform = openvdb::math::Transform::createLinearTransform(voxel_size);
-    openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> mesh(pts, tris);
-    auto grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(mesh, *xform, exterior_band, interior_band);
-    return grid->activeVoxelCount();
+    // meshToVolume reads index space; the other two take world points, as a user calls them.
+    std::vector<openvdb::Vec3s> world(pts);
+    for (auto& p : world) p *= float(voxel_size);
+    if (k == "unsigned") {
+        return openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*xform, world, tris, no_quads, band)
+            ->activeVoxelCount();
+    }
+    if (k == "level-set" || k == "solid") {
+        auto sdf = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xform, world, tris, no_quads, band);
+        if (k == "level-set") return sdf->activeVoxelCount();
+        return openvdb::tools::sdfInteriorMask(*sdf)->activeVoxelCount();
+    }
+    if (k == "filled") {
+        openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> mesh(pts, tris);
+        return openvdb::tools::meshToVolume<openvdb::FloatGrid>(mesh, *xform, band, std::numeric_limits<float>::max())
+            ->activeVoxelCount();
+    }
+    throw std::invalid_argument("unknown reference " + k);
 }
 
 }  // namespace voxelkit

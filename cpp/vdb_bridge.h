@@ -1,4 +1,4 @@
-// The C++ half of src/ffi/vdb.rs: OpenVDB file I/O and meshToVolume for benchmarks.
+// The C++ half of src/ffi/vdb.rs: OpenVDB file I/O and OpenVDB's own mesh conversions for benchmarks.
 #pragma once
 #include "rust/cxx.h"
 #include "voxelkit/cpp/trycatch.h"
@@ -14,7 +14,8 @@ class VdbWriter {
 public:
     void add_grid(rust::Str kind, rust::Str name, double voxel_size, std::array<double, 3> origin,
                   rust::Slice<const int32_t> leaf_origins, rust::Slice<const uint64_t> masks,
-                  rust::Slice<const float> values, rust::Slice<const MetaEntry> metadata);
+                  rust::Slice<const float> values, rust::Slice<const int32_t> leaf_tiles,
+                  rust::Slice<const int32_t> node_tiles, rust::Slice<const MetaEntry> metadata);
     void add_level_set(rust::Str name, rust::Str density_name, double voxel_size, std::array<double, 3> origin,
                        rust::Slice<const int32_t> leaf_origins, rust::Slice<const uint64_t> masks,
                        rust::Slice<const float> values, float background, bool is_signed,
@@ -31,7 +32,7 @@ public:
     size_t grid_count() const;
     GridInfo grid_info(size_t index) const;
     void read_leaves(size_t index, rust::Vec<int32_t>& leaf_origins, rust::Vec<uint64_t>& masks,
-                     rust::Vec<float>& values) const;
+                     rust::Vec<float>& values, rust::Vec<int32_t>& tiles) const;
 
 private:
     openvdb::GridBase::ConstPtr grid(size_t index) const;
@@ -41,8 +42,8 @@ private:
 std::unique_ptr<VdbWriter> new_vdb_writer();
 std::unique_ptr<VdbFile> open_vdb(rust::Str path);
 double openvdb_level_set_volume(rust::Str path, rust::Str name);
-uint64_t openvdb_mesh_to_volume(rust::Slice<const float> points, rust::Slice<const uint32_t> triangles,
-                                double voxel_size, float exterior_band, float interior_band, size_t threads);
+uint64_t openvdb_reference(rust::Str kind, rust::Slice<const float> points, rust::Slice<const uint32_t> triangles,
+                           double voxel_size, float band, size_t threads);
 
 }  // namespace voxelkit
 

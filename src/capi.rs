@@ -128,7 +128,7 @@ impl Default for Options {
             normals: false,
             surface: SurfaceMethod::Separating,
             fill: FillMethod::Flood,
-            flood: FloodMethod::Spans,
+            flood: FloodMethod::Blocks,
             depth: ALL_DIRECTIONS,
             subdivision: ParametricOptions::default(),
             threads: 0,
@@ -740,7 +740,7 @@ pub extern "C" fn vk_options_set_flood(
                 capacity: graystack.max(1),
             }
         } else {
-            FloodMethod::Spans
+            FloodMethod::Blocks
         };
         Ok(())
     })
@@ -977,7 +977,7 @@ pub extern "C" fn vk_measure_surface(
         non_null_out(measures)?;
         let task = Task::Measure {
             source: MeasureSource::Grid(g.clone()),
-            flood: FloodMethod::Spans,
+            flood: FloodMethod::Blocks,
             density: 1.0,
         };
         let outcome = run_job(&Options::default(), task)?;
@@ -1005,7 +1005,7 @@ pub extern "C" fn vk_grid_combine(
         let task = Task::Combine {
             a: GridSource::Grid(a.clone()),
             b: GridSource::Grid(b.clone()),
-            grid: "surface".into(),
+            grid: None,
             op,
             resample: resample != 0,
             curve: false,

@@ -1,11 +1,11 @@
 //! Blender opens what voxelkit writes: a headless Blender imports the .vdb as a volume
-//! object and loads the `density`, `surface` and `normal` grids at the right place, and the
-//! `density` and level-set `surface` of `--sdf`.
+//! object and loads the `density`, `voxels` and `normal` grids at the right place, the
+//! `density` and level-set `surface` of `--sdf`, and a solid's tiles; `density` comes first.
 //! Skipped (loudly) where Blender is not installed, outside CI; CI installs it.
 #![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 use std::process::Command;
-use voxelkit::io::vdb::write_vdb;
+use voxelkit::io::vdb::{WriteOptions, write_vdb_as};
 use voxelkit::mesh::generate;
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::SeparatingOptions;
@@ -26,30 +26,20 @@ fn blender_imports_the_volume() {
     let (grid, _) = common::voxelize_at(&mesh, 64, opts);
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("torus.vdb");
-    write_vdb(&path, &grid, &[]).unwrap();
-    let script = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/blender/inspect_volume.py"
-    );
-    let out = Command::new("blender")
-        .args([
-            "-b",
-            "--factory-startup",
-            "--python",
-            script,
-            "--",
-            path.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
+    let options = WriteOptions {
+        grids: vec!["density".into(), "voxels".into(), "normal".into()],
+        ..Default::default()
+    };
+    write_vdb_as(&path, &grid, &[], &[], &options).unwrap();
+    let text = blender_grids(&path);
     for g in [
         "GRID density FLOAT True",
-        "GRID surface BOOLEAN True",
+        "GRID voxels BOOLEAN True",
         "GRID normal VECTOR_FLOAT True",
     ] {
         assert!(text.contains(g), "`{g}` missing: {text}");
     }
+    assert_first_grid_is_density(&text);
     // BOUNDS (x0, y0, z0) (x1, y1, z1): Blender bounds a volume by the voxel centres of whole
     // 8^3 leaves, so the box holds the active centres and reaches at most a leaf beyond.
     let line = text
@@ -82,13 +72,51 @@ fn blender_imports_the_level_set() {
         return common::skip_or_fail("blender is not installed: the Blender level-set test");
     }
     let dir = tempfile::tempdir().unwrap();
-    let obj = dir.path().join("torus.obj");
+    let path = voxelkit_on_a_torus(dir.path(), &["mesh", "--sdf", "-r", "64"]);
+    let text = blender_grids(&path);
+    for g in ["GRID density FLOAT True", "GRID surface FLOAT True"] {
+        assert!(text.contains(g), "`{g}` missing: {text}");
+    }
+    assert_first_grid_is_density(&text);
+}
+
+#[test]
+fn blender_imports_a_solid_with_tiles() {
+    if Command::new("blender").arg("--version").output().is_err() {
+        return common::skip_or_fail("blender is not installed: the Blender solid test");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = voxelkit_on_a_torus(dir.path(), &["solid", "-r", "200"]);
+    let info = voxelkit::io::vdb::read_vdb_info(&path).unwrap();
+    let density = info.iter().find(|g| g.name == "density").unwrap();
+    assert!(
+        density.tile_count > 0,
+        "the solid's inside has whole blocks"
+    );
+    let text = blender_grids(&path);
+    for g in [
+        "GRID density FLOAT True",
+        "GRID shell BOOLEAN True",
+        "GRID interior BOOLEAN True",
+    ] {
+        assert!(text.contains(g), "`{g}` missing: {text}");
+    }
+    assert_first_grid_is_density(&text);
+}
+
+/// Runs `voxelkit COMMAND torus.obj OPTIONS -o out.vdb` (`args` = command then options) on a
+/// generated torus in `dir`; returns the output.
+fn voxelkit_on_a_torus(dir: &std::path::Path, args: &[&str]) -> std::path::PathBuf {
+    let obj = dir.join("torus.obj");
     generate::torus(glam::DVec3::ZERO, 1.0, 0.3, 64, 16)
         .write_obj(&obj)
         .unwrap();
-    let path = dir.path().join("torus-sdf.vdb");
+    let path = dir.join("torus.vdb");
     let made = Command::new(env!("CARGO_BIN_EXE_voxelkit"))
-        .args(["mesh", obj.to_str().unwrap(), "--sdf", "-r", "64", "-o"])
+        .arg(args[0])
+        .arg(&obj)
+        .args(&args[1..])
+        .arg("-o")
         .arg(&path)
         .output()
         .unwrap();
@@ -97,17 +125,25 @@ fn blender_imports_the_level_set() {
         "{}",
         String::from_utf8_lossy(&made.stderr)
     );
+    path
+}
+
+/// What headless Blender prints after importing `path` as a volume object.
+fn blender_grids(path: &std::path::Path) -> String {
     let script = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/tests/blender/inspect_volume.py"
     );
     let out = Command::new("blender")
         .args(["-b", "--factory-startup", "--python", script, "--"])
-        .arg(&path)
+        .arg(path)
         .output()
         .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    for g in ["GRID density FLOAT True", "GRID surface FLOAT True"] {
-        assert!(text.contains(g), "`{g}` missing: {text}");
-    }
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Blender's volume object shows the first grid: it must be `density`.
+fn assert_first_grid_is_density(text: &str) {
+    let first = text.lines().find(|l| l.starts_with("GRID")).unwrap_or("");
+    assert!(first.starts_with("GRID density "), "{text}");
 }

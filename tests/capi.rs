@@ -173,15 +173,15 @@ fn the_c_smoke_test_passes_static_and_shared_and_runs_clean_under_valgrind() {
     }
 }
 
-/// The voxels and the metadata of grid `surface` in a `.vdb` file.
+/// The voxels and the metadata of grid `density` in a `.vdb` file.
 fn surface_of(path: &Path) -> (Vec<[i64; 3]>, std::collections::BTreeMap<String, String>) {
-    let mut voxels: Vec<[i64; 3]> = read_vdb_grid(path, Some("surface"))
+    let mut voxels: Vec<[i64; 3]> = read_vdb_grid(path, Some("density"))
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
         .voxels()
         .collect();
     voxels.sort_unstable();
     let info = voxelkit::io::vdb::read_vdb_info(path).unwrap();
-    let surface = info.iter().find(|g| g.name == "surface").unwrap();
+    let surface = info.iter().find(|g| g.name == "density").unwrap();
     let meta = surface
         .metadata
         .iter()

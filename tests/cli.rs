@@ -279,7 +279,6 @@ fn mesh_shape_info_and_demo_produce_real_files() {
     let t = text(&o);
     assert!(o.status.success());
     for s in [
-        "surface",
         "density",
         "normal",
         "method = huang-separating",

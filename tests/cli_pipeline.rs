@@ -178,7 +178,7 @@ fn outputs_are_vdb_files_or_standard_output() {
     assert!(
         grids
             .iter()
-            .any(|g| g.name == "surface" && g.active_voxels > 0)
+            .any(|g| g.name == "density" && g.active_voxels > 0)
     );
     // The summary went to stderr, leaving stdout to the file.
     assert!(String::from_utf8_lossy(&piped.stderr).contains("voxels"));
@@ -234,7 +234,7 @@ fn grids_compression_and_half_precision_are_chosen_when_writing() {
     let (run, missing) = write("missing.vdb", &["--grids", "density,nope"]);
     let msg = text(&run);
     assert!(
-        !run.status.success() && msg.contains("nope") && msg.contains("surface"),
+        !run.status.success() && msg.contains("nope") && msg.contains("density"),
         "{msg}"
     );
     assert!(!missing.exists());

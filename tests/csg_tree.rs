@@ -53,7 +53,7 @@ fn the_flange_example_matches_its_exact_volume() {
             error < 1.0 / resolution as f64,
             "{resolution}: {volume} vs {exact}"
         );
-        let grid = read_vdb_grid(&out, Some("surface")).unwrap();
+        let grid = read_vdb_grid(&out, Some("density")).unwrap();
         assert_eq!(grid.voxel_count() as f64, json_field(&t, "voxels"));
     }
 }
@@ -105,7 +105,7 @@ fn trees_over_meshes_and_grids_obey_the_boolean_counts() {
     let a = run("a.json", "union", mesh, mesh);
     let b = run("b.json", "union", vdb, vdb);
     assert_eq!(run("u2.json", "union", vdb, mesh), union);
-    let written = read_vdb_grid(&path("d.json.vdb"), Some("surface")).unwrap();
+    let written = read_vdb_grid(&path("d.json.vdb"), Some("density")).unwrap();
     assert_eq!(written.voxel_count() as f64, diff);
     eprintln!("|A| {a} |B| {b} union {union} intersection {inter} difference {diff}");
     // |A| = |A - B| + |A ∩ B| and |A ∪ B| = |A| + |B| - |A ∩ B|.

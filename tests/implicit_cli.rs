@@ -23,7 +23,7 @@ fn examples_write_vdb_files() {
         ]);
         assert!(o.status.success(), "{example}: {}", text(&o));
         let grids = read_vdb_info(&out).unwrap();
-        let surface = grids.iter().find(|g| g.name == "surface").unwrap();
+        let surface = grids.iter().find(|g| g.name == "density").unwrap();
         assert!(
             surface.active_voxels > 1000,
             "{example}: {} voxels",
@@ -73,7 +73,7 @@ fn levels_are_written_with_their_own_voxel_size() {
     assert_eq!(level(0).active_voxels, 1);
     assert_eq!(level(0).voxel_size[0], 2.0);
     assert_eq!(level(5).voxel_size[0], 2.0 / 32.0);
-    let surface = grids.iter().find(|g| g.name == "surface").unwrap();
+    let surface = grids.iter().find(|g| g.name == "density").unwrap();
     assert_eq!(level(5).active_voxels, surface.active_voxels);
     for l in 1..=5 {
         assert!(level(l).active_voxels >= level(l - 1).active_voxels);

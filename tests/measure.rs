@@ -9,7 +9,7 @@ use voxelkit::grid::{Adjacency, DenseMask};
 use voxelkit::implicit::reference::reference_solids;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
 use voxelkit::ops::flood::{flood_from_border, padded};
-use voxelkit::ops::measure::measure_solid;
+use voxelkit::ops::measure::SolidMeasures;
 use voxelkit::ops::topology::{components, euler_characteristic};
 use voxelkit::solids::csg_leaves::measure_formula_solid;
 use voxelkit::voxelize::Separability;
@@ -51,7 +51,7 @@ fn volume_is_bracketed_and_converges() {
         let mut previous = f64::INFINITY;
         for resolution in [32, 64, 128] {
             let (inside, surface, h) = solid(&mesh, resolution);
-            let m = measure_solid(&inside, &surface, h);
+            let m = SolidMeasures::of(inside.count(), surface.count(), h);
             eprintln!(
                 "{name} {resolution}: {:.6} <= {exact:.6} <= {:.6}",
                 m.volume_inside, m.volume_with_surface

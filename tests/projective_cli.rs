@@ -13,12 +13,12 @@ use voxelkit::grid::{SparseGrid, offset_coord};
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
 use voxelkit::voxelize::projective::{Coloring, LineSource, voxelize_lines, voxelize_triangles};
 
-/// Every active voxel of the `Cd` grid and the `surface` count, through pyopenvdb; `None`
+/// Every active voxel of the `Cd` grid and the `density` count, through pyopenvdb; `None`
 /// (loudly) when pyopenvdb is missing.
 fn read_cd(path: &Path) -> Option<(HashMap<[i64; 3], Vec3>, u64)> {
     let script = r#"
 import sys, pyopenvdb as vdb
-print(vdb.read(sys.argv[1], "surface").activeVoxelCount())
+print(vdb.read(sys.argv[1], "density").activeVoxelCount())
 g = vdb.read(sys.argv[1], "Cd")
 for item in g.citerOnValues():
     lo, hi, c = item["min"], item["max"], item["value"]
@@ -185,7 +185,7 @@ fn the_beam_solid_from_the_command_line_holds_the_exact_volume() {
     let info = voxelkit::io::vdb::read_vdb_info(&out_path).unwrap();
     let mut names: Vec<&str> = info.iter().map(|g| g.name.as_str()).collect();
     names.sort();
-    assert_eq!(names, ["boundary", "density", "interior", "surface"]);
+    assert_eq!(names, ["density", "interior", "shell"]);
 }
 
 #[test]

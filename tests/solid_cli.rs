@@ -45,7 +45,7 @@ fn solid_measure_csg_and_intersect() {
     assert!(json_field(&out, "sweeps") >= 1.0);
     let grids = read_vdb_info(dir.path().join("torus.vdb").as_path()).unwrap();
     let count = |name: &str| grids.iter().find(|g| g.name == name).unwrap().active_voxels;
-    assert_eq!(count("density"), count("boundary") + count("interior"));
+    assert_eq!(count("density"), count("shell") + count("interior"));
 
     // measure reads the solid back and agrees; on the mesh it voxelizes first.
     let o = voxelkit(&["--json", "measure", &p("torus.vdb")]);
@@ -91,7 +91,7 @@ fn solid_measure_csg_and_intersect() {
         &p("curve.vdb"),
     ]);
     assert!(o.status.success(), "{}", text(&o));
-    let curve = read_vdb_grid(dir.path().join("curve.vdb").as_path(), Some("surface")).unwrap();
+    let curve = read_vdb_grid(dir.path().join("curve.vdb").as_path(), Some("density")).unwrap();
     assert!(curve.voxel_count() > 100);
     let o = voxelkit(&[
         "csg",
@@ -103,8 +103,8 @@ fn solid_measure_csg_and_intersect() {
         &p("union.vdb"),
     ]);
     assert!(o.status.success(), "{}", text(&o));
-    let union = read_vdb_grid(dir.path().join("union.vdb").as_path(), Some("surface")).unwrap();
-    let torus = read_vdb_grid(dir.path().join("torus-s.vdb").as_path(), Some("surface")).unwrap();
+    let union = read_vdb_grid(dir.path().join("union.vdb").as_path(), Some("density")).unwrap();
+    let torus = read_vdb_grid(dir.path().join("torus-s.vdb").as_path(), Some("density")).unwrap();
     assert!(union.voxel_count() > torus.voxel_count());
     let o = voxelkit(&[
         "csg",
@@ -166,7 +166,7 @@ fn depth_layer_solids_report_what_they_cannot_classify() {
     assert_eq!(json_field(&double, "unclassified_voxels"), 0.0);
     let grids = read_vdb_info(dir.path().join("g2.vdb").as_path()).unwrap();
     let count = |name: &str| grids.iter().find(|g| g.name == name).unwrap().active_voxels;
-    assert_eq!(count("density"), count("boundary") + count("interior"));
+    assert_eq!(count("density"), count("shell") + count("interior"));
     assert_eq!(count("unclassified"), 0);
 
     // Spheres in a hollow box: unclassifiable voxels, written as their own grid.

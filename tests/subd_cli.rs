@@ -42,10 +42,9 @@ fn subdiv_writes_a_vdb_that_openvdb_reads_back() {
     }
     let grids = read_vdb_info(&output).unwrap();
     let grid = |name: &str| grids.iter().find(|g| g.name == name).unwrap();
-    assert_eq!(grids.len(), 4);
-    let surface = grid("surface");
+    assert_eq!(grids.len(), 3);
+    let surface = grid("density");
     assert!(surface.active_voxels > 1000);
-    assert_eq!(grid("density").active_voxels, surface.active_voxels);
     assert_eq!(grid("normal").active_voxels, surface.active_voxels);
     assert_eq!(grid("opposite_normals").active_voxels, 0);
     let meta = |key: &str| {

@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 use voxelkit::grid::SparseGrid;
-use voxelkit::io::vdb::{read_vdb_grid, read_vdb_info, write_vdb};
+use voxelkit::io::vdb::{WriteOptions, read_vdb_grid, read_vdb_info, write_vdb_as};
 use voxelkit::mesh::generate;
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::SeparatingOptions;
@@ -33,13 +33,18 @@ fn written_example(dir: &std::path::Path) -> (SparseGrid, std::path::PathBuf) {
     };
     let (grid, _) = common::voxelize_at(&mesh, 96, opts);
     let path = dir.join("knot.vdb");
-    write_vdb(
+    write_vdb_as(
         &path,
         &grid,
+        &[],
         &[
             ("method", "huang-separating".into()),
             ("separability", "26".into()),
         ],
+        &WriteOptions {
+            grids: vec!["density".into(), "voxels".into(), "normal".into()],
+            ..Default::default()
+        },
     )
     .unwrap();
     (grid, path)
@@ -51,7 +56,7 @@ fn openvdb_reads_back_the_same_voxels_transform_and_metadata() {
     let (grid, path) = written_example(dir.path());
     let infos = read_vdb_info(&path).unwrap();
     let names: Vec<&str> = infos.iter().map(|i| i.name.as_str()).collect();
-    for expected in ["surface", "density", "normal"] {
+    for expected in ["voxels", "density", "normal"] {
         assert!(names.contains(&expected), "{names:?}");
     }
     for info in &infos {
@@ -73,7 +78,7 @@ fn openvdb_reads_back_the_same_voxels_transform_and_metadata() {
     }
     let density = infos.iter().find(|i| i.name == "density").unwrap();
     assert_eq!(density.grid_class, "fog volume");
-    for name in ["surface", "density"] {
+    for name in ["voxels", "density"] {
         let back = read_vdb_grid(&path, Some(name)).unwrap();
         assert_eq!(sorted_voxels(&back), sorted_voxels(&grid), "{name}");
         assert_eq!(back.transform, grid.transform);
@@ -96,7 +101,7 @@ fn pyopenvdb_reads_back_the_same_voxels_and_transform() {
     let (grid, path) = written_example(dir.path());
     let script = r#"
 import sys, pyopenvdb as vdb
-for name in ("surface", "density"):
+for name in ("voxels", "density"):
     g = vdb.read(sys.argv[1], name)
     o = g.transform.indexToWorld((0, 0, 0))
     print("grid", name, g.activeVoxelCount(), repr(g.transform.voxelSize()[0]), repr(o[0]), repr(o[1]), repr(o[2]))

@@ -24,6 +24,8 @@ pub mod bridge {
         uniform_linear: bool,
         active_voxels: u64,
         leaf_count: u64,
+        /// Active tiles, counted as 128^3 ones where larger.
+        tile_count: u64,
         bbox_min: [i32; 3],
         bbox_max: [i32; 3],
         metadata: Vec<MetaEntry>,
@@ -37,7 +39,9 @@ pub mod bridge {
 
         fn new_vdb_writer() -> UniquePtr<VdbWriter>;
         /// Adds a BoolGrid (`kind` = "bool"), fog-volume FloatGrid ("fog": `values` per voxel,
-        /// or 1 where empty) or Vec3SGrid of normals ("normal": 3 values per voxel).
+        /// or 1 where empty) or Vec3SGrid of normals ("normal": 3 values per voxel), plus
+        /// active tiles (true, or 1 in a fog volume) at `leaf_tiles` (8^3) and `node_tiles`
+        /// (128^3) origins.
         fn add_grid(
             self: Pin<&mut VdbWriter>,
             kind: &str,
@@ -47,6 +51,8 @@ pub mod bridge {
             leaf_origins: &[i32],
             masks: &[u64],
             values: &[f32],
+            leaf_tiles: &[i32],
+            node_tiles: &[i32],
             metadata: &[MetaEntry],
         ) -> Result<()>;
         /// Adds a narrow-band distance FloatGrid: `values` per active voxel (world units), the
@@ -79,7 +85,8 @@ pub mod bridge {
         fn open_vdb(path: &str) -> Result<UniquePtr<VdbFile>>;
         fn grid_count(self: &VdbFile) -> usize;
         fn grid_info(self: &VdbFile, index: usize) -> Result<GridInfo>;
-        /// Active voxels of a Bool, Mask or Float grid (tiles expanded), leaf by leaf;
+        /// Active voxels of a Bool, Mask or Float grid, leaf by leaf, and its active tiles
+        /// as (x, y, z, edge) with edge 8 or 128 (larger tiles split into 128^3 ones);
         /// `values` gets 512 floats per leaf for Float grids and stays empty otherwise.
         fn read_leaves(
             self: &VdbFile,
@@ -87,21 +94,23 @@ pub mod bridge {
             leaf_origins: &mut Vec<i32>,
             masks: &mut Vec<u64>,
             values: &mut Vec<f32>,
+            tiles: &mut Vec<i32>,
         ) -> Result<()>;
 
         /// OpenVDB's `tools::levelSetVolume` of the level set `name` in the file at `path`.
         fn openvdb_level_set_volume(path: &str, name: &str) -> Result<f64>;
 
-        /// OpenVDB's own conversion (`tools::meshToVolume`) of a triangle mesh given in index
-        /// space, with `exterior_band` voxels outside and `interior_band` inside (the largest
-        /// float fills the whole interior), on at most `threads` threads. Returns the number of
-        /// active voxels (for benchmarks).
-        fn openvdb_mesh_to_volume(
+        /// OpenVDB's own conversion of a triangle mesh given in index space, for benchmarks,
+        /// on at most `threads` threads: `kind` "unsigned" (`meshToUnsignedDistanceField`),
+        /// "level-set" (`meshToLevelSet`), "solid" (`meshToLevelSet` then `sdfInteriorMask`)
+        /// or "filled" (`meshToVolume` with the interior filled), `band` voxels wide.
+        /// Returns the number of active voxels of the result.
+        fn openvdb_reference(
+            kind: &str,
             points: &[f32],
             triangles: &[u32],
             voxel_size: f64,
-            exterior_band: f32,
-            interior_band: f32,
+            band: f32,
             threads: usize,
         ) -> Result<u64>;
     }

@@ -33,7 +33,7 @@ impl DenseMask {
     }
 
     /// The active voxels of `grid` inside `bbox`, copied 8 voxels (a leaf row along z) at
-    /// a time.
+    /// a time, tiles a whole row at a time.
     pub fn from_grid(grid: &SparseGrid, bbox: CoordBox) -> Result<Self> {
         let mut m = DenseMask::new(bbox)?;
         for leaf in grid.leaves() {
@@ -60,7 +60,31 @@ impl DenseMask {
                 }
             }
         }
+        for tile in grid.tiles().boxes() {
+            m.set_box(tile);
+        }
         Ok(m)
+    }
+
+    /// Sets the voxels of `b` that lie in the box, a z row at a time.
+    pub fn set_box(&mut self, b: CoordBox) {
+        let lo: Coord = std::array::from_fn(|a| b.min[a].max(self.bbox.min[a]));
+        let hi: Coord = std::array::from_fn(|a| b.max[a].min(self.bbox.max[a]));
+        if (0..3).any(|a| lo[a] > hi[a]) {
+            return;
+        }
+        let n = (hi[2] - lo[2] + 1) as usize;
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                let first = self.index([x, y, lo[2]]);
+                if n < 64 {
+                    // A leaf tile's row: one or two words.
+                    bits::or_bits(&mut self.bits, first, (1u64 << n) - 1);
+                } else {
+                    self.set_index_range(first, first + n - 1);
+                }
+            }
+        }
     }
 
     pub fn dims(&self) -> [usize; 3] {
@@ -141,9 +165,10 @@ impl DenseMask {
         out
     }
 
-    /// The set voxels as a sparse grid on `transform`, built leaf by leaf from 8-voxel rows.
+    /// The set voxels as a sparse grid on `transform`, built leaf by leaf from 8-voxel rows;
+    /// whole blocks become tiles.
     pub fn to_grid(&self, transform: super::Transform) -> SparseGrid {
-        let mut leaves = Vec::new();
+        let mut grid = SparseGrid::new(transform, super::Channels::NONE);
         let lo = super::coord::leaf_origin(self.bbox.min);
         let hi = self.bbox.max;
         let mut origin = lo;
@@ -173,8 +198,10 @@ impl DenseMask {
                             leaf.mask[dx as usize] |= row << (dy * 8 + (z0 - origin[2]));
                         }
                     }
-                    if !leaf.is_empty() {
-                        leaves.push(leaf);
+                    if leaf.mask == [u64::MAX; 8] {
+                        grid.fill_leaf_block(origin);
+                    } else if !leaf.is_empty() {
+                        grid.merge_leaf(leaf, |_, _| {});
                     }
                     origin[2] += 8;
                 }
@@ -182,7 +209,8 @@ impl DenseMask {
             }
             origin[0] += 8;
         }
-        SparseGrid::from_leaves(transform, super::Channels::NONE, leaves)
+        grid.compact();
+        grid
     }
 
     /// The set voxels with a face neighbour that is clear (or outside the box).

@@ -1,15 +1,18 @@
-//! Sparse voxel grids: 8^3 leaves keyed by origin, optional per-voxel channels,
-//! a cached write accessor, Boolean operations leaf by leaf, and the index-to-world transform.
+//! Sparse voxel grids: 8^3 leaves keyed by origin, optional per-voxel channels, tiles for
+//! whole 8^3 and 128^3 blocks, a cached write accessor, Boolean operations block by block,
+//! and the index-to-world transform.
 
 mod bits;
 mod coord;
 mod leaf;
 mod sparse;
+mod tiles;
 mod transform;
 
 pub use coord::{Coord, CoordBox, LEAF_VOXELS, leaf_offset, leaf_origin, offset_coord};
 pub use leaf::{Channels, Leaf};
-pub use sparse::{Accessor, SparseGrid};
+pub use sparse::{Accessor, Block, SparseGrid};
+pub use tiles::{NODE_DIM, Tiles, node_origin};
 pub use transform::Transform;
 
 mod adjacency;

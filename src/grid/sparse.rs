@@ -1,10 +1,12 @@
 //! The sparse voxel grid: leaves in a vector (cheap iteration, bulk transfer to OpenVDB)
-//! indexed by origin through a hash map.
+//! indexed by origin through a hash map, and tiles for whole 8^3 and 128^3 blocks. A block
+//! is either a tile or a leaf, never both; tiles carry no channels.
 
-use super::coord::{Coord, CoordBox, leaf_offset, leaf_origin};
+use super::coord::{Coord, CoordBox, leaf_offset, leaf_origin, offset_coord};
 use super::leaf::{Channels, Leaf};
+use super::tiles::{Tiles, node_leaf_origins, node_origin};
 use super::transform::Transform;
-use rustc_hash::FxHashMap;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 #[derive(Clone, Debug, Default)]
 pub struct SparseGrid {
@@ -12,7 +14,17 @@ pub struct SparseGrid {
     channels: Channels,
     leaves: Vec<Leaf>,
     index: FxHashMap<Coord, u32>,
+    tiles: Tiles,
 }
+
+/// What a grid holds in one 8^3 block.
+pub enum Block<'g> {
+    Empty,
+    Whole,
+    Partial(&'g Leaf),
+}
+
+const FULL: [u64; 8] = [u64::MAX; 8];
 
 impl SparseGrid {
     pub fn new(transform: Transform, channels: Channels) -> Self {
@@ -21,6 +33,7 @@ impl SparseGrid {
             channels,
             leaves: Vec::new(),
             index: FxHashMap::default(),
+            tiles: Tiles::default(),
         }
     }
 
@@ -37,8 +50,54 @@ impl SparseGrid {
         g
     }
 
+    /// The leaves (blocks held voxel by voxel); whole blocks are in `tiles`.
     pub fn leaves(&self) -> &[Leaf] {
         &self.leaves
+    }
+
+    /// The whole 8^3 and 128^3 blocks.
+    pub fn tiles(&self) -> &Tiles {
+        &self.tiles
+    }
+
+    /// Makes the 8^3 block at `origin` (a multiple of 8) whole.
+    pub fn fill_leaf_block(&mut self, origin: Coord) {
+        if self.tiles.covers(origin) {
+            return;
+        }
+        match self.index.get(&origin) {
+            // Channels live in leaves: keep the leaf, whole.
+            Some(&i) if self.channels != Channels::NONE => self.leaves[i as usize].mask = FULL,
+            Some(&i) => {
+                self.leaves[i as usize].mask = [0; 8];
+                self.tiles.insert_leaf(origin);
+            }
+            None => self.tiles.insert_leaf(origin),
+        }
+    }
+
+    /// Makes the 128^3 block at `origin` (a multiple of 128) whole.
+    pub fn fill_node_block(&mut self, origin: Coord) {
+        if self.channels != Channels::NONE {
+            node_leaf_origins(origin).for_each(|o| self.fill_leaf_block(o));
+            return;
+        }
+        self.tiles.insert_node(origin);
+        for leaf in &mut self.leaves {
+            if node_origin(leaf.origin) == origin {
+                leaf.mask = [0; 8];
+            }
+        }
+        self.prune();
+    }
+
+    /// What the grid holds in the 8^3 block at `origin`.
+    pub fn block(&self, origin: Coord) -> Block<'_> {
+        if self.tiles.covers(origin) {
+            Block::Whole
+        } else {
+            self.leaf(origin).map_or(Block::Empty, Block::Partial)
+        }
     }
 
     /// Replaces the value of every active voxel by `f(voxel, value)`, leaves in parallel.
@@ -49,12 +108,7 @@ impl SparseGrid {
             let on: Vec<usize> = leaf.offsets().collect();
             if let Some(values) = leaf.value.as_mut() {
                 for n in on {
-                    let c = [
-                        origin[0] + (n / 64) as i64,
-                        origin[1] + (n / 8 % 8) as i64,
-                        origin[2] + (n % 8) as i64,
-                    ];
-                    values[n] = f(c, values[n]);
+                    values[n] = f(offset_coord(origin, n), values[n]);
                 }
             }
         });
@@ -64,13 +118,18 @@ impl SparseGrid {
         self.index.get(&origin).map(|&i| &self.leaves[i as usize])
     }
 
-    /// Index of the leaf at `origin`, created empty when missing.
+    /// Index of the leaf at `origin`, created when missing (whole when the block was a
+    /// tile, which it replaces).
     fn leaf_index_or_insert(&mut self, origin: Coord) -> usize {
         if let Some(&i) = self.index.get(&origin) {
             return i as usize;
         }
         let i = self.leaves.len();
-        self.leaves.push(Leaf::new(origin, self.channels));
+        let mut leaf = Leaf::new(origin, self.channels);
+        if self.tiles.remove_leaf(origin) {
+            leaf.mask = FULL;
+        }
+        self.leaves.push(leaf);
         self.index.insert(origin, i as u32);
         i
     }
@@ -81,13 +140,19 @@ impl SparseGrid {
     }
 
     pub fn insert(&mut self, c: Coord) {
+        if self.tiles.covers(leaf_origin(c)) {
+            return;
+        }
         self.leaf_mut_or_insert(leaf_origin(c))
             .set_on(leaf_offset(c));
     }
 
     pub fn contains(&self, c: Coord) -> bool {
-        self.leaf(leaf_origin(c))
-            .is_some_and(|l| l.is_on(leaf_offset(c)))
+        match self.block(leaf_origin(c)) {
+            Block::Empty => false,
+            Block::Whole => true,
+            Block::Partial(l) => l.is_on(leaf_offset(c)),
+        }
     }
 
     /// A write accessor that remembers the last leaf it touched.
@@ -100,7 +165,7 @@ impl SparseGrid {
     }
 
     pub fn voxel_count(&self) -> u64 {
-        self.leaves.iter().map(|l| l.count() as u64).sum()
+        self.leaves.iter().map(|l| l.count() as u64).sum::<u64>() + self.tiles.voxel_count()
     }
 
     /// Number of leaves holding at least one active voxel.
@@ -109,23 +174,17 @@ impl SparseGrid {
     }
 
     pub fn is_empty(&self) -> bool {
-        self.leaves.iter().all(|l| l.is_empty())
+        self.tiles.is_empty() && self.leaves.iter().all(|l| l.is_empty())
     }
 
     /// Bounding box of the active voxels, `None` for an empty grid.
     pub fn bbox(&self) -> Option<CoordBox> {
         let mut b: Option<CoordBox> = None;
-        for leaf in &self.leaves {
+        let leaf_boxes = self.leaves.iter().filter_map(|leaf| {
             // A leaf's extent from its mask words: x by the non-empty words, y by the
             // non-empty bytes of their union, z by the union of those bytes.
-            let Some(x0) = leaf.mask.iter().position(|&w| w != 0) else {
-                continue;
-            };
-            let x1 = leaf
-                .mask
-                .iter()
-                .rposition(|&w| w != 0)
-                .expect("a non-empty word");
+            let x0 = leaf.mask.iter().position(|&w| w != 0)?;
+            let x1 = leaf.mask.iter().rposition(|&w| w != 0)?;
             let rows = leaf.mask.iter().fold(0u64, |a, &w| a | w);
             let bytes = (0..8).map(|y| rows >> (8 * y) & 0xff);
             let ys = bytes
@@ -134,34 +193,55 @@ impl SparseGrid {
                 .fold(0u64, |a, (y, r)| a | u64::from(r != 0) << y);
             let zs = bytes.fold(0u64, |a, r| a | r);
             let o = leaf.origin;
-            let lo = [
-                o[0] + x0 as i64,
-                o[1] + ys.trailing_zeros() as i64,
-                o[2] + zs.trailing_zeros() as i64,
-            ];
-            let hi = [
-                o[0] + x1 as i64,
-                o[1] + 63 - ys.leading_zeros() as i64,
-                o[2] + 63 - zs.leading_zeros() as i64,
-            ];
-            match b.as_mut() {
-                Some(b) => {
-                    b.expand(lo);
-                    b.expand(hi);
-                }
-                None => b = Some(CoordBox { min: lo, max: hi }),
-            }
+            Some(CoordBox {
+                min: [
+                    o[0] + x0 as i64,
+                    o[1] + ys.trailing_zeros() as i64,
+                    o[2] + zs.trailing_zeros() as i64,
+                ],
+                max: [
+                    o[0] + x1 as i64,
+                    o[1] + 63 - ys.leading_zeros() as i64,
+                    o[2] + 63 - zs.leading_zeros() as i64,
+                ],
+            })
+        });
+        for part in leaf_boxes.chain(self.tiles.boxes()) {
+            b = Some(b.map_or(part, |b| b.union(&part)));
         }
         b
     }
 
-    /// Every active voxel.
+    /// Every active voxel (leaves first, then tiles).
     pub fn voxels(&self) -> impl Iterator<Item = Coord> + '_ {
-        self.leaves.iter().flat_map(|l| l.coords())
+        let tiled: Vec<Coord> = self.tiles.blocks().collect();
+        let n = self.leaves.len();
+        // One flat_map over leaves and whole blocks by index (a chain of the two confuses
+        // valgrind's definedness tracking).
+        (0..n + tiled.len()).flat_map(move |i| {
+            let (origin, mask) = match self.leaves.get(i) {
+                Some(l) => (l.origin, l.mask),
+                None => (tiled[i - n], FULL),
+            };
+            (0..8).flat_map(move |w| {
+                let mut bits = mask[w];
+                std::iter::from_fn(move || {
+                    (bits != 0).then(|| {
+                        let n = w * 64 + bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        offset_coord(origin, n)
+                    })
+                })
+            })
+        })
     }
 
-    /// Merges `leaf` into the leaf of the same origin with `combine(existing, incoming)`.
+    /// Merges `leaf` into the leaf of the same origin with `combine(existing, incoming)`
+    /// (a whole block stays whole).
     pub fn merge_leaf(&mut self, leaf: Leaf, combine: impl FnOnce(&mut Leaf, &Leaf)) {
+        if self.tiles.covers(leaf.origin) {
+            return;
+        }
         match self.index.get(&leaf.origin) {
             Some(&i) => combine(&mut self.leaves[i as usize], &leaf),
             None => {
@@ -171,51 +251,156 @@ impl SparseGrid {
         }
     }
 
-    /// Merges every leaf of `other` into `self` with `combine(existing, incoming)`.
+    /// Merges every leaf of `other` into `self` with `combine(existing, incoming)`, and
+    /// `other`'s tiles as whole blocks.
     pub fn merge_with(&mut self, other: SparseGrid, mut combine: impl FnMut(&mut Leaf, &Leaf)) {
+        self.fill_tiles_of(&other);
         for leaf in other.leaves {
             self.merge_leaf(leaf, &mut combine);
         }
     }
 
+    /// Makes every block that is whole in `other` whole in `self`.
+    fn fill_tiles_of(&mut self, other: &SparseGrid) {
+        other
+            .tiles
+            .leaf_tiles()
+            .for_each(|o| self.fill_leaf_block(o));
+        other
+            .tiles
+            .node_tiles()
+            .for_each(|o| self.fill_node_block(o));
+    }
+
     /// Voxels active in `self` or `other`; where both are, `self`'s channels are kept.
     pub fn union(&mut self, other: &SparseGrid) {
+        self.fill_tiles_of(other);
         for leaf in &other.leaves {
+            if self.tiles.covers(leaf.origin) {
+                continue;
+            }
             let i = self.leaf_index_or_insert(leaf.origin);
             union_leaf(&mut self.leaves[i], leaf);
         }
+        self.compact();
     }
 
     /// Voxels active in both grids.
     pub fn intersection(&mut self, other: &SparseGrid) {
         for leaf in &mut self.leaves {
-            match other.leaf(leaf.origin) {
-                Some(o) => (0..8).for_each(|w| leaf.mask[w] &= o.mask[w]),
-                None => leaf.mask = [0; 8],
+            match other.block(leaf.origin) {
+                Block::Whole => {}
+                Block::Partial(o) => (0..8).for_each(|w| leaf.mask[w] &= o.mask[w]),
+                Block::Empty => leaf.mask = [0; 8],
+            }
+        }
+        // A whole block of `self` becomes what `other` holds there.
+        let mut blocks: Vec<Coord> = self.tiles.leaf_tiles().collect();
+        for node in self.tiles.node_tiles().collect::<Vec<_>>() {
+            if !other.tiles.has_node(node) {
+                self.tiles.remove_node(node);
+                blocks.extend(other.blocks_in_node(node));
+            }
+        }
+        for o in blocks {
+            match other.block(o) {
+                Block::Whole => self.tiles.insert_leaf(o),
+                Block::Partial(l) => {
+                    self.tiles.remove_leaf(o);
+                    self.leaf_mut_or_insert(o).mask = l.mask;
+                }
+                Block::Empty => {
+                    self.tiles.remove_leaf(o);
+                }
             }
         }
         self.prune();
+        self.compact();
     }
 
     /// Voxels active in `self` and not in `other`.
     pub fn difference(&mut self, other: &SparseGrid) {
         for leaf in &mut self.leaves {
-            if let Some(o) = other.leaf(leaf.origin) {
-                (0..8).for_each(|w| leaf.mask[w] &= !o.mask[w]);
+            match other.block(leaf.origin) {
+                Block::Whole => leaf.mask = [0; 8],
+                Block::Partial(o) => (0..8).for_each(|w| leaf.mask[w] &= !o.mask[w]),
+                Block::Empty => {}
+            }
+        }
+        // Whole blocks of `self` lose what `other` holds there; node tiles split only where
+        // `other` reaches into them.
+        let touched: FxHashSet<Coord> = other
+            .leaves
+            .iter()
+            .map(|l| l.origin)
+            .chain(other.tiles.leaf_tiles())
+            .map(node_origin)
+            .collect();
+        let mut blocks: Vec<Coord> = self.tiles.leaf_tiles().collect();
+        for node in self.tiles.node_tiles().collect::<Vec<_>>() {
+            if other.tiles.has_node(node) {
+                self.tiles.remove_node(node);
+            } else if touched.contains(&node) {
+                self.tiles.remove_node(node);
+                blocks.extend(node_leaf_origins(node));
+            }
+        }
+        for o in blocks {
+            match other.block(o) {
+                Block::Whole => {
+                    self.tiles.remove_leaf(o);
+                }
+                Block::Partial(l) => {
+                    self.tiles.remove_leaf(o);
+                    self.leaf_mut_or_insert(o).mask = l.mask.map(|w| !w);
+                }
+                Block::Empty => self.tiles.insert_leaf(o),
             }
         }
         self.prune();
+        self.compact();
+    }
+
+    /// Origins of the blocks `self` holds anything in, inside the 128^3 node at `node`.
+    fn blocks_in_node(&self, node: Coord) -> Vec<Coord> {
+        self.leaves
+            .iter()
+            .map(|l| l.origin)
+            .chain(self.tiles.leaf_tiles())
+            .filter(|&o| node_origin(o) == node)
+            .collect()
     }
 
     /// Drops empty leaves.
     pub fn prune(&mut self) {
         self.leaves.retain(|l| !l.is_empty());
+        self.reindex();
+    }
+
+    fn reindex(&mut self) {
         self.index = self
             .leaves
             .iter()
             .enumerate()
             .map(|(i, l)| (l.origin, i as u32))
             .collect();
+    }
+
+    /// Whole leaves become tiles (when the grid has no channels) and complete 128^3 groups
+    /// of tiles become node tiles.
+    pub fn compact(&mut self) {
+        if self.channels != Channels::NONE {
+            return;
+        }
+        let whole = self.leaves.iter().filter(|l| l.mask == FULL).count();
+        if whole > 0 {
+            for leaf in self.leaves.iter().filter(|l| l.mask == FULL) {
+                self.tiles.insert_leaf(leaf.origin);
+            }
+            self.leaves.retain(|l| l.mask != FULL);
+            self.reindex();
+        }
+        self.tiles.promote();
     }
 }
 

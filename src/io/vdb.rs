@@ -1,8 +1,10 @@
-//! OpenVDB files through the bridge: one `.vdb` holding `surface` (BoolGrid), `density`
-//! (fog volume: 1 on every voxel of the set, what Blender's volume object reads),
-//! `normal` (Vec3s, covariant-normalize) when the grid carries normals and `Cd` (Vec3s, the
-//! Houdini name for colour) when it carries colours; and reading any
-//! Bool, Mask or Float grid back. Writes are atomic (temporary file, then rename).
+//! OpenVDB files through the bridge. A voxel set is written as `density` (a fog volume: 1 on
+//! every voxel of the set, what Blender's volume object reads), `normal` (Vec3s,
+//! covariant-normalize) when the grid carries normals, `Cd` (Vec3s, the Houdini name for
+//! colour) when it carries colours, and on request `voxels` (the same set as a BoolGrid);
+//! whole blocks are written as active tiles. A level set is `surface`, Houdini's name. Any
+//! Bool, Mask or Float grid reads back, tiles as tiles. Writes are atomic (temporary file,
+//! then rename).
 
 use super::atomic::write_atomic;
 use crate::error::{Error, Result};
@@ -13,25 +15,65 @@ use std::path::Path;
 
 pub use crate::ffi::vdb::bridge::GridInfo;
 
-/// Leaves of `grid` as the bridge's flat arrays: origins (i32 x 3) and masks (u64 x 8).
-fn flatten<'g>(path: &Path, grid: &'g SparseGrid) -> Result<(Vec<i32>, Vec<u64>, Vec<&'g Leaf>)> {
+/// The boolean voxel set's name in a `.vdb`.
+pub const VOXELS_GRID: &str = "voxels";
+
+/// The level set's name in a `.vdb` (Houdini's VDB from Polygons calls it so).
+pub const LEVEL_SET_GRID: &str = "surface";
+
+/// The fog volume's name, first in every file voxelkit writes.
+pub const DENSITY_GRID: &str = "density";
+
+/// A grid's leaves and tiles as the bridge's flat arrays.
+struct Flat<'g> {
+    /// Leaf origins, i32 x 3 per leaf.
+    origins: Vec<i32>,
+    /// Leaf masks, u64 x 8 per leaf.
+    masks: Vec<u64>,
+    leaves: Vec<&'g Leaf>,
+    /// Origins of the 8^3 and the 128^3 tiles, i32 x 3 each.
+    leaf_tiles: Vec<i32>,
+    node_tiles: Vec<i32>,
+}
+
+/// A coordinate in OpenVDB's 32-bit index range (with room for a 128^3 block past it).
+fn index_coord(path: &Path, c: [i64; 3]) -> Result<[i32; 3]> {
+    let mut out = [0; 3];
+    for (o, &v) in out.iter_mut().zip(&c) {
+        *o = i32::try_from(v)
+            .ok()
+            .filter(|v| v.checked_add(127).is_some())
+            .ok_or_else(|| Error::Vdb {
+                path: path.to_path_buf(),
+                message: format!("block {c:?} is outside OpenVDB's 32-bit index range"),
+            })?;
+    }
+    Ok(out)
+}
+
+fn flatten<'g>(path: &Path, grid: &'g SparseGrid) -> Result<Flat<'g>> {
     let leaves: Vec<&Leaf> = grid.leaves().iter().filter(|l| !l.is_empty()).collect();
     let mut origins = Vec::with_capacity(leaves.len() * 3);
     let mut masks = Vec::with_capacity(leaves.len() * 8);
     for leaf in &leaves {
-        for &c in &leaf.origin {
-            let v = i32::try_from(c).ok().filter(|v| v.checked_add(7).is_some());
-            origins.push(v.ok_or_else(|| Error::Vdb {
-                path: path.to_path_buf(),
-                message: format!(
-                    "leaf origin {:?} is outside OpenVDB's 32-bit index range",
-                    leaf.origin
-                ),
-            })?);
-        }
+        origins.extend(index_coord(path, leaf.origin)?);
         masks.extend_from_slice(&leaf.mask);
     }
-    Ok((origins, masks, leaves))
+    let mut leaf_tiles = Vec::new();
+    for o in grid.tiles().leaf_tiles() {
+        leaf_tiles.extend(index_coord(path, o)?);
+    }
+    let mut node_tiles = Vec::new();
+    for o in grid.tiles().node_tiles() {
+        node_tiles.extend(index_coord(path, o)?);
+    }
+    Ok(Flat {
+        origins,
+        masks,
+        leaves,
+        leaf_tiles,
+        node_tiles,
+    })
 }
 
 /// OpenVDB refuses transforms whose voxel volume is within 1e-15 of zero.
@@ -57,23 +99,14 @@ fn vdb_error(path: &Path, e: impl std::fmt::Display) -> Error {
     }
 }
 
-/// Writes `grid` to `path` as `surface`, `density` and (when present) `normal` and `Cd` grids, each
-/// with `grid.transform` and `metadata` plus `voxelkit_version`.
+/// Writes `grid` to `path` as `density` and (when present) `normal` and `Cd` grids, each with
+/// `grid.transform` and `metadata` plus `voxelkit_version`.
 pub fn write_vdb(path: &Path, grid: &SparseGrid, metadata: &[(&str, String)]) -> Result<()> {
-    write_vdb_with_masks(path, grid, &[], metadata)
+    write_vdb_as(path, grid, &[], metadata, &WriteOptions::default())
 }
 
-/// `write_vdb`, plus one bool grid per `(name, mask)`, each with its own transform.
-pub fn write_vdb_with_masks(
-    path: &Path,
-    grid: &SparseGrid,
-    masks_to_add: &[(&str, &SparseGrid)],
-    metadata: &[(&str, String)],
-) -> Result<()> {
-    write_vdb_as(path, grid, masks_to_add, metadata, &WriteOptions::default())
-}
-
-/// `write_vdb_with_masks`, writing as `options` say.
+/// `write_vdb`, plus one bool grid per `(name, mask)`, each with its own transform, writing
+/// as `options` say; a grid not written is not built.
 pub fn write_vdb_as(
     path: &Path,
     grid: &SparseGrid,
@@ -82,60 +115,54 @@ pub fn write_vdb_as(
     options: &WriteOptions,
 ) -> Result<()> {
     check_voxel_size(path, grid.transform.voxel_size)?;
-    let (origins, masks, leaves) = flatten(path, grid)?;
+    let flat = flatten(path, grid)?;
     let meta = meta_entries(metadata);
-    let t = grid.transform;
-    let origin = t.origin.to_array();
     let mut writer = bridge::new_vdb_writer();
-    let mut add = |kind: &str, name: &str, values: &[f32]| {
+    let mut add = |kind: &str, name: &str, flat: &Flat, t: Transform, values: &[f32]| {
+        if !options.wants(name) {
+            return Ok(());
+        }
+        // Tiles carry no normals or colours.
+        let plain = matches!(kind, "bool" | "fog");
         writer
             .pin_mut()
             .add_grid(
                 kind,
                 name,
                 t.voxel_size,
-                origin,
-                &origins,
-                &masks,
+                t.origin.to_array(),
+                &flat.origins,
+                &flat.masks,
                 values,
+                if plain { &flat.leaf_tiles } else { &[] },
+                if plain { &flat.node_tiles } else { &[] },
                 &meta,
             )
             .map_err(|e| vdb_error(path, e))
     };
-    add("bool", "surface", &[])?;
-    add("fog", "density", &[])?;
-    if grid.channels().normal {
-        let mut normals = Vec::with_capacity(leaves.len() * LEAF_VOXELS * 3);
-        for leaf in &leaves {
+    let t = grid.transform;
+    add("fog", DENSITY_GRID, &flat, t, &[])?;
+    add("bool", VOXELS_GRID, &flat, t, &[])?;
+    if grid.channels().normal && options.wants("normal") {
+        let mut normals = Vec::with_capacity(flat.leaves.len() * LEAF_VOXELS * 3);
+        for leaf in &flat.leaves {
             let n = leaf.normal.as_ref().expect("grid with normal channel");
             normals.extend(n.iter().flatten());
         }
-        add("normal", "normal", &normals)?;
+        add("normal", "normal", &flat, t, &normals)?;
     }
-    if grid.channels().color {
-        let mut colors = Vec::with_capacity(leaves.len() * LEAF_VOXELS * 3);
-        for leaf in &leaves {
+    if grid.channels().color && options.wants("Cd") {
+        let mut colors = Vec::with_capacity(flat.leaves.len() * LEAF_VOXELS * 3);
+        for leaf in &flat.leaves {
             let c = leaf.color.as_ref().expect("grid with colour channel");
             colors.extend(c.iter().flatten());
         }
-        add("color", "Cd", &colors)?;
+        add("color", "Cd", &flat, t, &colors)?;
     }
     for (name, mask) in masks_to_add {
-        let (origins, masks, _) = flatten(path, mask)?;
-        let mt = mask.transform;
-        writer
-            .pin_mut()
-            .add_grid(
-                "bool",
-                name,
-                mt.voxel_size,
-                mt.origin.to_array(),
-                &origins,
-                &masks,
-                &[],
-                &meta,
-            )
-            .map_err(|e| vdb_error(path, e))?;
+        if options.wants(name) {
+            add("bool", name, &flatten(path, mask)?, mask.transform, &[])?;
+        }
     }
     write_file(path, &writer, options)
 }
@@ -143,11 +170,23 @@ pub fn write_vdb_as(
 /// How a `.vdb` is written: which grids, compressed how, floats at what precision.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct WriteOptions {
-    /// The grids to write, by name (all when empty).
+    /// The grids to write, by name (when empty: all but `voxels`, which repeats `density`'s
+    /// voxels as booleans).
     pub grids: Vec<String>,
     pub compression: Compression,
     /// Float and vector grids as 16-bit halves (half the size, about 3 decimal digits).
     pub half: bool,
+}
+
+impl WriteOptions {
+    /// Whether the grid `name` is to be written.
+    pub fn wants(&self, name: &str) -> bool {
+        if self.grids.is_empty() {
+            name != VOXELS_GRID
+        } else {
+            self.grids.iter().any(|g| g == name)
+        }
+    }
 }
 
 /// `.vdb` compression.
@@ -226,9 +265,9 @@ pub fn write_distance_band(
     options: &WriteOptions,
 ) -> Result<()> {
     check_voxel_size(path, grid.transform.voxel_size)?;
-    let (origins, masks, leaves) = flatten(path, grid)?;
-    let mut values = Vec::with_capacity(leaves.len() * LEAF_VOXELS);
-    for leaf in &leaves {
+    let flat = flatten(path, grid)?;
+    let mut values = Vec::with_capacity(flat.leaves.len() * LEAF_VOXELS);
+    for leaf in &flat.leaves {
         let v = leaf
             .value
             .as_ref()
@@ -238,7 +277,7 @@ pub fn write_distance_band(
     let meta = meta_entries(metadata);
     let t = grid.transform;
     let (name, density, signed) = match kind {
-        DistanceGrid::LevelSet => ("surface", "density", true),
+        DistanceGrid::LevelSet => (LEVEL_SET_GRID, DENSITY_GRID, true),
         DistanceGrid::Unsigned => ("distance", "", false),
     };
     let mut writer = bridge::new_vdb_writer();
@@ -249,8 +288,8 @@ pub fn write_distance_band(
             density,
             t.voxel_size,
             t.origin.to_array(),
-            &origins,
-            &masks,
+            &flat.origins,
+            &flat.masks,
             &values,
             background,
             signed,
@@ -307,21 +346,26 @@ pub fn read_vdb_info(path: &Path) -> Result<Vec<GridInfo>> {
         .collect()
 }
 
-/// Reads the Bool, Mask or Float grid `name` (or the first such grid) into a grid; Float
-/// values land in the value channel.
+/// Reads the Bool, Mask or Float grid `name` into a grid, or without a name the voxel set
+/// voxelkit writes (`voxels`, else `density`, else the first such grid). Float values land in
+/// the value channel; tiles stay tiles (their values are not kept).
 pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
     let file = open(path)?;
     let infos: Vec<GridInfo> = (0..file.grid_count())
         .map(|i| file.grid_info(i).map_err(|e| vdb_error(path, e)))
         .collect::<Result<_>>()?;
     let readable = |i: &GridInfo| matches!(i.value_type.as_str(), "bool" | "mask" | "float");
-    let index = infos
-        .iter()
-        .position(|i| name.map_or(readable(i), |n| i.name == n))
-        .ok_or_else(|| match name {
-            Some(n) => vdb_error(path, format!("no grid named `{n}`")),
-            None => vdb_error(path, "no bool, mask or float grid in the file"),
-        })?;
+    let named = |n: &str| infos.iter().position(|i| i.name == n && readable(i));
+    let index = match name {
+        Some(n) => infos.iter().position(|i| i.name == n),
+        None => named(VOXELS_GRID)
+            .or_else(|| named(DENSITY_GRID))
+            .or_else(|| infos.iter().position(readable)),
+    }
+    .ok_or_else(|| match name {
+        Some(n) => vdb_error(path, format!("no grid named `{n}`")),
+        None => vdb_error(path, "no bool, mask or float grid in the file"),
+    })?;
     let info = &infos[index];
     if !info.uniform_linear {
         return Err(vdb_error(
@@ -334,18 +378,16 @@ pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
             ),
         ));
     }
-    // Tiles are expanded into leaves: plan that before OpenVDB allocates anything.
-    let leaves = info
-        .active_voxels
-        .div_ceil(LEAF_VOXELS as u64)
-        .max(info.leaf_count);
+    // Plan the copy before anything is allocated: leaves with their values, tiles as origins.
     let per_leaf = if info.value_type == "float" {
         3 * 4 * LEAF_VOXELS
     } else {
         400
     } as u64;
     crate::system::check_fits(
-        leaves.saturating_mul(per_leaf),
+        info.leaf_count
+            .saturating_mul(per_leaf)
+            .saturating_add(info.tile_count.saturating_mul(64)),
         None,
         &format!(
             "{}: grid `{}` holds {} active voxels",
@@ -354,8 +396,9 @@ pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
             info.active_voxels
         ),
     )?;
-    let (mut origins, mut masks, mut values) = (Vec::new(), Vec::new(), Vec::new());
-    file.read_leaves(index, &mut origins, &mut masks, &mut values)
+    let (mut origins, mut masks, mut values, mut tiles) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    file.read_leaves(index, &mut origins, &mut masks, &mut values, &mut tiles)
         .map_err(|e| unreadable(path, e))?;
     let has_values = !values.is_empty();
     let channels = Channels {
@@ -376,30 +419,51 @@ pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
         })
         .collect();
     let transform = Transform::new(DVec3::from_array(info.origin), info.voxel_size[0]);
-    Ok(SparseGrid::from_leaves(transform, channels, leaves))
+    let mut grid = SparseGrid::from_leaves(transform, channels, leaves);
+    for t in tiles.chunks_exact(4) {
+        let origin = [t[0] as i64, t[1] as i64, t[2] as i64];
+        match t[3] {
+            8 => grid.fill_leaf_block(origin),
+            128 => grid.fill_node_block(origin),
+            edge => return Err(unreadable(path, format!("a tile of edge {edge}"))),
+        }
+    }
+    Ok(grid)
 }
 
-/// OpenVDB's `meshToVolume` on a triangle mesh in index space (benchmark reference), with
-/// `exterior_band` and `interior_band` voxels (`f32::MAX` inside fills the solid): returns its
-/// active voxel count.
-pub fn openvdb_mesh_to_volume(
+/// Which of OpenVDB's own mesh conversions a benchmark compares against.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OpenVdbReference {
+    /// `meshToUnsignedDistanceField`: the unsigned band a surface voxelization matches.
+    Unsigned,
+    /// `meshToLevelSet`: a narrow-band level set.
+    LevelSet,
+    /// `meshToLevelSet` then `sdfInteriorMask`: a solid.
+    Solid,
+    /// `meshToVolume` with the interior filled (a slower path to a solid).
+    Filled,
+}
+
+/// OpenVDB's conversion `kind` of a triangle mesh given in index space, `band` voxels wide,
+/// on at most `threads` threads: returns its active voxel count.
+pub fn openvdb_reference(
+    kind: OpenVdbReference,
     index_points: &[f32],
     triangles: &[u32],
     voxel_size: f64,
-    exterior_band: f32,
-    interior_band: f32,
+    band: f32,
     threads: usize,
 ) -> Result<u64> {
-    bridge::openvdb_mesh_to_volume(
-        index_points,
-        triangles,
-        voxel_size,
-        exterior_band,
-        interior_band,
-        threads,
+    let name = match kind {
+        OpenVdbReference::Unsigned => "unsigned",
+        OpenVdbReference::LevelSet => "level-set",
+        OpenVdbReference::Solid => "solid",
+        OpenVdbReference::Filled => "filled",
+    };
+    bridge::openvdb_reference(name, index_points, triangles, voxel_size, band, threads).map_err(
+        |e| Error::Vdb {
+            path: format!("<OpenVDB {name}>").into(),
+            message: e.to_string(),
+        },
     )
-    .map_err(|e| Error::Vdb {
-        path: "<meshToVolume>".into(),
-        message: e.to_string(),
-    })
 }

@@ -4,8 +4,6 @@
 //! union of closed unit cubes (χ = vertices - edges + faces - cubes), from which the genus of
 //! its boundary follows for solids without cavities: genus = components - χ.
 
-use crate::grid::DenseMask;
-
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SolidMeasures {
     pub inside_voxels: u64,
@@ -25,14 +23,16 @@ impl SolidMeasures {
     }
 }
 
-/// Volumes of a solid given its `inside` and `surface` voxels (disjoint) and voxel size.
-pub fn measure_solid(inside: &DenseMask, surface: &DenseMask, voxel_size: f64) -> SolidMeasures {
-    let cell = voxel_size.powi(3);
-    let (inside_voxels, surface_voxels) = (inside.count(), surface.count());
-    SolidMeasures {
-        inside_voxels,
-        surface_voxels,
-        volume_inside: inside_voxels as f64 * cell,
-        volume_with_surface: (inside_voxels + surface_voxels) as f64 * cell,
+impl SolidMeasures {
+    /// Volumes of a solid from its numbers of `inside` and `surface` voxels (disjoint sets)
+    /// and its voxel size.
+    pub fn of(inside_voxels: u64, surface_voxels: u64, voxel_size: f64) -> SolidMeasures {
+        let cell = voxel_size.powi(3);
+        SolidMeasures {
+            inside_voxels,
+            surface_voxels,
+            volume_inside: inside_voxels as f64 * cell,
+            volume_with_surface: (inside_voxels + surface_voxels) as f64 * cell,
+        }
     }
 }

@@ -2,6 +2,7 @@
 
 pub mod csg;
 pub mod flood;
+pub mod flood_blocks;
 pub mod flood_linear;
 pub mod flood_spans;
 pub mod flood_xyz;

@@ -275,7 +275,7 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             ..
         } => {
             let load = |g: &super::GridSource| match g {
-                super::GridSource::File(path) => read_vdb_grid(path, Some(grid)),
+                super::GridSource::File(path) => read_vdb_grid(path, grid.as_deref()),
                 super::GridSource::Grid(g) => Ok(g.clone()),
             };
             let (ga, gb) = (load(a)?, load(b)?);
@@ -320,9 +320,9 @@ fn solid_plan(mesh: &MeshSource, fit: GridFit, fill: super::Fill) -> Result<(Loa
     Ok((Loaded::Mesh(mesh), p))
 }
 
-/// The surface of a `.vdb` to measure: a solid's `boundary` when it is one, else `surface`.
+/// The surface of a `.vdb` to measure: a solid's `shell` when it is one, else its voxel set.
 fn read_surface(path: &std::path::Path) -> Result<SparseGrid> {
-    read_vdb_grid(path, Some("boundary")).or_else(|_| read_vdb_grid(path, Some("surface")))
+    read_vdb_grid(path, Some("shell")).or_else(|_| read_vdb_grid(path, None))
 }
 
 /// A grid's index box (the voxel at the origin when it is empty).

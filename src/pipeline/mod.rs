@@ -83,7 +83,7 @@ pub enum Fill {
 }
 
 /// What `measure` measures: a mesh (its flooded 26-separating surface), a `.vdb` surface (a
-/// solid's `boundary`, else its `surface`) or a surface in memory.
+/// solid's `shell`, else its voxel set) or a surface in memory.
 #[derive(Clone, Debug)]
 pub enum MeasureSource {
     Mesh(MeshSource),
@@ -155,12 +155,12 @@ pub enum Task {
     },
     /// A CSG tree in JSON (see `ops::csg_tree`); its file sets the grid.
     CsgTree(PathBuf),
-    /// A Boolean of two grids (from files: their grid `grid`); `curve`: the intersection of
-    /// two surfaces.
+    /// A Boolean of two grids (from files: their grid `grid`, or the voxel set voxelkit
+    /// writes); `curve`: the intersection of two surfaces.
     Combine {
         a: GridSource,
         b: GridSource,
-        grid: String,
+        grid: Option<String>,
         op: BooleanOp,
         resample: bool,
         curve: bool,

@@ -31,7 +31,7 @@ use std::time::Instant;
 pub struct Outcome {
     /// The voxel set: a surface (with its normal or colour channel) or a whole solid.
     pub grid: SparseGrid,
-    /// Bool grids written beside it (`boundary`, `interior`, `unclassified`,
+    /// Bool grids written beside it (`shell`, `interior`, `unclassified`,
     /// `opposite_normals`, `level_0` ..), by name.
     pub extra: Vec<(String, SparseGrid)>,
     /// The metadata every written grid carries (`method`, `source_file`, ...).

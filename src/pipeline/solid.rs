@@ -88,8 +88,7 @@ fn solid_details(
     })
 }
 
-/// A surface plus the voxels inside it: `surface` and `density` on both, `boundary` and
-/// `interior` apart.
+/// A surface plus the voxels inside it: `density` on both, `shell` and `interior` apart.
 /// `describe` reports on the whole solid.
 fn surface_and_inside(
     surface: SparseGrid,
@@ -102,11 +101,11 @@ fn surface_and_inside(
     whole.union(&solid.inside);
     let details = describe(&whole, &solid)?;
     Ok(Outcome::new(whole, meta, Details::Solid(details))
-        .with("boundary", surface)
+        .with("shell", surface)
         .with("interior", solid.inside))
 }
 
-/// A solid classified at voxel centres: `boundary` (voxels with a face towards the
+/// A solid classified at voxel centres: `shell` (voxels with a face towards the
 /// outside) and `interior` beside the whole.
 fn centre_solid(
     solid: &DenseMask,
@@ -117,7 +116,7 @@ fn centre_solid(
     let outer = solid.boundary();
     let interior = solid.minus(&outer).to_grid(t);
     Outcome::new(solid.to_grid(t), meta, details)
-        .with("boundary", outer.to_grid(t))
+        .with("shell", outer.to_grid(t))
         .with("interior", interior)
 }
 

@@ -16,7 +16,7 @@ use crate::grid::{SparseGrid, Transform};
 use crate::mesh::inside::inside_centres;
 use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
-use crate::ops::measure::measure_solid;
+use crate::ops::measure::SolidMeasures;
 use crate::solids::exterior_flood::Solid;
 use crate::voxelize::Progress;
 use crate::voxelize::projective::{Coloring, ProjectiveStats, voxelize_triangles};
@@ -41,7 +41,7 @@ pub fn beam_solid(
     let blocked = DenseMask::from_grid(&surface, bbox)?;
     let beams = inside_centres(mesh, &transform, bbox)?;
     let inside = beams.minus(&blocked);
-    let measures = measure_solid(&inside, &blocked, transform.voxel_size);
+    let measures = SolidMeasures::of(inside.count(), blocked.count(), transform.voxel_size);
     let solid = Solid {
         inside: inside.to_grid(transform),
         measures,

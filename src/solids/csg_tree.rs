@@ -9,7 +9,7 @@
 //!                                    "radius": 0.8, "height": 1 } } ] },
 //!       { "formula": { "text": "(sqrt(x^2 + y^2) - 0.8)^2 + (z - 1)^2 - 0.01",
 //!                      "bounds": { "min": [-1, -1, 0.8], "max": [1, 1, 1.2] } } },
-//!       { "mesh": "bolt.obj" }, { "vdb": { "file": "pocket.vdb", "grid": "surface" } } ] } }
+//!       { "mesh": "bolt.obj" }, { "vdb": { "file": "pocket.vdb", "grid": "voxels" } } ] } }
 //! ```
 //!
 //! Every node is an object with one key, its kind (serde's externally tagged enum): `union`,
@@ -157,7 +157,7 @@ enum FormulaSpec {
     },
 }
 
-/// `"grid.vdb"`, or `{"file": "grid.vdb", "grid": "surface"}`.
+/// `"grid.vdb"`, or `{"file": "grid.vdb", "grid": "voxels"}`.
 #[derive(Deserialize)]
 #[serde(
     untagged,
@@ -330,7 +330,7 @@ impl Reader<'_> {
                     VdbSpec::Full { file, grid } => (file, grid),
                 };
                 let source = self.folder.join(file);
-                let grid = read_vdb_grid(&source, Some(name.as_deref().unwrap_or("surface")))
+                let grid = read_vdb_grid(&source, name.as_deref())
                     .map_err(|e| self.error(&format!("{at}.vdb"), &e.to_string()))?;
                 Ok(CsgNode::Grid { grid, source })
             }

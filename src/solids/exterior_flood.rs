@@ -7,15 +7,19 @@
 use crate::error::Result;
 use crate::grid::{Channels, DenseMask, SparseGrid};
 use crate::ops::flood::padded;
+use crate::ops::flood_blocks::inside_by_blocks;
 use crate::ops::flood_spans::flood_spans;
 use crate::ops::flood_xyz::{FloodXyzStats, flood_xyz};
-use crate::ops::measure::{SolidMeasures, measure_solid};
+use crate::ops::measure::SolidMeasures;
 use crate::progress::Progress;
 
 /// Which flood finds the exterior.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FloodMethod {
-    /// Scanline spans (fast).
+    /// Whole empty 8^3 blocks at once, voxels only in blocks with surface voxels (fastest;
+    /// the inside comes out as tiles).
+    Blocks,
+    /// Scanline spans over a dense bit volume.
     Spans,
     /// Lai & Cheng's FloodingXYZ with a GRAYSTACK of this capacity.
     Xyz { capacity: usize },
@@ -42,11 +46,24 @@ pub fn solid_from_surface(
             xyz_stats: None,
         });
     };
+    if method == FloodMethod::Blocks {
+        let inside = inside_by_blocks(surface, progress)?;
+        let measures = SolidMeasures::of(
+            inside.voxel_count(),
+            surface.voxel_count(),
+            surface.transform.voxel_size,
+        );
+        return Ok(Solid {
+            inside,
+            measures,
+            xyz_stats: None,
+        });
+    }
     let bbox = padded(bbox, 2);
     let blocked = DenseMask::from_grid(surface, bbox)?;
     let seed = [bbox.min];
     let (exterior, xyz_stats) = match method {
-        FloodMethod::Spans => (flood_spans(&blocked, &seed, progress)?, None),
+        FloodMethod::Blocks | FloodMethod::Spans => (flood_spans(&blocked, &seed, progress)?, None),
         FloodMethod::Xyz { capacity } => {
             let (reached, stats) = flood_xyz(&blocked, &seed, capacity, progress)?;
             (reached, Some(stats))
@@ -54,7 +71,11 @@ pub fn solid_from_surface(
     };
     let inside_mask = DenseMask::neither(&blocked, &exterior);
     let inside = inside_mask.to_grid(surface.transform);
-    let measures = measure_solid(&inside_mask, &blocked, surface.transform.voxel_size);
+    let measures = SolidMeasures::of(
+        inside_mask.count(),
+        blocked.count(),
+        surface.transform.voxel_size,
+    );
     Ok(Solid {
         inside,
         measures,

@@ -98,7 +98,7 @@ int main(int argc, char **argv) {
     /* Write and read back. */
     OK(vk_grid_write_vdb(surface, argv[2]));
     vk_grid *back = NULL;
-    OK(vk_grid_read_vdb(argv[2], "surface", &back));
+    OK(vk_grid_read_vdb(argv[2], "density", &back));
     uint64_t back_voxels = 0;
     OK(vk_grid_voxel_count(back, &back_voxels));
     CHECK(back_voxels == voxels);

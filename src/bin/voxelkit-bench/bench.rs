@@ -1,11 +1,12 @@
-//! `voxelkit bench`: our separating voxelizer against OpenVDB's `tools::meshToVolume` with a
-//! one-voxel band, on the same mesh, voxel size and thread count, in the same process.
+//! `voxelkit bench`: our separating voxelizer against OpenVDB's
+//! `tools::meshToUnsignedDistanceField` with a one-voxel band, on the same mesh, voxel size and
+//! thread count, in the same process.
 
 use crate::json::Json;
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
-use voxelkit::io::vdb::openvdb_mesh_to_volume;
+use voxelkit::io::vdb::{OpenVdbReference, openvdb_reference};
 use voxelkit::mesh::{GridFit, Mesh, fit_transform};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{Criterion, SeparatingOptions, voxelize_mesh};
@@ -40,20 +41,23 @@ pub struct BenchArgs {
 #[derive(clap::Subcommand)]
 enum BenchKind {
     /// The Catmull-Clark voxelizer: evaluations against uniform sampling, and time against
-    /// OpenVDB's meshToVolume on a tessellation of the same limit surface.
+    /// OpenVDB's meshToUnsignedDistanceField on a tessellation of the same limit surface.
     Subdiv(crate::bench_subdiv::SubdivBenchArgs),
     /// Implicit surfaces: the paper's Fig. 5 by interval octree, against naive corner signs.
     Implicit(crate::bench_implicit::ImplicitBenchArgs),
-    /// Solids: surface plus flood against OpenVDB's meshToVolume with the interior filled.
+    /// Solids: surface plus flood against OpenVDB's meshToLevelSet plus sdfInteriorMask.
     Solid(crate::bench_solid::SolidBenchArgs),
     /// Volume and area convergence on exact solids; depth-layer volumes of real meshes.
     Measure(crate::bench_measure::MeasureBenchArgs),
     /// The projective voxelizer in triangles/s and lines/s against the separating one;
     /// with --leaks, voxel counts and flood leaks of both.
     Projective(crate::bench_projective::ProjectiveBenchArgs),
-    /// Level sets: `voxelkit mesh --sdf` (the whole process) against OpenVDB's
-    /// meshToLevelSet with the same band.
-    Levelset(crate::bench_level_set::LevelSetBenchArgs),
+    /// The whole `voxelkit` process (`mesh`, `solid` or `mesh --sdf`) against the cheapest
+    /// OpenVDB call with the same output, with file sizes and both processes' peaks.
+    Whole(crate::bench_whole::WholeBenchArgs),
+    /// One OpenVDB reference run, in a process of its own (used by `whole`).
+    #[command(hide = true)]
+    Openvdb(crate::bench_whole::OpenVdbRunArgs),
 }
 
 /// `mesh` as OpenVDB's mesher takes it: points in the index space of `t` and triangle
@@ -113,7 +117,8 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
         Some(BenchKind::Solid(solid)) => return crate::bench_solid::run(solid, json),
         Some(BenchKind::Measure(m)) => return crate::bench_measure::run(m, json),
         Some(BenchKind::Projective(p)) => return crate::bench_projective::run(p, json),
-        Some(BenchKind::Levelset(l)) => return crate::bench_level_set::run(l, json),
+        Some(BenchKind::Whole(w)) => return crate::bench_whole::run(w, json),
+        Some(BenchKind::Openvdb(o)) => return crate::bench_whole::run_openvdb(o),
         None => {}
     }
     let data = data_folder(&args.data);
@@ -147,11 +152,11 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
             for &threads in &args.thread_counts {
                 let pool = thread_pool(threads)?;
                 let (vdb_s, vdb_voxels) = best_of(args.repeat, || {
-                    openvdb_mesh_to_volume(
+                    openvdb_reference(
+                        OpenVdbReference::Unsigned,
                         &index_points,
                         &tris,
                         transform.voxel_size,
-                        1.0,
                         1.0,
                         threads,
                     )

@@ -1,7 +1,7 @@
 //! `voxelkit bench solid`: solids at 512^3 and 1024^3 — our surface plus exterior flood (span
 //! flood, and Lai & Cheng's FloodingXYZ), the paper's linear flooding on small sizes, and
-//! OpenVDB's own solid (meshToVolume with the interior filled) on the same mesh, voxel size
-//! and thread count, in the same process.
+//! OpenVDB's own solid (meshToLevelSet with its default half width of 3, then
+//! sdfInteriorMask) on the same mesh, voxel size and thread count, in the same process.
 
 use crate::bench::{best_of, data_folder};
 use crate::json::Json;
@@ -9,7 +9,7 @@ use clap::Args;
 use std::path::PathBuf;
 use voxelkit::Result;
 use voxelkit::grid::DenseMask;
-use voxelkit::io::vdb::openvdb_mesh_to_volume;
+use voxelkit::io::vdb::{OpenVdbReference, openvdb_reference};
 use voxelkit::mesh::{GridFit, Mesh, fit_transform};
 use voxelkit::ops::flood::padded;
 use voxelkit::ops::flood_linear::flood_linear;
@@ -98,7 +98,14 @@ pub fn run(args: &SolidBenchArgs, json: bool) -> Result<()> {
             };
             let (points, tris) = crate::bench::openvdb_mesh(&mesh, &t);
             let (vdb_s, vdb_voxels) = best_of(args.repeat, || {
-                openvdb_mesh_to_volume(&points, &tris, t.voxel_size, 1.0, f32::MAX, args.threads)
+                openvdb_reference(
+                    OpenVdbReference::Solid,
+                    &points,
+                    &tris,
+                    t.voxel_size,
+                    3.0,
+                    args.threads,
+                )
             })?;
             let ours = surface_s + spans_s;
             let voxels = solid.measures.inside_voxels + solid.measures.surface_voxels;

@@ -1,7 +1,7 @@
 //! `voxelkit bench subdiv`: the parametric Catmull-Clark voxelizer per mesh, resolution and
 //! adjacency — seconds, evaluations, evaluations per second, and the evaluations a uniform
 //! grid at the same finest spacing would need (the paper's case for adaptivity). The reference
-//! in the same process: OpenVDB's meshToVolume (one-voxel band) on a tessellation of the same
+//! in the same process: OpenVDB's meshToUnsignedDistanceField (one-voxel band) on a tessellation of the same
 //! limit surface with about one voxel between samples, on the same thread count (tessellating
 //! is not timed).
 
@@ -10,7 +10,7 @@ use crate::json::Json;
 use clap::Args;
 use std::path::PathBuf;
 use voxelkit::grid::Adjacency;
-use voxelkit::io::vdb::openvdb_mesh_to_volume;
+use voxelkit::io::vdb::{OpenVdbReference, openvdb_reference};
 use voxelkit::mesh::{GridFit, fit_transform};
 use voxelkit::subd::{ControlMesh, LimitSurface};
 use voxelkit::voxelize::parametric::{ParametricOptions, voxelize_subdivision};
@@ -154,7 +154,7 @@ pub fn run(args: &SubdivBenchArgs, json: bool) -> Result<()> {
     Ok(())
 }
 
-/// OpenVDB meshToVolume on a tessellation with about one voxel between samples.
+/// OpenVDB's meshToUnsignedDistanceField on a tessellation with about one voxel between samples.
 fn reference_seconds(
     limit: &LimitSurface,
     transform: voxelkit::grid::Transform,
@@ -184,7 +184,14 @@ fn reference_seconds(
     });
     let (points, tris) = crate::bench::openvdb_mesh(&mesh, &transform);
     let (seconds, _) = best_of(args.repeat, || {
-        openvdb_mesh_to_volume(&points, &tris, transform.voxel_size, 1.0, 1.0, args.threads)
+        openvdb_reference(
+            OpenVdbReference::Unsigned,
+            &points,
+            &tris,
+            transform.voxel_size,
+            1.0,
+            args.threads,
+        )
     })?;
     Ok(seconds)
 }

@@ -4,11 +4,11 @@
 
 mod bench;
 mod bench_implicit;
-mod bench_level_set;
 mod bench_measure;
 mod bench_projective;
 mod bench_solid;
 mod bench_subdiv;
+mod bench_whole;
 mod json;
 
 use clap::Parser;
@@ -19,9 +19,10 @@ use voxelkit::voxelize::separating::Criterion;
 #[command(
     name = "voxelkit-bench",
     version,
-    about = "Benchmark voxelkit against OpenVDB's meshToVolume with a one-voxel band, in the same run \
-             (`subdiv`: the Catmull-Clark voxelizer; `implicit`: the interval octree; `solid`: filled \
-             solids; `measure`: volume convergence; `projective`: triangles/s)"
+    about = "Benchmark voxelkit against OpenVDB's meshToUnsignedDistanceField with a one-voxel band, \
+             in the same run (`whole`: the whole voxelkit process against OpenVDB; `subdiv`: the \
+             Catmull-Clark voxelizer; `implicit`: the interval octree; `solid`: filled solids; \
+             `measure`: volume convergence; `projective`: triangles/s)"
 )]
 struct Cli {
     /// Print one JSON object instead of the tables.

@@ -12,7 +12,9 @@ use voxelkit::solids::exterior_flood::FloodMethod;
 /// The floods to choose from.
 #[derive(clap::ValueEnum, Clone, Copy)]
 enum FloodKind {
-    /// The fast scanline flood.
+    /// Whole empty 8^3 blocks at once, voxel by voxel only where the surface is (fastest).
+    Blocks,
+    /// The scanline flood over a dense bit volume.
     Spans,
     /// Lai & Cheng's FloodingXYZ with a GRAYSTACK.
     Xyz,
@@ -21,7 +23,7 @@ enum FloodKind {
 /// How the exterior is flooded.
 #[derive(Args, Clone, Copy)]
 pub struct FloodArgs {
-    #[arg(long, value_enum, default_value = "spans")]
+    #[arg(long, value_enum, default_value = "blocks")]
     flood: FloodKind,
     /// GRAYSTACK capacity for --flood xyz (entries; when full, sweeps resume the flood).
     #[arg(long, default_value_t = 1 << 20)]
@@ -34,6 +36,7 @@ impl FloodArgs {
             FloodKind::Xyz => FloodMethod::Xyz {
                 capacity: self.graystack.max(1),
             },
+            FloodKind::Blocks => FloodMethod::Blocks,
             FloodKind::Spans => FloodMethod::Spans,
         }
     }
@@ -82,8 +85,10 @@ pub struct SolidArgs {
     /// Half width of the --sdf band, in voxels.
     #[arg(long, default_value_t = 3.0, value_name = "W")]
     pub band: f64,
-    /// Output .vdb: `surface` and `density` (1 on the whole solid), `boundary` (its outer
-    /// voxels) and `interior`; depth layers add `unclassified`.
+    /// Output .vdb: `density` (1 on the whole solid, whole blocks as tiles), `shell` (its
+    /// outer voxels) and `interior`; depth layers add `unclassified`; `voxels` (the whole
+    /// solid as booleans) when --grids names it. With --sdf: `density` and the level set
+    /// `surface`.
     #[arg(short, long)]
     pub output: PathBuf,
 }
@@ -104,9 +109,10 @@ pub struct CsgArgs {
     /// or voxel_size (see examples/csg/).
     #[arg(long, conflicts_with_all = ["operation", "a", "b"])]
     tree: Option<PathBuf>,
-    /// The grid read from both files.
-    #[arg(long, default_value = "surface")]
-    grid: String,
+    /// The grid read from both files [default: `voxels`, else `density`, else the first
+    /// bool, mask or float grid].
+    #[arg(long)]
+    grid: Option<String>,
     /// Resample the second grid onto the first's transform when they differ.
     #[arg(long)]
     resample: bool,
@@ -208,7 +214,7 @@ pub fn intersect(args: &IntersectArgs, global: &Global) -> Result<()> {
     let task = Task::Combine {
         a: GridSource::File(args.a.clone()),
         b: GridSource::File(args.b.clone()),
-        grid: "surface".into(),
+        grid: None,
         op: BooleanOp::Intersection,
         resample: args.resample,
         curve: true,
