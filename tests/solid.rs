@@ -66,3 +66,52 @@ fn flooded_solids_match_ray_parity_off_the_surface() {
         }
     }
 }
+
+/// The block flood (the default) fills exactly the voxels the voxel-by-voxel span flood fills,
+/// on every closed mesh of the data folder, and holds the whole blocks of the inside as tiles.
+#[test]
+fn the_block_flood_fills_what_the_voxel_flood_fills_on_every_closed_mesh() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    let mut names: Vec<_> = std::fs::read_dir(data.join("meshes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+        .collect();
+    names.sort();
+    let mut closed = 0;
+    for path in names {
+        let mesh = Mesh::load(&path).unwrap();
+        if !mesh.edge_counts().is_closed() {
+            continue;
+        }
+        closed += 1;
+        for resolution in [128, 256] {
+            let options = SeparatingOptions {
+                separability: Separability::TwentySix,
+                ..Default::default()
+            };
+            let (surface, _) = common::voxelize_at(&mesh, resolution, options);
+            let none = voxelkit::progress::Progress::none();
+            let blocks = solid_from_surface(&surface, FloodMethod::Blocks, &none).unwrap();
+            let spans = solid_from_surface(&surface, FloodMethod::Spans, &none).unwrap();
+            let what = format!("{} at {resolution}", path.display());
+            assert_eq!(blocks.measures, spans.measures, "{what}");
+            assert!(
+                spans.inside.voxels().all(|c| blocks.inside.contains(c)),
+                "{what}"
+            );
+            let tiles = blocks.inside.tiles();
+            assert!(tiles.voxel_count() > 0, "{what}: no whole block inside");
+            eprintln!(
+                "{what}: {} inside voxels, {} in {} tiles of 8^3 and {} of 128^3",
+                blocks.measures.inside_voxels,
+                tiles.voxel_count(),
+                tiles.leaf_tiles().count(),
+                tiles.node_tiles().count()
+            );
+        }
+    }
+    assert!(closed >= 10, "only {closed} closed meshes found");
+}

@@ -504,6 +504,72 @@ mod tests {
         assert!(d.voxels().all(|c| c[0] < 20));
     }
 
+    /// A grid of scattered voxels, whole 8^3 blocks and whole 128^3 blocks, and its voxels.
+    fn tiled(rng: &mut crate::random::SplitMix64) -> (SparseGrid, FxHashSet<Coord>) {
+        let mut g = SparseGrid::default();
+        let mut set = FxHashSet::default();
+        let mut pick = |lo: f64, hi: f64| rng.range(lo, hi).floor() as i64;
+        for _ in 0..300 {
+            let c = [pick(-140.0, 140.0), pick(-140.0, 140.0), pick(-20.0, 20.0)];
+            g.insert(c);
+            set.insert(c);
+        }
+        let mut blocks: Vec<(Coord, i64)> = Vec::new();
+        for _ in 0..12 {
+            blocks.push(([pick(-16.0, 16.0) * 8, pick(-16.0, 16.0) * 8, pick(-3.0, 3.0) * 8], 8));
+        }
+        blocks.push(([pick(-1.0, 1.0) * 128, 0, -128], 128));
+        for (o, d) in blocks {
+            if d == 8 {
+                g.fill_leaf_block(o);
+            } else {
+                g.fill_node_block(o);
+            }
+            for x in 0..d {
+                for y in 0..d {
+                    for z in 0..d {
+                        set.insert([o[0] + x, o[1] + y, o[2] + z]);
+                    }
+                }
+            }
+        }
+        g.compact();
+        (g, set)
+    }
+
+    fn voxel_set(g: &SparseGrid) -> FxHashSet<Coord> {
+        let set: FxHashSet<Coord> = g.voxels().collect();
+        assert_eq!(set.len() as u64, g.voxel_count(), "a voxel listed twice");
+        set
+    }
+
+    #[test]
+    fn booleans_with_tiles_match_set_algebra() {
+        let mut rng = crate::random::SplitMix64(11);
+        for round in 0..3 {
+            let (a, sa) = tiled(&mut rng);
+            let (b, sb) = tiled(&mut rng);
+            assert_eq!(voxel_set(&a), sa);
+            assert!(a.tiles().node_tiles().count() == 1, "round {round}");
+            let mut u = a.clone();
+            u.union(&b);
+            assert_eq!(voxel_set(&u), &sa | &sb, "union, round {round}");
+            let mut i = a.clone();
+            i.intersection(&b);
+            assert_eq!(voxel_set(&i), &sa & &sb, "intersection, round {round}");
+            let mut d = a.clone();
+            d.difference(&b);
+            assert_eq!(voxel_set(&d), &sa - &sb, "difference, round {round}");
+            for c in sa.iter().take(500) {
+                assert!(a.contains(*c));
+            }
+            let bbox = a.bbox().unwrap();
+            for c in &sa {
+                assert!(bbox.contains(*c));
+            }
+        }
+    }
+
     #[test]
     fn coordinates_beyond_2048_cubed_do_not_overflow() {
         let big = 1i64 << 33;
