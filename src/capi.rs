@@ -942,6 +942,7 @@ pub extern "C" fn vk_fill_mesh(
             mesh: mesh_source(mesh)?,
             fill,
             density: 1.0,
+            topology: false,
         };
         let outcome = run_job(o, task)?;
         let found = match &outcome.report.details {

@@ -105,6 +105,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
                 mesh: mesh(),
                 fill: Fill::Flood(FloodMethod::Spans),
                 density: 1.0,
+                topology: true,
             },
         ),
         (
@@ -113,6 +114,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
                 mesh: mesh(),
                 fill: Fill::DepthLayers(DepthLayerOptions::default()),
                 density: 1.0,
+                topology: true,
             },
         ),
         (
@@ -121,6 +123,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
                 mesh: mesh(),
                 fill: Fill::Beam,
                 density: 1.0,
+                topology: true,
             },
         ),
         (
@@ -254,6 +257,7 @@ fn the_exterior_flood_stops_when_asked() {
                 mesh,
                 fill: Fill::Flood(flood),
                 density: 1.0,
+                topology: true,
             }
         };
         let result = Job::new(task, GridFit::Resolution(256)).run(&StopWhenPolled);

@@ -171,6 +171,7 @@ fn the_beam_solid_from_the_command_line_holds_the_exact_volume() {
         path.to_str().unwrap(),
         "--method",
         "beam",
+        "--topology",
         "-r",
         "96",
         "-o",

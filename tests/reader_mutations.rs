@@ -70,6 +70,7 @@ fn read_mesh(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), TestCaseError> 
                     mesh,
                     fill: Fill::DepthLayers(Default::default()),
                     density: 1.0,
+                    topology: true,
                 },
             ] {
                 let _ = Job::new(task, GridFit::Resolution(12)).run(&Unobserved);

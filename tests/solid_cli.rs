@@ -30,6 +30,7 @@ fn solid_measure_csg_and_intersect() {
         "xyz",
         "--graystack",
         "256",
+        "--topology",
         "-o",
         &p("torus.vdb"),
     ]);

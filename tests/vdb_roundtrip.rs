@@ -144,3 +144,46 @@ for name in ("voxels", "density"):
         assert_eq!(voxels, expected, "{}", header[0]);
     }
 }
+
+/// A grid with whole 8^3 and 128^3 blocks, written and read back: the blocks stay tiles in
+/// the file and in memory, and OpenVDB (through pyopenvdb too) counts the same voxels.
+#[test]
+fn tiles_are_written_and_read_as_tiles() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut grid = SparseGrid::default();
+    grid.fill_node_block([-128, 0, 128]);
+    for o in [[0, 0, 0], [8, 0, 0], [-64, 8, 16]] {
+        grid.fill_leaf_block(o);
+    }
+    for c in [[3, 9, -1], [200, 5, 5], [-129, 0, 128]] {
+        grid.insert(c);
+    }
+    let path = dir.path().join("tiles.vdb");
+    let options = WriteOptions {
+        grids: vec!["density".into(), "voxels".into()],
+        ..Default::default()
+    };
+    write_vdb_as(&path, &grid, &[], &[], &options).unwrap();
+    for info in read_vdb_info(&path).unwrap() {
+        assert_eq!(info.active_voxels, grid.voxel_count(), "{}", info.name);
+        assert_eq!(info.tile_count, 4, "{}", info.name);
+        assert_eq!(info.leaf_count, 3, "{}", info.name);
+        let back = read_vdb_grid(&path, Some(&info.name)).unwrap();
+        assert_eq!(back.tiles().node_tiles().count(), 1);
+        assert_eq!(back.tiles().leaf_tiles().count(), 3);
+        assert_eq!(sorted_voxels(&back), sorted_voxels(&grid), "{}", info.name);
+    }
+    let script = r#"
+import sys, pyopenvdb as vdb
+for name in ("density", "voxels"):
+    g = vdb.read(sys.argv[1], name)
+    print(name, g.activeVoxelCount(), g.leafCount())
+"#;
+    let Some(text) = run_pyopenvdb(script, &path, "the tile read-back test") else {
+        return;
+    };
+    for name in ["density", "voxels"] {
+        let line = format!("{name} {} 3", grid.voxel_count());
+        assert!(text.contains(&line), "`{line}` missing from {text}");
+    }
+}

@@ -78,7 +78,12 @@ impl SparseGrid {
 
     /// Makes the 128^3 block at `origin` (a multiple of 128) whole.
     pub fn fill_node_block(&mut self, origin: Coord) {
+        if !node_leaf_origins(origin).any(|o| self.index.contains_key(&o)) {
+            self.tiles.insert_node(origin);
+            return;
+        }
         if self.channels != Channels::NONE {
+            // Channels live in leaves: keep those, whole.
             node_leaf_origins(origin).for_each(|o| self.fill_leaf_block(o));
             return;
         }
@@ -516,7 +521,14 @@ mod tests {
         }
         let mut blocks: Vec<(Coord, i64)> = Vec::new();
         for _ in 0..12 {
-            blocks.push(([pick(-16.0, 16.0) * 8, pick(-16.0, 16.0) * 8, pick(-3.0, 3.0) * 8], 8));
+            blocks.push((
+                [
+                    pick(-16.0, 16.0) * 8,
+                    pick(-16.0, 16.0) * 8,
+                    pick(-3.0, 3.0) * 8,
+                ],
+                8,
+            ));
         }
         blocks.push(([pick(-1.0, 1.0) * 128, 0, -128], 128));
         for (o, d) in blocks {

@@ -140,6 +140,9 @@ pub enum Task {
         mesh: MeshSource,
         fill: Fill,
         density: f64,
+        /// Also count components and genus (a pass over the whole solid; `Measure` always
+        /// does).
+        topology: bool,
     },
     Measure {
         source: MeasureSource,
@@ -522,9 +525,15 @@ impl PlannedJob {
             (Task::DistanceBand { band, signed, .. }, Loaded::Mesh(mesh)) => {
                 solid::distance_band(mesh, t, *band, *signed, &fit, progress)
             }
-            (Task::Solid { fill, density, .. }, Loaded::Mesh(mesh)) => {
-                solid::mesh_solid(mesh, t, *fill, *density, &fit, progress)
-            }
+            (
+                Task::Solid {
+                    fill,
+                    density,
+                    topology,
+                    ..
+                },
+                Loaded::Mesh(mesh),
+            ) => solid::mesh_solid(mesh, t, *fill, *density, *topology, &fit, progress),
             (Task::Measure { flood, density, .. }, Loaded::Mesh(mesh)) => {
                 solid::measure_mesh(mesh, t, *flood, *density, progress)
             }

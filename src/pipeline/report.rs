@@ -153,10 +153,12 @@ pub struct SolidDetails {
     pub density: f64,
     pub mass_inside: f64,
     pub mass_with_surface: f64,
-    /// 26-connected components of surface plus inside.
-    pub components: u64,
+    /// 26-connected components of surface plus inside (when counted).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub components: Option<u64>,
     /// Genus of the boundary, for solids without cavities: components - Euler characteristic.
-    pub genus: i64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub genus: Option<i64>,
     pub inside_rule: String,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mesh_signed_volume: Option<f64>,
@@ -366,9 +368,13 @@ fn solid_summary(place: &str, s: &SolidDetails, timing: &str) -> String {
             x.line_floods, x.sweeps, x.graystack_overflows
         )
     });
+    let topology = match (s.components, s.genus) {
+        (Some(c), Some(g)) => format!("{c} component(s), genus {g}; "),
+        _ => String::new(),
+    };
     format!(
         "{place}{mesh}: {} inside + {} surface voxels; volume {:.6} (inside) .. {:.6} (with surface); \
-         mass {:.6} .. {:.6} at density {}; {} component(s), genus {}; {}{xyz}; {timing}",
+         mass {:.6} .. {:.6} at density {}; {topology}{}{xyz}; {timing}",
         s.inside_voxels,
         s.surface_voxels,
         s.volume_inside,
@@ -376,8 +382,6 @@ fn solid_summary(place: &str, s: &SolidDetails, timing: &str) -> String {
         s.mass_inside,
         s.mass_with_surface,
         s.density,
-        s.components,
-        s.genus,
         s.inside_rule
     )
 }

@@ -9,7 +9,7 @@ use super::report::{
     FloodingXyzDetails, SolidDetails,
 };
 use crate::error::Result;
-use crate::grid::{Adjacency, Channels, DenseMask, SparseGrid, Transform};
+use crate::grid::{Adjacency, DenseMask, SparseGrid, Transform};
 use crate::io::vdb::DistanceGrid;
 use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
@@ -56,16 +56,23 @@ fn topology(whole: &SparseGrid) -> Result<(u64, i64)> {
     Ok((parts, parts as i64 - euler_characteristic(&all)))
 }
 
-/// The report of a surface and the solid inside it.
+/// The report of a surface and the solid inside it (with components and genus when
+/// `with_topology`).
 fn solid_details(
     whole: &SparseGrid,
     solid: &Solid,
     density: f64,
     rule: &str,
     mesh: Option<&Mesh>,
+    with_topology: bool,
 ) -> Result<SolidDetails> {
     let m = solid.measures;
-    let (components, genus) = topology(whole)?;
+    let (components, genus) = if with_topology {
+        let (c, g) = topology(whole)?;
+        (Some(c), Some(g))
+    } else {
+        (None, None)
+    };
     let (mass_inside, mass_with_surface) = m.mass(density);
     Ok(SolidDetails {
         inside_voxels: m.inside_voxels,
@@ -96,9 +103,9 @@ fn surface_and_inside(
     meta: Vec<(&str, String)>,
     describe: impl FnOnce(&SparseGrid, &Solid) -> Result<SolidDetails>,
 ) -> Result<Outcome> {
-    let mut whole = SparseGrid::new(surface.transform, Channels::NONE);
+    // The inside is mostly tiles: start from it and add the surface's leaves.
+    let mut whole = solid.inside.clone();
     whole.union(&surface);
-    whole.union(&solid.inside);
     let details = describe(&whole, &solid)?;
     Ok(Outcome::new(whole, meta, Details::Solid(details))
         .with("shell", surface)
@@ -125,6 +132,7 @@ pub(super) fn mesh_solid(
     t: Transform,
     fill: Fill,
     density: f64,
+    topology: bool,
     resolution: &str,
     progress: &Progress,
 ) -> Result<Outcome> {
@@ -143,7 +151,7 @@ pub(super) fn mesh_solid(
             let solid = solid_from_surface(&surface, flood, progress)?;
             let method = meta("huang-26-separating-surface+exterior-flood");
             surface_and_inside(surface, solid, method, |whole, solid| {
-                solid_details(whole, solid, density, FLOOD_RULE, Some(mesh))
+                solid_details(whole, solid, density, FLOOD_RULE, Some(mesh), topology)
             })?
         }
         Fill::Beam => {
@@ -151,7 +159,7 @@ pub(super) fn mesh_solid(
             let mut method = meta("projective-beam");
             method.push(("color", "none".into()));
             surface_and_inside(surface, solid, method, |whole, solid| {
-                solid_details(whole, solid, density, BEAM_RULE, Some(mesh))
+                solid_details(whole, solid, density, BEAM_RULE, Some(mesh), topology)
             })?
         }
         Fill::DepthLayers(options) => {
@@ -275,7 +283,7 @@ pub(super) fn measure_mesh(
         ("source_file", mesh.source.display().to_string()),
     ];
     let outcome = surface_and_inside(surface, solid, meta, |whole, solid| {
-        let details = solid_details(whole, solid, density, FLOOD_RULE, Some(mesh))?;
+        let details = solid_details(whole, solid, density, FLOOD_RULE, Some(mesh), true)?;
         Ok(SolidDetails {
             mesh_area: Some(mesh.area()),
             ..details
@@ -299,7 +307,7 @@ pub(super) fn measure_surface(
         ("source_file", source.to_string()),
     ];
     let outcome = surface_and_inside(surface.clone(), solid, meta, |whole, solid| {
-        solid_details(whole, solid, density, FLOOD_RULE, None)
+        solid_details(whole, solid, density, FLOOD_RULE, None, true)
     })?;
     Ok(outcome.timed(start))
 }

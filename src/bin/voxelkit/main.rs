@@ -148,8 +148,8 @@ enum Command {
         resolution: u32,
     },
     /// Fill a mesh: by exterior flooding of its 26-separating surface (closed meshes), or by
-    /// depth layers, which report the voxels they cannot classify; prints volumes, mass,
-    /// components and genus.
+    /// depth layers, which report the voxels they cannot classify; prints volumes and mass
+    /// (components and genus with --topology).
     Solid(solids::SolidArgs),
     /// Boolean of two voxel grids (.vdb): union, intersection or difference; or a whole CSG
     /// tree of shapes, formulas, meshes and grids from a JSON file (--tree).

@@ -76,6 +76,10 @@ pub struct SolidArgs {
     pub method: SolidMethod,
     #[command(flatten)]
     pub fill: FillArgs,
+    /// Also count the solid's components (26-connected) and genus, as `measure` does (a
+    /// pass over every voxel of the solid).
+    #[arg(long)]
+    pub topology: bool,
     #[command(flatten)]
     pub depth: crate::solid_depth::DepthArgs,
     /// Write the solid as a level set instead (as `mesh --sdf`): exact signed distances
@@ -160,6 +164,7 @@ pub fn solid(args: &SolidArgs, global: &Global) -> Result<()> {
         mesh: MeshSource::File(args.input.clone()),
         fill,
         density: args.fill.density,
+        topology: args.topology,
     };
     run_and_report(
         Job::new(task, args.fill.fit.grid_fit()),
