@@ -161,7 +161,7 @@ void VdbWriter::add_level_set(rust::Str name, rust::Str density_name, double vox
 double openvdb_level_set_volume(rust::Str path, rust::Str name) {
     ensure_initialized();
     openvdb::io::File file{std::string(path)};
-    file.open();
+    file.open(/*delayLoad=*/false);
     auto base = file.readGrid(std::string(name));
     file.close();
     auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
@@ -220,7 +220,7 @@ void VdbWriter::write(rust::Str path, rust::Str compression, bool half, rust::Sl
 std::unique_ptr<VdbFile> open_vdb(rust::Str path) {
     ensure_initialized();
     openvdb::io::File file{std::string(path)};
-    file.open();
+    file.open(/*delayLoad=*/false);  // read now: delayed loading trusts the file's per-leaf metadata
     auto grids = file.getGrids();
     file.close();
     return std::make_unique<VdbFile>(grids);

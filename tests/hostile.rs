@@ -170,6 +170,8 @@ fn damaged_vdb_files_are_refused_plainly_and_huge_tiles_before_allocating() {
     for (name, cut) in [
         ("half.vdb", bytes.len() / 2),
         ("head.vdb", 200),
+        // The header alone (magic, versions, flags, UUID): not a file without grids.
+        ("header.vdb", 57),
         ("empty.vdb", 0),
     ] {
         let damaged = dir.path().join(name);
@@ -285,6 +287,31 @@ fn a_formula_zero_everywhere_stops_at_the_memory_limit() {
         out.to_str().unwrap(),
     ]);
     assert!(sphere.status.success(), "{}", text(&sphere));
+}
+
+/// Voxels of `voxelkit implicit FORMULA -r 64` over [-1, 1]^3.
+fn implicit_voxels(formula: &str) -> f64 {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("f.vdb");
+    let o = voxelkit(&[
+        "--json",
+        "implicit",
+        formula,
+        "-r",
+        "64",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{formula}: {}", text(&o));
+    json_field(&String::from_utf8_lossy(&o.stdout), "voxels")
+}
+
+#[test]
+fn a_pole_is_not_taken_for_a_root() {
+    // 1/x and 1/(x - x) have no zero; x^-1 - 2 is zero on the plane x = 1/2 only.
+    assert_eq!(implicit_voxels("1/x"), 0.0);
+    assert_eq!(implicit_voxels("1/(x-x)"), 0.0);
+    assert_eq!(implicit_voxels("x^-1 - 2"), implicit_voxels("x - 0.5"));
 }
 
 #[test]

@@ -3,7 +3,9 @@
 
 use proptest::prelude::*;
 use voxelkit::Error;
-use voxelkit::implicit::{BoxTest, Coordinates, Dual, Formula, Interval, test_box, to_coordinates};
+use voxelkit::implicit::{
+    BoxTest, Coordinates, Dual, Formula, Interval, Split, test_box, to_coordinates,
+};
 
 fn value(text: &str, at: [f64; 3]) -> f64 {
     Formula::parse(text, Coordinates::Cartesian)
@@ -200,7 +202,7 @@ fn check_conversion(
         }
         // F - v is zero at p, so the box must not be ruled out.
         let shifted = Formula::parse(&format!("({text}) - ({v:?})"), coords).unwrap();
-        let mut slots = Vec::new();
+        let mut slots: Vec<Split> = Vec::new();
         let test = test_box(&shifted.tape, coords, boxed, false, false, &mut slots);
         prop_assert!(
             test != BoxTest::Empty,
@@ -237,7 +239,7 @@ proptest! {
             // (G - v) - r is zero at p (written with -r when `negative`).
             let shifted = Formula::parse(&format!("({text}) - ({v:?}) - r"), Coordinates::Spherical).unwrap();
             prop_assert!(shifted.tape.isolated(0).is_some());
-            let test = test_box(&shifted.tape, Coordinates::Spherical, boxed, negative, true, &mut Vec::new());
+            let test = test_box(&shifted.tape, Coordinates::Spherical, boxed, negative, true, &mut Vec::<Split>::new());
             prop_assert_eq!(test, BoxTest::MayContain, "{} at {:?}", text, p);
         }
     }
@@ -259,7 +261,7 @@ fn boxes_across_the_cut_and_on_the_axis() {
             b,
             both_signs,
             whole_axis,
-            &mut Vec::new(),
+            &mut Vec::<Split>::new(),
         )
     };
     let i = |a: f64, b: f64| Interval::new(a, b);

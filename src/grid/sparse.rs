@@ -78,7 +78,8 @@ impl SparseGrid {
 
     /// Makes the 128^3 block at `origin` (a multiple of 128) whole.
     pub fn fill_node_block(&mut self, origin: Coord) {
-        if !node_leaf_origins(origin).any(|o| self.index.contains_key(&o)) {
+        let leaves_under = || node_leaf_origins(origin).any(|o| self.index.contains_key(&o));
+        if self.index.is_empty() || !leaves_under() {
             self.tiles.insert_node(origin);
             return;
         }

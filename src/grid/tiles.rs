@@ -90,8 +90,12 @@ impl Tiles {
     /// Makes the 128^3 block at `origin` whole, absorbing its 8^3 tiles.
     pub fn insert_node(&mut self, origin: Coord) {
         if self.nodes.insert(origin) {
-            for o in node_leaf_origins(origin) {
-                self.leaves.remove(&o);
+            if self.leaves.len() < 4096 {
+                self.leaves.retain(|&o| node_origin(o) != origin);
+            } else {
+                for o in node_leaf_origins(origin) {
+                    self.leaves.remove(&o);
+                }
             }
         }
     }

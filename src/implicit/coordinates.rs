@@ -18,6 +18,7 @@
 
 use super::Coordinates;
 use super::interval::Interval;
+use super::split::Enclosure;
 use super::tape::{Number, Tape};
 use std::f64::consts::PI;
 
@@ -82,17 +83,18 @@ fn theta_pieces(x: Interval, z: Interval) -> Option<([Interval; 2], usize)> {
 /// Whether the Cartesian box `b` may hold a point where `tape` (written in `c`) is zero;
 /// `slots` is scratch space. With `whole_axis`, a box on the axis is bounded with θ in
 /// [-π, π] instead of being `Undecided` (for boxes too small to subdivide further).
-pub fn test_box(
+pub fn test_box<N: Enclosure>(
     tape: &Tape,
     c: Coordinates,
     b: [Interval; 3],
     both_signs: bool,
     whole_axis: bool,
-    slots: &mut Vec<Interval>,
+    slots: &mut Vec<N>,
 ) -> BoxTest {
     let [x, _, z] = b;
-    let contains =
-        |v: [Interval; 3], slots: &mut Vec<Interval>| tape.eval_with(v, slots).contains_zero();
+    let contains = |v: [Interval; 3], slots: &mut Vec<N>| {
+        tape.eval_with(v.map(N::from), slots).contains_zero()
+    };
     if c == Coordinates::Cartesian {
         return if contains(b, slots) {
             BoxTest::MayContain
@@ -130,10 +132,13 @@ pub fn test_box(
     } else {
         BoxTest::MayContain
     };
-    let holds = |v: [Interval; 3], negative: bool, slots: &mut Vec<Interval>| match isolated {
+    let holds = |v: [Interval; 3], negative: bool, slots: &mut Vec<N>| match isolated {
         Some(g) => {
-            tape.eval_with(v, slots);
-            meets_r(slots[g as usize], negative)
+            tape.eval_with(v.map(N::from), slots);
+            slots[g as usize]
+                .pieces()
+                .iter()
+                .any(|&piece| meets_r(piece, negative))
         }
         None => contains(v, slots),
     };

@@ -7,11 +7,13 @@ mod dual;
 mod interval;
 mod parse;
 pub mod reference;
+mod split;
 mod tape;
 
 pub use coordinates::{BoxTest, test_box, to_coordinates, value_at};
 pub use dual::Dual;
 pub use interval::Interval;
+pub use split::{Enclosure, Split};
 pub use tape::{Instr, Number, Tape};
 
 use crate::error::Result;

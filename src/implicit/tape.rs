@@ -63,6 +63,14 @@ impl Tape {
         self.instrs.is_empty()
     }
 
+    /// Whether the formula divides (a quotient or a negative power): only then can an
+    /// interval result have a gap at a pole.
+    pub fn divides(&self) -> bool {
+        self.instrs
+            .iter()
+            .any(|i| matches!(i, Instr::Div(..)) || matches!(i, Instr::Pow(_, n) if *n < 0))
+    }
+
     /// When the formula is `G - v` with variable `k` (v) appearing nowhere else, the slot of
     /// G: then F = 0 is `G = v`, and G's interval can be compared with v's directly.
     pub fn isolated(&self, k: u8) -> Option<u32> {

@@ -2,3 +2,5 @@
 pub mod atomic;
 #[cfg(feature = "vdb")]
 pub mod vdb;
+#[cfg(feature = "vdb")]
+mod vdb_structure;

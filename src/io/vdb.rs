@@ -317,6 +317,7 @@ fn open(path: &Path) -> Result<cxx::UniquePtr<bridge::VdbFile>> {
     let p = path
         .to_str()
         .ok_or_else(|| vdb_error(path, "path is not UTF-8"))?;
+    super::vdb_structure::check_structure(path)?;
     bridge::open_vdb(p).map_err(|e| unreadable(path, e))
 }
 

@@ -12,7 +12,7 @@
 use super::Progress;
 use crate::error::{Error, Result};
 use crate::grid::{Channels, Coord, SparseGrid, Transform};
-use crate::implicit::{BoxTest, Dual, Formula, Interval, test_box};
+use crate::implicit::{BoxTest, Dual, Formula, Interval, Split, test_box};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -95,6 +95,7 @@ pub fn voxelize_implicit(
         cells,
         depth,
         options: *options,
+        divides: formula.tape.divides(),
     };
     // Expand the top levels serially; the subtrees below run in parallel.
     let top_level = depth.min(TOP_LEVEL);
@@ -176,6 +177,9 @@ struct Run<'a> {
     cells: [i64; 3],
     depth: u32,
     options: OctreeOptions,
+    /// Whether the formula divides: then boxes are evaluated as split intervals, which
+    /// keep a pole out of the enclosure (plain intervals are faster otherwise).
+    divides: bool,
 }
 
 struct Partial {
@@ -183,6 +187,7 @@ struct Partial {
     levels: Vec<SparseGrid>,
     stats: OctreeStats,
     slots: Vec<Interval>,
+    split_slots: Vec<Split>,
     dual_slots: Vec<Dual>,
 }
 
@@ -204,6 +209,7 @@ impl Partial {
             levels,
             stats: OctreeStats::default(),
             slots: Vec::new(),
+            split_slots: Vec::new(),
             dual_slots: Vec::new(),
         }
     }
@@ -252,14 +258,12 @@ impl Run<'_> {
     fn test(&self, b: [Interval; 3], whole_axis: bool, part: &mut Partial) -> BoxTest {
         part.stats.cells_tested += 1;
         let f = self.formula;
-        test_box(
-            &f.tape,
-            f.coordinates,
-            b,
-            self.options.both_signs,
-            whole_axis,
-            &mut part.slots,
-        )
+        let (c, both) = (f.coordinates, self.options.both_signs);
+        if self.divides {
+            test_box(&f.tape, c, b, both, whole_axis, &mut part.split_slots)
+        } else {
+            test_box(&f.tape, c, b, both, whole_axis, &mut part.slots)
+        }
     }
 
     /// The kept children of a kept cell (recording them per level).

@@ -51,7 +51,8 @@ struct Cli {
     /// [default: the memory available].
     #[arg(long, global = true, value_name = "MIB")]
     max_memory: Option<u64>,
-    /// Write only these grids of the .vdb, by name (e.g. `density,surface`) [default: all].
+    /// Write only these grids of the .vdb, by name (e.g. `density,voxels`) [default: all but
+    /// `voxels`, the boolean copy of `density`'s voxels].
     #[arg(long, global = true, value_delimiter = ',', value_name = "NAMES")]
     grids: Vec<String>,
     /// .vdb compression: blosc (OpenVDB's default), zip or none.
