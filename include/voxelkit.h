@@ -222,8 +222,8 @@ vk_status vk_grid_combine(const vk_grid *a, const vk_grid *b, vk_boolean op, int
 /* Reads grid `name` (NULL: the first Bool, Mask or Float grid) of a .vdb file. */
 vk_status vk_grid_read_vdb(const char *path, const char *name, vk_grid **out);
 
-/* Writes `surface`, `density` and, when the grid has them, `normal` and `Cd` grids
- * (written to a temporary file, then renamed). */
+/* Writes `density` (a fog volume, whole blocks as tiles) and, when the grid has them,
+ * `normal` and `Cd` grids (written to a temporary file, then renamed). */
 vk_status vk_grid_write_vdb(const vk_grid *grid, const char *path);
 
 vk_status vk_grid_voxel_count(const vk_grid *grid, uint64_t *count);
@@ -237,6 +237,17 @@ vk_status vk_grid_transform(const vk_grid *grid, double *voxel_size, double orig
  */
 vk_status vk_grid_copy_leaves(const vk_grid *grid, size_t first, size_t count,
                               int32_t *origins, uint64_t *masks);
+
+/*
+ * Whole 8^3 and 128^3 blocks are held as tiles, not leaves (a solid's inside is mostly
+ * tiles): the voxel count is the leaves' voxels plus the tiles'. vk_grid_copy_tiles copies
+ * tiles first .. first + count: `origins` receives 3 * count int32 (the tile's voxel
+ * (0, 0, 0)), `edges` count int32 (8 or 128: OpenVDB's tiles of level 1 and 2, for
+ * `tree.addTile(edge == 8 ? 1 : 2, origin, value, true)`). Tiles carry no normals or colours.
+ */
+vk_status vk_grid_tile_count(const vk_grid *grid, size_t *count);
+vk_status vk_grid_copy_tiles(const vk_grid *grid, size_t first, size_t count, int32_t *origins,
+                             int32_t *edges);
 
 /*
  * Copies per-voxel normals or colours of leaves first .. first + count: 3 * 512 floats per

@@ -1128,6 +1128,61 @@ pub extern "C" fn vk_grid_copy_leaves(
     })
 }
 
+/// The grid's tiles as (origin, edge), in the order the copies use.
+fn tile_list(grid: &SparseGrid) -> Vec<(crate::grid::Coord, i32)> {
+    let tiles = grid.tiles();
+    tiles
+        .leaf_tiles()
+        .map(|o| (o, 8))
+        .chain(tiles.node_tiles().map(|o| (o, 128)))
+        .collect()
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_tile_count(grid: *const VkGrid, count: *mut usize) -> VkStatus {
+    guard(|| {
+        let g = &borrow(grid, Kind::Grid)?.grid;
+        put(count, tile_list(g).len())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_copy_tiles(
+    grid: *const VkGrid,
+    first: usize,
+    count: usize,
+    origins: *mut i32,
+    edges: *mut i32,
+) -> VkStatus {
+    guard(|| {
+        let g = &borrow(grid, Kind::Grid)?.grid;
+        let tiles = tile_list(g);
+        let n = tiles.len();
+        let chosen = match first.checked_add(count) {
+            Some(end) if end <= n => &tiles[first..end],
+            _ => {
+                return Err(invalid(format!(
+                    "tiles {first} .. {first}+{count} are out of range: the grid has {n}"
+                )));
+            }
+        };
+        let origins = slice_mut(origins, 3 * count, "origins")?;
+        let edges = slice_mut(edges, count, "edges")?;
+        for (k, &(origin, edge)) in chosen.iter().enumerate() {
+            for a in 0..3 {
+                origins[3 * k + a] = i32::try_from(origin[a])
+                    .ok()
+                    .filter(|v| v.checked_add(edge).is_some())
+                    .ok_or_else(|| {
+                        invalid(format!("tile at {origin:?} lies beyond 32-bit coordinates"))
+                    })?;
+            }
+            edges[k] = edge;
+        }
+        Ok(())
+    })
+}
+
 /// Copies a per-voxel `[f32; 3]` channel of leaves `first .. first + count`.
 fn copy_channel(
     grid: *const VkGrid,

@@ -44,7 +44,8 @@ int print_progress(uint64_t done, uint64_t total, void* /*user_data*/) {
     return 0;
 }
 
-// A fog volume with 1 on every voxel of `grid`, built leaf by leaf from the leaf masks.
+// A fog volume with 1 on every voxel of `grid`, built leaf by leaf from the leaf masks, plus
+// its tiles.
 openvdb::FloatGrid::Ptr to_openvdb(const vk_grid* grid) {
     size_t leaves = 0;
     check(vk_grid_leaf_count(grid, &leaves), "vk_grid_leaf_count");
@@ -71,6 +72,15 @@ openvdb::FloatGrid::Ptr to_openvdb(const vk_grid* grid) {
             }
         }
         accessor.addLeaf(leaf);
+    }
+    // Whole blocks (a solid's inside) come as tiles: OpenVDB's tiles of level 1 (8^3) and 2 (128^3).
+    size_t tiles = 0;
+    check(vk_grid_tile_count(grid, &tiles), "vk_grid_tile_count");
+    std::vector<int32_t> tile_origins(3 * tiles), edges(tiles);
+    check(vk_grid_copy_tiles(grid, 0, tiles, tile_origins.data(), edges.data()), "vk_grid_copy_tiles");
+    for (size_t i = 0; i < tiles; ++i) {
+        const openvdb::Coord at(tile_origins[3 * i], tile_origins[3 * i + 1], tile_origins[3 * i + 2]);
+        out->tree().addTile(edges[i] == 8 ? 1 : 2, at, 1.0f, true);
     }
     return out;
 }

@@ -117,6 +117,30 @@ int main(int argc, char **argv) {
         OK(vk_options_set_fill_method(opts, (vk_fill_method)method));
         OK(vk_fill_mesh(box, opts, &solid, &m));
         CHECK(m.volume_inside <= 1.0 + 1e-9 && m.volume_with_surface >= 1.0 - 1e-9);
+        /* Leaves plus whole-block tiles hold every voxel of the solid. */
+        size_t n_leaves = 0, n_tiles = 0;
+        uint64_t n_voxels = 0, counted = 0;
+        OK(vk_grid_leaf_count(solid, &n_leaves));
+        OK(vk_grid_tile_count(solid, &n_tiles));
+        OK(vk_grid_voxel_count(solid, &n_voxels));
+        CHECK(n_tiles > 0);
+        int32_t *leaf_origins = malloc(3 * sizeof(int32_t) * (n_leaves + 1));
+        uint64_t *leaf_masks = malloc(8 * sizeof(uint64_t) * (n_leaves + 1));
+        int32_t *tile_origins = malloc(3 * sizeof(int32_t) * n_tiles);
+        int32_t *tile_edges = malloc(sizeof(int32_t) * n_tiles);
+        OK(vk_grid_copy_leaves(solid, 0, n_leaves, leaf_origins, leaf_masks));
+        OK(vk_grid_copy_tiles(solid, 0, n_tiles, tile_origins, tile_edges));
+        CHECK(vk_grid_copy_tiles(solid, n_tiles, 1, tile_origins, tile_edges) == VK_ERROR_INVALID_ARGUMENT);
+        for (size_t k = 0; k < 8 * n_leaves; k++) counted += (uint64_t)__builtin_popcountll(leaf_masks[k]);
+        for (size_t k = 0; k < n_tiles; k++) {
+            CHECK(tile_edges[k] == 8 || tile_edges[k] == 128);
+            counted += (uint64_t)tile_edges[k] * tile_edges[k] * tile_edges[k];
+        }
+        CHECK(counted == n_voxels);
+        free(leaf_origins);
+        free(leaf_masks);
+        free(tile_origins);
+        free(tile_edges);
         OK(vk_grid_free(solid));
     }
 
