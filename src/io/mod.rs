@@ -1,5 +1,6 @@
 //! File output helpers and format bridges.
 pub mod atomic;
+pub mod binvox;
 #[cfg(feature = "vdb")]
 pub mod vdb;
 #[cfg(feature = "vdb")]

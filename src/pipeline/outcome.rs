@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use crate::grid::{SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::io::atomic::check_output;
+use crate::io::binvox::write_binvox;
 use crate::io::vdb::{DistanceGrid, WriteOptions, write_distance_band, write_vdb_as};
 use crate::mesh::Mesh;
 use crate::ops::csg::{BooleanOp, combine as combine_grids};
@@ -43,7 +44,13 @@ pub struct Outcome {
 }
 
 /// Output formats by extension; `-` is standard output (as `.vdb`).
-const FORMATS: &str = ".vdb (or - for standard output)";
+const FORMATS: &str = ".vdb (or - for standard output) and .binvox";
+
+/// Whether `path` names a binvox file.
+fn is_binvox(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("binvox"))
+}
 
 /// Refuses an output voxelkit cannot write, or one that is an input, before any work.
 pub fn check_output_path(path: &Path, inputs: &[&Path]) -> Result<()> {
@@ -54,7 +61,7 @@ pub fn check_output_path(path: &Path, inputs: &[&Path]) -> Result<()> {
     let vdb = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("vdb"));
-    if !vdb {
+    if !vdb && !is_binvox(path) {
         return Err(Error::InvalidArgument(format!(
             "{}: voxelkit cannot write this format; it writes {FORMATS}",
             path.display()
@@ -106,10 +113,22 @@ impl Outcome {
         self
     }
 
-    /// Writes the grids to `path` (`.vdb`; `-` for standard output) as `options` say,
-    /// atomically, refusing to replace any of `inputs`; records the output in the report.
+    /// Writes the grids to `path` (`.vdb`; `-` for standard output) as `options` say, or the
+    /// voxel set alone to a `.binvox`, atomically, refusing to replace any of `inputs`;
+    /// records the output in the report.
     pub fn write(&mut self, path: &Path, inputs: &[&Path], options: &WriteOptions) -> Result<()> {
         check_output_path(path, inputs)?;
+        if is_binvox(path) {
+            if self.distances.is_some() {
+                return Err(Error::InvalidArgument(format!(
+                    "{}: binvox holds voxel sets, not distances; write the level set as .vdb",
+                    path.display()
+                )));
+            }
+            write_binvox(path, &self.grid)?;
+            self.report.output = Some(path.display().to_string());
+            return Ok(());
+        }
         let meta: Vec<(&str, String)> = self
             .metadata
             .iter()

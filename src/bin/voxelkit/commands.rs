@@ -47,7 +47,8 @@ pub struct VoxelizeArgs {
     pub fit: FitArgs,
     #[command(flatten)]
     pub surface: SurfaceArgs,
-    /// Output .vdb file.
+    /// Output: a .vdb (`density`, `normal` with --normals; `voxels` with --grids), or a
+    /// .binvox (the voxel set alone).
     #[arg(short, long)]
     pub output: PathBuf,
 }

@@ -59,7 +59,7 @@ pub struct LinesArgs {
     fit: FitArgs,
     #[command(flatten)]
     color: ColorArgs,
-    /// Output .vdb: `surface`, `density` and, with colours, `Cd`.
+    /// Output: a .vdb (`density` and, with colours, `Cd`), or a .binvox (the voxels alone).
     #[arg(short, long)]
     output: PathBuf,
 }
