@@ -74,12 +74,7 @@ fn the_block_flood_fills_what_the_voxel_flood_fills_on_every_closed_mesh() {
     let Some(data) = common::data_dir() else {
         return;
     };
-    let mut names: Vec<_> = std::fs::read_dir(data.join("meshes"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
-        .collect();
-    names.sort();
+    let names = common::shared_meshes(&data);
     let mut closed = 0;
     for path in names {
         let mesh = Mesh::load(&path).unwrap();

@@ -8,6 +8,7 @@ mod fit;
 pub mod generate;
 pub mod inside;
 mod obj;
+mod off;
 mod stl;
 
 pub use closed::EdgeCounts;
@@ -71,7 +72,7 @@ impl Mesh {
         }
     }
 
-    /// Loads an `.obj` or `.stl` file (chosen by extension) and checks it has faces, as every
+    /// Loads an `.obj`, `.stl` or `.off` file (chosen by extension) and checks it has faces, as every
     /// surface and solid method needs.
     pub fn load(path: &Path) -> Result<Mesh> {
         let mesh = Self::read(path)?;
@@ -101,6 +102,7 @@ impl Mesh {
         let mesh = match ext.as_deref() {
             Some("obj") => obj::load_obj(path)?,
             Some("stl") => stl::load_stl(path)?,
+            Some("off") => off::load_off(path)?,
             _ => {
                 return Err(Error::UnsupportedFormat {
                     path: path.to_path_buf(),

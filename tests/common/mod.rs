@@ -25,6 +25,17 @@ pub fn data_dir() -> Option<PathBuf> {
     }
 }
 
+/// Every `.obj` in the data folder's `meshes/`, sorted.
+pub fn shared_meshes(data: &std::path::Path) -> Vec<PathBuf> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(data.join("meshes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+        .collect();
+    paths.sort();
+    paths
+}
+
 /// The closed meshes of the data folder used for separability tests.
 pub const CLOSED_MESHES: [&str; 10] = [
     "bunny-closed",
