@@ -498,6 +498,7 @@ fn run_job(options: &Options, task: Task) -> std::result::Result<Outcome, Failur
             threads: (options.threads > 0).then_some(options.threads as usize),
             max_memory: options.max_memory,
         },
+        up_axis: Default::default(),
     };
     let outcome = job.run(&reporter)?;
     reporter.finish();

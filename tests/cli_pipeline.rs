@@ -269,3 +269,32 @@ fn grids_compression_and_half_precision_are_chosen_when_writing() {
         }
     }
 }
+
+/// `--up-axis y` turns a Y-up file to Z-up as Blender's OBJ importer does: a torus centred at
+/// y = 2 comes out centred at z = 2, with the same voxel count as when it is read Z-up.
+#[test]
+fn a_y_up_mesh_is_turned_z_up_on_request() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("torus.obj");
+    voxelkit::mesh::generate::torus(glam::DVec3::new(0.0, 2.0, 0.0), 1.0, 0.3, 32, 8)
+        .write_obj(&obj)
+        .unwrap();
+    let centre_and_count = |up: &str| {
+        let out = dir.path().join(format!("{up}.vdb"));
+        let o = voxelkit(&["--up-axis", up, "mesh", s(&obj), "-r", "32", "-o", s(&out)]);
+        assert!(o.status.success(), "{}", text(&o));
+        let grid = voxelkit::io::vdb::read_vdb_grid(&out, None).unwrap();
+        let b = grid.bbox().unwrap();
+        let t = grid.transform;
+        let centre = (t.index_to_world(b.min) + t.index_to_world(b.max)) / 2.0;
+        (centre, grid.voxel_count())
+    };
+    let (kept, n_kept) = centre_and_count("z");
+    let (turned, n_turned) = centre_and_count("y");
+    assert!((kept.y - 2.0).abs() < 0.1 && kept.z.abs() < 0.1, "{kept}");
+    assert!(
+        (turned.z - 2.0).abs() < 0.1 && turned.y.abs() < 0.1,
+        "{turned}"
+    );
+    assert_eq!(n_kept, n_turned);
+}

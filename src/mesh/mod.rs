@@ -10,6 +10,8 @@ pub mod inside;
 mod obj;
 mod off;
 mod stl;
+mod up_axis;
+pub use up_axis::UpAxis;
 
 pub use closed::EdgeCounts;
 pub use fit::{GridFit, fit_transform, index_box};

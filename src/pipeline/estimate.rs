@@ -13,7 +13,7 @@ use crate::error::{Error, Result};
 use crate::grid::{CoordBox, SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::io::vdb::read_vdb_grid;
-use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
+use crate::mesh::{Aabb, GridFit, Mesh, UpAxis, fit_transform, index_box};
 use crate::ops::flood::padded;
 use crate::solids::csg_tree::read_csg_tree;
 use crate::subd::ControlMesh;
@@ -135,10 +135,10 @@ fn mesh_plan(mesh: &Mesh, fit: GridFit) -> Result<(Transform, CoordBox)> {
 }
 
 pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
-    let fit = job.fit;
+    let (fit, up) = (job.fit, job.up_axis);
     Ok(match &job.task {
         Task::MeshSurface { mesh, method } => {
-            let mesh = mesh.load(false)?;
+            let mesh = mesh.load(false, up)?;
             let (t, _) = mesh_plan(&mesh, fit)?;
             let (channels, items) = match method {
                 super::SurfaceMethod::Separating(o) => {
@@ -154,7 +154,7 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             (Loaded::Mesh(mesh), p)
         }
         Task::DistanceBand { mesh, band, .. } => {
-            let mesh = mesh.load(false)?;
+            let mesh = mesh.load(false, up)?;
             let (t, b) = mesh_plan(&mesh, fit)?;
             // A band 2w+1 voxels thick crosses about that many eighths of each leaf it meets;
             // each leaf is held with its values, then twice more by OpenVDB (level set, fog).
@@ -164,7 +164,7 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             (Loaded::Mesh(mesh), p)
         }
         Task::SeparationCheck { mesh, options } => {
-            let mesh = mesh.load(false)?;
+            let mesh = mesh.load(false, up)?;
             let (t, b) = mesh_plan(&mesh, fit)?;
             // Four bit volumes over the box: surface, inside centres, flood, minimality.
             let bytes = surface_bytes(area_in_voxels(&mesh, &t), u32::from(options.normals))
@@ -173,7 +173,7 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             (Loaded::Mesh(mesh), p)
         }
         Task::Lines { mesh, edges, color } => {
-            let mesh = mesh.load(true)?;
+            let mesh = mesh.load(true, up)?;
             let (t, _) = mesh_plan(&mesh, fit)?;
             let source = lines_source(&mesh, *edges);
             let segments = projective::line_segments(&mesh, source);
@@ -242,13 +242,13 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             let p = plan_of(t, &bbox, bytes, items);
             (Loaded::Formula(parsed), p)
         }
-        Task::Solid { mesh, fill, .. } => solid_plan(mesh, fit, *fill)?,
+        Task::Solid { mesh, fill, .. } => solid_plan(mesh, fit, up, *fill)?,
         // Measuring a mesh fills its flooded surface.
         Task::Measure {
             source: MeasureSource::Mesh(mesh),
             flood,
             ..
-        } => solid_plan(mesh, fit, super::Fill::Flood(*flood))?,
+        } => solid_plan(mesh, fit, up, super::Fill::Flood(*flood))?,
         Task::Measure {
             source: MeasureSource::Vdb(path),
             ..
@@ -306,8 +306,13 @@ fn plan_of(transform: Transform, bbox: &Aabb, bytes: f64, work_items: u64) -> Pl
 }
 
 /// Filling `mesh` by `fill`: its surface, the bit volumes over its box and the solid.
-fn solid_plan(mesh: &MeshSource, fit: GridFit, fill: super::Fill) -> Result<(Loaded, Plan)> {
-    let mesh = mesh.load(false)?;
+fn solid_plan(
+    mesh: &MeshSource,
+    fit: GridFit,
+    up: UpAxis,
+    fill: super::Fill,
+) -> Result<(Loaded, Plan)> {
+    let mesh = mesh.load(false, up)?;
     let (t, b) = mesh_plan(&mesh, fit)?;
     let (masks, items) = match fill {
         super::Fill::Flood(_) => (6, separating::work_items(&mesh)),

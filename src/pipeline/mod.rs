@@ -15,7 +15,7 @@ pub use report::*;
 use crate::error::{Error, Result};
 use crate::grid::{SparseGrid, Transform};
 use crate::implicit::{Coordinates, Formula};
-use crate::mesh::{GridFit, Mesh};
+use crate::mesh::{GridFit, Mesh, UpAxis};
 use crate::ops::csg::BooleanOp;
 use crate::progress::{Observer, Progress};
 use crate::shapes::{Cylinder, Quadric, Sphere};
@@ -185,6 +185,8 @@ pub struct Job {
     pub task: Task,
     pub fit: GridFit,
     pub limits: Limits,
+    /// Which axis of the mesh files points up (files only; meshes in memory are kept).
+    pub up_axis: UpAxis,
 }
 
 /// What planning found: where the grid lies and what the work will cost.
@@ -247,10 +249,10 @@ impl GridFit {
 }
 
 impl MeshSource {
-    fn load(&self, lines: bool) -> Result<Mesh> {
+    fn load(&self, lines: bool, up: UpAxis) -> Result<Mesh> {
         match self {
-            MeshSource::File(path) if lines => Mesh::load_lines(path),
-            MeshSource::File(path) => Mesh::load(path),
+            MeshSource::File(path) if lines => Ok(Mesh::load_lines(path)?.with_up_axis(up)),
+            MeshSource::File(path) => Ok(Mesh::load(path)?.with_up_axis(up)),
             MeshSource::Mesh(mesh) => {
                 if !lines {
                     mesh.validate()?;
@@ -352,6 +354,7 @@ impl Job {
             task,
             fit,
             limits: Limits::default(),
+            up_axis: UpAxis::default(),
         }
     }
 

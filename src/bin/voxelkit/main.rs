@@ -61,6 +61,11 @@ struct Cli {
     /// Write float and vector grids at half precision (16-bit: half the size).
     #[arg(long, global = true)]
     half: bool,
+    /// The up axis of the input mesh files: `y` turns a Y-up file (most OBJ) to Z-up as
+    /// Blender's OBJ importer does, (x, y, z) -> (x, -z, y), so the volume stands where the
+    /// imported mesh stands; `z` keeps the coordinates.
+    #[arg(long, global = true, default_value = "z", value_name = "AXIS")]
+    up_axis: voxelkit::mesh::UpAxis,
     #[command(subcommand)]
     command: Command,
 }
@@ -187,6 +192,7 @@ fn main() -> ExitCode {
     let global = run::Global {
         threads: cli.threads,
         max_memory_mib: cli.max_memory,
+        up_axis: cli.up_axis,
         json: cli.json,
         write: voxelkit::io::vdb::WriteOptions {
             grids: cli.grids,

@@ -17,6 +17,7 @@ use voxelkit::progress::Observer;
 pub struct Global {
     pub threads: Option<usize>,
     pub max_memory_mib: Option<u64>,
+    pub up_axis: voxelkit::mesh::UpAxis,
     pub json: bool,
     pub write: WriteOptions,
 }
@@ -80,6 +81,7 @@ pub fn run_job(job: Job, output: Option<&Path>, global: &Global) -> Result<Outco
     let start = Instant::now();
     let planned = Job {
         limits: global.limits(),
+        up_axis: global.up_axis,
         ..job
     }
     .plan()?;

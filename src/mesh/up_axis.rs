@@ -1,0 +1,64 @@
+//! Which axis of a mesh file points up. OBJ and many other formats are written Y-up; Blender
+//! and OpenVDB's viewers are Z-up, and Blender's OBJ importer turns a Y-up file a quarter turn
+//! about x, (x, y, z) -> (x, -z, y). Reading the file the same way puts the volume where
+//! Blender puts the imported mesh.
+
+use super::Mesh;
+use glam::DVec3;
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum UpAxis {
+    /// The file is Y-up: turned to Z-up as Blender's OBJ importer turns it.
+    Y,
+    /// The file's coordinates are kept.
+    #[default]
+    Z,
+}
+
+impl std::str::FromStr for UpAxis {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "y" | "Y" => Ok(UpAxis::Y),
+            "z" | "Z" => Ok(UpAxis::Z),
+            _ => Err(format!("the up axis is y or z, not `{s}`")),
+        }
+    }
+}
+
+impl Mesh {
+    /// The mesh with its `up` axis turned to +z (a rotation: orientation and volume kept).
+    pub fn with_up_axis(mut self, up: UpAxis) -> Mesh {
+        if up == UpAxis::Y {
+            for p in &mut self.positions {
+                *p = DVec3::new(p.x, -p.z, p.y);
+            }
+        }
+        self
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn y_up_turns_to_z_up_keeping_the_volume() {
+        let mesh = crate::mesh::generate::torus(DVec3::new(0.0, 2.0, 0.0), 1.0, 0.3, 16, 8);
+        let volume = mesh.signed_volume();
+        let turned = mesh.clone().with_up_axis(UpAxis::Y);
+        assert!((turned.signed_volume() - volume).abs() < 1e-12);
+        // The centre at y = 2 goes to z = 2.
+        let b = turned.bbox();
+        assert!(((b.min.z + b.max.z) / 2.0 - 2.0).abs() < 1e-9);
+        assert_eq!(
+            mesh.with_up_axis(UpAxis::Z).positions,
+            turned
+                .with_up_axis(UpAxis::Z)
+                .positions
+                .iter()
+                .map(|p| DVec3::new(p.x, p.z, -p.y))
+                .collect::<Vec<_>>()
+        );
+    }
+}
