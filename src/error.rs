@@ -29,7 +29,7 @@ pub enum Error {
     },
     #[error("{path}: the mesh is empty ({message})")]
     EmptyMesh { path: PathBuf, message: String },
-    #[error("{path}: unsupported file type (expected .obj, .stl or .off)")]
+    #[error("{path}: unsupported file type (expected .obj, .stl, .ply or .off)")]
     UnsupportedFormat { path: PathBuf },
     #[error("invalid argument: {0}")]
     InvalidArgument(String),

@@ -1,4 +1,4 @@
-//! Every reader of untrusted input survives mutated input: valid OBJ, OFF, STL (ASCII and binary),
+//! Every reader of untrusted input survives mutated input: valid OBJ, OFF, PLY and STL (ASCII and binary),
 //! formula, CSG-tree and `.vdb` files with random bytes changed, inserted, deleted or cut off
 //! are either read or refused with an error naming the file (and meshes that read are
 //! voxelized or refused); never a panic, never a crash, never a hang.
@@ -103,6 +103,15 @@ fn off_text() -> Vec<u8> {
     std::fs::read(&path).unwrap()
 }
 
+fn ply_bytes(binary: bool) -> Vec<u8> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.ply");
+    generate::icosphere(DVec3::ZERO, 1.0, 1)
+        .write_ply(&path, binary)
+        .unwrap();
+    std::fs::read(&path).unwrap()
+}
+
 fn stl_ascii() -> Vec<u8> {
     let m = generate::icosphere(DVec3::ZERO, 1.0, 0);
     let mut s = String::from("solid s\n");
@@ -176,6 +185,12 @@ proptest! {
     fn mutated_off_files_are_read_or_refused(e in edits()) {
         let dir = tempfile::tempdir().unwrap();
         read_mesh(dir.path(), "m.off", &apply(off_text(), &e))?;
+    }
+
+    #[test]
+    fn mutated_ply_files_are_read_or_refused(e in edits(), binary in any::<bool>()) {
+        let dir = tempfile::tempdir().unwrap();
+        read_mesh(dir.path(), "m.ply", &apply(ply_bytes(binary), &e))?;
     }
 
     #[test]

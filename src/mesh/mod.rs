@@ -9,6 +9,7 @@ pub mod generate;
 pub mod inside;
 mod obj;
 mod off;
+mod ply;
 mod stl;
 mod up_axis;
 pub use up_axis::UpAxis;
@@ -74,7 +75,7 @@ impl Mesh {
         }
     }
 
-    /// Loads an `.obj`, `.stl` or `.off` file (chosen by extension) and checks it has faces, as every
+    /// Loads an `.obj`, `.stl`, `.off` or `.ply` file (chosen by extension) and checks it has faces, as every
     /// surface and solid method needs.
     pub fn load(path: &Path) -> Result<Mesh> {
         let mesh = Self::read(path)?;
@@ -105,6 +106,7 @@ impl Mesh {
             Some("obj") => obj::load_obj(path)?,
             Some("stl") => stl::load_stl(path)?,
             Some("off") => off::load_off(path)?,
+            Some("ply") => ply::load_ply(path)?,
             _ => {
                 return Err(Error::UnsupportedFormat {
                     path: path.to_path_buf(),

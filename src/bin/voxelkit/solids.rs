@@ -69,7 +69,7 @@ pub enum SolidMethod {
 
 #[derive(Args)]
 pub struct SolidArgs {
-    /// Closed input mesh (.obj, .stl or .off); its orientation does not matter. With
+    /// Closed input mesh (.obj, .stl, .ply or .off); its orientation does not matter. With
     /// --method depth-layers open meshes are accepted and their undecidable voxels reported.
     pub input: PathBuf,
     #[arg(long, value_enum, default_value = "flood")]
@@ -109,7 +109,7 @@ pub struct CsgArgs {
     #[arg(required_unless_present = "tree")]
     b: Option<PathBuf>,
     /// A CSG tree in JSON: union / intersection / difference over box, cylinder, sphere,
-    /// formula (solid where F < 0), mesh (closed .obj/.stl/.off) and vdb leaves, with a resolution
+    /// formula (solid where F < 0), mesh (closed .obj/.stl/.ply/.off) and vdb leaves, with a resolution
     /// or voxel_size (see examples/csg/).
     #[arg(long, conflicts_with_all = ["operation", "a", "b"])]
     tree: Option<PathBuf>,
