@@ -33,7 +33,7 @@ use voxelkit::voxelize::separating::Criterion;
         tolerance voxels (subdiv --enclose): voxels added where the surface grazes a voxel\n    \
         edge or corner no sample lands in\n  \
         inside/surface voxels, volume inside .. with surface (solids): the true volume lies\n    \
-        between them; components (26-connected) and genus (components - Euler characteristic)\n  \
+        between them; components (26-connected) and genus (components - Euler characteristic;\n    measure, and solid --topology)\n  \
         unclassified voxels (depth layers): voxels no direction decides, written as\n    \
         `unclassified`\n  \
         voxelize seconds, seconds: the voxelization itself, and the whole run\n  \
