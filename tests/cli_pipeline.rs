@@ -154,17 +154,17 @@ fn json_reports_are_typed_and_errors_are_json_objects() {
 }
 
 #[test]
-fn outputs_are_vdb_or_binvox_files_or_standard_output() {
+fn outputs_are_vdb_binvox_or_vox_files_or_standard_output() {
     let dir = tempfile::tempdir().unwrap();
     let obj = dir.path().join("tetra.obj");
     std::fs::write(&obj, TETRA).unwrap();
-    for name in ["out.npy", "out.vox", "out"] {
+    for name in ["out.npy", "out.npz", "out"] {
         let out = dir.path().join(name);
         let refused = voxelkit(&["mesh", s(&obj), "-r", "16", "-o", s(&out)]);
         let msg = text(&refused);
         assert!(!refused.status.success(), "{name}: {msg}");
         assert!(
-            msg.contains(".vdb") && msg.contains("standard output") && msg.contains(".binvox"),
+            msg.contains(".vdb") && msg.contains("standard output") && msg.contains(".vox"),
             "{msg}"
         );
         assert!(!out.exists());

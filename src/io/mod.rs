@@ -5,3 +5,4 @@ pub mod binvox;
 pub mod vdb;
 #[cfg(feature = "vdb")]
 mod vdb_structure;
+pub mod vox;

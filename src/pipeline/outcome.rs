@@ -12,6 +12,7 @@ use crate::implicit::Formula;
 use crate::io::atomic::check_output;
 use crate::io::binvox::write_binvox;
 use crate::io::vdb::{DistanceGrid, WriteOptions, write_distance_band, write_vdb_as};
+use crate::io::vox::write_vox;
 use crate::mesh::Mesh;
 use crate::ops::csg::{BooleanOp, combine as combine_grids};
 use crate::ops::minimality::simple_voxel_count;
@@ -44,12 +45,22 @@ pub struct Outcome {
 }
 
 /// Output formats by extension; `-` is standard output (as `.vdb`).
-const FORMATS: &str = ".vdb (or - for standard output) and .binvox";
+const FORMATS: &str = ".vdb (or - for standard output), .binvox and .vox";
 
-/// Whether `path` names a binvox file.
-fn is_binvox(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("binvox"))
+/// The voxel-set formats besides `.vdb`, by extension.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum VoxelFile {
+    Binvox,
+    Vox,
+}
+
+fn voxel_file(path: &Path) -> Option<VoxelFile> {
+    let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+    match ext.as_str() {
+        "binvox" => Some(VoxelFile::Binvox),
+        "vox" => Some(VoxelFile::Vox),
+        _ => None,
+    }
 }
 
 /// Refuses an output voxelkit cannot write, or one that is an input, before any work.
@@ -61,7 +72,7 @@ pub fn check_output_path(path: &Path, inputs: &[&Path]) -> Result<()> {
     let vdb = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("vdb"));
-    if !vdb && !is_binvox(path) {
+    if !vdb && voxel_file(path).is_none() {
         return Err(Error::InvalidArgument(format!(
             "{}: voxelkit cannot write this format; it writes {FORMATS}",
             path.display()
@@ -114,18 +125,22 @@ impl Outcome {
     }
 
     /// Writes the grids to `path` (`.vdb`; `-` for standard output) as `options` say, or the
-    /// voxel set alone to a `.binvox`, atomically, refusing to replace any of `inputs`;
+    /// voxel set alone to a `.binvox` or `.vox`, atomically, refusing to replace any of `inputs`;
     /// records the output in the report.
     pub fn write(&mut self, path: &Path, inputs: &[&Path], options: &WriteOptions) -> Result<()> {
         check_output_path(path, inputs)?;
-        if is_binvox(path) {
+        if let Some(format) = voxel_file(path) {
             if self.distances.is_some() {
                 return Err(Error::InvalidArgument(format!(
-                    "{}: binvox holds voxel sets, not distances; write the level set as .vdb",
+                    "{}: .binvox and .vox hold voxel sets, not distances; write the level set \
+                     as .vdb",
                     path.display()
                 )));
             }
-            write_binvox(path, &self.grid)?;
+            match format {
+                VoxelFile::Binvox => write_binvox(path, &self.grid)?,
+                VoxelFile::Vox => write_vox(path, &self.grid)?,
+            }
             self.report.output = Some(path.display().to_string());
             return Ok(());
         }

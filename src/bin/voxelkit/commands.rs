@@ -48,7 +48,7 @@ pub struct VoxelizeArgs {
     #[command(flatten)]
     pub surface: SurfaceArgs,
     /// Output: a .vdb (`density`, `normal` with --normals; `voxels` with --grids), or a
-    /// .binvox (the voxel set alone).
+    /// .binvox or .vox (the voxel set alone).
     #[arg(short, long)]
     pub output: PathBuf,
 }

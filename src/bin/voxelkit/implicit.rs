@@ -78,7 +78,8 @@ pub struct ImplicitArgs {
     /// F(-r, theta + pi, -phi) = 0 (cylindrical: F(-r, theta + pi, y) = 0).
     #[arg(long)]
     negative_r: bool,
-    /// Output: a .vdb (`density`, `normal`, and the levels), or a .binvox (the voxels alone).
+    /// Output: a .vdb (`density`, `normal`, and the levels), or a .binvox or .vox (the voxels
+    /// alone).
     #[arg(short, long)]
     output: PathBuf,
 }

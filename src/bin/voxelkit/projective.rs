@@ -59,7 +59,8 @@ pub struct LinesArgs {
     fit: FitArgs,
     #[command(flatten)]
     color: ColorArgs,
-    /// Output: a .vdb (`density` and, with colours, `Cd`), or a .binvox (the voxels alone).
+    /// Output: a .vdb (`density` and, with colours, `Cd`), or a .binvox or .vox (the voxels
+    /// alone).
     #[arg(short, long)]
     output: PathBuf,
 }

@@ -89,9 +89,9 @@ pub struct SolidArgs {
     /// Half width of the --sdf band, in voxels.
     #[arg(long, default_value_t = 3.0, value_name = "W")]
     pub band: f64,
-    /// Output: a .binvox (the whole solid), or a .vdb: `density` (1 on the whole solid, whole
-    /// blocks as tiles), `shell` (its outer voxels) and `interior`; depth layers add
-    /// `unclassified`; `voxels` (the whole solid as booleans) when --grids names it. With
+    /// Output: a .binvox or .vox (the whole solid), or a .vdb: `density` (1 on the whole
+    /// solid, whole blocks as tiles), `shell` (its outer voxels) and `interior`; depth layers
+    /// add `unclassified`; `voxels` (the whole solid as booleans) when --grids names it. With
     /// --sdf: `density` and the level set `surface`.
     #[arg(short, long)]
     pub output: PathBuf,

@@ -40,7 +40,7 @@ pub struct SubdivVoxelizeArgs {
     /// paper's test alone misses voxels the surface passes through).
     #[arg(long)]
     enclose: bool,
-    /// Output: a .vdb (`density`, `normal` and `opposite_normals` grids), or a .binvox.
+    /// Output: a .vdb (`density`, `normal` and `opposite_normals` grids), or a .binvox or .vox.
     #[arg(short, long, required = true)]
     output: Option<PathBuf>,
 }

@@ -1,7 +1,8 @@
-//! `.binvox` output read back by the format's reference semantics (header `dim`, `translate`,
-//! `scale`; run-length bytes, x slowest, then z, y fastest; voxel centres at
-//! `translate + (index + 0.5) * scale / dim`): the same voxels as the `.vdb` of the same run,
-//! for a surface and a solid; distances and empty sets refused without a file.
+//! Voxel-set outputs besides `.vdb`. `.binvox` read back by the format's reference semantics
+//! (header `dim`, `translate`, `scale`; run-length bytes, x slowest, then z, y fastest; voxel
+//! centres at `translate + (index + 0.5) * scale / dim`) and `.vox` read back by `dot_vox`:
+//! the same voxels as the `.vdb` of the same run (colours from `Cd` in `.vox`); distances and
+//! models past 256^3 refused without a file.
 #![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 use glam::DVec3;
@@ -130,4 +131,83 @@ fn distances_are_refused_as_binvox_and_nothing_is_left() {
         1,
         "only the mesh"
     );
+}
+
+/// Projective voxels of a coloured torus as `.vox`: one model with the `.vdb`'s voxels, from
+/// its box's minimum, coloured from `Cd` to within the palette's step.
+#[test]
+fn a_coloured_surface_as_vox_holds_the_voxels_and_colours_of_its_vdb() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("torus.obj");
+    let mut torus = generate::torus(DVec3::ZERO, 1.0, 0.3, 48, 12);
+    torus.colors = torus
+        .positions
+        .iter()
+        .map(|p| glam::Vec3::new((p.x as f32 + 1.3) / 2.6, 0.2, 0.9))
+        .collect();
+    torus.write_obj(&obj).unwrap();
+    let (vox, vdb) = (dir.path().join("t.vox"), dir.path().join("t.vdb"));
+    for out in [&vox, &vdb] {
+        let o = voxelkit(&[
+            "--grids",
+            "voxels,Cd",
+            "mesh",
+            obj.to_str().unwrap(),
+            "--method",
+            "projective",
+            "-r",
+            "60",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let grid = read_vdb_grid(&vdb, Some("voxels")).unwrap();
+    let data = dot_vox::load_bytes(&std::fs::read(&vox).unwrap()).unwrap();
+    assert_eq!(data.models.len(), 1);
+    let model = &data.models[0];
+    assert_eq!(model.voxels.len() as u64, grid.voxel_count());
+    let min = grid.bbox().unwrap().min;
+    let mut reds = Vec::new();
+    for v in &model.voxels {
+        let c = [
+            min[0] + v.x as i64,
+            min[1] + v.y as i64,
+            min[2] + v.z as i64,
+        ];
+        assert!(grid.contains(c), "{c:?}");
+        let colour = data.palette[v.i as usize];
+        assert!(
+            (colour.g as f32 / 255.0 - 0.2).abs() <= 0.1 + 1e-6,
+            "{colour:?}"
+        );
+        reds.push(colour.r);
+    }
+    reds.sort_unstable();
+    reds.dedup();
+    assert!(reds.len() >= 5, "red follows x: {reds:?}");
+}
+
+#[test]
+fn a_model_past_256_voxels_is_refused_as_vox() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("torus.obj");
+    generate::torus(DVec3::ZERO, 1.0, 0.3, 32, 8)
+        .write_obj(&obj)
+        .unwrap();
+    let out = dir.path().join("big.vox");
+    let o = voxelkit(&[
+        "mesh",
+        obj.to_str().unwrap(),
+        "-r",
+        "300",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let msg = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && msg.contains("big.vox") && msg.contains("256"),
+        "{msg}"
+    );
+    assert!(!out.exists());
 }
