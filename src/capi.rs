@@ -1129,21 +1129,11 @@ pub extern "C" fn vk_grid_copy_leaves(
     })
 }
 
-/// The grid's tiles as (origin, edge), in the order the copies use.
-fn tile_list(grid: &SparseGrid) -> Vec<(crate::grid::Coord, i32)> {
-    let tiles = grid.tiles();
-    tiles
-        .leaf_tiles()
-        .map(|o| (o, 8))
-        .chain(tiles.node_tiles().map(|o| (o, 128)))
-        .collect()
-}
-
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_grid_tile_count(grid: *const VkGrid, count: *mut usize) -> VkStatus {
     guard(|| {
         let g = &borrow(grid, Kind::Grid)?.grid;
-        put(count, tile_list(g).len())
+        put(count, g.tiles().with_edges().count())
     })
 }
 
@@ -1157,7 +1147,7 @@ pub extern "C" fn vk_grid_copy_tiles(
 ) -> VkStatus {
     guard(|| {
         let g = &borrow(grid, Kind::Grid)?.grid;
-        let tiles = tile_list(g);
+        let tiles: Vec<_> = g.tiles().with_edges().collect();
         let n = tiles.len();
         let chosen = match first.checked_add(count) {
             Some(end) if end <= n => &tiles[first..end],
@@ -1173,12 +1163,12 @@ pub extern "C" fn vk_grid_copy_tiles(
             for a in 0..3 {
                 origins[3 * k + a] = i32::try_from(origin[a])
                     .ok()
-                    .filter(|v| v.checked_add(edge).is_some())
+                    .filter(|v| v.checked_add(edge as i32).is_some())
                     .ok_or_else(|| {
                         invalid(format!("tile at {origin:?} lies beyond 32-bit coordinates"))
                     })?;
             }
-            edges[k] = edge;
+            edges[k] = edge as i32;
         }
         Ok(())
     })

@@ -289,16 +289,17 @@ fn a_formula_zero_everywhere_stops_at_the_memory_limit() {
     assert!(sphere.status.success(), "{}", text(&sphere));
 }
 
-/// Voxels of `voxelkit implicit FORMULA -r 64` over [-1, 1]^3.
-fn implicit_voxels(formula: &str) -> f64 {
+/// Voxels of `voxelkit implicit FORMULA -r RESOLUTION` over [-1, 1]^3.
+fn implicit_voxels(formula: &str, resolution: u32) -> f64 {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("f.vdb");
+    let r = resolution.to_string();
     let o = voxelkit(&[
         "--json",
         "implicit",
         formula,
         "-r",
-        "64",
+        &r,
         "-o",
         out.to_str().unwrap(),
     ]);
@@ -309,29 +310,17 @@ fn implicit_voxels(formula: &str) -> f64 {
 #[test]
 fn a_pole_is_not_taken_for_a_root() {
     // 1/x and 1/(x - x) have no zero; x^-1 - 2 is zero on the plane x = 1/2 only.
-    assert_eq!(implicit_voxels("1/x"), 0.0);
-    assert_eq!(implicit_voxels("1/(x-x)"), 0.0);
-    assert_eq!(implicit_voxels("x^-1 - 2"), implicit_voxels("x - 0.5"));
+    assert_eq!(implicit_voxels("1/x", 64), 0.0);
+    assert_eq!(implicit_voxels("1/(x-x)", 64), 0.0);
+    assert_eq!(
+        implicit_voxels("x^-1 - 2", 64),
+        implicit_voxels("x - 0.5", 64)
+    );
 }
 
 #[test]
 fn a_formula_at_resolution_one_is_one_voxel() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("one.vdb");
-    let o = voxelkit(&[
-        "--json",
-        "implicit",
-        "x^2 + y^2 + z^2 - 0.5",
-        "-r",
-        "1",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", text(&o));
-    assert_eq!(
-        json_field(&String::from_utf8_lossy(&o.stdout), "voxels"),
-        1.0
-    );
+    assert_eq!(implicit_voxels("x^2 + y^2 + z^2 - 0.5", 1), 1.0);
 }
 
 #[test]

@@ -73,16 +73,10 @@ impl DenseMask {
         if (0..3).any(|a| lo[a] > hi[a]) {
             return;
         }
-        let n = (hi[2] - lo[2] + 1) as usize;
         for x in lo[0]..=hi[0] {
             for y in lo[1]..=hi[1] {
                 let first = self.index([x, y, lo[2]]);
-                if n < 64 {
-                    // A leaf tile's row: one or two words.
-                    bits::or_bits(&mut self.bits, first, (1u64 << n) - 1);
-                } else {
-                    self.set_index_range(first, first + n - 1);
-                }
+                self.set_index_range(first, first + (hi[2] - lo[2]) as usize);
             }
         }
     }

@@ -132,7 +132,7 @@ impl SparseGrid {
         }
         let i = self.leaves.len();
         let mut leaf = Leaf::new(origin, self.channels);
-        if self.tiles.remove_leaf(origin) {
+        if !self.tiles.is_empty() && self.tiles.remove_leaf(origin) {
             leaf.mask = FULL;
         }
         self.leaves.push(leaf);

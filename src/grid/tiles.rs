@@ -69,15 +69,19 @@ impl Tiles {
             .chain(self.node_tiles().flat_map(node_leaf_origins))
     }
 
+    /// Every tile as its origin and edge (8 or 128): leaf tiles first.
+    pub fn with_edges(&self) -> impl Iterator<Item = (Coord, i64)> + '_ {
+        self.leaf_tiles()
+            .map(|o| (o, 8))
+            .chain(self.node_tiles().map(|o| (o, NODE_DIM)))
+    }
+
     /// Every tile as its box of voxels.
     pub fn boxes(&self) -> impl Iterator<Item = CoordBox> + '_ {
-        let cube = |o: Coord, d: i64| CoordBox {
+        self.with_edges().map(|(o, d)| CoordBox {
             min: o,
             max: o.map(|v| v + d - 1),
-        };
-        self.leaf_tiles()
-            .map(move |o| cube(o, 8))
-            .chain(self.node_tiles().map(move |o| cube(o, NODE_DIM)))
+        })
     }
 
     /// Makes the 8^3 block at `origin` whole.

@@ -59,13 +59,14 @@ fn flatten<'g>(path: &Path, grid: &'g SparseGrid) -> Result<Flat<'g>> {
         origins.extend(index_coord(path, leaf.origin)?);
         masks.extend_from_slice(&leaf.mask);
     }
-    let mut leaf_tiles = Vec::new();
-    for o in grid.tiles().leaf_tiles() {
-        leaf_tiles.extend(index_coord(path, o)?);
-    }
-    let mut node_tiles = Vec::new();
-    for o in grid.tiles().node_tiles() {
-        node_tiles.extend(index_coord(path, o)?);
+    let (mut leaf_tiles, mut node_tiles) = (Vec::new(), Vec::new());
+    for (o, edge) in grid.tiles().with_edges() {
+        let list = if edge == 8 {
+            &mut leaf_tiles
+        } else {
+            &mut node_tiles
+        };
+        list.extend(index_coord(path, o)?);
     }
     Ok(Flat {
         origins,
