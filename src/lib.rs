@@ -12,6 +12,9 @@ pub mod ops;
 #[cfg(feature = "vdb")]
 pub mod pipeline;
 pub mod progress;
+/// The Python module `voxelkit._voxelkit` (built by maturin).
+#[cfg(feature = "python")]
+mod python;
 pub mod random;
 pub mod shapes;
 pub mod solids;

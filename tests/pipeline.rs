@@ -12,7 +12,7 @@ use voxelkit::Error;
 use voxelkit::implicit::Coordinates;
 use voxelkit::mesh::{GridFit, generate};
 use voxelkit::pipeline::{
-    ColorChoice, Fill, Job, MeasureSource, MeshSource, Shape, SurfaceMethod, Task,
+    ColorChoice, CsgSource, Fill, Job, MeasureSource, MeshSource, Shape, SurfaceMethod, Task,
 };
 use voxelkit::progress::Observer;
 use voxelkit::shapes::Sphere;
@@ -142,7 +142,7 @@ fn every_task_refuses_an_impossible_grid_at_planning() {
     let dir = tempfile::tempdir().unwrap();
     let (torus, cube, tree) = fixtures(dir.path());
     let mut all = tasks(&torus, &cube);
-    all.push(("csg tree", Task::CsgTree(tree)));
+    all.push(("csg tree", Task::CsgTree(CsgSource::File(tree))));
     for (name, task) in all {
         for fit in [GridFit::Resolution(1 << 20), GridFit::VoxelSize(1e-30)] {
             let start = Instant::now();

@@ -377,6 +377,13 @@ impl SparseGrid {
             .collect()
     }
 
+    /// Keeps the leaves whose origin `keep` accepts (a grid without tiles: a surface).
+    pub fn retain_leaves(&mut self, keep: impl Fn(Coord) -> bool) {
+        debug_assert!(self.tiles.is_empty(), "only leaves are filtered");
+        self.leaves.retain(|l| keep(l.origin));
+        self.reindex();
+    }
+
     /// Drops empty leaves.
     pub fn prune(&mut self) {
         self.leaves.retain(|l| !l.is_empty());

@@ -6,6 +6,7 @@ pub mod flood_blocks;
 pub mod flood_linear;
 pub mod flood_spans;
 pub mod flood_xyz;
+pub mod labels;
 pub mod measure;
 pub mod minimality;
 pub mod seed;

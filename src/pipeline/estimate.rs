@@ -8,14 +8,14 @@
 //! A surface of area A (in voxels) crosses about A/32 leaves, a line of length L about L/4;
 //! a solid is assumed to fill half its box.
 
-use super::{Job, Loaded, MeasureSource, MeshSource, Plan, Task, lines_source};
+use super::{CsgSource, Job, Loaded, MeasureSource, MeshSource, Plan, Task, lines_source};
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::io::vdb::read_vdb_grid;
 use crate::mesh::{Aabb, GridFit, Mesh, UpAxis, fit_transform, index_box};
 use crate::ops::flood::padded;
-use crate::solids::csg_tree::read_csg_tree;
+use crate::solids::csg_tree::{parse_csg_tree, read_csg_tree};
 use crate::subd::ControlMesh;
 use crate::voxelize::{projective, separating};
 use glam::DVec3;
@@ -60,6 +60,19 @@ fn solid_bytes(cells: f64, masks: u32) -> f64 {
 /// A mesh's area in voxels^2.
 fn area_in_voxels(mesh: &Mesh, t: &Transform) -> f64 {
     mesh.area() / (t.voxel_size * t.voxel_size)
+}
+
+/// Peak bytes of one brick's work (see `bricks`): the surface of its `faces`, and for a
+/// solid the labels and masks over its `size^3` voxels and the solid's leaves.
+pub(super) fn brick_bytes(faces: &Mesh, t: &Transform, size: u32, solid: bool) -> u64 {
+    let cells = f64::from(size).powi(3);
+    let fill = if solid {
+        // u32 labels, two bit masks, and the solid's leaves.
+        cells * 4.25 + leaf_bytes(cells * SOLID_FILL / 512.0, 0)
+    } else {
+        0.0
+    };
+    (BASE_BYTES + surface_bytes(area_in_voxels(faces, t), 0) + fill) as u64
 }
 
 /// Voxels of a box, as a float (boxes past 2^64 voxels must still be refused, not wrap).
@@ -257,8 +270,13 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             source: MeasureSource::Grid(grid),
             ..
         } => grid_plan(grid.clone()),
-        Task::CsgTree(path) => {
-            let tree = read_csg_tree(path)?;
+        Task::CsgTree(source) => {
+            let tree = match source {
+                CsgSource::File(path) => read_csg_tree(path)?,
+                CsgSource::Json { text, folder } => {
+                    parse_csg_tree(text, std::path::Path::new("the CSG tree"), folder)?
+                }
+            };
             let (t, bounds) = tree.transform()?;
             let b = checked_box(&bounds, &t)?;
             // Two masks per node at most (its own and its result), and the result's boundary.

@@ -4,6 +4,8 @@
 //! allocated; `PlannedJob::run` does the work under an `Observer` (progress, cancellation)
 //! and returns an `Outcome`: the grids, their `.vdb` metadata and the report.
 
+pub mod brick_exterior;
+pub mod bricks;
 mod estimate;
 mod outcome;
 mod report;
@@ -11,6 +13,7 @@ mod solid;
 
 pub use outcome::{Outcome, check_output_path};
 pub use report::*;
+pub use solid::FLOOD_NEEDS_CLOSED;
 
 use crate::error::{Error, Result};
 use crate::grid::{SparseGrid, Transform};
@@ -91,6 +94,13 @@ pub enum MeasureSource {
     Grid(SparseGrid),
 }
 
+/// A CSG tree: a JSON file, or JSON text whose file names are found in `folder`.
+#[derive(Clone, Debug)]
+pub enum CsgSource {
+    File(PathBuf),
+    Json { text: String, folder: PathBuf },
+}
+
 /// A voxel grid: a grid of a `.vdb` file (named by the task), or one in memory.
 #[derive(Clone, Debug)]
 pub enum GridSource {
@@ -156,8 +166,8 @@ pub enum Task {
         band: f64,
         signed: bool,
     },
-    /// A CSG tree in JSON (see `ops::csg_tree`); its file sets the grid.
-    CsgTree(PathBuf),
+    /// A CSG tree in JSON (see `ops::csg_tree`); the tree sets the grid.
+    CsgTree(CsgSource),
     /// A Boolean of two grids (from files: their grid `grid`, or the voxel set voxelkit
     /// writes); `curve`: the intersection of two surfaces.
     Combine {
@@ -249,7 +259,8 @@ impl GridFit {
 }
 
 impl MeshSource {
-    fn load(&self, lines: bool, up: UpAxis) -> Result<Mesh> {
+    /// The mesh (polygons, or with `lines` also polylines), turned `up` when read from a file.
+    pub fn load(&self, lines: bool, up: UpAxis) -> Result<Mesh> {
         match self {
             MeshSource::File(path) if lines => Ok(Mesh::load_lines(path)?.with_up_axis(up)),
             MeshSource::File(path) => Ok(Mesh::load(path)?.with_up_axis(up)),
@@ -335,7 +346,7 @@ impl Task {
                 source: MeasureSource::Vdb(p),
                 ..
             }
-            | Task::CsgTree(p) => vec![p.clone()],
+            | Task::CsgTree(CsgSource::File(p)) => vec![p.clone()],
             Task::Combine { a, b, .. } => [a, b]
                 .into_iter()
                 .filter_map(|g| match g {

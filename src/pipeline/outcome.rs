@@ -11,7 +11,10 @@ use crate::grid::{SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::io::atomic::check_output;
 use crate::io::binvox::write_binvox;
-use crate::io::vdb::{DistanceGrid, WriteOptions, write_distance_band, write_vdb_as};
+use crate::io::brick_set::{BrickSet, is_brick_set};
+use crate::io::vdb::{
+    DistanceGrid, WriteOptions, read_vdb_grid, write_distance_band, write_vdb_as,
+};
 use crate::io::vox::write_vox;
 use crate::mesh::Mesh;
 use crate::ops::csg::{BooleanOp, combine as combine_grids};
@@ -108,6 +111,42 @@ impl Outcome {
                 .into_iter()
                 .map(|(k, v)| (k.to_string(), v))
                 .collect(),
+            report,
+            distances: None,
+        }
+    }
+
+    /// A grid of a `.vdb` file (its grid `name`, else the voxel set voxelkit writes), as an
+    /// outcome that can be examined and written again.
+    /// A brick-set index (`.json`, see `io::brick_set`) reads as its bricks merged.
+    pub fn read_vdb(path: &Path, name: Option<&str>) -> Result<Outcome> {
+        let start = Instant::now();
+        let source = path.display().to_string();
+        let (grid, method) = if is_brick_set(path) {
+            (BrickSet::read(path)?.merge(path)?, "voxelkit bricks")
+        } else {
+            (read_vdb_grid(path, name)?, "read")
+        };
+        let metadata = vec![
+            ("method", method.to_string()),
+            ("source_file", source.clone()),
+        ];
+        let mut outcome = Outcome::new(grid, metadata, Details::None);
+        outcome.report.input = source;
+        outcome.report.finish(start);
+        Ok(outcome)
+    }
+
+    /// One of `parent`'s grids as an outcome of its own, with `parent`'s metadata.
+    pub fn from_grid(grid: SparseGrid, parent: &Outcome) -> Outcome {
+        let mut report = parent.report.clone();
+        report.voxels = grid.voxel_count();
+        report.leaves = grid.leaf_count() as u64;
+        report.output = None;
+        Outcome {
+            grid,
+            extra: Vec::new(),
+            metadata: parent.metadata.clone(),
             report,
             distances: None,
         }

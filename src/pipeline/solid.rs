@@ -25,7 +25,7 @@ use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 use std::time::Instant;
 
 /// Why the flood needs a closed mesh, for the error that refuses an open one.
-const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it and leave the solid hollow \
+pub const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it and leave the solid hollow \
      (--method depth-layers reports which voxels an open mesh leaves undecidable)";
 
 /// What inside means for the exterior flood.

@@ -172,7 +172,13 @@ enum VdbSpec {
 /// place in the tree (`tree.difference[1].cylinder.radius`).
 pub fn read_csg_tree(path: &Path) -> Result<CsgTree> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    let mut json = serde_json::Deserializer::from_str(&text);
+    parse_csg_tree(&text, path, path.parent().unwrap_or(Path::new(".")))
+}
+
+/// Reads a tree given as JSON text; `path` names it in errors and the files it names are
+/// found in `folder`.
+pub fn parse_csg_tree(text: &str, path: &Path, folder: &Path) -> Result<CsgTree> {
+    let mut json = serde_json::Deserializer::from_str(text);
     let file: TreeFile = serde_path_to_error::deserialize(&mut json).map_err(|e| {
         let at = e.path().to_string();
         let inner = e.into_inner();
@@ -186,10 +192,7 @@ pub fn read_csg_tree(path: &Path) -> Result<CsgTree> {
             },
         }
     })?;
-    let reader = Reader {
-        file: path,
-        folder: path.parent().unwrap_or(Path::new(".")),
-    };
+    let reader = Reader { file: path, folder };
     let fit = match (file.resolution, file.voxel_size) {
         (Some(r), None) => {
             if !(1.0..=1e6).contains(&r) || r.fract() != 0.0 {

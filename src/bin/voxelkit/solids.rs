@@ -6,7 +6,7 @@ use clap::Args;
 use std::path::PathBuf;
 use voxelkit::Result;
 use voxelkit::ops::csg::BooleanOp;
-use voxelkit::pipeline::{Fill, GridSource, Job, MeasureSource, MeshSource, Task};
+use voxelkit::pipeline::{CsgSource, Fill, GridSource, Job, MeasureSource, MeshSource, Task};
 use voxelkit::solids::exterior_flood::FloodMethod;
 
 /// The floods to choose from.
@@ -207,7 +207,7 @@ pub fn csg(args: &CsgArgs, global: &Global) -> Result<()> {
             resample: args.resample,
             curve: false,
         },
-        (_, _, _, Some(tree)) => Task::CsgTree(tree.clone()),
+        (_, _, _, Some(tree)) => Task::CsgTree(CsgSource::File(tree.clone())),
         _ => unreachable!("clap requires --tree or A and B"),
     };
     // The grid comes from the inputs (the first grid, or the tree's resolution).

@@ -1,0 +1,228 @@
+"""Type stubs of the extension module (see the package docstring)."""
+
+from os import PathLike
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+Path = Union[str, PathLike]
+MeshSource = Union[Path, Tuple[npt.ArrayLike, Union[npt.ArrayLike, Sequence[Sequence[int]]]]]
+Progress = Callable[[str, int, int], Any]
+Vec3 = Tuple[float, float, float]
+Index = Tuple[int, int, int]
+
+class Grid:
+    """A sparse voxel grid with the report of the job that made it."""
+
+    @property
+    def ijk(self) -> npt.NDArray[np.int64]:
+        """The active voxels, (N, 3): leaves first, then whole tiles."""
+    def values(self, name: str) -> npt.NDArray[np.float32]:
+        """`distance` (N,), `normal` or `Cd` (N, 3) in the order of `ijk`; NaN on tiles."""
+    def to_dense(self) -> Tuple[npt.NDArray[np.bool_], Tuple[int, int, int]]:
+        """A dense boolean array and the index of its element [0, 0, 0]."""
+    @property
+    def voxel_size(self) -> float: ...
+    @property
+    def origin(self) -> Vec3:
+        """World position of the centre of voxel (0, 0, 0)."""
+    def index_to_world(self, ijk: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
+    @property
+    def bbox(self) -> Optional[Tuple[Index, Index]]: ...
+    @property
+    def report(self) -> Dict[str, Any]:
+        """The CLI's JSON report."""
+    @property
+    def extras(self) -> List[str]:
+        """Grids beside the main one (`shell`, `interior`, ...)."""
+    def extra(self, name: str) -> "Grid": ...
+    def write(
+        self,
+        path: Path,
+        grids: Optional[Sequence[str]] = None,
+        compression: str = "blosc",
+        half: bool = False,
+    ) -> None:
+        """Writes .vdb, .binvox or .vox by extension, atomically, never over an input."""
+    def write_vdb(
+        self,
+        path: Path,
+        grids: Optional[Sequence[str]] = None,
+        compression: str = "blosc",
+        half: bool = False,
+    ) -> None: ...
+    def __len__(self) -> int: ...
+
+def mesh(
+    source: MeshSource,
+    resolution: Optional[int] = None,
+    voxel_size: Optional[float] = None,
+    separability: int = 26,
+    method: str = "separating",
+    criterion: str = "huang",
+    normals: bool = False,
+    colors: bool = True,
+    color: Optional[Vec3] = None,
+    sdf: bool = False,
+    udf: bool = False,
+    band: float = 3.0,
+    threads: Optional[int] = None,
+    max_memory_mib: Optional[int] = None,
+    up_axis: str = "z",
+    progress: Optional[Progress] = None,
+) -> Grid: ...
+def solid(
+    source: MeshSource,
+    resolution: Optional[int] = None,
+    voxel_size: Optional[float] = None,
+    method: str = "flood",
+    flood: str = "blocks",
+    graystack: int = 1 << 20,
+    directions: int = 3,
+    layers: str = "double",
+    density: float = 1.0,
+    topology: bool = False,
+    sdf: bool = False,
+    band: float = 3.0,
+    threads: Optional[int] = None,
+    max_memory_mib: Optional[int] = None,
+    up_axis: str = "z",
+    progress: Optional[Progress] = None,
+) -> Grid: ...
+def subdiv(
+    source: MeshSource,
+    resolution: Optional[int] = None,
+    voxel_size: Optional[float] = None,
+    adjacency: int = 26,
+    enclose: bool = False,
+    presplit: int = 8,
+    threads: Optional[int] = None,
+    max_memory_mib: Optional[int] = None,
+    up_axis: str = "z",
+    progress: Optional[Progress] = None,
+) -> Grid: ...
+def implicit(
+    formula: str,
+    coords: str = "cartesian",
+    bounds: Optional[Union[Tuple[float, float], Tuple[Vec3, Vec3]]] = None,
+    resolution: int = 256,
+    levels: bool = False,
+    negative_r: bool = False,
+    threads: Optional[int] = None,
+    max_memory_mib: Optional[int] = None,
+    progress: Optional[Progress] = None,
+) -> Grid: ...
+def lines(
+    source: MeshSource,
+    resolution: Optional[int] = None,
+    voxel_size: Optional[float] = None,
+    edges: bool = False,
+    colors: bool = True,
+    color: Optional[Vec3] = None,
+    threads: Optional[int] = None,
+    max_memory_mib: Optional[int] = None,
+    up_axis: str = "z",
+    progress: Optional[Progress] = None,
+) -> Grid: ...
+def csg(
+    tree: Union[Path, Dict[str, Any]],
+    threads: Optional[int] = None,
+    max_memory_mib: Optional[int] = None,
+    progress: Optional[Progress] = None,
+) -> Grid: ...
+def measure(
+    source: Union[MeshSource, Grid],
+    resolution: Optional[int] = None,
+    voxel_size: Optional[float] = None,
+    flood: str = "blocks",
+    graystack: int = 1 << 20,
+    density: float = 1.0,
+    threads: Optional[int] = None,
+    max_memory_mib: Optional[int] = None,
+    up_axis: str = "z",
+    progress: Optional[Progress] = None,
+) -> Grid: ...
+def combine(
+    a: Union[Grid, Path],
+    b: Union[Grid, Path],
+    op: str = "union",
+    grid: Optional[str] = None,
+    resample: bool = False,
+    threads: Optional[int] = None,
+    progress: Optional[Progress] = None,
+) -> Grid: ...
+def read_vdb(path: Path, grid: Optional[str] = None) -> Grid:
+    """A .vdb grid, or a brick set's index (.json) merged."""
+
+class BrickPlan:
+    @property
+    def origin(self) -> Vec3: ...
+    @property
+    def voxel_size(self) -> float: ...
+    @property
+    def size(self) -> int: ...
+    @property
+    def extent(self) -> Tuple[Index, Index]: ...
+    @property
+    def bricks(self) -> List[Index]: ...
+    @property
+    def face_count(self) -> int: ...
+    def faces_of(
+        self, b: Index
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32], npt.NDArray[np.uint32]]: ...
+
+def brick_plan(
+    source: MeshSource,
+    brick: int,
+    resolution: Optional[int] = None,
+    voxel_size: Optional[float] = None,
+    solid: bool = False,
+    up_axis: str = "z",
+) -> BrickPlan: ...
+def brick_surface_file(
+    positions: npt.NDArray[np.float64],
+    indices: npt.NDArray[np.uint32],
+    starts: npt.NDArray[np.uint32],
+    origin: Vec3,
+    voxel_size: float,
+    brick: Index,
+    size: int,
+    path: Path,
+    separability: int = 26,
+    max_memory_mib: Optional[int] = None,
+) -> int: ...
+def brick_faces(
+    positions: npt.NDArray[np.float64],
+    indices: npt.NDArray[np.uint32],
+    starts: npt.NDArray[np.uint32],
+    origin: Vec3,
+    voxel_size: float,
+    brick: Index,
+    size: int,
+    max_memory_mib: Optional[int] = None,
+) -> List[npt.NDArray[np.uint32]]: ...
+def brick_solid_file(
+    positions: npt.NDArray[np.float64],
+    indices: npt.NDArray[np.uint32],
+    starts: npt.NDArray[np.uint32],
+    origin: Vec3,
+    voxel_size: float,
+    brick: Index,
+    size: int,
+    exterior: Sequence[int],
+    path: Path,
+    max_memory_mib: Optional[int] = None,
+) -> int: ...
+def brick_exterior(
+    plan: BrickPlan, faces: Dict[Index, Sequence[npt.NDArray[np.uint32]]]
+) -> Dict[Index, List[int]]: ...
+def brick_finish(
+    plan: BrickPlan,
+    files: Dict[Index, str],
+    full_bricks: Sequence[Index],
+    index: Path,
+    merged: Optional[Path] = None,
+) -> Optional[Grid]: ...

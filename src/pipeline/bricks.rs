@@ -1,0 +1,218 @@
+//! Voxelizing in bricks, so that one job can spread over processes or machines (the Python
+//! module's Dask front end). Index space is cut into cubes of `size` voxels aligned on
+//! multiples of `size` (a multiple of 8, so leaves never straddle two bricks). A brick
+//! receives only the faces whose box, grown by one voxel, reaches it: the separating
+//! criterion is local to a face's neighbourhood, so the brick's part of the surface is
+//! exactly the part of the whole surface inside it.
+//!
+//! Solids: each brick labels its outside components (clear voxels, face-connected, as the
+//! exterior flood goes) and hands in the labels on its six faces; `exterior_labels` joins
+//! them across bricks and finds those connected to the layout's border, which lies at
+//! least one voxel beyond the surface; each brick then keeps the rest as inside.
+
+use crate::error::{Error, Result};
+use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
+use crate::mesh::{GridFit, Mesh, fit_transform, index_box};
+use crate::ops::flood::padded;
+use crate::ops::labels::label_clear_components;
+use crate::progress::Progress;
+use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
+use std::collections::BTreeMap;
+
+/// A brick's coordinates: brick `b` covers voxels `b * size ..= b * size + size - 1`.
+pub type BrickIndex = [i64; 3];
+
+/// The bricks covering a mesh's grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BrickLayout {
+    pub transform: Transform,
+    pub size: i64,
+    /// The first and last brick along each axis.
+    pub min: BrickIndex,
+    pub max: BrickIndex,
+}
+
+impl BrickLayout {
+    /// The grid `fit` places the mesh on (as a single job would), cut into bricks of `size`
+    /// covering the surface and a border of at least one clear voxel around it.
+    pub fn new(mesh: &Mesh, fit: GridFit, size: u32) -> Result<BrickLayout> {
+        if size < 8 || !size.is_multiple_of(8) {
+            return Err(Error::InvalidArgument(format!(
+                "the brick size must be a positive multiple of 8 voxels, not {size}"
+            )));
+        }
+        let transform = fit_transform(&mesh.bbox(), fit)?;
+        // The surface reaches one voxel beyond the box; one more keeps a clear border.
+        let domain = padded(index_box(&mesh.bbox(), &transform), 1);
+        let size = i64::from(size);
+        Ok(BrickLayout {
+            transform,
+            size,
+            min: domain.min.map(|v| v.div_euclid(size)),
+            max: domain.max.map(|v| v.div_euclid(size)),
+        })
+    }
+
+    /// The voxels of brick `b`.
+    pub fn voxels(&self, b: BrickIndex) -> CoordBox {
+        CoordBox {
+            min: b.map(|v| v * self.size),
+            max: b.map(|v| v * self.size + self.size - 1),
+        }
+    }
+
+    /// Every brick of the layout.
+    pub fn all(&self) -> impl Iterator<Item = BrickIndex> + '_ {
+        (self.min[0]..=self.max[0]).flat_map(move |x| {
+            (self.min[1]..=self.max[1])
+                .flat_map(move |y| (self.min[2]..=self.max[2]).map(move |z| [x, y, z]))
+        })
+    }
+
+    /// The faces of `mesh` each brick receives (face numbers, ascending): those whose
+    /// index box, grown by one voxel, meets the brick.
+    pub fn bin_faces(&self, mesh: &Mesh) -> BTreeMap<BrickIndex, Vec<u32>> {
+        let mut bins: BTreeMap<BrickIndex, Vec<u32>> = BTreeMap::new();
+        for f in 0..mesh.face_count() {
+            let mut lo = [i64::MAX; 3];
+            let mut hi = [i64::MIN; 3];
+            for &v in mesh.face(f) {
+                let p = self.transform.world_to_index(mesh.p(v)).to_array();
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a].floor() as i64 - 1);
+                    hi[a] = hi[a].max(p[a].ceil() as i64 + 1);
+                }
+            }
+            let first = lo.map(|v| v.div_euclid(self.size));
+            let last = hi.map(|v| v.div_euclid(self.size));
+            for x in first[0]..=last[0] {
+                for y in first[1]..=last[1] {
+                    for z in first[2]..=last[2] {
+                        bins.entry([x, y, z]).or_default().push(f as u32);
+                    }
+                }
+            }
+        }
+        bins
+    }
+}
+
+/// The faces `faces` of `mesh` as a mesh of their own, with only the vertices they use.
+pub fn sub_mesh(mesh: &Mesh, faces: &[u32]) -> Mesh {
+    let mut renumber = vec![u32::MAX; mesh.positions.len()];
+    let mut positions = Vec::new();
+    let mut polygons = Vec::with_capacity(faces.len());
+    for &f in faces {
+        let polygon: Vec<u32> = mesh
+            .face(f as usize)
+            .iter()
+            .map(|&v| {
+                if renumber[v as usize] == u32::MAX {
+                    renumber[v as usize] = positions.len() as u32;
+                    positions.push(mesh.positions[v as usize]);
+                }
+                renumber[v as usize]
+            })
+            .collect();
+        polygons.push(polygon);
+    }
+    let mut sub = Mesh::from_polygons(mesh.source.clone(), positions, &polygons);
+    sub.numbered_from_zero = true;
+    sub
+}
+
+/// The part of the separating surface of the brick's faces that lies in `brick`.
+pub fn brick_surface(
+    faces: &Mesh,
+    transform: Transform,
+    brick: CoordBox,
+    options: &SeparatingOptions,
+    progress: &Progress,
+) -> Result<SparseGrid> {
+    let (mut surface, _) = voxelize_mesh(faces, transform, options, progress)?;
+    surface.retain_leaves(|origin| brick.contains(origin));
+    Ok(surface)
+}
+
+/// A brick's outside components.
+pub struct BrickOutside {
+    /// The brick's surface voxels.
+    pub blocked: DenseMask,
+    /// Per voxel (in `blocked`'s order): 0 on the surface, else its component.
+    pub labels: Vec<u32>,
+    pub components: u32,
+}
+
+/// The six faces of a brick, in the order -x, +x, -y, +y, -z, +z.
+pub const FACES: usize = 6;
+
+impl BrickOutside {
+    pub fn label(surface: &SparseGrid, brick: CoordBox) -> Result<BrickOutside> {
+        let blocked = DenseMask::from_grid(surface, brick)?;
+        let (labels, components) = label_clear_components(&blocked)?;
+        Ok(BrickOutside {
+            blocked,
+            labels,
+            components,
+        })
+    }
+
+    /// The labels on face `face` (see `FACES`): `size^2` of them, indexed `u * size + v` by
+    /// the other two axes in order (y, z for an x face).
+    pub fn face(&self, face: usize) -> Vec<u32> {
+        let (axis, high) = (face / 2, face % 2 == 1);
+        let b = self.blocked.bbox;
+        let size = (b.max[0] - b.min[0] + 1) as usize;
+        let (u_axis, v_axis) = match axis {
+            0 => (1, 2),
+            1 => (0, 2),
+            _ => (0, 1),
+        };
+        let mut out = Vec::with_capacity(size * size);
+        let mut c = b.min;
+        c[axis] = if high { b.max[axis] } else { b.min[axis] };
+        for u in 0..size as i64 {
+            for v in 0..size as i64 {
+                c[u_axis] = b.min[u_axis] + u;
+                c[v_axis] = b.min[v_axis] + v;
+                out.push(self.labels[self.blocked.index(c)]);
+            }
+        }
+        out
+    }
+
+    /// The surface and every clear voxel whose component is not in `exterior` (ascending).
+    pub fn solid(&self, surface: &SparseGrid, exterior: &[u32]) -> SparseGrid {
+        let mut inside = DenseMask::new(self.blocked.bbox).expect("the brick's box was allocated");
+        for (i, &label) in self.labels.iter().enumerate() {
+            if label != 0 && exterior.binary_search(&label).is_err() {
+                inside.set_index(i);
+            }
+        }
+        let mut whole = inside.to_grid(surface.transform);
+        whole.union(surface);
+        whole
+    }
+}
+
+/// Refuses a brick whose work is estimated above `limit` bytes (default: the memory
+/// available), naming the brick.
+pub fn check_brick_fits(
+    faces: &Mesh,
+    transform: &Transform,
+    brick: CoordBox,
+    solid: bool,
+    limit: Option<u64>,
+) -> Result<()> {
+    let size = (brick.max[0] - brick.min[0] + 1) as u32;
+    let bytes = super::estimate::brick_bytes(faces, transform, size, solid);
+    crate::system::check_fits(
+        bytes,
+        limit,
+        &format!(
+            "the brick of {size}^3 voxels at {:?} with {} faces; use smaller bricks",
+            brick.min,
+            faces.face_count()
+        ),
+    )
+}

@@ -1,0 +1,260 @@
+//! `voxelkit.Grid`: what every Python call returns — the voxels as numpy arrays, the
+//! channels, the transform, the report, the extra grids, and writing.
+
+use super::to_py_err;
+use crate::grid::{SparseGrid, Transform};
+use crate::io::vdb::{Compression, WriteOptions};
+use crate::pipeline::Outcome;
+use numpy::ndarray::{Array1, Array2, Array3};
+use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayLike2};
+use pyo3::exceptions::{PyKeyError, PyValueError};
+use pyo3::prelude::*;
+use std::path::PathBuf;
+
+/// A sparse voxel grid with the report of the job that made it.
+///
+/// `ijk` lists the active voxels (leaves first, then whole tiles); `values(name)` gives a
+/// channel in the same order; `index_to_world` maps indices to world positions of voxel
+/// centres.
+#[pyclass(name = "Grid", module = "voxelkit")]
+pub struct Grid {
+    outcome: Outcome,
+    /// Files the job read: writing refuses to replace them.
+    inputs: Vec<PathBuf>,
+}
+
+impl Grid {
+    pub fn new(outcome: Outcome, inputs: Vec<PathBuf>) -> Grid {
+        Grid { outcome, inputs }
+    }
+
+    pub fn sparse(&self) -> &SparseGrid {
+        &self.outcome.grid
+    }
+
+    fn transform(&self) -> Transform {
+        self.outcome.grid.transform
+    }
+
+    /// A channel per active voxel, `width` floats each, NaN on whole tiles (which carry
+    /// no channels).
+    fn channel(
+        &self,
+        width: usize,
+        get: impl Fn(&crate::grid::Leaf, usize) -> Option<&[f32]>,
+    ) -> Vec<f32> {
+        let grid = &self.outcome.grid;
+        let mut out = Vec::with_capacity(grid.voxel_count() as usize * width);
+        for leaf in grid.leaves() {
+            for n in leaf.offsets() {
+                match get(leaf, n) {
+                    Some(v) => out.extend_from_slice(v),
+                    None => out.extend(std::iter::repeat_n(f32::NAN, width)),
+                }
+            }
+        }
+        let tiled = grid.voxel_count() as usize - out.len() / width;
+        out.extend(std::iter::repeat_n(f32::NAN, tiled * width));
+        out
+    }
+
+    /// The names `values` accepts for this grid.
+    fn channel_names(&self) -> Vec<&'static str> {
+        let c = self.outcome.grid.channels();
+        [(c.value, "distance"), (c.normal, "normal"), (c.color, "Cd")]
+            .into_iter()
+            .filter_map(|(on, name)| on.then_some(name))
+            .collect()
+    }
+}
+
+#[pymethods]
+impl Grid {
+    /// The active voxels as an (N, 3) int64 array of indices.
+    #[getter]
+    fn ijk<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
+        let flat: Vec<i64> = self.outcome.grid.voxels().flatten().collect();
+        let n = flat.len() / 3;
+        Array2::from_shape_vec((n, 3), flat)
+            .expect("three indices per voxel")
+            .into_pyarray(py)
+    }
+
+    /// A channel in the order of `ijk`: `"distance"` (N,) for distance bands and the
+    /// separating voxelizer's distances, `"normal"` and `"Cd"` (N, 3). Whole tiles give NaN.
+    fn values<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        let c = self.outcome.grid.channels();
+        let (width, data) = match name {
+            "distance" if c.value => (
+                1,
+                self.channel(1, |l, n| l.value.as_ref().map(|v| &v[n..n + 1])),
+            ),
+            "normal" if c.normal => (
+                3,
+                self.channel(3, |l, n| l.normal.as_ref().map(|v| &v[n][..])),
+            ),
+            "Cd" if c.color => (
+                3,
+                self.channel(3, |l, n| l.color.as_ref().map(|v| &v[n][..])),
+            ),
+            _ => {
+                return Err(PyKeyError::new_err(format!(
+                    "no channel `{name}`: this grid has {:?}",
+                    self.channel_names()
+                )));
+            }
+        };
+        if width == 1 {
+            Ok(Array1::from_vec(data).into_pyarray(py).into_any())
+        } else {
+            let n = data.len() / width;
+            Ok(Array2::from_shape_vec((n, width), data)
+                .expect("width floats per voxel")
+                .into_pyarray(py)
+                .into_any())
+        }
+    }
+
+    /// The voxels as a dense boolean array and the index of its element [0, 0, 0]:
+    /// `dense[i - ox, j - oy, k - oz]` is voxel (i, j, k). Refused with MemoryError when the
+    /// array would not fit.
+    fn to_dense<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray3<bool>>, [i64; 3])> {
+        let grid = &self.outcome.grid;
+        let Some(b) = grid.bbox() else {
+            return Ok((Array3::from_elem((0, 0, 0), false).into_pyarray(py), [0; 3]));
+        };
+        let dims = [0, 1, 2].map(|a| (b.max[a] - b.min[a] + 1) as u64);
+        let cells = dims.iter().try_fold(1u64, |acc, &d| acc.checked_mul(d));
+        let bytes = cells.unwrap_or(u64::MAX);
+        crate::system::check_fits(bytes, None, &format!("a dense array of {dims:?} voxels"))
+            .map_err(to_py_err)?;
+        let mut dense = Array3::from_elem(dims.map(|d| d as usize), false);
+        for v in grid.voxels() {
+            dense[[0, 1, 2].map(|a| (v[a] - b.min[a]) as usize)] = true;
+        }
+        Ok((dense.into_pyarray(py), b.min))
+    }
+
+    /// Edge length of a voxel in world units.
+    #[getter]
+    fn voxel_size(&self) -> f64 {
+        self.transform().voxel_size
+    }
+
+    /// World position of the centre of voxel (0, 0, 0).
+    #[getter]
+    fn origin(&self) -> [f64; 3] {
+        self.transform().origin.to_array()
+    }
+
+    /// World positions of voxel centres for an (N, 3) array of indices (integers, or any
+    /// fractional index).
+    fn index_to_world<'py>(
+        &self,
+        py: Python<'py>,
+        ijk: PyArrayLike2<'py, f64, AllowTypeChange>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let a = ijk.as_array();
+        if a.ncols() != 3 {
+            return Err(PyValueError::new_err(format!(
+                "expected an (N, 3) array, got shape {:?}",
+                a.shape()
+            )));
+        }
+        let t = self.transform();
+        let o = t.origin.to_array();
+        Ok(
+            Array2::from_shape_fn(a.dim(), |(i, c)| o[c] + t.voxel_size * a[[i, c]])
+                .into_pyarray(py),
+        )
+    }
+
+    /// The smallest and largest voxel index, or None when there are no voxels.
+    #[getter]
+    fn bbox(&self) -> Option<([i64; 3], [i64; 3])> {
+        self.outcome.grid.bbox().map(|b| (b.min, b.max))
+    }
+
+    /// The job's report (the CLI's `--json`): counts, measures, timings, warnings.
+    #[getter]
+    fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        py.import("json")?
+            .call_method1("loads", (self.outcome.report.to_json(),))
+    }
+
+    /// The grids beside the main one (a solid's `shell` and `interior`, `unclassified`, ...).
+    #[getter]
+    fn extras(&self) -> Vec<String> {
+        self.outcome.extra.iter().map(|(n, _)| n.clone()).collect()
+    }
+
+    /// One of `extras` as a Grid of its own.
+    fn extra(&self, name: &str) -> PyResult<Grid> {
+        let (_, grid) = self
+            .outcome
+            .extra
+            .iter()
+            .find(|(n, _)| n == name)
+            .ok_or_else(|| {
+                PyKeyError::new_err(format!("no grid `{name}`: there are {:?}", self.extras()))
+            })?;
+        let outcome = Outcome::from_grid(grid.clone(), &self.outcome);
+        Ok(Grid::new(outcome, self.inputs.clone()))
+    }
+
+    /// Writes the grid as the CLI does, by extension: `.vdb` (all grids, or those `grids`
+    /// names: `density`, `voxels`, `normal`, `Cd`, `shell`, ...), `.binvox` or `.vox`;
+    /// atomically, never over an input of the job.
+    #[pyo3(signature = (path, grids = None, compression = "blosc", half = false))]
+    fn write(
+        &mut self,
+        py: Python<'_>,
+        path: PathBuf,
+        grids: Option<Vec<String>>,
+        compression: &str,
+        half: bool,
+    ) -> PyResult<()> {
+        let options = WriteOptions {
+            grids: grids.unwrap_or_default(),
+            compression: compression
+                .parse::<Compression>()
+                .map_err(PyValueError::new_err)?,
+            half,
+        };
+        let inputs: Vec<&std::path::Path> = self.inputs.iter().map(PathBuf::as_path).collect();
+        let outcome = &mut self.outcome;
+        py.detach(|| outcome.write(&path, &inputs, &options))
+            .map_err(to_py_err)
+    }
+
+    /// `write` for a `.vdb` path.
+    #[pyo3(signature = (path, grids = None, compression = "blosc", half = false))]
+    fn write_vdb(
+        &mut self,
+        py: Python<'_>,
+        path: PathBuf,
+        grids: Option<Vec<String>>,
+        compression: &str,
+        half: bool,
+    ) -> PyResult<()> {
+        self.write(py, path, grids, compression, half)
+    }
+
+    fn __len__(&self) -> usize {
+        self.outcome.grid.voxel_count() as usize
+    }
+
+    fn __repr__(&self) -> String {
+        let r = &self.outcome.report;
+        format!(
+            "<voxelkit.Grid {} voxels, voxel size {}, {}>",
+            self.outcome.grid.voxel_count(),
+            self.transform().voxel_size,
+            if r.method.is_empty() {
+                &r.input
+            } else {
+                &r.method
+            }
+        )
+    }
+}
