@@ -54,6 +54,8 @@ class Grid:
         compression: str = "blosc",
         half: bool = False,
     ) -> None: ...
+    def same_voxels(self, other: "Grid") -> bool:
+        """Whether both hold exactly the same voxel indices."""
     def __len__(self) -> int: ...
 
 def mesh(

@@ -134,8 +134,11 @@ def run(
     keep_bricks=False,
     up_axis="z",
     progress=False,
+    client=None,
 ):
-    """Voxelizes ``source`` (a path or a (vertices, faces) pair) in bricks on Dask.
+    """Voxelizes ``source`` (a path or a (vertices, faces) pair) in bricks on Dask: on
+    ``client`` (a dask.distributed.Client) when given, else on the scheduler at
+    ``scheduler``, else on a local cluster of ``workers`` processes started for the call.
 
     Returns a dict: the merged ``grid`` (a voxelkit.Grid, or None when the bricks were kept),
     ``output`` (the .vdb, or the brick set's index), ``bricks`` (with faces), ``full_bricks``,
@@ -153,7 +156,9 @@ def run(
     os.makedirs(folder)
     show = _Progress(progress)
     threads = max(1, (os.cpu_count() or 1) // max(1, workers))
-    client, cluster = _client(scheduler, workers, threads)
+    own = client is None
+    if own:
+        client, cluster = _client(scheduler, workers, threads)
     try:
         origin, h, size = plan.origin, plan.voxel_size, plan.size
         arrays = {b: client.scatter(plan.faces_of(b)) for b in plan.bricks}
@@ -183,9 +188,10 @@ def run(
             counts = _run(client, calls, "surface", show)
         peaks = list(client.run(_peak_rss_mib).values())
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        if own:
+            client.close()
+            if cluster is not None:
+                cluster.close()
     voxels = sum(counts.values()) + len(full_bricks) * size**3
     available = _available_bytes()
     merge = not keep_bricks and (

@@ -80,8 +80,9 @@ impl Grid {
             .into_pyarray(py)
     }
 
-    /// A channel in the order of `ijk`: `"distance"` (N,) for distance bands and the
-    /// separating voxelizer's distances, `"normal"` and `"Cd"` (N, 3). Whole tiles give NaN.
+    /// A channel in the order of `ijk`: `"distance"` (N,): world units for `sdf`/`udf` bands,
+    /// voxels for the separating voxelizer's `normals=True`; `"normal"` and `"Cd"` (N, 3).
+    /// Whole tiles give NaN.
     fn values<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
         let c = self.outcome.grid.channels();
         let (width, data) = match name {
@@ -238,6 +239,20 @@ impl Grid {
         half: bool,
     ) -> PyResult<()> {
         self.write(py, path, grids, compression, half)
+    }
+
+    /// Whether `other` holds exactly the same voxel indices (compared block by block, never
+    /// voxel by voxel where both hold whole tiles).
+    fn same_voxels(&self, py: Python<'_>, other: PyRef<'_, Grid>) -> bool {
+        let (a, b) = (&self.outcome.grid, &other.outcome.grid);
+        py.detach(|| {
+            if a.voxel_count() != b.voxel_count() {
+                return false;
+            }
+            let mut rest = a.clone();
+            rest.difference(b);
+            rest.voxel_count() == 0
+        })
     }
 
     fn __len__(&self) -> usize {

@@ -6,7 +6,8 @@ use clap::{Args, Subcommand};
 use glam::DVec3;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
-use voxelkit::io::vdb::read_vdb_info;
+use voxelkit::io::brick_set::{BrickSet, is_brick_set};
+use voxelkit::io::vdb::{DENSITY_GRID, VOXELS_GRID, read_vdb_info};
 use voxelkit::mesh::{GridFit, generate};
 use voxelkit::ops::separability::check_mesh_separation;
 use voxelkit::pipeline::{Details, Job, MeshSource, Shape, SurfaceMethod, Task};
@@ -249,7 +250,64 @@ struct GridSummary {
     metadata: std::collections::BTreeMap<String, String>,
 }
 
+/// `info` on a brick set's index: the bricks, and the voxels of their main grids.
+fn brick_set_info(index: &Path, global: &Global) -> Result<()> {
+    let set = BrickSet::read(index)?;
+    let mut voxels = (set.full_bricks.len() as u64) * (set.brick_size as u64).pow(3);
+    let mut rows = Vec::new();
+    for (brick, file) in set.bricks.iter().zip(set.files(index)) {
+        let grids = read_vdb_info(&file)?;
+        let main = grids
+            .iter()
+            .find(|g| g.name == VOXELS_GRID)
+            .or_else(|| grids.iter().find(|g| g.name == DENSITY_GRID))
+            .or(grids.first());
+        let count = main.map_or(0, |g| g.active_voxels);
+        voxels += count;
+        rows.push(serde_json::json!({
+            "brick": brick.brick,
+            "file": file.display().to_string(),
+            "active_voxels": count,
+        }));
+    }
+    if global.json {
+        let j = serde_json::json!({
+            "file": index.display().to_string(),
+            "brick_size": set.brick_size,
+            "voxel_size": set.voxel_size,
+            "origin": set.origin,
+            "active_voxels": voxels,
+            "bricks": rows,
+            "full_bricks": set.full_bricks,
+        });
+        println!("{j}");
+        return Ok(());
+    }
+    println!(
+        "{}: brick set of {} bricks in files and {} whole bricks of {}^3 voxels: {} active voxels",
+        index.display(),
+        set.bricks.len(),
+        set.full_bricks.len(),
+        set.brick_size,
+        voxels
+    );
+    println!(
+        "    transform: voxel size {:?}, voxel (0,0,0) at {:?}",
+        set.voxel_size, set.origin
+    );
+    for r in &rows {
+        println!(
+            "  brick {} {}: {} active voxels",
+            r["brick"], r["file"], r["active_voxels"]
+        );
+    }
+    Ok(())
+}
+
 pub fn info(file: &Path, global: &Global) -> Result<()> {
+    if is_brick_set(file) {
+        return brick_set_info(file, global);
+    }
     let grids = read_vdb_info(file)?;
     if global.json {
         let items: Vec<GridSummary> = grids

@@ -21,9 +21,10 @@ use voxelkit::voxelize::separating::Criterion;
     about = "Voxelize meshes and analytic surfaces into separating voxel surfaces and write OpenVDB files",
     long_about = "Voxelize meshes and analytic surfaces into 6- or 26-separating voxel surfaces \
                   (Huang et al.'s distance criterion) and write OpenVDB .vdb files that Blender, \
-                  Houdini and any OpenVDB program open. Each .vdb holds `surface` (bool), \
-                  `density` (fog volume) and, with --normals, `normal` (Vec3); with --sdf, \
-                  `density` and the level set `surface` (float, class LEVEL_SET).",
+                  Houdini and any OpenVDB program open. Each .vdb holds `density` (fog volume) \
+                  and, with --normals, `normal` (Vec3); `voxels` (bool) when --grids names it; \
+                  with --sdf, `density` and the level set `surface` (float, class LEVEL_SET). \
+                  The Python module (pip install .) runs the same jobs.",
     after_long_help = "What a summary (or --json) reports:\n  \
         voxels, leaves: voxels of the main grid (surface or whole solid) and their 8^3 leaves\n  \
         vertex/edge/body voxels: voxels first made by a vertex sphere, edge cylinder, face slab\n  \
@@ -134,7 +135,8 @@ enum Command {
         #[command(subcommand)]
         shape: commands::ShapeKind,
     },
-    /// Describe the grids of a .vdb file: types, counts, transform, metadata.
+    /// Describe the grids of a .vdb file (types, counts, transform, metadata), or the bricks
+    /// of a brick set by its index (`index.json`, from `python -m voxelkit.distributed`).
     Info { file: PathBuf },
     /// Check a mesh voxelization: separability by flooding and the share of simple voxels.
     Check {

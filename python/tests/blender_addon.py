@@ -1,0 +1,64 @@
+# Run inside headless Blender by test_blender.py: registers the add-on, voxelizes a monkey
+# and the mesh file given after `--` with the operator, and prints what Blender loaded.
+import json
+import sys
+
+import bpy
+import numpy as np
+
+import voxelkit
+import voxelkit.blender
+
+mesh_file = sys.argv[sys.argv.index("--") + 1]
+bpy.ops.wm.read_factory_settings(use_empty=True)
+voxelkit.register()
+
+
+def world_box(obj):
+    vertices, _ = voxelkit.blender.world_mesh(obj, bpy.context.evaluated_depsgraph_get())
+    return vertices.min(axis=0), vertices.max(axis=0)
+
+
+def voxelize(obj, **settings):
+    for o in bpy.context.view_layer.objects:
+        o.select_set(False)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    before = set(bpy.data.objects.keys())
+    result = bpy.ops.object.voxelkit_voxelize(**settings)
+    [name] = set(bpy.data.objects.keys()) - before
+    volume_object = bpy.data.objects[name]
+    volume = volume_object.data
+    loaded = volume.grids.load()
+    names = [g.name for g in volume.grids]
+    density = volume.grids["density"]
+    # Blender's placement of voxel centres (its grid-to-object matrix and the object's
+    # matrix) against voxelkit's own reading of the file.
+    grid = voxelkit.read_vdb(bpy.path.abspath(volume.filepath))
+    lo, hi = (np.array(c, dtype=float) for c in grid.bbox)
+    to_world = np.array(volume_object.matrix_world) @ np.array(density.matrix_object)
+    corners = [(to_world @ np.append(c, 1.0))[:3] for c in (lo, hi)]
+    mesh_lo, mesh_hi = world_box(obj)
+    print("RESULT " + json.dumps({
+        "object": obj.name,
+        "operator": list(result),
+        "loaded": loaded,
+        "density_loaded": density.load(),
+        "grids": names,
+        "voxel_size": grid.voxel_size,
+        "voxels": len(grid),
+        "blender_corners": [list(map(float, c)) for c in corners],
+        "voxelkit_corners": grid.index_to_world([lo, hi]).tolist(),
+        "mesh_box": [mesh_lo.tolist(), mesh_hi.tolist()],
+    }))
+
+
+bpy.ops.mesh.primitive_monkey_add(location=(1.0, -2.0, 0.5), rotation=(0.3, 0.2, 0.1), scale=(1.5, 1.5, 1.5))
+voxelize(bpy.context.active_object, resolution=64)
+bpy.ops.wm.obj_import(filepath=mesh_file)
+imported = bpy.context.selected_objects[0]
+imported.location = (0.0, 3.0, 0.0)
+voxelize(imported, resolution=96, fill="solid")
+voxelize(imported, resolution=64, fill="sdf")
+voxelkit.unregister()
+print("DONE")

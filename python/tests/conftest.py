@@ -1,0 +1,76 @@
+"""Shared fixtures: the shared test data, the CLI built by cargo, and pyopenvdb.
+
+The shared data folder is `$VOXELKIT_DATA` (default: ../shared/data beside the repository).
+Where it, the CLI, pyopenvdb or Blender is missing, tests fail under CI (`CI=true`) and are
+skipped with a loud warning elsewhere.
+"""
+
+import os
+import subprocess
+import warnings
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def missing(what):
+    """Fails in CI, skips loudly elsewhere."""
+    message = f"MISSING: {what}"
+    if os.environ.get("CI") == "true":
+        pytest.fail(message)
+    warnings.warn(message)
+    pytest.skip(message)
+
+
+@pytest.fixture(scope="session")
+def data():
+    folder = Path(os.environ.get("VOXELKIT_DATA", REPO.parent / "shared" / "data"))
+    if not (folder / "meshes").is_dir():
+        missing(f"the shared test data is not at {folder} (set VOXELKIT_DATA)")
+    return folder
+
+
+@pytest.fixture(scope="session")
+def cli():
+    """The `voxelkit` command line tool of this checkout (`cargo build --release`)."""
+    path = Path(os.environ.get("VOXELKIT_CLI", REPO / "target" / "release" / "voxelkit"))
+    if not path.is_file():
+        missing(f"the voxelkit CLI at {path} (run cargo build --release)")
+
+    def run(*args):
+        done = subprocess.run([str(path), *map(str, args)], capture_output=True, text=True)
+        assert done.returncode == 0, done.stderr
+        return done
+
+    return run
+
+
+@pytest.fixture(scope="session")
+def pyopenvdb():
+    try:
+        import pyopenvdb
+    except ImportError:
+        missing("pyopenvdb (Debian's python3-openvdb), the independent .vdb reader")
+    return pyopenvdb
+
+
+def closed_meshes(data):
+    """The shared meshes a solid can be made of (the flood refuses open ones)."""
+    import voxelkit
+
+    closed = []
+    for path in sorted((data / "meshes").glob("*.obj")):
+        try:
+            voxelkit.solid(path, resolution=8)
+        except ValueError as e:
+            assert "open" in str(e) or "boundary" in str(e), e
+            continue
+        closed.append(path)
+    return closed
+
+
+def voxel_set(ijk):
+    """Voxel indices as a set of tuples, for comparisons that name the differences."""
+    return set(map(tuple, ijk.tolist()))

@@ -1,0 +1,44 @@
+"""The Blender add-on in headless Blender 3.4: a monkey and a shared mesh voxelized by the
+operator into Volume objects whose `density` grid loads, placed by Blender exactly where
+voxelkit puts the voxels, and covering the mesh object's box within one voxel."""
+
+import json
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+
+import voxelkit
+from conftest import missing
+
+SCRIPT = Path(__file__).with_name("blender_addon.py")
+
+
+def test_the_add_on_voxelizes_into_volume_objects(data, tmp_path):
+    blender = shutil.which("blender")
+    if blender is None:
+        missing("blender (Debian's blender package) for the add-on test")
+    package = Path(voxelkit.__file__).resolve().parents[1]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(package), os.environ.get("PYTHONPATH")])))
+    env["TMPDIR"] = str(tmp_path)
+    done = subprocess.run(
+        [blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python", str(SCRIPT),
+         "--", str(data / "meshes" / "spot_triangulated.obj")],
+        capture_output=True, text=True, timeout=600, env=env,
+    )
+    assert done.returncode == 0 and "DONE" in done.stdout, done.stdout[-3000:] + done.stderr[-3000:]
+    results = [json.loads(l[len("RESULT "):]) for l in done.stdout.splitlines() if l.startswith("RESULT ")]
+    assert [r["object"] for r in results] == ["Suzanne", results[1]["object"], results[1]["object"]]
+    for r in results:
+        assert r["operator"] == ["FINISHED"] and r["loaded"] and r["density_loaded"], r
+        assert r["grids"][0] == "density", r["grids"]
+        h = r["voxel_size"]
+        # Blender places the voxel centres where voxelkit does.
+        assert np.allclose(r["blender_corners"], r["voxelkit_corners"], atol=1e-4 * h + 1e-6), r
+        # The outermost voxel centres lie within a voxel of the mesh object's world box.
+        lo, hi = np.array(r["voxelkit_corners"])
+        mesh_lo, mesh_hi = np.array(r["mesh_box"])
+        assert (np.abs(lo - mesh_lo) <= h).all() and (np.abs(hi - mesh_hi) <= h).all(), r
+    assert "surface" in results[2]["grids"], "the level set is written as `surface`"

@@ -1,0 +1,99 @@
+"""Dask scale-out: a brick run gives exactly the single-process voxels, for surfaces and
+solids, on every closed mesh of the shared data; it succeeds where the single run does not fit
+the memory limit; kept brick sets read back as one grid."""
+
+import subprocess
+import sys
+
+import pytest
+
+import voxelkit
+import voxelkit.distributed as vd
+from conftest import closed_meshes, missing, voxel_set
+
+
+@pytest.fixture(scope="module")
+def dask():
+    try:
+        import dask.distributed
+    except ImportError:
+        missing('Dask (pip install ".[distributed]")')
+    return dask.distributed
+
+
+@pytest.fixture(scope="module")
+def client(dask):
+    from dask.distributed import Client, LocalCluster
+
+    cluster = LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+        env={"RAYON_NUM_THREADS": "1"},
+    )
+    client = Client(cluster)
+    yield client
+    client.close()
+    cluster.close()
+
+
+@pytest.fixture(scope="module")
+def meshes(data):
+    found = closed_meshes(data)
+    assert len(found) >= 10, found
+    return found
+
+
+@pytest.mark.parametrize("solid", [False, True], ids=["surface", "solid"])
+def test_bricks_equal_the_single_run(meshes, client, tmp_path, solid):
+    for path in meshes:
+        out = tmp_path / f"{path.stem}-{solid}.vdb"
+        result = vd.run(path, out, solid=solid, resolution=512, brick=128, client=client)
+        single = (voxelkit.solid if solid else voxelkit.mesh)(path, resolution=512)
+        assert result["grid"].same_voxels(single), path.name
+        assert result["voxels"] == len(single) and result["bricks"] > 8
+        assert result["output"] == str(out) and voxelkit.read_vdb(out).same_voxels(single)
+
+
+def test_bricks_fit_where_the_single_run_does_not(data, client, tmp_path):
+    path = data / "meshes" / "bunny-closed.obj"
+    estimate = voxelkit.solid(path, resolution=64).report["estimated_mib"]
+    single = voxelkit.solid(path, resolution=768)
+    limit = int(single.report["estimated_mib"] * 0.5)
+    assert limit > estimate
+    with pytest.raises(MemoryError):
+        voxelkit.solid(path, resolution=768, max_memory_mib=limit)
+    result = vd.solid(path, tmp_path / "b.vdb", resolution=768, brick=128, max_memory_mib=limit, client=client)
+    assert result["grid"].same_voxels(single)
+    assert result["full_bricks"] > 0, "bricks wholly inside are written as tiles"
+    # A brick that cannot fit is refused with the reason.
+    with pytest.raises(MemoryError, match="brick"):
+        vd.solid(path, tmp_path / "c.vdb", resolution=768, brick=512, max_memory_mib=limit, client=client)
+
+
+def test_kept_bricks_read_as_one_grid(data, client, cli, tmp_path):
+    path = data / "meshes" / "torus.obj"
+    result = vd.mesh(path, tmp_path / "t.vdb", resolution=300, brick=64, keep_bricks=True, client=client)
+    index = tmp_path / "t.bricks" / "index.json"
+    assert result["output"] == str(index) and result["grid"] is None
+    assert not (tmp_path / "t.vdb").exists()
+    merged = voxelkit.read_vdb(index)
+    assert voxel_set(merged.ijk) == voxel_set(voxelkit.mesh(path, resolution=300).ijk)
+    info = cli("info", index).stdout
+    assert "bricks" in info and str(result["voxels"]) in info
+
+
+def test_the_command_line_starts_its_own_cluster(data, dask, tmp_path):
+    path = data / "meshes" / "cow.obj"
+    out = tmp_path / "cow.vdb"
+    done = subprocess.run(
+        [sys.executable, "-m", "voxelkit.distributed", "mesh", str(path), "-r", "256",
+         "--brick", "64", "--workers", "2", "-o", str(out)],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "voxels from" in done.stdout and "worker peak memory" in done.stdout
+    assert voxel_set(voxelkit.read_vdb(out).ijk) == voxel_set(voxelkit.mesh(path, resolution=256).ijk)
+    bad = subprocess.run(
+        [sys.executable, "-m", "voxelkit.distributed", "mesh", str(tmp_path / "none.obj"), "-o", str(out)],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert bad.returncode == 1 and "none.obj" in bad.stderr
