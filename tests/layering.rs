@@ -18,7 +18,7 @@ const LAYERS: [&[&str]; 13] = [
     &["ops"],
     &["solids"],
     &["pipeline"],
-    &["capi"],
+    &["capi", "python"],
 ];
 
 fn rank(module: &str) -> Option<usize> {
