@@ -5,7 +5,7 @@
 
 use super::flood::padded;
 use crate::error::Result;
-use crate::grid::{Adjacency, DenseMask, SparseGrid};
+use crate::grid::{Adjacency, Coord, DenseMask, SparseGrid};
 use rayon::prelude::*;
 
 /// Position of offset `(dx,dy,dz)` (each in -1..=1) in a 27-bit neighbourhood mask.
@@ -63,34 +63,37 @@ fn is_simple(occupied: u32, masks: &[u32; 27]) -> bool {
     true
 }
 
-/// The number of N-simple voxels of `surface` (N = `adjacency`).
-pub fn simple_voxel_count(surface: &SparseGrid, adjacency: Adjacency) -> Result<u64> {
+/// The N-simple voxels of `surface` (N = `adjacency`), leaf by leaf.
+pub fn simple_voxels(surface: &SparseGrid, adjacency: Adjacency) -> Result<Vec<Coord>> {
     let Some(bbox) = surface.bbox() else {
-        return Ok(0);
+        return Ok(Vec::new());
     };
     let dense = DenseMask::from_grid(surface, padded(bbox, 1))?;
     let masks = neighbour_masks(adjacency);
     Ok(surface
         .leaves()
         .par_iter()
-        .map(|leaf| {
-            leaf.coords()
-                .filter(|c| {
-                    let mut occ = 0u32;
-                    for dx in -1..=1 {
-                        for dy in -1..=1 {
-                            for dz in -1..=1 {
-                                if dense.get([c[0] + dx, c[1] + dy, c[2] + dz]) {
-                                    occ |= 1 << bit(dx, dy, dz);
-                                }
+        .flat_map_iter(|leaf| {
+            leaf.coords().filter(|c| {
+                let mut occ = 0u32;
+                for dx in -1..=1 {
+                    for dy in -1..=1 {
+                        for dz in -1..=1 {
+                            if dense.get([c[0] + dx, c[1] + dy, c[2] + dz]) {
+                                occ |= 1 << bit(dx, dy, dz);
                             }
                         }
                     }
-                    is_simple(occ, &masks)
-                })
-                .count() as u64
+                }
+                is_simple(occ, &masks)
+            })
         })
-        .sum())
+        .collect())
+}
+
+/// The number of N-simple voxels of `surface` (N = `adjacency`).
+pub fn simple_voxel_count(surface: &SparseGrid, adjacency: Adjacency) -> Result<u64> {
+    Ok(simple_voxels(surface, adjacency)?.len() as u64)
 }
 
 #[cfg(test)]

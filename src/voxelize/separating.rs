@@ -20,12 +20,24 @@
 //! `t` of the plane of a face around that edge or vertex: `Criterion::Clipped` keeps just
 //! those voxels, which removes most simple voxels the paper's full spheres and cylinders add.
 //!
+//! Slabs are half-open: with the face normal `n` turned so that its largest component is
+//! positive, a body voxel has `-t <= d < t` for `d = n·(x - p)`. A face lying exactly half-way
+//! between two rows of centres (a box whose faces fall on voxel boundaries, as the grid fit
+//! places a bounding box) then keeps one row, not both. The proof still holds: for an N-step
+//! from A to B across the face, `d_B - d_A` lies in `[-2t, 2t]` with `d_A, d_B` of opposite
+//! signs; if neither lay in `[-t, t)`, the one below would have `d < -t` and the other
+//! `d >= t`, a gap over `2t`. The included centre is the closer one except at a tie, where
+//! both lie `|B-A|/2 <= Rc` from P, so the edge and vertex part of the argument is unchanged.
+//! Spheres and cylinders stay closed; the clipped criterion uses the same half-open slabs.
+//!
 //! Deviations from the paper:
 //! - Polygons are fanned into triangles for the body test. The fan's inner diagonals get
 //!   no cylinder when the polygon is planar (a centre projecting inside the polygon projects
 //!   into one of its triangles); non-planar polygons keep them, as the proof needs.
 //! - Faces of zero area have no plane: their edges and vertices still cover them.
-//! - All tests accept a margin of 1e-9 voxels so rounding never opens a hole.
+//! - All tests accept a margin of 1e-9 voxels so rounding never opens a hole: a slab is
+//!   `-t - margin <= d < t - margin/2`, so that rounding can add a voxel at a tie but never
+//!   drop both.
 //! - Class counts follow the paper's order: vertex first, then edge, then body; each voxel
 //!   is counted once, so the three counts add up to the total.
 
@@ -40,6 +52,22 @@ use rayon::prelude::*;
 
 /// Tolerance, in voxels, added to every inclusion test.
 const MARGIN: f64 = 1e-9;
+
+/// The slab's bounds on `d = n·(x - p)` for the turned normal (see the module docs): the
+/// voxel is in when `lo <= d < hi`.
+fn slab_bounds(t: f64) -> (f64, f64) {
+    (-t - MARGIN, t - MARGIN / 2.0)
+}
+
+/// `n` turned so that its largest component is positive: the orientation the half-open slabs
+/// are measured in, the same for a face whatever its winding.
+fn turned(n: DVec3) -> DVec3 {
+    if n[n.abs().max_position()] < 0.0 {
+        -n
+    } else {
+        n
+    }
+}
 /// Extra room when clipping candidate rows (the exact tests run on every candidate).
 const ROW_SLACK: f64 = 1e-6;
 
@@ -137,8 +165,9 @@ impl Adjacency {
         self.faces[p.faces.clone()].iter().any(|&f| {
             let range = self.triangle_starts[f as usize]..self.triangle_starts[f as usize + 1];
             triangles[range].iter().any(|tri| {
-                tri.normal.dot(x - tri.corners[0]).abs()
-                    <= sep.slab_half_thickness(tri.normal) + MARGIN
+                let (lo, hi) = slab_bounds(sep.slab_half_thickness(tri.normal));
+                let d = turned(tri.normal).dot(x - tri.corners[0]);
+                lo <= d && d < hi
             })
         })
     }
@@ -432,11 +461,22 @@ fn is_planar(face: &[u32], pos: &[DVec3], n: DVec3) -> bool {
 /// Integer range `ceil(lo)..=floor(hi)`.
 #[inline]
 fn int_range(lo: f64, hi: f64) -> std::ops::RangeInclusive<i64> {
-    // Truncation plus a fix-up: `f64::ceil`/`floor` are libm calls without SSE4.1.
-    let (l, h) = (lo as i64, hi as i64);
-    let l = if (l as f64) < lo { l + 1 } else { l };
+    let h = hi as i64;
     let h = if (h as f64) > hi { h - 1 } else { h };
-    l..=h
+    ceil_int(lo)..=h
+}
+
+/// `ceil(x)` by truncation plus a fix-up: `f64::ceil`/`floor` are libm calls without SSE4.1.
+#[inline]
+fn ceil_int(x: f64) -> i64 {
+    let l = x as i64;
+    if (l as f64) < x { l + 1 } else { l }
+}
+
+/// Integer range `ceil(lo)..ceil(hi)`: the integers `v` with `lo <= v < hi`.
+#[inline]
+fn half_open_range(lo: f64, hi: f64) -> std::ops::RangeInclusive<i64> {
+    ceil_int(lo)..=ceil_int(hi) - 1
 }
 
 /// Values of `v` with `a v^2 + 2 b v + c <= 0` (`a > 0`), widened by `MARGIN`; empty when none.
@@ -523,16 +563,20 @@ fn edge_cylinder(
     }
 }
 
-/// S_b: voxel centres within `t` of the triangle's plane whose projection lies inside it.
+/// S_b: voxel centres in the triangle's half-open slab (see the module docs) whose projection
+/// lies inside it.
 fn face_body(tri: &Triangle, sep: Separability, sink: &mut Sink) {
-    let n = tri.normal;
+    // The slab is measured along the turned normal; the row bounds below do not depend on
+    // the normal's sign, the edge planes do (they point inwards for the face's own normal).
+    let n = turned(tri.normal);
     let [a, b, c] = tri.corners;
+    let (d_lo, d_hi) = slab_bounds(sep.slab_half_thickness(n));
     let t = sep.slab_half_thickness(n) + MARGIN;
     let w = n.abs().max_position();
     let (u, v) = ((w + 1) % 3, (w + 2) % 3);
     // In-plane inward normals of the edges: the planes E_i of the paper.
     let sides = [(a, b), (b, c), (c, a)].map(|(p, q)| {
-        let m = n.cross(q - p);
+        let m = tri.normal.cross(q - p);
         (m / m.length(), p)
     });
     let lo = a.min(b).min(c) - DVec3::splat(t);
@@ -561,16 +605,16 @@ fn face_body(tri: &Triangle, sep: Separability, sink: &mut Sink) {
         }
         for iv in int_range(v_lo, v_hi) {
             let s = n[u] * (iu as f64 - a[u]) + n[v] * (iv as f64 - a[v]);
-            // -t <= s + n_w (k - a_w) <= t, solved for k.
-            let k0 = a[w] + (-t - s) / n[w];
-            let k1 = a[w] + (t - s) / n[w];
-            for k in int_range(k0.min(k1), k0.max(k1)) {
+            // d_lo <= s + n_w (k - a_w) < d_hi with n_w > 0, solved for k.
+            let k0 = a[w] + (d_lo - s) / n[w];
+            let k1 = a[w] + (d_hi - s) / n[w];
+            for k in half_open_range(k0, k1) {
                 let mut x = DVec3::ZERO;
                 x[w] = k as f64;
                 x[u] = iu as f64;
                 x[v] = iv as f64;
                 if sides.iter().all(|(m, p)| m.dot(x - *p) >= -MARGIN) {
-                    sink.add(to_coord(x), n.dot(x - a).abs(), n);
+                    sink.add(to_coord(x), n.dot(x - a).abs(), tri.normal);
                 }
             }
         }
