@@ -55,13 +55,13 @@ const MARGIN: f64 = 1e-9;
 
 /// The slab's bounds on `d = n·(x - p)` for the turned normal (see the module docs): the
 /// voxel is in when `lo <= d < hi`.
-fn slab_bounds(t: f64) -> (f64, f64) {
+pub(super) fn slab_bounds(t: f64) -> (f64, f64) {
     (-t - MARGIN, t - MARGIN / 2.0)
 }
 
 /// `n` turned so that its largest component is positive: the orientation the half-open slabs
 /// are measured in, the same for a face whatever its winding.
-fn turned(n: DVec3) -> DVec3 {
+pub(super) fn turned(n: DVec3) -> DVec3 {
     if n[n.abs().max_position()] < 0.0 {
         -n
     } else {

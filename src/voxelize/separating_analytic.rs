@@ -15,12 +15,16 @@
 //! principal curvature in voxel units). So `t` grows by `k'/2` for 6- and `3k'/2` for
 //! 26-separation, which restores the planar proof; for polygons (k = 0) nothing changes.
 //!
+//! Slabs are half-open as for polygons (`separating.rs`): `-t <= d < t` for the signed
+//! distance along the normal turned to a positive largest component.
+//!
 //! The scan visits 8^3 blocks of the shape's box and skips a block when the distance at its
 //! centre exceeds the block's radius plus `Rc`: the distance is 1-Lipschitz, so no voxel
 //! is lost by the culling.
 
 use super::Progress;
 use super::Separability;
+use super::separating::{slab_bounds, turned};
 use super::sink::{nearest_channels, voxelize_parallel};
 use crate::grid::{SparseGrid, Transform};
 use crate::mesh::Aabb;
@@ -219,14 +223,21 @@ pub fn voxelize_surface(
             for x in origin[0].max(lo[0])..(origin[0] + 8).min(hi[0] + 1) {
                 for y in origin[1].max(lo[1])..(origin[1] + 8).min(hi[1] + 1) {
                     for z in origin[2].max(lo[2])..(origin[2] + 8).min(hi[2] + 1) {
-                        let near = surface.nearest(transform.index_to_world([x, y, z]));
-                        let limit = if near.on_edge {
-                            rc
-                        } else {
-                            separability.slab_half_thickness(near.normal) + curvature_margin
-                        };
+                        let p = transform.index_to_world([x, y, z]);
+                        let near = surface.nearest(p);
                         let d = near.distance / h;
-                        if d <= limit + 1e-9 {
+                        let kept = if near.on_edge {
+                            d <= rc + 1e-9
+                        } else {
+                            let t = separability.slab_half_thickness(near.normal);
+                            let (lo, hi) = slab_bounds(t + curvature_margin);
+                            // Normals point to where `side` is positive; the slab is
+                            // half-open along the turned normal, as for polygons.
+                            let along = if surface.side(p) < 0.0 { -d } else { d };
+                            let signed = along * turned(near.normal).dot(near.normal).signum();
+                            lo <= signed && signed < hi
+                        };
+                        if kept {
                             sink.add([x, y, z], d, near.normal);
                         }
                     }
