@@ -97,3 +97,10 @@ def test_the_command_line_starts_its_own_cluster(data, dask, tmp_path):
         capture_output=True, text=True, timeout=300,
     )
     assert bad.returncode == 1 and "none.obj" in bad.stderr
+
+
+def test_a_voxel_size_openvdb_cannot_store_is_refused_before_any_work(data, tmp_path):
+    out = tmp_path / "tiny.vdb"
+    with pytest.raises(OSError, match="cannot store voxel size"):
+        vd.mesh(data / "meshes" / "igea.obj", out, resolution=8192, brick=1024)
+    assert not list(tmp_path.iterdir()), "nothing is left behind"

@@ -183,6 +183,7 @@ def brick_plan(
     voxel_size: Optional[float] = None,
     solid: bool = False,
     up_axis: str = "z",
+    output: Optional[Path] = None,
 ) -> BrickPlan: ...
 def brick_surface_file(
     positions: npt.NDArray[np.float64],

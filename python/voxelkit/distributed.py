@@ -18,7 +18,8 @@ with ``--keep-bricks``) kept as ``OUT.bricks/`` with an index ``OUT.bricks/index
 that folder, so with ``--scheduler`` it must be on a file system every worker sees.
 
 Without ``--scheduler`` a local cluster of ``--workers`` processes is started, each running
-its bricks on (cores / workers) threads. ``--max-memory`` (MiB) bounds each brick's work.
+its bricks on (cores / workers) threads; the worker processes are spawned, so a script that
+calls ``run`` must do so under ``if __name__ == "__main__":``. ``--max-memory`` (MiB) bounds each brick's work.
 """
 
 import argparse
@@ -58,9 +59,13 @@ def _solid_brick(arrays, origin, voxel_size, brick, size, exterior, path, max_me
 
 
 def _peak_rss_mib():
-    import resource
-
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    """This process's peak resident memory: VmHWM, which starts afresh in a spawned worker
+    (ru_maxrss would carry over the memory of the process that spawned it)."""
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024.0
+    return float("nan")
 
 
 def _available_bytes():
@@ -148,12 +153,23 @@ def run(
     output = os.fspath(output)
     plan = vk.brick_plan(
         source, brick, resolution=resolution, voxel_size=voxel_size, solid=solid,
-        up_axis=up_axis,
+        up_axis=up_axis, output=output,
     )
     folder = os.path.splitext(output)[0] + ".bricks"
     if os.path.exists(folder):
         raise OSError(f"{folder}: already exists; remove it or choose another output")
     os.makedirs(folder)
+    try:
+        return _run_in(plan, folder, output, solid, separability, scheduler, workers,
+                       max_memory_mib, keep_bricks, progress, client, start)
+    except BaseException:
+        # No half-written output: the bricks of a failed or interrupted run go.
+        shutil.rmtree(folder, ignore_errors=True)
+        raise
+
+
+def _run_in(plan, folder, output, solid, separability, scheduler, workers, max_memory_mib,
+            keep_bricks, progress, client, start):
     show = _Progress(progress)
     threads = max(1, (os.cpu_count() or 1) // max(1, workers))
     own = client is None

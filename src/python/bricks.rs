@@ -9,7 +9,7 @@ use super::to_py_err;
 use crate::error::Result;
 use crate::grid::{CoordBox, Transform};
 use crate::io::brick_set::BrickSet;
-use crate::io::vdb::{WriteOptions, write_vdb_as};
+use crate::io::vdb::{WriteOptions, check_voxel_size, write_vdb_as};
 use crate::mesh::{GridFit, Mesh, UpAxis};
 use crate::pipeline::Outcome;
 use crate::pipeline::brick_exterior::exterior_labels;
@@ -109,7 +109,9 @@ impl BrickPlan {
 /// Reads the mesh (as the CLI does), places it on the grid a single run would use, and cuts
 /// it into bricks of `brick` voxels; `solid`: the mesh must be closed.
 #[pyfunction]
-#[pyo3(signature = (source, brick, resolution = None, voxel_size = None, solid = false, up_axis = "z"))]
+#[pyo3(signature = (source, brick, resolution = None, voxel_size = None, solid = false,
+    up_axis = "z", output = None))]
+#[allow(clippy::too_many_arguments)]
 pub fn brick_plan(
     py: Python<'_>,
     source: &Bound<'_, PyAny>,
@@ -118,6 +120,7 @@ pub fn brick_plan(
     voxel_size: Option<f64>,
     solid: bool,
     up_axis: &str,
+    output: Option<PathBuf>,
 ) -> PyResult<BrickPlan> {
     let source = mesh_source(source)?;
     let up: UpAxis = up_axis.parse().map_err(PyValueError::new_err)?;
@@ -132,6 +135,8 @@ pub fn brick_plan(
             mesh.require_closed(crate::pipeline::FLOOD_NEEDS_CLOSED)?;
         }
         let layout = BrickLayout::new(&mesh, fit, brick)?;
+        let named = output.unwrap_or_else(|| PathBuf::from("the bricks"));
+        check_voxel_size(&named, layout.transform.voxel_size)?;
         let bins = layout.bin_faces(&mesh);
         Ok(BrickPlan { mesh, layout, bins })
     })
