@@ -60,5 +60,7 @@ imported = bpy.context.selected_objects[0]
 imported.location = (0.0, 3.0, 0.0)
 voxelize(imported, resolution=96, fill="solid")
 voxelize(imported, resolution=64, fill="sdf")
+print("PANEL", hasattr(bpy.types, "VOXELKIT_PT_panel"), hasattr(bpy.types.Scene, "voxelkit"))
 voxelkit.unregister()
+print("UNREGISTERED", hasattr(bpy.types, "VOXELKIT_PT_panel"))
 print("DONE")

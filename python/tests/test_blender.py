@@ -42,3 +42,4 @@ def test_the_add_on_voxelizes_into_volume_objects(data, tmp_path):
         mesh_lo, mesh_hi = np.array(r["mesh_box"])
         assert (np.abs(lo - mesh_lo) <= h).all() and (np.abs(hi - mesh_hi) <= h).all(), r
     assert "surface" in results[2]["grids"], "the level set is written as `surface`"
+    assert "PANEL True True" in done.stdout and "UNREGISTERED False" in done.stdout
