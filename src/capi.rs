@@ -769,6 +769,7 @@ pub extern "C" fn vk_options_set_depth_layers(
             } else {
                 Layers::Single
             },
+            ..o.depth
         };
         Ok(())
     })

@@ -10,18 +10,33 @@ use voxelkit::grid::{DenseMask, SparseGrid, Transform};
 use voxelkit::mesh::inside::inside_centres;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate, index_box};
 use voxelkit::solids::depth_layers::{
-    DepthLayerOptions, DepthLayerSolid, Layers, depth_layer_solid,
+    DepthLayerOptions, DepthLayerSolid, Layers, Unclassified, depth_layer_solid,
 };
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 
 fn solid(mesh: &Mesh, t: &Transform, directions: usize, layers: Layers) -> DepthLayerSolid {
+    solid_by(mesh, t, directions, layers, Unclassified::NoDirection)
+}
+
+fn solid_by(
+    mesh: &Mesh,
+    t: &Transform,
+    directions: usize,
+    layers: Layers,
+    unclassified: Unclassified,
+) -> DepthLayerSolid {
     let bbox = index_box(&mesh.bbox(), t);
+    let options = DepthLayerOptions {
+        directions,
+        layers,
+        unclassified,
+    };
     depth_layer_solid(
         mesh,
         t,
         bbox,
-        &DepthLayerOptions { directions, layers },
+        &options,
         &voxelkit::progress::Progress::none(),
     )
     .unwrap()
@@ -202,4 +217,89 @@ fn open_meshes_are_reported_never_filled_or_left_hollow() {
         }
     }
     assert!(interior > 200_000);
+}
+
+/// Passalis et al.'s rule (unclassified when any direction counts more than four crossings)
+/// marks every voxel today's rule marks, and more: on the spheres in a hollow box, voxels of
+/// the walls' gap whose z ray meets a sphere are decided by x or y today.
+#[test]
+fn the_papers_rule_marks_more_voxels_unclassified_never_fewer() {
+    let mesh = generate::spheres_in_box();
+    let t = fit_transform(&mesh.bbox(), GridFit::Resolution(96)).unwrap();
+    for directions in [3, 16] {
+        let today = solid_by(
+            &mesh,
+            &t,
+            directions,
+            Layers::Double,
+            Unclassified::NoDirection,
+        );
+        let paper = solid_by(&mesh, &t, directions, Layers::Double, Unclassified::Paper);
+        let exact = inside_centres(&mesh, &t, paper.inside.bbox).unwrap();
+        for i in 0..paper.inside.len() {
+            assert!(
+                !today.unclassified.get_index(i) || paper.unclassified.get_index(i),
+                "{directions}: {:?} unclassified today only",
+                paper.inside.coord(i)
+            );
+            if !paper.unclassified.get_index(i) {
+                assert_eq!(
+                    paper.inside.get_index(i),
+                    exact.get_index(i),
+                    "{directions}"
+                );
+            }
+        }
+        eprintln!(
+            "spheres in a box, {directions} directions: {} unclassified by the paper's rule, {} today",
+            paper.stats.unclassified_voxels, today.stats.unclassified_voxels
+        );
+        assert!(paper.stats.unclassified_voxels > today.stats.unclassified_voxels);
+    }
+}
+
+/// Single layers (Karabassi et al. generalised to N directions, §3.1): a voxel is inside when
+/// it lies between the first and last crossing along every direction, so every direction
+/// added can only remove voxels, and the true inside always stays. The trefoil's pockets the
+/// axes miss are emptied by 8 directions; the G between plates keeps its hollow, which no
+/// direction sees.
+#[test]
+fn single_layers_with_more_directions_shrink_towards_the_inside() {
+    let fixtures = [
+        ("g shape", generate::g_shape()),
+        ("g between plates", generate::g_between_plates()),
+        ("random", generate::random_closed(3)),
+        ("trefoil", generate::trefoil(1.0, 0.3, 96, 16)),
+    ];
+    for (name, mesh) in &fixtures {
+        let t = fit_transform(&mesh.bbox(), GridFit::Resolution(80)).unwrap();
+        let by = |n| solid(mesh, &t, n, Layers::Single);
+        let (three, eight, sixteen) = (by(3), by(8), by(16));
+        let exact = inside_centres(mesh, &t, three.inside.bbox).unwrap();
+        let shell = DenseMask::from_grid(&surface(mesh, t), three.inside.bbox).unwrap();
+        for i in 0..exact.len() {
+            let (a, b, c) = (
+                three.inside.get_index(i),
+                eight.inside.get_index(i),
+                sixteen.inside.get_index(i),
+            );
+            assert!(!c || b, "{name}: 16 directions keep a voxel 8 drop");
+            assert!(!b || a, "{name}: 8 directions keep a voxel 3 drop");
+            if exact.get_index(i) && !shell.get_index(i) {
+                assert!(c, "{name} {:?}: inside, dropped by 16", exact.coord(i));
+            }
+        }
+        let counts = [&three, &eight, &sixteen].map(|s| s.stats.inside_voxels);
+        eprintln!(
+            "{name}: single layers fill {counts:?} with 3, 8, 16 directions, exact {}",
+            exact.count()
+        );
+        if *name == "trefoil" {
+            // The knot's loops hide pockets from the axes that the diagonals see.
+            assert!(
+                counts[1] < counts[0] && counts[2] == exact.count(),
+                "{counts:?}"
+            );
+        }
+    }
 }

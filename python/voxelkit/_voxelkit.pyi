@@ -85,6 +85,7 @@ def solid(
     graystack: int = 1 << 20,
     directions: int = 3,
     layers: str = "double",
+    unclassified: str = "no-direction",
     density: float = 1.0,
     topology: bool = False,
     sdf: bool = False,

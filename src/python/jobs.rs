@@ -12,7 +12,7 @@ use crate::pipeline::{
     ColorChoice, CsgSource, Fill, GridSource, Job, Limits, MeasureSource, Outcome, SurfaceMethod,
     Task,
 };
-use crate::solids::depth_layers::{DepthLayerOptions, Layers};
+use crate::solids::depth_layers::{DepthLayerOptions, Layers, Unclassified};
 use crate::solids::exterior_flood::FloodMethod;
 use crate::voxelize::Separability;
 use crate::voxelize::parametric::ParametricOptions;
@@ -158,7 +158,8 @@ pub fn mesh(
 /// et al.); with `sdf`, its level set. The report holds the volume, mass and area.
 #[pyfunction]
 #[pyo3(signature = (source, resolution = None, voxel_size = None, method = "flood",
-    flood = "blocks", graystack = 1 << 20, directions = 3, layers = "double", density = 1.0,
+    flood = "blocks", graystack = 1 << 20, directions = 3, layers = "double",
+    unclassified = "no-direction", density = 1.0,
     topology = false, sdf = false, band = 3.0, threads = None, max_memory_mib = None,
     up_axis = "z", progress = None))]
 #[allow(clippy::too_many_arguments)]
@@ -172,6 +173,7 @@ pub fn solid(
     graystack: usize,
     directions: usize,
     layers: &str,
+    unclassified: &str,
     density: f64,
     topology: bool,
     sdf: bool,
@@ -199,6 +201,15 @@ pub fn solid(
                     _ => {
                         return Err(PyValueError::new_err(format!(
                             "layers must be single or double, not `{layers}`"
+                        )));
+                    }
+                },
+                unclassified: match unclassified {
+                    "no-direction" => Unclassified::NoDirection,
+                    "paper" => Unclassified::Paper,
+                    _ => {
+                        return Err(PyValueError::new_err(format!(
+                            "unclassified must be no-direction or paper, not `{unclassified}`"
                         )));
                     }
                 },

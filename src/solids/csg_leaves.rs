@@ -123,6 +123,7 @@ pub fn formula_solid(
 pub const ALL_DIRECTIONS: DepthLayerOptions = DepthLayerOptions {
     directions: crate::solids::depth_layers::DIRECTIONS.len(),
     layers: Layers::Double,
+    unclassified: crate::solids::depth_layers::Unclassified::NoDirection,
 };
 
 /// A closed mesh by depth layers; voxels they cannot decide are an error naming the mesh.

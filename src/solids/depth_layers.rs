@@ -14,9 +14,10 @@
 //!
 //! Two decisions differ from the hardware version, both because software crossings are exact.
 //! The layers are the nearest crossings, not front and back faces, so the result does not
-//! depend on face orientation (inward-oriented meshes work). And one direction whose count
-//! allows a decision suffices (directions are tried in order: z, x, y, then the diagonals),
-//! where the paper gives up as soon as any direction counts more than four.
+//! depend on face orientation (inward-oriented meshes work). And by default one direction
+//! whose count allows a decision suffices (directions are tried in order: z, x, y, then the
+//! diagonals), where the paper gives up as soon as any direction counts more than four;
+//! `Unclassified::Paper` applies the paper's rule.
 //!
 //! The directions are integer vectors with a component of ±1: with `k` that component and
 //! `i, j` the others, `(a, b, t) = (p_i - t d_i, p_j - t d_j, p_k d_k)` is a unimodular change
@@ -59,11 +60,23 @@ pub enum Layers {
     Double,
 }
 
+/// Which voxels double layers leave unclassified.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Unclassified {
+    /// Those no direction can decide: one direction whose ray counts at most four crossings
+    /// decides (exact crossings make every such direction agree).
+    #[default]
+    NoDirection,
+    /// Passalis et al.'s rule: those on a ray of any direction counting more than four.
+    Paper,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DepthLayerOptions {
     /// How many of `DIRECTIONS` to render (3 = the axes, Karabassi's six z-buffers).
     pub directions: usize,
     pub layers: Layers,
+    pub unclassified: Unclassified,
 }
 
 impl Default for DepthLayerOptions {
@@ -71,6 +84,7 @@ impl Default for DepthLayerOptions {
         DepthLayerOptions {
             directions: 3,
             layers: Layers::Double,
+            unclassified: Unclassified::NoDirection,
         }
     }
 }
@@ -302,16 +316,25 @@ impl View {
 
 /// What the views say of one voxel with double layers: `Some(inside)` or `None`
 /// (unclassifiable), and whether an odd count was among the reasons.
-fn classify_double(views: &[View], p: [i64; 3], open_input: bool) -> (Option<bool>, bool) {
+fn classify_double(
+    views: &[View],
+    p: [i64; 3],
+    open_input: bool,
+    rule: Unclassified,
+) -> (Option<bool>, bool) {
+    // Every ray is looked at when an odd one (open input) or, by the paper's rule, one
+    // counting more than four could leave the voxel unclassified.
+    let look_at_all = open_input || rule == Unclassified::Paper;
     let mut decided = None;
     for v in views {
         match v.double(p) {
             Verdict::Open => return (None, true),
+            Verdict::Undecided if rule == Unclassified::Paper => return (None, false),
             Verdict::Undecided => {}
             verdict => {
                 if decided.is_none() {
                     decided = Some(verdict == Verdict::Inside);
-                    if !open_input {
+                    if !look_at_all {
                         break;
                     }
                 }
@@ -383,9 +406,11 @@ pub fn depth_layer_solid(
             for y in 0..ny {
                 let row = (x * ny + y) * nz;
                 let (ray, _) = z_view.voxel_ray([x as i64, y as i64, 0]);
-                // The z ray decides the whole row when its count allows.
+                // The z ray decides the whole row when its count allows (and no other
+                // direction can overrule it).
                 if options.layers == Layers::Double
                     && !open_input
+                    && options.unclassified == Unclassified::NoDirection
                     && let Ok(spans) = z_view.inside_spans(ray)
                 {
                     for s in spans {
@@ -405,14 +430,16 @@ pub fn depth_layer_solid(
                                 push_voxel(&mut ins, row + z);
                             }
                         }
-                        Layers::Double => match classify_double(&views, p, open_input) {
-                            (Some(true), _) => push_voxel(&mut ins, row + z),
-                            (Some(false), _) => {}
-                            (None, odd) => {
-                                push_voxel(&mut unc, row + z);
-                                open += odd as u64;
+                        Layers::Double => {
+                            match classify_double(&views, p, open_input, options.unclassified) {
+                                (Some(true), _) => push_voxel(&mut ins, row + z),
+                                (Some(false), _) => {}
+                                (None, odd) => {
+                                    push_voxel(&mut unc, row + z);
+                                    open += odd as u64;
+                                }
                             }
-                        },
+                        }
                     }
                 }
             }

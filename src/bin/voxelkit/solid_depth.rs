@@ -1,7 +1,7 @@
 //! The options of `voxelkit solid --method depth-layers` (Passalis et al.'s depth buffers).
 
 use clap::Args;
-use voxelkit::solids::depth_layers::{DepthLayerOptions, Layers};
+use voxelkit::solids::depth_layers::{DepthLayerOptions, Layers, Unclassified};
 
 #[derive(clap::ValueEnum, Clone, Copy)]
 enum LayersKind {
@@ -9,6 +9,16 @@ enum LayersKind {
     Double,
     /// One layer per side (Karabassi et al.): fills concavities no direction sees.
     Single,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy)]
+enum UnclassifiedKind {
+    /// A voxel is unclassified only when no direction decides it (at most four crossings on
+    /// one of its rays decide; exact crossings make deciding directions agree).
+    NoDirection,
+    /// Passalis et al.'s rule: unclassified when a ray of any direction through the voxel
+    /// counts more than four crossings.
+    Paper,
 }
 
 /// Options of --method depth-layers.
@@ -21,6 +31,9 @@ pub struct DepthArgs {
     directions: u32,
     #[arg(long, value_enum, default_value = "double")]
     layers: LayersKind,
+    /// Which voxels double layers leave unclassified.
+    #[arg(long, value_enum, default_value = "no-direction")]
+    unclassified: UnclassifiedKind,
 }
 
 impl DepthArgs {
@@ -30,6 +43,10 @@ impl DepthArgs {
             layers: match self.layers {
                 LayersKind::Double => Layers::Double,
                 LayersKind::Single => Layers::Single,
+            },
+            unclassified: match self.unclassified {
+                UnclassifiedKind::NoDirection => Unclassified::NoDirection,
+                UnclassifiedKind::Paper => Unclassified::Paper,
             },
         }
     }
