@@ -66,7 +66,7 @@ def test_bricks_fit_where_the_single_run_does_not(data, client, tmp_path):
     assert result["full_bricks"] > 0, "bricks wholly inside are written as tiles"
     # A brick that cannot fit is refused with the reason.
     with pytest.raises(MemoryError, match="brick"):
-        vd.solid(path, tmp_path / "c.vdb", resolution=768, brick=512, max_memory_mib=limit, client=client)
+        vd.solid(path, tmp_path / "c.vdb", resolution=768, brick=1024, max_memory_mib=limit, client=client)
 
 
 def test_kept_bricks_read_as_one_grid(data, client, cli, tmp_path):

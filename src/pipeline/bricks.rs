@@ -14,7 +14,7 @@ use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
 use crate::mesh::{GridFit, Mesh, fit_transform, index_box};
 use crate::ops::flood::padded;
-use crate::ops::labels::label_clear_components;
+use crate::ops::labels::{ClearRuns, label_clear_runs};
 use crate::progress::Progress;
 use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 use std::collections::BTreeMap;
@@ -138,9 +138,8 @@ pub fn brick_surface(
 pub struct BrickOutside {
     /// The brick's surface voxels.
     pub blocked: DenseMask,
-    /// Per voxel (in `blocked`'s order): 0 on the surface, else its component.
-    pub labels: Vec<u32>,
-    pub components: u32,
+    /// The clear voxels as runs along z, labelled by component.
+    pub runs: ClearRuns,
 }
 
 /// The six faces of a brick, in the order -x, +x, -y, +y, -z, +z.
@@ -149,44 +148,55 @@ pub const FACES: usize = 6;
 impl BrickOutside {
     pub fn label(surface: &SparseGrid, brick: CoordBox) -> Result<BrickOutside> {
         let blocked = DenseMask::from_grid(surface, brick)?;
-        let (labels, components) = label_clear_components(&blocked)?;
-        Ok(BrickOutside {
-            blocked,
-            labels,
-            components,
-        })
+        let runs = label_clear_runs(&blocked)?;
+        Ok(BrickOutside { blocked, runs })
     }
 
     /// The labels on face `face` (see `FACES`): `size^2` of them, indexed `u * size + v` by
-    /// the other two axes in order (y, z for an x face).
+    /// the other two axes in order (y, z for an x face); 0 on the surface.
     pub fn face(&self, face: usize) -> Vec<u32> {
         let (axis, high) = (face / 2, face % 2 == 1);
-        let b = self.blocked.bbox;
-        let size = (b.max[0] - b.min[0] + 1) as usize;
-        let (u_axis, v_axis) = match axis {
-            0 => (1, 2),
-            1 => (0, 2),
-            _ => (0, 1),
-        };
-        let mut out = Vec::with_capacity(size * size);
-        let mut c = b.min;
-        c[axis] = if high { b.max[axis] } else { b.min[axis] };
-        for u in 0..size as i64 {
-            for v in 0..size as i64 {
-                c[u_axis] = b.min[u_axis] + u;
-                c[v_axis] = b.min[v_axis] + v;
-                out.push(self.labels[self.blocked.index(c)]);
+        let [nx, ny, nz] = self.blocked.dims();
+        let mut out = vec![0u32; nx * ny];
+        let at = |n: usize| if high { n - 1 } else { 0 };
+        match axis {
+            // Whole rows: fill each run's span.
+            0 | 1 => {
+                let rows: Vec<(usize, usize)> = if axis == 0 {
+                    (0..ny).map(|y| (at(nx), y)).collect()
+                } else {
+                    (0..nx).map(|x| (x, at(ny))).collect()
+                };
+                for (u, (x, y)) in rows.into_iter().enumerate() {
+                    let row = x * ny + y;
+                    for k in self.runs.row_starts[row]..self.runs.row_starts[row + 1] {
+                        let (z0, z1) = self.runs.runs[k];
+                        out[u * nz + z0 as usize..=u * nz + z1 as usize].fill(self.runs.labels[k]);
+                    }
+                }
+            }
+            // One voxel per row: its end.
+            _ => {
+                for x in 0..nx {
+                    for y in 0..ny {
+                        out[x * ny + y] = self.runs.label_at(ny, x, y, at(nz) as u32);
+                    }
+                }
             }
         }
         out
     }
 
-    /// The surface and every clear voxel whose component is not in `exterior` (ascending).
+    /// The surface and every clear run whose component is not in `exterior` (ascending).
     pub fn solid(&self, surface: &SparseGrid, exterior: &[u32]) -> SparseGrid {
         let mut inside = DenseMask::new(self.blocked.bbox).expect("the brick's box was allocated");
-        for (i, &label) in self.labels.iter().enumerate() {
-            if label != 0 && exterior.binary_search(&label).is_err() {
-                inside.set_index(i);
+        let nz = self.blocked.dims()[2];
+        for (row, pair) in self.runs.row_starts.windows(2).enumerate() {
+            for k in pair[0]..pair[1] {
+                if exterior.binary_search(&self.runs.labels[k]).is_err() {
+                    let (z0, z1) = self.runs.runs[k];
+                    inside.set_index_range(row * nz + z0 as usize, row * nz + z1 as usize);
+                }
             }
         }
         let mut whole = inside.to_grid(surface.transform);

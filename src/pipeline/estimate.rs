@@ -62,13 +62,17 @@ fn area_in_voxels(mesh: &Mesh, t: &Transform) -> f64 {
     mesh.area() / (t.voxel_size * t.voxel_size)
 }
 
+/// Bytes per labelled run of clear voxels: its span, label and union-find parent.
+const RUN_BYTES: f64 = 16.0;
+
 /// Peak bytes of one brick's work (see `bricks`): the surface of its `faces`, and for a
-/// solid the labels and masks over its `size^3` voxels and the solid's leaves.
+/// solid the two bit masks over its `size^3` voxels, the labelled runs (a few per row) and
+/// the solid's leaves.
 pub(super) fn brick_bytes(faces: &Mesh, t: &Transform, size: u32, solid: bool) -> u64 {
     let cells = f64::from(size).powi(3);
     let fill = if solid {
-        // u32 labels, two bit masks, and the solid's leaves.
-        cells * 4.25 + leaf_bytes(cells * SOLID_FILL / 512.0, 0)
+        let runs = 4.0 * f64::from(size).powi(2);
+        cells / 4.0 + runs * RUN_BYTES + leaf_bytes(cells * SOLID_FILL / 512.0, 0)
     } else {
         0.0
     };
