@@ -20,7 +20,7 @@ use crate::pipeline::{
 };
 use crate::progress::Observer;
 use crate::solids::csg_leaves::ALL_DIRECTIONS;
-use crate::solids::depth_layers::{DIRECTIONS, DepthLayerOptions, Layers};
+use crate::solids::depth_layers::{DepthLayerOptions, DirectionSet, Layers};
 use crate::solids::exterior_flood::FloodMethod;
 use crate::voxelize::Separability;
 use crate::voxelize::parametric::ParametricOptions;
@@ -756,14 +756,8 @@ pub extern "C" fn vk_options_set_depth_layers(
     guard(|| {
         let options = options_mut(options)?;
         let mut o = lock(&options);
-        if !(3..=DIRECTIONS.len() as u32).contains(&directions) {
-            return Err(invalid(format!(
-                "depth layers take 3 to {} directions, not {directions}",
-                DIRECTIONS.len()
-            )));
-        }
         o.depth = DepthLayerOptions {
-            directions: directions as usize,
+            directions: DirectionSet::first(directions as usize)?,
             layers: if double_layers != 0 {
                 Layers::Double
             } else {

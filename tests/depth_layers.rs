@@ -10,7 +10,7 @@ use voxelkit::grid::{DenseMask, SparseGrid, Transform};
 use voxelkit::mesh::inside::inside_centres;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate, index_box};
 use voxelkit::solids::depth_layers::{
-    DepthLayerOptions, DepthLayerSolid, Layers, Unclassified, depth_layer_solid,
+    DepthLayerOptions, DepthLayerSolid, DirectionSet, Layers, Unclassified, depth_layer_solid,
 };
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
@@ -28,7 +28,7 @@ fn solid_by(
 ) -> DepthLayerSolid {
     let bbox = index_box(&mesh.bbox(), t);
     let options = DepthLayerOptions {
-        directions,
+        directions: DirectionSet::first(directions).unwrap(),
         layers,
         unclassified,
     };
@@ -301,5 +301,55 @@ fn single_layers_with_more_directions_shrink_towards_the_inside() {
                 "{counts:?}"
             );
         }
+    }
+}
+
+/// §3.1's arbitrary directions: the user's own integer directions classify exactly like the
+/// built-in ones (every decided voxel off the surface agrees with the exact test), and
+/// directions the rays cannot follow through voxel centres, or parallel ones, are refused.
+#[test]
+fn user_directions_classify_exactly_and_bad_ones_are_refused() {
+    let mesh = generate::g_between_plates();
+    let t = fit_transform(&mesh.bbox(), GridFit::Resolution(80)).unwrap();
+    let bbox = index_box(&mesh.bbox(), &t);
+    for list in [
+        vec![[1, 2, 0], [0, 1, 3], [2, -3, 1]],
+        vec![[0, 1, 0], [3, 1, 2]],
+        vec![[1, 1, 1]],
+    ] {
+        for layers in [Layers::Double, Layers::Single] {
+            let options = DepthLayerOptions {
+                directions: DirectionSet::given(&list).unwrap(),
+                layers,
+                ..Default::default()
+            };
+            let s = depth_layer_solid(
+                &mesh,
+                &t,
+                bbox,
+                &options,
+                &voxelkit::progress::Progress::none(),
+            )
+            .unwrap();
+            assert_eq!(s.stats.per_direction.len(), list.len());
+            let (wrong, unclassified) = disagreement(&mesh, &t, &s);
+            eprintln!("{list:?} {layers:?}: {wrong} wrong, {unclassified} unclassified");
+            if layers == Layers::Double {
+                assert_eq!(wrong, 0, "{list:?}");
+            } else {
+                // Single layers fill what no direction sees, never empty the inside.
+                let exact = inside_centres(&mesh, &t, bbox).unwrap();
+                assert!((0..exact.len()).all(|i| !exact.get_index(i) || s.inside.get_index(i)));
+            }
+        }
+    }
+    for (bad, why) in [
+        (vec![[2, 3, 5]], "component of 1 or -1"),
+        (vec![[1, 2, 0], [-1, -2, 0]], "parallel"),
+        (vec![[0, 0, 0]], "component of 1 or -1"),
+        (vec![], "1 to 16"),
+    ] {
+        let e = DirectionSet::given(&bad).unwrap_err().to_string();
+        assert!(e.contains(why), "{bad:?}: {e}");
     }
 }

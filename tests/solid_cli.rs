@@ -196,4 +196,46 @@ fn depth_layer_solids_report_what_they_cannot_classify() {
     assert!(json_field(&open, "odd_rays") > 0.0);
     assert!(json_field(&open, "unclassified_on_odd_rays") > 0.0);
     assert_eq!(json_field(&open, "boundary_edges"), 4.0);
+
+    // The paper's unclassified rule marks more of the boxed spheres; the user's own directions
+    // are taken, and a direction without a component of ±1 is refused before any work.
+    let paper = run(
+        &p("boxed.obj"),
+        &["--method", "depth-layers", "--unclassified", "paper"],
+        &p("boxed-paper.vdb"),
+    );
+    assert!(
+        json_field(&paper, "unclassified_voxels") > json_field(&boxed, "unclassified_voxels"),
+        "{paper}"
+    );
+    let own = run(
+        &p("g.obj"),
+        &[
+            "--method",
+            "depth-layers",
+            "--directions",
+            "0,0,1;1,-1,0;2,1,1",
+        ],
+        &p("g3.vdb"),
+    );
+    assert!(
+        (json_field(&own, "volume") - exact).abs() < 0.02 * exact,
+        "{own}"
+    );
+    let o = voxelkit(&[
+        "solid",
+        &p("g.obj"),
+        "--method",
+        "depth-layers",
+        "--directions",
+        "2,3,5",
+        "-o",
+        &p("g4.vdb"),
+    ]);
+    assert!(
+        !o.status.success() && text(&o).contains("component of 1 or -1"),
+        "{}",
+        text(&o)
+    );
+    assert!(!dir.path().join("g4.vdb").exists());
 }

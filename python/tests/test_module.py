@@ -251,3 +251,7 @@ def test_depth_layers_take_the_papers_unclassified_rule(data):
     assert "unclassified" in paper.extras
     with pytest.raises(ValueError, match="no-direction or paper"):
         voxelkit.solid(path, resolution=16, method="depth-layers", unclassified="never")
+    own = voxelkit.solid(path, resolution=48, method="depth-layers", directions=[(0, 0, 1), (1, 1, 0), (2, 1, -1)])
+    assert own.report["directions"][2]["direction"] == [2, 1, -1]
+    with pytest.raises(ValueError, match="component of 1 or -1"):
+        voxelkit.solid(path, resolution=16, method="depth-layers", directions=[(2, 3, 5)])

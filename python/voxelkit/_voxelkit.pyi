@@ -83,7 +83,7 @@ def solid(
     method: str = "flood",
     flood: str = "blocks",
     graystack: int = 1 << 20,
-    directions: int = 3,
+    directions: Optional[Union[int, Sequence[Index]]] = None,
     layers: str = "double",
     unclassified: str = "no-direction",
     density: float = 1.0,

@@ -338,7 +338,10 @@ fn solid_plan(
     let (t, b) = mesh_plan(&mesh, fit)?;
     let (masks, items) = match fill {
         super::Fill::Flood(_) => (6, separating::work_items(&mesh)),
-        super::Fill::DepthLayers(o) => (6, o.directions as u64 + (b.max[0] - b.min[0] + 1) as u64),
+        super::Fill::DepthLayers(o) => (
+            6,
+            o.directions.len() as u64 + (b.max[0] - b.min[0] + 1) as u64,
+        ),
         super::Fill::Beam => (5, mesh.face_count() as u64),
     };
     let bytes =

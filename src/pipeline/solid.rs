@@ -201,7 +201,7 @@ pub(super) fn mesh_solid(
                     Layers::Double => "double layers + stencil",
                     Layers::Single => "single layer",
                 },
-                options.directions
+                options.directions.len()
             );
             centre_solid(
                 &solid.inside,

@@ -12,7 +12,7 @@ use crate::pipeline::{
     ColorChoice, CsgSource, Fill, GridSource, Job, Limits, MeasureSource, Outcome, SurfaceMethod,
     Task,
 };
-use crate::solids::depth_layers::{DepthLayerOptions, Layers, Unclassified};
+use crate::solids::depth_layers::{DepthLayerOptions, DirectionSet, Layers, Unclassified};
 use crate::solids::exterior_flood::FloodMethod;
 use crate::voxelize::Separability;
 use crate::voxelize::parametric::ParametricOptions;
@@ -79,6 +79,21 @@ fn flood_method(flood: &str, graystack: usize) -> PyResult<FloodMethod> {
             "flood must be blocks, spans or xyz, not `{flood}`"
         ))),
     }
+}
+
+/// `directions`: a count of the built-in directions (default all 16, as the CLI), or a list
+/// of integer (x, y, z) triples.
+fn direction_set(directions: Option<&Bound<'_, PyAny>>) -> PyResult<DirectionSet> {
+    let Some(directions) = directions else {
+        return Ok(DirectionSet::ALL);
+    };
+    let set = match directions.extract::<usize>() {
+        Ok(n) => DirectionSet::first(n),
+        Err(_) => DirectionSet::given(&directions.extract::<Vec<[i64; 3]>>().map_err(|_| {
+            PyValueError::new_err("directions: a count, or a list of (x, y, z) integer triples")
+        })?),
+    };
+    set.map_err(super::to_py_err)
 }
 
 fn color_choice(color: Option<[f32; 3]>, from_mesh: bool) -> ColorChoice {
@@ -156,9 +171,14 @@ pub fn mesh(
 /// A closed mesh's solid: `method="flood"` (the 26-separating surface and everything the
 /// exterior flood cannot reach), `"depth-layers"` (Passalis et al.) or `"beam"` (Jegathese
 /// et al.); with `sdf`, its level set. The report holds the volume, mass and area.
+///
+/// Depth layers: `directions` is a count of the 16 built-in directions (default all) or a
+/// list of integer (x, y, z) triples, each with a component of ±1; `layers` single or double;
+/// `unclassified` "no-direction" (a voxel no direction decides) or "paper" (a voxel on a ray
+/// of any direction crossing more than four times).
 #[pyfunction]
 #[pyo3(signature = (source, resolution = None, voxel_size = None, method = "flood",
-    flood = "blocks", graystack = 1 << 20, directions = 3, layers = "double",
+    flood = "blocks", graystack = 1 << 20, directions = None, layers = "double",
     unclassified = "no-direction", density = 1.0,
     topology = false, sdf = false, band = 3.0, threads = None, max_memory_mib = None,
     up_axis = "z", progress = None))]
@@ -171,7 +191,7 @@ pub fn solid(
     method: &str,
     flood: &str,
     graystack: usize,
-    directions: usize,
+    directions: Option<&Bound<'_, PyAny>>,
     layers: &str,
     unclassified: &str,
     density: f64,
@@ -194,7 +214,7 @@ pub fn solid(
         let fill = match method {
             "flood" => Fill::Flood(flood_method(flood, graystack)?),
             "depth-layers" => Fill::DepthLayers(DepthLayerOptions {
-                directions,
+                directions: direction_set(directions)?,
                 layers: match layers {
                     "single" => Layers::Single,
                     "double" => Layers::Double,

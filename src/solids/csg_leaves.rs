@@ -121,7 +121,7 @@ pub fn formula_solid(
 
 /// Depth layers over all directions, the most that can be decided.
 pub const ALL_DIRECTIONS: DepthLayerOptions = DepthLayerOptions {
-    directions: crate::solids::depth_layers::DIRECTIONS.len(),
+    directions: crate::solids::depth_layers::DirectionSet::ALL,
     layers: Layers::Double,
     unclassified: crate::solids::depth_layers::Unclassified::NoDirection,
 };
@@ -141,7 +141,7 @@ pub fn mesh_solid(
              along all {} directions)",
             mesh.source.display(),
             s.stats.unclassified_voxels,
-            options.directions
+            options.directions.len()
         )));
     }
     Ok(s.inside)

@@ -71,10 +71,114 @@ pub enum Unclassified {
     Paper,
 }
 
+/// The view directions of a depth-layer solid: the first few of `DIRECTIONS`, or the user's
+/// own (§3.1's arbitrary directions, as integer vectors with a ±1 component so that their rays
+/// pass through voxel centres).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DirectionSet {
+    len: usize,
+    /// Components within ±`MAX_COMPONENT`, small enough to keep the options small.
+    list: [[i8; 3]; DIRECTIONS.len()],
+}
+
+/// The largest direction component accepted (steeper directions add nothing at voxel scale).
+const MAX_COMPONENT: i64 = 100;
+
+impl DirectionSet {
+    /// All of `DIRECTIONS`, the most that can be decided.
+    pub const ALL: DirectionSet = DirectionSet::all();
+
+    const fn all() -> DirectionSet {
+        let mut list = [[0i8; 3]; DIRECTIONS.len()];
+        let mut n = 0;
+        while n < DIRECTIONS.len() {
+            let d = DIRECTIONS[n];
+            list[n] = [d[0] as i8, d[1] as i8, d[2] as i8];
+            n += 1;
+        }
+        DirectionSet {
+            len: DIRECTIONS.len(),
+            list,
+        }
+    }
+
+    /// The first `n` of `DIRECTIONS` (3 = the axes, Karabassi's six z-buffers), 3 to 16.
+    pub fn first(n: usize) -> Result<DirectionSet> {
+        if !(3..=DIRECTIONS.len()).contains(&n) {
+            return Err(Error::InvalidArgument(format!(
+                "depth layers take 3 to {} directions, not {n}",
+                DIRECTIONS.len()
+            )));
+        }
+        DirectionSet::given(&DIRECTIONS[..n])
+    }
+
+    /// The user's directions, 1 to 16 of them, in the order given: integer vectors, each with
+    /// a component of ±1 and no two parallel.
+    pub fn given(list: &[[i64; 3]]) -> Result<DirectionSet> {
+        if list.is_empty() || list.len() > DIRECTIONS.len() {
+            return Err(Error::InvalidArgument(format!(
+                "depth layers take 1 to {} directions, not {}",
+                DIRECTIONS.len(),
+                list.len()
+            )));
+        }
+        for (n, d) in list.iter().enumerate() {
+            if !d.iter().any(|c| c.abs() == 1) {
+                return Err(Error::InvalidArgument(format!(
+                    "direction {d:?}: a depth-layer direction needs a component of 1 or -1 (its \
+                     rays then pass through voxel centres), e.g. 2,1,3"
+                )));
+            }
+            if d.iter().any(|c| c.abs() > MAX_COMPONENT) {
+                return Err(Error::InvalidArgument(format!(
+                    "direction {d:?}: components are at most {MAX_COMPONENT} in size"
+                )));
+            }
+            let parallel = |e: &[i64; 3]| {
+                let c = [
+                    d[1] * e[2] - d[2] * e[1],
+                    d[2] * e[0] - d[0] * e[2],
+                    d[0] * e[1] - d[1] * e[0],
+                ];
+                c == [0, 0, 0]
+            };
+            if let Some(e) = list[..n].iter().find(|e| parallel(e)) {
+                return Err(Error::InvalidArgument(format!(
+                    "directions {e:?} and {d:?} are parallel: they see the same rays"
+                )));
+            }
+        }
+        let mut set = DirectionSet {
+            len: list.len(),
+            list: [[0; 3]; DIRECTIONS.len()],
+        };
+        for (to, from) in set.list.iter_mut().zip(list) {
+            *to = from.map(|c| c as i8);
+        }
+        Ok(set)
+    }
+
+    /// The directions, in order.
+    pub fn to_vec(&self) -> Vec<[i64; 3]> {
+        self.list[..self.len]
+            .iter()
+            .map(|d| d.map(i64::from))
+            .collect()
+    }
+
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DepthLayerOptions {
-    /// How many of `DIRECTIONS` to render (3 = the axes, Karabassi's six z-buffers).
-    pub directions: usize,
+    pub directions: DirectionSet,
     pub layers: Layers,
     pub unclassified: Unclassified,
 }
@@ -82,7 +186,7 @@ pub struct DepthLayerOptions {
 impl Default for DepthLayerOptions {
     fn default() -> Self {
         DepthLayerOptions {
-            directions: 3,
+            directions: DirectionSet::first(3).expect("three directions"),
             layers: Layers::Double,
             unclassified: Unclassified::NoDirection,
         }
@@ -355,8 +459,8 @@ fn push_voxel(runs: &mut Vec<(usize, usize)>, index: usize) {
     }
 }
 
-/// The solid of `mesh` on `transform` over `bbox`: depth buffers from `options.directions`
-/// directions, classified with single or double layers; `progress` counts the directions
+/// The solid of `mesh` on `transform` over `bbox`: depth buffers along `options.directions`,
+/// classified with single or double layers; `progress` counts the directions
 /// rendered, then the x slabs classified.
 pub fn depth_layer_solid(
     mesh: &Mesh,
@@ -365,13 +469,6 @@ pub fn depth_layer_solid(
     options: &DepthLayerOptions,
     progress: &Progress,
 ) -> Result<DepthLayerSolid> {
-    if !(3..=DIRECTIONS.len()).contains(&options.directions) {
-        return Err(Error::InvalidArgument(format!(
-            "depth layers take 3 to {} directions, not {}",
-            DIRECTIONS.len(),
-            options.directions
-        )));
-    }
     let mut inside = DenseMask::new(bbox)?;
     let mut unclassified = DenseMask::new(bbox)?;
     let dims = inside.dims();
@@ -381,7 +478,9 @@ pub fn depth_layer_solid(
         .iter()
         .map(|&p| transform.world_to_index(p) - origin)
         .collect();
-    let views = DIRECTIONS[..options.directions]
+    let views = options
+        .directions
+        .to_vec()
         .par_iter()
         .map(|&d| {
             let view = View::render(d, dims, &points, mesh);
@@ -411,6 +510,7 @@ pub fn depth_layer_solid(
                 if options.layers == Layers::Double
                     && !open_input
                     && options.unclassified == Unclassified::NoDirection
+                    && z_view.d == [0, 0, 1]
                     && let Ok(spans) = z_view.inside_spans(ray)
                 {
                     for s in spans {

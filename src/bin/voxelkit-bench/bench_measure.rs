@@ -11,7 +11,7 @@ use voxelkit::Result;
 use voxelkit::implicit::reference::reference_solids;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, index_box};
 use voxelkit::solids::csg_leaves::measure_formula_solid;
-use voxelkit::solids::depth_layers::{DepthLayerOptions, depth_layer_solid};
+use voxelkit::solids::depth_layers::{DepthLayerOptions, DirectionSet, depth_layer_solid};
 
 #[derive(Args)]
 pub struct MeasureBenchArgs {
@@ -83,7 +83,7 @@ pub fn run(args: &MeasureBenchArgs, json: bool) -> Result<()> {
         for &resolution in &args.mesh_resolutions {
             let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution))?;
             let options = DepthLayerOptions {
-                directions: 16,
+                directions: DirectionSet::ALL,
                 ..Default::default()
             };
             let s = pool.install(|| {
