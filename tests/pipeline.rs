@@ -79,6 +79,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
                 }),
                 separability: Separability::TwentySix,
                 normals: false,
+                curvature_margin: true,
             },
         ),
         (

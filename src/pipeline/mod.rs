@@ -131,6 +131,8 @@ pub enum Task {
         shape: Shape,
         separability: Separability,
         normals: bool,
+        /// Widen the slabs by the curvature margin (false: the paper's plain rule).
+        curvature_margin: bool,
     },
     /// A Catmull-Clark limit surface from its control mesh.
     Subdivision {
@@ -511,9 +513,13 @@ impl PlannedJob {
                     shape,
                     separability,
                     normals,
+                    curvature_margin,
                 },
                 Loaded::Shape,
-            ) => outcome::shape(shape, t, *separability, *normals, &fit, progress),
+            ) => {
+                let margin = *curvature_margin;
+                outcome::shape(shape, t, *separability, *normals, margin, &fit, progress)
+            }
             (Task::Subdivision { options, .. }, Loaded::Control(control)) => {
                 outcome::subdivision(control, t, options, &fit, progress)
             }

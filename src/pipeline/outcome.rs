@@ -366,14 +366,27 @@ pub(super) fn shape(
     t: Transform,
     separability: Separability,
     normals: bool,
+    curvature_margin: bool,
     resolution: &str,
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
-    let grid = voxelize_surface(shape.surface(), t, separability, normals, progress)?;
+    let grid = voxelize_surface(
+        shape.surface(),
+        t,
+        separability,
+        normals,
+        curvature_margin,
+        progress,
+    )?;
     let name = shape.describe();
     let sep = separability.adjacency();
-    let mut meta = provenance("huang-separating-analytic", &name, resolution);
+    let method = if curvature_margin {
+        "huang-separating-analytic"
+    } else {
+        "huang-separating-analytic-plain"
+    };
+    let mut meta = provenance(method, &name, resolution);
     meta.insert(1, ("separability", sep.to_string()));
     let details = Details::Shape {
         shape: name,

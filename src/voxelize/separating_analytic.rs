@@ -189,11 +189,14 @@ impl AnalyticSurface for Quadric {
 
 /// Voxelizes `surface` inside its box with `transform`; returns the grid (with distance and
 /// normal channels when `normals` is set).
+/// `curvature_margin: false` keeps the paper's plain rule (`t` alone), which can leave holes
+/// on curved surfaces (see the module docs); for comparing with the paper.
 pub fn voxelize_surface(
     surface: &dyn AnalyticSurface,
     transform: Transform,
     separability: Separability,
     normals: bool,
+    curvature_margin: bool,
     progress: &Progress,
 ) -> crate::Result<SparseGrid> {
     let bbox = surface.bbox();
@@ -206,9 +209,10 @@ pub fn voxelize_surface(
     let block_radius = 3.5 * 3f64.sqrt();
     let k = (surface.max_curvature() * h).min(0.5);
     let turn = k / (1.0 - k);
-    let curvature_margin = match separability {
-        Separability::Six => 0.5 * turn,
-        Separability::TwentySix => 1.5 * turn,
+    let curvature_margin = match (curvature_margin, separability) {
+        (false, _) => 0.0,
+        (true, Separability::Six) => 0.5 * turn,
+        (true, Separability::TwentySix) => 1.5 * turn,
     };
     let grid = voxelize_parallel(
         &blocks,

@@ -225,6 +225,7 @@ pub fn shape(kind: &ShapeKind, global: &Global) -> Result<()> {
         shape,
         separability: common.surface.separability,
         normals: common.surface.normals,
+        curvature_margin: !common.surface.no_curvature_margin,
     };
     run_and_report(
         Job::new(task, common.fit.grid_fit()),
@@ -408,6 +409,7 @@ pub fn demo(folder: &Path, resolution: u32, global: &Global) -> Result<()> {
             separability: sep,
             criterion: Criterion::Huang,
             normals: true,
+            no_curvature_margin: false,
         };
         let fit = FitArgs {
             resolution: Some(resolution),

@@ -93,6 +93,10 @@ pub struct SurfaceArgs {
     /// Also write a `normal` grid (nearest face/edge/vertex normal per voxel).
     #[arg(long)]
     normals: bool,
+    /// Analytic shapes: the paper's plain rule, slabs of half thickness t without the margin
+    /// for the surface's curvature (which can leave holes on curved surfaces; for comparison).
+    #[arg(long)]
+    no_curvature_margin: bool,
 }
 
 fn parse_separability(s: &str) -> Result<Separability, String> {
