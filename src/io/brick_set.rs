@@ -34,6 +34,14 @@ pub struct BrickFile {
     pub file: String,
 }
 
+/// The voxels of brick `b` of edge `size`: `b * size ..= b * size + size - 1`.
+pub fn brick_voxels(b: [i64; 3], size: i64) -> CoordBox {
+    CoordBox {
+        min: b.map(|v| v * size),
+        max: b.map(|v| v * size + size - 1),
+    }
+}
+
 /// Whether `path` names a brick-set index (by extension: `.json`).
 pub fn is_brick_set(path: &Path) -> bool {
     path.extension()
@@ -89,7 +97,7 @@ impl BrickSet {
         let mut grid = SparseGrid::new(self.transform(), crate::grid::Channels::NONE);
         for (brick, file) in self.bricks.iter().zip(self.files(index)) {
             let part = read_vdb_grid(&file, None)?;
-            let voxels = self.voxels(brick.brick);
+            let voxels = brick_voxels(brick.brick, self.brick_size);
             if let Some(b) = part.bbox()
                 && !(voxels.contains(b.min) && voxels.contains(b.max))
             {
@@ -102,17 +110,10 @@ impl BrickSet {
             grid.union(&part);
         }
         for &b in &self.full_bricks {
-            fill_box(&mut grid, self.voxels(b));
+            fill_box(&mut grid, brick_voxels(b, self.brick_size));
         }
         grid.compact();
         Ok(grid)
-    }
-
-    fn voxels(&self, b: [i64; 3]) -> CoordBox {
-        CoordBox {
-            min: b.map(|v| v * self.brick_size),
-            max: b.map(|v| v * self.brick_size + self.brick_size - 1),
-        }
     }
 }
 

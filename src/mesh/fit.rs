@@ -19,6 +19,18 @@ pub enum GridFit {
     VoxelSize(f64),
 }
 
+impl GridFit {
+    /// The fit the front ends' options ask for: the voxel size when given, else the
+    /// resolution, else 256 voxels along the longest axis.
+    pub fn from_options(resolution: Option<u32>, voxel_size: Option<f64>) -> GridFit {
+        match (resolution, voxel_size) {
+            (_, Some(h)) => GridFit::VoxelSize(h),
+            (Some(r), None) => GridFit::Resolution(r),
+            (None, None) => GridFit::Resolution(256),
+        }
+    }
+}
+
 /// The transform that places `bbox` in index space as described in the module docs.
 pub fn fit_transform(bbox: &Aabb, fit: GridFit) -> Result<Transform> {
     let longest = bbox.extent().max_element();

@@ -12,6 +12,7 @@
 
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
+use crate::io::brick_set::brick_voxels;
 use crate::mesh::{GridFit, Mesh, fit_transform, index_box};
 use crate::ops::flood::padded;
 use crate::ops::labels::{ClearRuns, label_clear_runs};
@@ -55,10 +56,7 @@ impl BrickLayout {
 
     /// The voxels of brick `b`.
     pub fn voxels(&self, b: BrickIndex) -> CoordBox {
-        CoordBox {
-            min: b.map(|v| v * self.size),
-            max: b.map(|v| v * self.size + self.size - 1),
-        }
+        brick_voxels(b, self.size)
     }
 
     /// Every brick of the layout.

@@ -8,7 +8,7 @@ use super::grid::Grid;
 use super::to_py_err;
 use crate::error::Result;
 use crate::grid::{CoordBox, Transform};
-use crate::io::brick_set::BrickSet;
+use crate::io::brick_set::{BrickSet, brick_voxels};
 use crate::io::vdb::{WriteOptions, check_voxel_size, write_vdb_as};
 use crate::mesh::{GridFit, Mesh, UpAxis};
 use crate::pipeline::Outcome;
@@ -124,11 +124,7 @@ pub fn brick_plan(
 ) -> PyResult<BrickPlan> {
     let source = mesh_source(source)?;
     let up: UpAxis = up_axis.parse().map_err(PyValueError::new_err)?;
-    let fit = match (resolution, voxel_size) {
-        (_, Some(h)) => GridFit::VoxelSize(h),
-        (Some(r), None) => GridFit::Resolution(r),
-        (None, None) => GridFit::Resolution(256),
-    };
+    let fit = GridFit::from_options(resolution, voxel_size);
     py.detach(|| -> Result<BrickPlan> {
         let mesh = source.load(false, up)?;
         if solid {
@@ -177,10 +173,7 @@ impl BrickJob {
         Ok(BrickJob {
             faces,
             transform: Transform::new(DVec3::from_array(origin), voxel_size),
-            voxels: CoordBox {
-                min: brick.map(|v| v * size),
-                max: brick.map(|v| v * size + size - 1),
-            },
+            voxels: brick_voxels(brick, size),
         })
     }
 

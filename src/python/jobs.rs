@@ -30,14 +30,12 @@ fn parse<T: FromStr<Err = String>>(s: &str) -> PyResult<T> {
 }
 
 fn fit(resolution: Option<u32>, voxel_size: Option<f64>) -> PyResult<GridFit> {
-    match (resolution, voxel_size) {
-        (Some(_), Some(_)) => Err(PyValueError::new_err(
+    if resolution.is_some() && voxel_size.is_some() {
+        return Err(PyValueError::new_err(
             "give resolution or voxel_size, not both",
-        )),
-        (None, Some(h)) => Ok(GridFit::VoxelSize(h)),
-        (Some(r), None) => Ok(GridFit::Resolution(r)),
-        (None, None) => Ok(GridFit::Resolution(256)),
+        ));
     }
+    Ok(GridFit::from_options(resolution, voxel_size))
 }
 
 /// The keywords every function takes besides its own.
@@ -49,6 +47,20 @@ struct Common {
 }
 
 impl Common {
+    fn new(
+        threads: Option<usize>,
+        max_memory_mib: Option<u64>,
+        up_axis: &str,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<Common> {
+        Ok(Common {
+            threads,
+            max_memory_mib,
+            up_axis: parse(up_axis)?,
+            progress,
+        })
+    }
+
     fn run(self, py: Python<'_>, task: Task, fit: GridFit) -> PyResult<Grid> {
         let job = Job {
             limits: Limits {
@@ -159,13 +171,11 @@ pub fn mesh(
         };
         Task::MeshSurface { mesh, method }
     };
-    let common = Common {
-        threads,
-        max_memory_mib,
-        up_axis: parse(up_axis)?,
-        progress,
-    };
-    common.run(py, task, fit(resolution, voxel_size)?)
+    Common::new(threads, max_memory_mib, up_axis, progress)?.run(
+        py,
+        task,
+        fit(resolution, voxel_size)?,
+    )
 }
 
 /// A closed mesh's solid: `method="flood"` (the 26-separating surface and everything the
@@ -248,13 +258,11 @@ pub fn solid(
             topology,
         }
     };
-    let common = Common {
-        threads,
-        max_memory_mib,
-        up_axis: parse(up_axis)?,
-        progress,
-    };
-    common.run(py, task, fit(resolution, voxel_size)?)
+    Common::new(threads, max_memory_mib, up_axis, progress)?.run(
+        py,
+        task,
+        fit(resolution, voxel_size)?,
+    )
 }
 
 /// A Catmull-Clark limit surface from its control mesh (Lai & Cheng): every voxel meets the
@@ -296,13 +304,11 @@ pub fn subdiv(
             enclose,
         },
     };
-    let common = Common {
-        threads,
-        max_memory_mib,
-        up_axis: parse(up_axis)?,
-        progress,
-    };
-    common.run(py, task, fit(resolution, voxel_size)?)
+    Common::new(threads, max_memory_mib, up_axis, progress)?.run(
+        py,
+        task,
+        fit(resolution, voxel_size)?,
+    )
 }
 
 /// The surface F = 0 of a formula (Stolte & Kaufman's interval octree): `coords` is
@@ -346,13 +352,11 @@ pub fn implicit(
         levels,
         negative_r,
     };
-    let common = Common {
-        threads,
-        max_memory_mib,
-        up_axis: UpAxis::default(),
-        progress,
-    };
-    common.run(py, task, GridFit::Resolution(resolution))
+    Common::new(threads, max_memory_mib, "z", progress)?.run(
+        py,
+        task,
+        GridFit::Resolution(resolution),
+    )
 }
 
 /// 3D lines (Jegathese et al.): the polylines (OBJ `l`) of a file, and with `edges` (or
@@ -380,13 +384,11 @@ pub fn lines(
         edges,
         color: color_choice(color, colors),
     };
-    let common = Common {
-        threads,
-        max_memory_mib,
-        up_axis: parse(up_axis)?,
-        progress,
-    };
-    common.run(py, task, fit(resolution, voxel_size)?)
+    Common::new(threads, max_memory_mib, up_axis, progress)?.run(
+        py,
+        task,
+        fit(resolution, voxel_size)?,
+    )
 }
 
 /// A CSG tree (the CLI's `csg --tree` JSON): a path to the JSON file, or the tree as a dict
@@ -412,13 +414,11 @@ pub fn csg(
     } else {
         CsgSource::File(tree.extract::<PathBuf>()?)
     };
-    let common = Common {
-        threads,
-        max_memory_mib,
-        up_axis: UpAxis::default(),
-        progress,
-    };
-    common.run(py, Task::CsgTree(source), GridFit::Resolution(256))
+    Common::new(threads, max_memory_mib, "z", progress)?.run(
+        py,
+        Task::CsgTree(source),
+        GridFit::Resolution(256),
+    )
 }
 
 /// Volume, mass, area, components and genus of a closed mesh (its flooded 26-separating
@@ -458,13 +458,11 @@ pub fn measure(
         flood: flood_method(flood, graystack)?,
         density,
     };
-    let common = Common {
-        threads,
-        max_memory_mib,
-        up_axis: parse(up_axis)?,
-        progress,
-    };
-    common.run(py, task, fit(resolution, voxel_size)?)
+    Common::new(threads, max_memory_mib, up_axis, progress)?.run(
+        py,
+        task,
+        fit(resolution, voxel_size)?,
+    )
 }
 
 /// A Boolean of two grids (Grids, or `.vdb` paths whose grid `grid` or voxel set is read):
@@ -498,13 +496,7 @@ pub fn combine(
         resample,
         curve: false,
     };
-    let common = Common {
-        threads,
-        max_memory_mib: None,
-        up_axis: UpAxis::default(),
-        progress,
-    };
-    common.run(py, task, GridFit::Resolution(256))
+    Common::new(threads, None, "z", progress)?.run(py, task, GridFit::Resolution(256))
 }
 
 /// A grid of a `.vdb` file: the one named `grid`, else the voxel set voxelkit writes

@@ -236,10 +236,13 @@ pub fn voxelize_surface(
                             let t = separability.slab_half_thickness(near.normal);
                             let (lo, hi) = slab_bounds(t + curvature_margin);
                             // Normals point to where `side` is positive; the slab is
-                            // half-open along the turned normal, as for polygons.
-                            let along = if surface.side(p) < 0.0 { -d } else { d };
-                            let signed = along * turned(near.normal).dot(near.normal).signum();
-                            lo <= signed && signed < hi
+                            // half-open along the turned normal, as for polygons. The side
+                            // is only asked for voxels the closed slab holds.
+                            d <= -lo && {
+                                let along = if surface.side(p) < 0.0 { -d } else { d };
+                                let signed = along * turned(near.normal).dot(near.normal).signum();
+                                lo <= signed && signed < hi
+                            }
                         };
                         if kept {
                             sink.add([x, y, z], d, near.normal);

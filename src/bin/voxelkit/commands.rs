@@ -18,11 +18,7 @@ use voxelkit::{Error, Result};
 
 impl FitArgs {
     pub fn grid_fit(&self) -> GridFit {
-        match (self.resolution, self.voxel_size) {
-            (_, Some(h)) => GridFit::VoxelSize(h),
-            (Some(r), None) => GridFit::Resolution(r),
-            (None, None) => GridFit::Resolution(256),
-        }
+        GridFit::from_options(self.resolution, self.voxel_size)
     }
 }
 
