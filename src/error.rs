@@ -13,7 +13,7 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
-    #[error("{path}:{line}: {message}")]
+    #[error("{path}{}: {message}", line_suffix(*line))]
     Parse {
         path: PathBuf,
         /// 1-based line number; 0 when the format has no lines (binary STL: see message).
@@ -29,7 +29,7 @@ pub enum Error {
     },
     #[error("{path}: the mesh is empty ({message})")]
     EmptyMesh { path: PathBuf, message: String },
-    #[error("{path}: unsupported file type (expected .obj, .stl, .ply or .off)")]
+    #[error("{path}: unsupported file type (expected .obj, .stl, .ply, .off, .gltf or .glb)")]
     UnsupportedFormat { path: PathBuf },
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
@@ -62,6 +62,15 @@ pub enum Error {
 }
 
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// `:12` for line 12; nothing for formats without lines (line 0).
+fn line_suffix(line: usize) -> String {
+    if line > 0 {
+        format!(":{line}")
+    } else {
+        String::new()
+    }
+}
 
 /// A count as people read it: digits up to a billion, then scientific notation.
 fn short_number(n: u64) -> String {

@@ -1,4 +1,5 @@
-//! Every reader of untrusted input survives mutated input: valid OBJ, OFF, PLY and STL (ASCII and binary),
+//! Every reader of untrusted input survives mutated input: valid OBJ, OFF, PLY, glTF (`.glb` and
+//! `.gltf`) and STL (ASCII and binary),
 //! formula, CSG-tree and `.vdb` files with random bytes changed, inserted, deleted or cut off
 //! are either read or refused with an error naming the file (and meshes that read are
 //! voxelized or refused); never a panic, never a crash, never a hang.
@@ -112,6 +113,15 @@ fn ply_bytes(binary: bool) -> Vec<u8> {
     std::fs::read(&path).unwrap()
 }
 
+fn gltf_bytes(layout: voxelkit::mesh::GltfLayout, name: &str) -> Vec<u8> {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(name);
+    generate::icosphere(DVec3::ZERO, 1.0, 1)
+        .write_gltf(&path, layout, &[glam::DMat4::from_scale(DVec3::splat(2.0))])
+        .unwrap();
+    std::fs::read(&path).unwrap()
+}
+
 fn stl_ascii() -> Vec<u8> {
     let m = generate::icosphere(DVec3::ZERO, 1.0, 0);
     let mut s = String::from("solid s\n");
@@ -191,6 +201,18 @@ proptest! {
     fn mutated_ply_files_are_read_or_refused(e in edits(), binary in any::<bool>()) {
         let dir = tempfile::tempdir().unwrap();
         read_mesh(dir.path(), "m.ply", &apply(ply_bytes(binary), &e))?;
+    }
+
+    #[test]
+    fn mutated_gltf_files_are_read_or_refused(e in edits(), binary in any::<bool>()) {
+        use voxelkit::mesh::GltfLayout;
+        let dir = tempfile::tempdir().unwrap();
+        let (layout, name) = if binary {
+            (GltfLayout::Binary, "m.glb")
+        } else {
+            (GltfLayout::Embedded, "m.gltf")
+        };
+        read_mesh(dir.path(), name, &apply(gltf_bytes(layout, name), &e))?;
     }
 
     #[test]

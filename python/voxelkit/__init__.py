@@ -11,7 +11,7 @@ line tool, with the same options and messages::
     grid.report         # the CLI's JSON report as a dict
     grid.write("bunny.vdb")
 
-A mesh is a path (.obj, .stl, .ply, .off) or a ``(vertices, faces)`` pair of arrays. Every
+A mesh is a path (.obj, .stl, .ply, .off, .gltf, .glb) or a ``(vertices, faces)`` pair of arrays. Every
 call releases the GIL while it works; Ctrl-C cancels it, and ``progress=f`` calls
 ``f(stage, done, total)`` a few times a second (raising in ``f`` cancels too). Errors are
 ``ValueError`` (bad input), ``MemoryError`` (work that does not fit), ``OSError`` (files).

@@ -249,7 +249,7 @@ def main(argv=None):
         ("solid", "the solid of a closed mesh (surface and inside)"),
     ):
         p = commands.add_parser(name, help=help_text)
-        p.add_argument("input", help="mesh file (.obj, .stl, .ply, .off)")
+        p.add_argument("input", help="mesh file (.obj, .stl, .ply, .off, .gltf, .glb)")
         p.add_argument("-o", "--output", required=True, help="output .vdb")
         fit = p.add_mutually_exclusive_group()
         fit.add_argument("-r", "--resolution", type=int, help="voxels along the longest side (default 256)")

@@ -1,4 +1,5 @@
-//! Polygon meshes: loading (OBJ with n-gons kept, binary and ASCII STL), validation,
+//! Polygon meshes: loading (OBJ with n-gons kept, binary and ASCII STL, PLY, OFF, glTF),
+//! validation,
 //! measurement, fitting to a grid, and the project's own generated fixtures.
 
 mod closed;
@@ -6,12 +7,14 @@ pub mod crossings;
 mod fit;
 #[cfg(feature = "fixtures")]
 pub mod generate;
+mod gltf_scene;
 pub mod inside;
 mod obj;
 mod off;
 mod ply;
 mod stl;
 mod up_axis;
+pub use gltf_scene::GltfLayout;
 pub use up_axis::UpAxis;
 
 pub use closed::EdgeCounts;
@@ -75,7 +78,7 @@ impl Mesh {
         }
     }
 
-    /// Loads an `.obj`, `.stl`, `.off` or `.ply` file (chosen by extension) and checks it has faces, as every
+    /// Loads an `.obj`, `.stl`, `.off`, `.ply`, `.gltf` or `.glb` file (chosen by extension) and checks it has faces, as every
     /// surface and solid method needs.
     pub fn load(path: &Path) -> Result<Mesh> {
         let mesh = Self::read(path)?;
@@ -107,6 +110,7 @@ impl Mesh {
             Some("stl") => stl::load_stl(path)?,
             Some("off") => off::load_off(path)?,
             Some("ply") => ply::load_ply(path)?,
+            Some("gltf" | "glb") => gltf_scene::load_gltf(path)?,
             _ => {
                 return Err(Error::UnsupportedFormat {
                     path: path.to_path_buf(),

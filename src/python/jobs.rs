@@ -119,7 +119,7 @@ fn color_choice(color: Option<[f32; 3]>, from_mesh: bool) -> ColorChoice {
 /// A polygon mesh's surface: 6- or 26-separating (Huang et al.) or projective (Jegathese
 /// et al.); with `sdf` or `udf`, exact distances within `band` voxels instead.
 ///
-/// `source` is a path (.obj, .stl, .ply, .off) or a `(vertices, faces)` pair.
+/// `source` is a path (.obj, .stl, .ply, .off, .gltf, .glb) or a `(vertices, faces)` pair.
 #[pyfunction]
 #[pyo3(signature = (source, resolution = None, voxel_size = None, separability = 26,
     method = "separating", criterion = "huang", normals = false, colors = true, color = None,

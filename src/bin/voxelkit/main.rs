@@ -113,7 +113,7 @@ pub fn parse_criterion(s: &str) -> Result<Criterion, String> {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Voxelize a polygon mesh (.obj, .stl, .ply or .off) into a separating surface, or by projective
+    /// Voxelize a polygon mesh (.obj, .stl, .ply, .off, .gltf or .glb) into a separating surface, or by projective
     /// scan-lines with vertex colours carried into a `Cd` grid; or write its level set
     /// (--sdf) or unsigned distances (--udf).
     Mesh {

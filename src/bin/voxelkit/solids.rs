@@ -69,7 +69,7 @@ pub enum SolidMethod {
 
 #[derive(Args)]
 pub struct SolidArgs {
-    /// Closed input mesh (.obj, .stl, .ply or .off); its orientation does not matter. With
+    /// Closed input mesh (.obj, .stl, .ply, .off, .gltf or .glb); its orientation does not matter. With
     /// --method depth-layers open meshes are accepted and their undecidable voxels reported.
     pub input: PathBuf,
     #[arg(long, value_enum, default_value = "flood")]
