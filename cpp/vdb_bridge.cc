@@ -290,7 +290,16 @@ void copy_leaves(const GridT& src, rust::Vec<int32_t>& origins, rust::Vec<uint64
         origins.push_back(o.z());
         for (openvdb::Index w = 0; w < 8; ++w) masks.push_back(mask.template getWord<openvdb::Index64>(w));
         if (values) {
-            for (openvdb::Index n = 0; n < 512; ++n) values->push_back(float(it->getValue(n)));
+            for (openvdb::Index n = 0; n < 512; ++n) {
+                const auto v = it->getValue(n);
+                if constexpr (std::is_same_v<typename GridT::ValueType, openvdb::Vec3s>) {
+                    values->push_back(v.x());
+                    values->push_back(v.y());
+                    values->push_back(v.z());
+                } else {
+                    values->push_back(float(v));
+                }
+            }
         }
     }
     auto push_tile = [&](const openvdb::Coord& o, int32_t edge) {
@@ -323,8 +332,10 @@ void VdbFile::read_leaves(size_t index, rust::Vec<int32_t>& leaf_origins, rust::
         copy_leaves(*m, leaf_origins, masks, nullptr, tiles);
     else if (auto f = openvdb::gridConstPtrCast<openvdb::FloatGrid>(g))
         copy_leaves(*f, leaf_origins, masks, &values, tiles);
+    else if (auto v = openvdb::gridConstPtrCast<openvdb::Vec3SGrid>(g))
+        copy_leaves(*v, leaf_origins, masks, &values, tiles);
     else throw std::invalid_argument("grid '" + g->getName() + "' has value type " + g->valueType() +
-                                     "; only bool, mask and float grids can be read");
+                                     "; only bool, mask, float and vec3s grids can be read");
 }
 
 uint64_t openvdb_reference(rust::Str kind, rust::Slice<const float> points, rust::Slice<const uint32_t> triangles,

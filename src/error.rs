@@ -56,6 +56,9 @@ pub enum Error {
     },
     #[error("{0}")]
     Unsupported(String),
+    /// Some inputs of a batch failed (each reported on its own); the others were written.
+    #[error("{failed} of {total} inputs failed (each is named above)")]
+    Batch { failed: usize, total: usize },
     /// The observer asked the work to stop; nothing was kept.
     #[error("cancelled")]
     Cancelled,

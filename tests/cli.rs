@@ -130,7 +130,8 @@ fn broken_stl_names_the_triangle_or_line() {
 
 #[test]
 fn unsupported_extension_and_missing_file() {
-    assert_mesh_fails("mesh.glb", b"glTF", &[], &["mesh.glb", "unsupported"]);
+    assert_mesh_fails("mesh.3ds", b"MM", &[], &["mesh.3ds", "unsupported"]);
+    assert_mesh_fails("mesh.glb", b"glTF", &[], &["mesh.glb", "glTF"]);
     assert_mesh_fails("mesh.ply", b"ply\n", &[], &["mesh.ply", "PLY"]);
     let o = voxelkit(&["mesh", "does-not-exist.obj", "-o", "never.vdb"]);
     assert!(!o.status.success() && text(&o).contains("does-not-exist.obj"));

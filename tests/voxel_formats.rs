@@ -188,25 +188,74 @@ fn a_coloured_surface_as_vox_holds_the_voxels_and_colours_of_its_vdb() {
     assert!(reds.len() >= 5, "red follows x: {reds:?}");
 }
 
+/// Past 256 voxels per axis the set is split into 256^3 models placed by the scene graph:
+/// read back with `dot_vox`, the models at their translations hold exactly the `.vdb`'s
+/// voxels. Past 2048 per axis it is refused, leaving no file.
 #[test]
-fn a_model_past_256_voxels_is_refused_as_vox() {
+fn a_set_past_256_voxels_is_split_into_models_and_past_2048_refused() {
     let dir = tempfile::tempdir().unwrap();
     let obj = dir.path().join("torus.obj");
     generate::torus(DVec3::ZERO, 1.0, 0.3, 32, 8)
         .write_obj(&obj)
         .unwrap();
-    let out = dir.path().join("big.vox");
+    let (vox, vdb) = (dir.path().join("big.vox"), dir.path().join("big.vdb"));
+    for out in [&vox, &vdb] {
+        let o = voxelkit(&[
+            "--grids",
+            "voxels",
+            "mesh",
+            obj.to_str().unwrap(),
+            "-r",
+            "600",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let grid = read_vdb_grid(&vdb, Some("voxels")).unwrap();
+    let min = grid.bbox().unwrap().min;
+    let data = dot_vox::load_bytes(&std::fs::read(&vox).unwrap()).unwrap();
+    // 600 x 600 x 138 voxels: 3 x 3 x 1 blocks, less the empty centre.
+    assert!(data.models.len() > 4, "{}", data.models.len());
+    let mut seen = 0u64;
+    for node in &data.scenes {
+        let dot_vox::SceneNode::Transform { frames, child, .. } = node else {
+            continue;
+        };
+        let dot_vox::SceneNode::Shape { models, .. } = &data.scenes[*child as usize] else {
+            continue;
+        };
+        let t = frames[0].position().unwrap();
+        let model = &data.models[models[0].model_id as usize];
+        let corner = [
+            t.x as i64 - (model.size.x / 2) as i64,
+            t.y as i64 - (model.size.y / 2) as i64,
+            t.z as i64 - (model.size.z / 2) as i64,
+        ];
+        for v in &model.voxels {
+            let c = [
+                min[0] + corner[0] + v.x as i64,
+                min[1] + corner[1] + v.y as i64,
+                min[2] + corner[2] + v.z as i64,
+            ];
+            assert!(grid.contains(c), "{c:?}");
+            seen += 1;
+        }
+    }
+    assert_eq!(seen, grid.voxel_count());
+
+    let out = dir.path().join("huge.vox");
     let o = voxelkit(&[
         "mesh",
         obj.to_str().unwrap(),
         "-r",
-        "300",
+        "2100",
         "-o",
         out.to_str().unwrap(),
     ]);
     let msg = String::from_utf8_lossy(&o.stderr);
     assert!(
-        !o.status.success() && msg.contains("big.vox") && msg.contains("256"),
+        !o.status.success() && msg.contains("huge.vox") && msg.contains("2048"),
         "{msg}"
     );
     assert!(!out.exists());

@@ -85,9 +85,10 @@ pub mod bridge {
         fn open_vdb(path: &str) -> Result<UniquePtr<VdbFile>>;
         fn grid_count(self: &VdbFile) -> usize;
         fn grid_info(self: &VdbFile, index: usize) -> Result<GridInfo>;
-        /// Active voxels of a Bool, Mask or Float grid, leaf by leaf, and its active tiles
-        /// as (x, y, z, edge) with edge 8 or 128 (larger tiles split into 128^3 ones);
-        /// `values` gets 512 floats per leaf for Float grids and stays empty otherwise.
+        /// Active voxels of a Bool, Mask, Float or Vec3S grid, leaf by leaf, and its active
+        /// tiles as (x, y, z, edge) with edge 8 or 128 (larger tiles split into 128^3 ones);
+        /// `values` gets 512 floats per leaf for Float grids, 3 x 512 for Vec3S grids, and
+        /// stays empty otherwise.
         fn read_leaves(
             self: &VdbFile,
             index: usize,

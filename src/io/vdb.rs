@@ -24,6 +24,12 @@ pub const LEVEL_SET_GRID: &str = "surface";
 /// The fog volume's name, first in every file voxelkit writes.
 pub const DENSITY_GRID: &str = "density";
 
+/// The per-voxel unit normals (Vec3S), with `--normals`.
+pub const NORMAL_GRID: &str = "normal";
+
+/// The per-voxel colours (Vec3S), Houdini's name.
+pub const COLOR_GRID: &str = "Cd";
+
 /// A grid's leaves and tiles as the bridge's flat arrays.
 struct Flat<'g> {
     /// Leaf origins, i32 x 3 per leaf.
@@ -145,21 +151,21 @@ pub fn write_vdb_as(
     let t = grid.transform;
     add("fog", DENSITY_GRID, &flat, t, &[])?;
     add("bool", VOXELS_GRID, &flat, t, &[])?;
-    if grid.channels().normal && options.wants("normal") {
+    if grid.channels().normal && options.wants(NORMAL_GRID) {
         let mut normals = Vec::with_capacity(flat.leaves.len() * LEAF_VOXELS * 3);
         for leaf in &flat.leaves {
             let n = leaf.normal.as_ref().expect("grid with normal channel");
             normals.extend(n.iter().flatten());
         }
-        add("normal", "normal", &flat, t, &normals)?;
+        add("normal", NORMAL_GRID, &flat, t, &normals)?;
     }
-    if grid.channels().color && options.wants("Cd") {
+    if grid.channels().color && options.wants(COLOR_GRID) {
         let mut colors = Vec::with_capacity(flat.leaves.len() * LEAF_VOXELS * 3);
         for leaf in &flat.leaves {
             let c = leaf.color.as_ref().expect("grid with colour channel");
             colors.extend(c.iter().flatten());
         }
-        add("color", "Cd", &flat, t, &colors)?;
+        add("color", COLOR_GRID, &flat, t, &colors)?;
     }
     for (name, mask) in masks_to_add {
         if options.wants(name) {
@@ -349,9 +355,11 @@ pub fn read_vdb_info(path: &Path) -> Result<Vec<GridInfo>> {
         .collect()
 }
 
-/// Reads the Bool, Mask or Float grid `name` into a grid, or without a name the voxel set
-/// voxelkit writes (`voxels`, else `density`, else the first such grid). Float values land in
-/// the value channel; tiles stay tiles (their values are not kept).
+/// Reads the Bool, Mask, Float or Vec3S grid `name` into a grid, or without a name the voxel
+/// set voxelkit writes (`voxels`, else `density`, else the first bool, mask or float grid).
+/// Float values land in the value channel; vectors in the normal channel for a grid named
+/// `normal` and in the colour channel otherwise (`Cd`); tiles stay tiles (their values are
+/// not kept).
 pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
     let file = open(path)?;
     let infos: Vec<GridInfo> = (0..file.grid_count())
@@ -382,10 +390,10 @@ pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
         ));
     }
     // Plan the copy before anything is allocated: leaves with their values, tiles as origins.
-    let per_leaf = if info.value_type == "float" {
-        3 * 4 * LEAF_VOXELS
-    } else {
-        400
+    let per_leaf = match info.value_type.as_str() {
+        "float" => 3 * 4 * LEAF_VOXELS,
+        "vec3s" => 3 * 3 * 4 * LEAF_VOXELS,
+        _ => 400,
     } as u64;
     crate::system::check_fits(
         info.leaf_count
@@ -403,10 +411,11 @@ pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     file.read_leaves(index, &mut origins, &mut masks, &mut values, &mut tiles)
         .map_err(|e| unreadable(path, e))?;
-    let has_values = !values.is_empty();
+    let vectors = info.value_type == "vec3s";
     let channels = Channels {
-        value: has_values,
-        ..Channels::NONE
+        value: !values.is_empty() && !vectors,
+        normal: vectors && info.name == NORMAL_GRID,
+        color: vectors && info.name != NORMAL_GRID,
     };
     let leaves = origins
         .chunks_exact(3)
@@ -417,6 +426,12 @@ pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
             leaf.mask.copy_from_slice(m);
             if let Some(v) = leaf.value.as_mut() {
                 v.copy_from_slice(&values[i * LEAF_VOXELS..(i + 1) * LEAF_VOXELS]);
+            }
+            if let Some(v) = leaf.normal.as_mut().or(leaf.color.as_mut()) {
+                let chunk = &values[3 * i * LEAF_VOXELS..3 * (i + 1) * LEAF_VOXELS];
+                for (n, xyz) in chunk.chunks_exact(3).enumerate() {
+                    v[n] = [xyz[0], xyz[1], xyz[2]];
+                }
             }
             leaf
         })

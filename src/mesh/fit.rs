@@ -17,6 +17,9 @@ pub enum GridFit {
     Resolution(u32),
     /// Voxel edge length in world units.
     VoxelSize(f64),
+    /// A placement decided beforehand (one grid shared by several meshes, e.g. the frames of
+    /// an animation): used as it is, whatever the mesh's box.
+    Placed(Transform),
 }
 
 impl GridFit {
@@ -35,6 +38,7 @@ impl GridFit {
 pub fn fit_transform(bbox: &Aabb, fit: GridFit) -> Result<Transform> {
     let longest = bbox.extent().max_element();
     let voxel_size = match fit {
+        GridFit::Placed(t) => return Ok(t),
         GridFit::Resolution(0) => {
             return Err(Error::InvalidArgument(
                 "resolution must be at least 1".into(),
@@ -87,5 +91,10 @@ mod tests {
         assert_eq!(t.world_to_voxel(b.max - 1e-9), [7, 1, 0]);
         assert!(fit_transform(&b, GridFit::Resolution(0)).is_err());
         assert!(fit_transform(&b, GridFit::VoxelSize(f64::NAN)).is_err());
+        let elsewhere = Aabb {
+            min: DVec3::splat(10.0),
+            max: DVec3::splat(11.0),
+        };
+        assert_eq!(fit_transform(&elsewhere, GridFit::Placed(t)).unwrap(), t);
     }
 }

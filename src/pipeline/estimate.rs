@@ -126,6 +126,10 @@ fn checked_box(bbox: &Aabb, t: &Transform) -> Result<CoordBox> {
 
 /// The octree's resolution: voxels along the longest side of the bounds.
 pub(super) fn octree_resolution(fit: GridFit, min: DVec3, max: DVec3) -> Result<u32> {
+    let fit = match fit {
+        GridFit::Placed(t) => GridFit::VoxelSize(t.voxel_size),
+        other => other,
+    };
     match fit {
         GridFit::Resolution(r) => Ok(r),
         GridFit::VoxelSize(h) if h.is_finite() && h > 0.0 => {
@@ -138,9 +142,9 @@ pub(super) fn octree_resolution(fit: GridFit, min: DVec3, max: DVec3) -> Result<
                 Ok(r.max(1.0) as u32)
             }
         }
-        GridFit::VoxelSize(h) => Err(Error::InvalidArgument(format!(
-            "voxel size must be a positive number, got {h:?}"
-        ))),
+        GridFit::VoxelSize(h) | GridFit::Placed(Transform { voxel_size: h, .. }) => Err(
+            Error::InvalidArgument(format!("voxel size must be a positive number, got {h:?}")),
+        ),
     }
 }
 

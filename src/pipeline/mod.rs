@@ -4,6 +4,7 @@
 //! allocated; `PlannedJob::run` does the work under an `Observer` (progress, cancellation)
 //! and returns an `Outcome`: the grids, their `.vdb` metadata and the report.
 
+pub mod batch;
 pub mod brick_exterior;
 pub mod bricks;
 mod estimate;
@@ -256,6 +257,10 @@ impl GridFit {
         match self {
             GridFit::Resolution(r) => r.to_string(),
             GridFit::VoxelSize(h) => format!("voxel size {h:?}"),
+            GridFit::Placed(t) => format!(
+                "voxel size {:?}, origin {:?},{:?},{:?} (shared)",
+                t.voxel_size, t.origin.x, t.origin.y, t.origin.z
+            ),
         }
     }
 }

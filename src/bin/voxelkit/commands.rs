@@ -1,5 +1,6 @@
 //! The subcommands other than `bench`: each is arguments -> `Job` -> report.
 
+use crate::batch::{self, OutputArgs};
 use crate::run::{Global, run_and_report, run_job};
 use crate::{FitArgs, SurfaceArgs};
 use clap::{Args, Subcommand};
@@ -109,23 +110,6 @@ impl DistanceArgs {
     }
 }
 
-/// `mesh --sdf | --udf` and `solid --sdf`: the distance band of a mesh file.
-pub fn distances(
-    input: &Path,
-    band: f64,
-    signed: bool,
-    fit: FitArgs,
-    output: &Path,
-    global: &Global,
-) -> Result<()> {
-    let task = Task::DistanceBand {
-        mesh: MeshSource::File(input.to_path_buf()),
-        band,
-        signed,
-    };
-    run_and_report(Job::new(task, fit.grid_fit()), output, global)
-}
-
 impl SurfaceArgs {
     pub fn separating(&self) -> SeparatingOptions {
         SeparatingOptions {
@@ -147,16 +131,40 @@ fn surface_job(mesh: MeshSource, fit: FitArgs, surface: SurfaceArgs) -> Job {
     )
 }
 
-pub fn mesh(input: &Path, args: &VoxelizeArgs, global: &Global) -> Result<()> {
-    run_and_report(
-        surface_job(
-            MeshSource::File(input.to_path_buf()),
-            args.fit,
-            args.surface,
-        ),
-        &args.output,
-        global,
-    )
+/// `voxelkit mesh`: a separating or projective surface, or a distance band, of each input.
+#[allow(clippy::too_many_arguments)]
+pub fn mesh(
+    inputs: &[PathBuf],
+    projective: bool,
+    color: &crate::projective::ColorArgs,
+    distance: &DistanceArgs,
+    fit: FitArgs,
+    surface: SurfaceArgs,
+    out: &OutputArgs,
+    global: &Global,
+) -> Result<()> {
+    if !projective && color.given() {
+        return Err(Error::InvalidArgument(
+            "--color and --no-color need --method projective (the separating surface carries no colour)".into(),
+        ));
+    }
+    let method = if projective {
+        SurfaceMethod::Projective(color.choice())
+    } else {
+        SurfaceMethod::Separating(surface.separating())
+    };
+    let task = |mesh| {
+        if distance.given() {
+            Task::DistanceBand {
+                mesh,
+                band: distance.band,
+                signed: distance.sdf,
+            }
+        } else {
+            Task::MeshSurface { mesh, method }
+        }
+    };
+    batch::run(inputs, out, fit.grid_fit(), global, task)
 }
 
 fn positive(name: &str, v: f64) -> Result<()> {

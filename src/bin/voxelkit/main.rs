@@ -1,5 +1,6 @@
 //! The `voxelkit` command line: a thin shell over the library.
 
+mod batch;
 mod commands;
 mod implicit;
 mod projective;
@@ -117,8 +118,10 @@ enum Command {
     /// scan-lines with vertex colours carried into a `Cd` grid; or write its level set
     /// (--sdf) or unsigned distances (--udf).
     Mesh {
-        /// Input mesh: .obj (polygons kept; `v x y z r g b` colours read) or .stl.
-        input: PathBuf,
+        /// Input meshes: .obj (polygons kept; `v x y z r g b` colours read), .stl, .ply,
+        /// .off, .gltf or .glb; several with --out-dir, or one pattern with --frames.
+        #[arg(required = true, num_args = 1..)]
+        inputs: Vec<PathBuf>,
         /// separating: Huang et al.'s 6/26-separating surface; projective: Jegathese et al.'s
         /// scan-lines in each triangle's dominant plane (fast, colours, no separability
         /// guarantee where triangles meet; ignores -s, --criterion and --normals).
@@ -129,7 +132,11 @@ enum Command {
         #[command(flatten)]
         distance: commands::DistanceArgs,
         #[command(flatten)]
-        args: commands::VoxelizeArgs,
+        fit: FitArgs,
+        #[command(flatten)]
+        surface: SurfaceArgs,
+        #[command(flatten)]
+        out: batch::OutputArgs,
     },
     /// Voxelize 3D polylines (OBJ `l`) or the edges of a mesh by marching each segment's
     /// dominant axis (Jegathese et al.), carrying vertex colours into a `Cd` grid.
@@ -208,38 +215,23 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Mesh {
-            input,
+            inputs,
+            method,
+            color,
             distance,
-            args,
-            ..
-        } if distance.given() => commands::distances(
-            &input,
-            distance.band,
-            distance.sdf,
-            args.fit,
-            &args.output,
+            fit,
+            surface,
+            out,
+        } => commands::mesh(
+            &inputs,
+            method == MeshMethod::Projective,
+            &color,
+            &distance,
+            fit,
+            surface,
+            &out,
             &global,
         ),
-        Command::Mesh {
-            method: MeshMethod::Separating,
-            color,
-            ..
-        } if color.given() => Err(voxelkit::Error::InvalidArgument(
-            "--color and --no-color need --method projective (the separating surface carries no colour)".into(),
-        )),
-        Command::Mesh {
-            input,
-            method: MeshMethod::Separating,
-            args,
-            ..
-        } => commands::mesh(&input, &args, &global),
-        Command::Mesh {
-            input,
-            method: MeshMethod::Projective,
-            color,
-            args,
-            ..
-        } => projective::mesh(&input, args.fit, &color, &args.output, &global),
         Command::Lines(args) => projective::lines(&args, &global),
         Command::Shape { shape } => commands::shape(&shape, &global),
         Command::Info { file } => commands::info(&file, &global),

@@ -1,13 +1,14 @@
-//! The projective voxelizer (Jegathese et al.) on the command line: `voxelkit lines` and
-//! `voxelkit mesh --method projective` (`solid --method beam` is with the solids).
+//! The projective voxelizer (Jegathese et al.) on the command line: `voxelkit lines`, and the
+//! colour options of `voxelkit mesh --method projective` (`solid --method beam` is with the
+//! solids).
 
 use crate::FitArgs;
 use crate::run::{Global, run_and_report};
 use clap::Args;
 use glam::Vec3;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use voxelkit::Result;
-use voxelkit::pipeline::{ColorChoice, Job, MeshSource, SurfaceMethod, Task};
+use voxelkit::pipeline::{ColorChoice, Job, MeshSource, Task};
 
 fn parse_color(s: &str) -> std::result::Result<Vec3, String> {
     let v: Vec<f32> = s
@@ -39,7 +40,7 @@ impl ColorArgs {
         self.color.is_some() || self.no_color
     }
 
-    fn choice(&self) -> ColorChoice {
+    pub fn choice(&self) -> ColorChoice {
         match (self.color, self.no_color) {
             (Some(c), _) => ColorChoice::Constant(c),
             (None, true) => ColorChoice::None,
@@ -72,19 +73,4 @@ pub fn lines(args: &LinesArgs, global: &Global) -> Result<()> {
         color: args.color.choice(),
     };
     run_and_report(Job::new(task, args.fit.grid_fit()), &args.output, global)
-}
-
-/// `voxelkit mesh --method projective`.
-pub fn mesh(
-    input: &Path,
-    fit: FitArgs,
-    color: &ColorArgs,
-    output: &Path,
-    global: &Global,
-) -> Result<()> {
-    let task = Task::MeshSurface {
-        mesh: MeshSource::File(input.to_path_buf()),
-        method: SurfaceMethod::Projective(color.choice()),
-    };
-    run_and_report(Job::new(task, fit.grid_fit()), output, global)
 }

@@ -9,7 +9,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 use voxelkit::Result;
 use voxelkit::io::vdb::{WriteOptions, check_voxel_size};
-use voxelkit::pipeline::{Job, Limits, Outcome, check_output_path};
+use voxelkit::pipeline::{Job, Limits, Outcome, PlannedJob, check_output_path};
 use voxelkit::progress::Observer;
 
 /// What every command shares: threads, memory limit, output style.
@@ -75,31 +75,53 @@ impl Observer for Bars {
     }
 }
 
-/// Plans `job`, refuses an `output` that cannot be written (or is an input) before any
-/// work, runs it, writes the outcome to `output` and returns it with the whole run timed.
-pub fn run_job(job: Job, output: Option<&Path>, global: &Global) -> Result<Outcome> {
-    let start = Instant::now();
+/// Plans `job` and refuses an `output` that cannot be written (or is an input), before any
+/// work.
+pub fn plan_job(job: Job, output: Option<&Path>, global: &Global) -> Result<PlannedJob> {
     let planned = Job {
         limits: global.limits(),
         up_axis: global.up_axis,
         ..job
     }
     .plan()?;
-    let inputs = planned.input_files();
-    let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
     if let Some(out) = output {
+        let inputs = planned.input_files();
+        let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
         check_output_path(out, &inputs)?;
         check_voxel_size(out, planned.plan().transform.voxel_size)?;
     }
-    let bars = Bars::new(global.json);
-    let result = planned.run(&bars);
-    bars.finish();
-    let mut outcome = result?;
+    Ok(planned)
+}
+
+/// Runs a planned job under `observer`, writes the outcome to `output` and returns it with
+/// the whole run, from `start`, timed.
+pub fn finish_job(
+    planned: PlannedJob,
+    output: Option<&Path>,
+    observer: &dyn Observer,
+    global: &Global,
+    start: Instant,
+) -> Result<Outcome> {
+    let inputs = planned.input_files();
+    let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
+    let mut outcome = planned.run(observer)?;
     if let Some(out) = output {
         outcome.write(out, &inputs, &global.write)?;
     }
     outcome.report.finish(start);
     Ok(outcome)
+}
+
+/// Plans `job`, refuses an `output` that cannot be written (or is an input) before any
+/// work, runs it with progress bars, writes the outcome to `output` and returns it with the
+/// whole run timed.
+pub fn run_job(job: Job, output: Option<&Path>, global: &Global) -> Result<Outcome> {
+    let start = Instant::now();
+    let planned = plan_job(job, output, global)?;
+    let bars = Bars::new(global.json);
+    let result = finish_job(planned, output, &bars, global, start);
+    bars.finish();
+    result
 }
 
 /// Runs `job` and prints its report: on stdout, or on stderr when the `.vdb` goes to stdout.

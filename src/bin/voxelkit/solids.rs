@@ -69,9 +69,11 @@ pub enum SolidMethod {
 
 #[derive(Args)]
 pub struct SolidArgs {
-    /// Closed input mesh (.obj, .stl, .ply, .off, .gltf or .glb); its orientation does not matter. With
-    /// --method depth-layers open meshes are accepted and their undecidable voxels reported.
-    pub input: PathBuf,
+    /// Closed input meshes (.obj, .stl, .ply, .off, .gltf or .glb; several with --out-dir,
+    /// or one pattern with --frames); their orientation does not matter. With --method
+    /// depth-layers open meshes are accepted and their undecidable voxels reported.
+    #[arg(required = true, num_args = 1..)]
+    pub inputs: Vec<PathBuf>,
     #[arg(long, value_enum, default_value = "flood")]
     pub method: SolidMethod,
     #[command(flatten)]
@@ -93,8 +95,8 @@ pub struct SolidArgs {
     /// solid, whole blocks as tiles), `shell` (its outer voxels) and `interior`; depth layers
     /// add `unclassified`; `voxels` (the whole solid as booleans) when --grids names it. With
     /// --sdf: `density` and the level set `surface`.
-    #[arg(short, long)]
-    pub output: PathBuf,
+    #[command(flatten)]
+    pub out: crate::batch::OutputArgs,
 }
 
 #[derive(Args)]
@@ -151,25 +153,33 @@ fn parse_op(s: &str) -> std::result::Result<BooleanOp, String> {
 }
 
 pub fn solid(args: &SolidArgs, global: &Global) -> Result<()> {
-    if args.sdf {
-        let fit = args.fill.fit;
-        return crate::commands::distances(&args.input, args.band, true, fit, &args.output, global);
-    }
     let fill = match args.method {
         SolidMethod::Flood => Fill::Flood(args.fill.flood.method()),
         SolidMethod::DepthLayers => Fill::DepthLayers(args.depth.options()),
         SolidMethod::Beam => Fill::Beam,
     };
-    let task = Task::Solid {
-        mesh: MeshSource::File(args.input.clone()),
-        fill,
-        density: args.fill.density,
-        topology: args.topology,
+    let task = |mesh| {
+        if args.sdf {
+            Task::DistanceBand {
+                mesh,
+                band: args.band,
+                signed: true,
+            }
+        } else {
+            Task::Solid {
+                mesh,
+                fill,
+                density: args.fill.density,
+                topology: args.topology,
+            }
+        }
     };
-    run_and_report(
-        Job::new(task, args.fill.fit.grid_fit()),
-        &args.output,
+    crate::batch::run(
+        &args.inputs,
+        &args.out,
+        args.fill.fit.grid_fit(),
         global,
+        task,
     )
 }
 
