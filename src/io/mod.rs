@@ -3,6 +3,7 @@ pub mod atomic;
 pub mod binvox;
 #[cfg(feature = "vdb")]
 pub mod brick_set;
+pub mod preview;
 #[cfg(feature = "vdb")]
 pub mod vdb;
 #[cfg(feature = "vdb")]

@@ -11,6 +11,9 @@ pub struct Report {
     pub output: Option<String>,
     /// The input file or a description of the input (shape, formula, arrays).
     pub input: String,
+    /// The preview picture written beside the output (`--preview`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub preview: Option<String>,
     /// The method, as written to the `.vdb` metadata.
     pub method: String,
     /// Voxels of the main grid (the surface, or the whole solid).
@@ -349,6 +352,9 @@ impl Report {
                 t
             }
         };
+        if let Some(p) = &self.preview {
+            text.push_str(&format!("\npreview: {p}"));
+        }
         for w in &self.warnings {
             text.push_str(&format!("\nwarning: {w}"));
         }

@@ -4,6 +4,7 @@ mod batch;
 mod commands;
 mod implicit;
 mod projective;
+mod render;
 mod run;
 mod solid_depth;
 mod solids;
@@ -68,6 +69,10 @@ struct Cli {
     /// imported mesh stands; `z` keeps the coordinates.
     #[arg(long, global = true, default_value = "z", value_name = "AXIS")]
     up_axis: voxelkit::mesh::UpAxis,
+    /// Also draw each result as a picture beside its output (`out.vdb` gives `out.png`;
+    /// `voxelkit render` takes views and sizes).
+    #[arg(long, global = true)]
+    preview: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -149,6 +154,9 @@ enum Command {
     /// Describe the grids of a .vdb file (types, counts, transform, metadata), or the bricks
     /// of a brick set by its index (`index.json`, from `python -m voxelkit.distributed`).
     Info { file: PathBuf },
+    /// Draw the voxels of a .vdb as a PNG picture: each voxel a cube, lit by the file's
+    /// `normal` grid when it has one, coloured by its `Cd` grid.
+    Render(render::RenderArgs),
     /// Check a mesh voxelization: separability by flooding and the share of simple voxels.
     Check {
         /// Closed input mesh.
@@ -207,6 +215,7 @@ fn main() -> ExitCode {
         max_memory_mib: cli.max_memory,
         up_axis: cli.up_axis,
         json: cli.json,
+        preview: cli.preview,
         write: voxelkit::io::vdb::WriteOptions {
             grids: cli.grids,
             compression: cli.compression,
@@ -235,6 +244,7 @@ fn main() -> ExitCode {
         Command::Lines(args) => projective::lines(&args, &global),
         Command::Shape { shape } => commands::shape(&shape, &global),
         Command::Info { file } => commands::info(&file, &global),
+        Command::Render(args) => render::run(&args, &global),
         Command::Check {
             input,
             fit,

@@ -20,6 +20,8 @@ pub struct Global {
     pub up_axis: voxelkit::mesh::UpAxis,
     pub json: bool,
     pub write: WriteOptions,
+    /// Draw a picture of each result beside its output (`--preview`).
+    pub preview: bool,
 }
 
 impl Global {
@@ -107,6 +109,10 @@ pub fn finish_job(
     let mut outcome = planned.run(observer)?;
     if let Some(out) = output {
         outcome.write(out, &inputs, &global.write)?;
+        if global.preview {
+            let png = crate::render::beside(&outcome.grid, out, Default::default())?;
+            outcome.report.preview = Some(png.display().to_string());
+        }
     }
     outcome.report.finish(start);
     Ok(outcome)
