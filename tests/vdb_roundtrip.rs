@@ -88,10 +88,14 @@ fn openvdb_reads_back_the_same_voxels_transform_and_metadata() {
         let v = leaf.value.as_ref().unwrap();
         assert!(leaf.offsets().all(|n| v[n] == 1.0));
     }
-    assert!(
-        read_vdb_grid(&path, Some("normal")).is_err(),
-        "vec3 grids are not readable as masks"
-    );
+    // The Vec3S grid reads into the normal channel, value for value.
+    let normals = read_vdb_grid(&path, Some("normal")).unwrap();
+    assert_eq!(sorted_voxels(&normals), sorted_voxels(&grid));
+    for leaf in grid.leaves() {
+        let (ours, back) = (leaf.normal.as_ref().unwrap(), normals.leaf(leaf.origin).unwrap());
+        let back = back.normal.as_ref().unwrap();
+        assert!(leaf.offsets().all(|n| ours[n] == back[n]));
+    }
     assert!(read_vdb_grid(&path, Some("nope")).is_err());
 }
 
