@@ -915,6 +915,8 @@ pub extern "C" fn vk_voxelize_formula(
             max,
             levels: false,
             negative_r: false,
+            theta_range: Default::default(),
+            squared: false,
         })
     })
 }
@@ -932,7 +934,7 @@ pub extern "C" fn vk_fill_mesh(
         let fill = match o.fill {
             FillMethod::Flood => Fill::Flood(o.flood),
             FillMethod::DepthLayers => Fill::DepthLayers(o.depth),
-            FillMethod::Beam => Fill::Beam,
+            FillMethod::Beam => Fill::Beam(Default::default()),
         };
         let task = Task::Solid {
             mesh: mesh_source(mesh)?,

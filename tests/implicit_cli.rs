@@ -45,6 +45,70 @@ fn examples_write_vdb_files() {
     assert!(o.status.success(), "{}", text(&o));
 }
 
+/// `--theta-range` (the paper's [0, 2π) by default) and `--squared` reach the octree: the
+/// cylindrical spiral θ - r makes its full turn only in [0, 2π), and the squared Fig. 5
+/// surface holds every lobe, twice the typed one's voxels.
+#[test]
+fn theta_range_and_the_squared_substitution_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.vdb");
+    let voxels = |extra: &[&str], formula: &str, coords: &str, bounds: &str| {
+        let mut args = vec![
+            "--json",
+            "implicit",
+            formula,
+            "--coords",
+            coords,
+            "--bounds",
+            bounds,
+            "-r",
+            "64",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = voxelkit(&args);
+        assert!(o.status.success(), "{}", text(&o));
+        cli_support::json_field(&String::from_utf8_lossy(&o.stdout), "voxels")
+    };
+    let spiral = "theta - r + 0*y";
+    let full = voxels(&[], spiral, "cylindrical", "-7,7");
+    let paper = voxels(
+        &["--theta-range", "positive"],
+        spiral,
+        "cylindrical",
+        "-7,7",
+    );
+    let half = voxels(
+        &["--theta-range", "symmetric"],
+        spiral,
+        "cylindrical",
+        "-7,7",
+    );
+    assert_eq!(full, paper);
+    assert!(full > 2.5 * half, "{full} vs {half}");
+    let fig5 = "sin(3*theta)*sin(4*phi) - r";
+    let typed = voxels(&[], fig5, "spherical", "-1,1");
+    let squared = voxels(&["--squared"], fig5, "spherical", "-1,1");
+    assert!(
+        (1.8..2.2).contains(&(squared / typed)),
+        "{squared} vs {typed}"
+    );
+    let o = voxelkit(&[
+        "implicit",
+        spiral,
+        "--theta-range",
+        "degrees",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !o.status.success() && text(&o).contains("positive"),
+        "{}",
+        text(&o)
+    );
+}
+
 #[test]
 fn levels_are_written_with_their_own_voxel_size() {
     let dir = tempfile::tempdir().unwrap();

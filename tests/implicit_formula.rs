@@ -4,7 +4,7 @@
 use proptest::prelude::*;
 use voxelkit::Error;
 use voxelkit::implicit::{
-    BoxTest, Coordinates, Dual, Formula, Interval, Split, test_box, to_coordinates,
+    BoxTest, Coordinates, Dual, Formula, Interval, Split, ThetaRange, test_box,
 };
 
 fn value(text: &str, at: [f64; 3]) -> f64 {
@@ -192,23 +192,44 @@ fn check_conversion(
     size: [f64; 3],
     samples: Vec<[f64; 3]>,
 ) -> Result<(), TestCaseError> {
-    let f = Formula::parse(text, coords).unwrap();
+    for theta_range in [ThetaRange::Positive, ThetaRange::Symmetric] {
+        let f = Formula {
+            theta_range,
+            ..Formula::parse(text, coords).unwrap()
+        };
+        check_conversion_in(&f, text, lo, size, &samples)?;
+    }
+    Ok(())
+}
+
+fn check_conversion_in(
+    f: &Formula,
+    text: &str,
+    lo: [f64; 3],
+    size: [f64; 3],
+    samples: &[[f64; 3]],
+) -> Result<(), TestCaseError> {
+    let coords = f.coordinates;
     let boxed: [Interval; 3] = std::array::from_fn(|k| Interval::new(lo[k], lo[k] + size[k]));
     for t in samples {
         let p: [f64; 3] = std::array::from_fn(|k| lo[k] + size[k] * t[k]);
-        let v = f.tape.eval(to_coordinates(coords, p));
+        let v = f.tape.eval(f.coordinates_of(p));
         if !v.is_finite() {
             continue;
         }
         // F - v is zero at p, so the box must not be ruled out.
-        let shifted = Formula::parse(&format!("({text}) - ({v:?})"), coords).unwrap();
+        let shifted = Formula {
+            theta_range: f.theta_range,
+            ..Formula::parse(&format!("({text}) - ({v:?})"), coords).unwrap()
+        };
         let mut slots: Vec<Split> = Vec::new();
-        let test = test_box(&shifted.tape, coords, boxed, false, false, &mut slots);
+        let test = test_box(&shifted, boxed, false, false, &mut slots);
         prop_assert!(
             test != BoxTest::Empty,
-            "{text} = {v} at {p:?} in box {boxed:?}"
+            "{text} = {v} at {p:?} in box {boxed:?} ({:?})",
+            f.theta_range
         );
-        let bounded = test_box(&shifted.tape, coords, boxed, false, true, &mut slots);
+        let bounded = test_box(&shifted, boxed, false, true, &mut slots);
         prop_assert_eq!(bounded, BoxTest::MayContain, "{} on the axis", text);
     }
     Ok(())
@@ -223,23 +244,31 @@ proptest! {
         check_conversion(Coordinates::Spherical, &text, lo, size, samples)?;
     }
 
-    /// Formulas G(θ, φ) - r, where r is compared with G as squares.
+    /// Formulas G(θ, φ) - r, where r is compared with G as squares: as typed (r = G, and
+    /// with -r) and under the paper's substitution (r = |G|), θ in either range.
     #[test]
-    fn isolated_r_boxes_enclose_their_points(text in formula_over(["theta", "phi", "theta"]), (lo, size, samples) in box_and_points(), negative in any::<bool>()) {
-        let g = Formula::parse(&text, Coordinates::Spherical).unwrap();
+    fn isolated_r_boxes_enclose_their_points(text in formula_over(["theta", "phi", "theta"]), (lo, size, samples) in box_and_points(), negative in any::<bool>(), squared in any::<bool>(), positive in any::<bool>()) {
+        let theta_range = if positive { ThetaRange::Positive } else { ThetaRange::Symmetric };
+        let g = Formula { theta_range, ..Formula::parse(&text, Coordinates::Spherical).unwrap() };
         let boxed: [Interval; 3] = std::array::from_fn(|k| Interval::new(lo[k], lo[k] + size[k]));
         for t in samples {
             let p: [f64; 3] = std::array::from_fn(|k| lo[k] + size[k] * t[k]);
-            let [r, theta, phi] = to_coordinates(Coordinates::Spherical, p);
-            let (r, theta, phi) = if negative { (-r, theta + std::f64::consts::PI, -phi) } else { (r, theta, phi) };
-            let v = g.tape.eval([r, theta, phi]) - r;
+            let [r, theta, phi] = g.coordinates_of(p);
+            let (r, theta, phi) = if negative && !squared { (-r, theta + std::f64::consts::PI, -phi) } else { (r, theta, phi) };
+            let at = g.tape.eval([r, theta, phi]);
+            // Typed: (G - v) - r is zero at p; squared: (G - v)² = r² with v = G - r·sign(G).
+            let v = if squared { at - r * at.signum() } else { at - r };
             if !v.is_finite() {
                 continue;
             }
-            // (G - v) - r is zero at p (written with -r when `negative`).
-            let shifted = Formula::parse(&format!("({text}) - ({v:?}) - r"), Coordinates::Spherical).unwrap();
+            let shifted = Formula {
+                theta_range,
+                squared,
+                ..Formula::parse(&format!("({text}) - ({v:?}) - r"), Coordinates::Spherical).unwrap()
+            };
             prop_assert!(shifted.tape.isolated(0).is_some());
-            let test = test_box(&shifted.tape, Coordinates::Spherical, boxed, negative, true, &mut Vec::<Split>::new());
+            let both = negative && !squared;
+            let test = test_box(&shifted, boxed, both, true, &mut Vec::<Split>::new());
             prop_assert_eq!(test, BoxTest::MayContain, "{} at {:?}", text, p);
         }
     }
@@ -253,33 +282,69 @@ proptest! {
 
 #[test]
 fn boxes_across_the_cut_and_on_the_axis() {
-    let theta = Formula::parse("theta - 3.1", Coordinates::Cylindrical).unwrap();
+    let formula = |text: &str, coordinates, theta_range| Formula {
+        theta_range,
+        ..Formula::parse(text, coordinates).unwrap()
+    };
+    let symmetric = |text: &str| formula(text, Coordinates::Cylindrical, ThetaRange::Symmetric);
+    let positive = |text: &str| formula(text, Coordinates::Cylindrical, ThetaRange::Positive);
     let test = |f: &Formula, b: [Interval; 3], both_signs: bool, whole_axis: bool| {
-        test_box(
-            &f.tape,
-            f.coordinates,
-            b,
-            both_signs,
-            whole_axis,
-            &mut Vec::<Split>::new(),
-        )
+        test_box(f, b, both_signs, whole_axis, &mut Vec::<Split>::new())
     };
     let i = |a: f64, b: f64| Interval::new(a, b);
-    // Across the negative x axis: θ near +π on one side and -π on the other.
+    // (-π, π]: across the negative x axis, θ near +π on one side and -π on the other.
+    let theta = symmetric("theta - 3.1");
     let across = [i(-1.0, -0.5), i(0.0, 1.0), i(-0.1, 0.1)];
     assert_eq!(test(&theta, across, false, false), BoxTest::MayContain);
-    let minus = Formula::parse("theta + 3.1", Coordinates::Cylindrical).unwrap();
+    let minus = symmetric("theta + 3.1");
     assert_eq!(test(&minus, across, false, false), BoxTest::MayContain);
     // Away from the cut, θ near 0 only.
     let right = [i(0.5, 1.0), i(0.0, 1.0), i(-0.1, 0.1)];
     assert_eq!(test(&theta, right, false, false), BoxTest::Empty);
-    // On the axis θ is anything: undecided, or bounded by [-π, π].
+    // [0, 2π): the same boxes hold θ near π (no cut there), and θ near 0 or 2π across +x.
+    assert_eq!(
+        test(&positive("theta - 3.1"), across, false, false),
+        BoxTest::MayContain
+    );
+    assert_eq!(
+        test(&positive("theta + 3.1"), across, false, false),
+        BoxTest::Empty
+    );
+    assert_eq!(
+        test(&positive("theta - 0.05"), right, false, false),
+        BoxTest::MayContain
+    );
+    assert_eq!(
+        test(&positive("theta - 6.25"), right, false, false),
+        BoxTest::MayContain
+    );
+    assert_eq!(
+        test(&positive("theta - 3.1"), right, false, false),
+        BoxTest::Empty
+    );
+    // On the axis θ is anything: undecided, or bounded by the whole turn.
     let axis = [i(-0.1, 0.1), i(0.0, 1.0), i(-0.1, 0.1)];
     assert_eq!(test(&theta, axis, false, false), BoxTest::Undecided);
     assert_eq!(test(&theta, axis, false, true), BoxTest::MayContain);
+    assert_eq!(
+        test(&positive("theta - 6"), axis, false, true),
+        BoxTest::MayContain
+    );
+    assert_eq!(
+        test(&symmetric("theta - 6"), axis, false, true),
+        BoxTest::Empty
+    );
     // Negative r: r + 0.5 = 0 has no point at r >= 0, but one at r = -0.5.
-    let negative = Formula::parse("r + 0.5", Coordinates::Spherical).unwrap();
+    let negative = formula("r + 0.5", Coordinates::Spherical, ThetaRange::Positive);
     let shell = [i(0.4, 0.6), i(-0.05, 0.05), i(-0.05, 0.05)];
     assert_eq!(test(&negative, shell, false, false), BoxTest::Empty);
     assert_eq!(test(&negative, shell, true, false), BoxTest::MayContain);
+    // The paper's substitution: -0.5 - r = 0 squared is r = 0.5.
+    let squared = Formula {
+        squared: true,
+        ..formula("-0.5 - r", Coordinates::Spherical, ThetaRange::Positive)
+    };
+    assert_eq!(test(&squared, shell, false, false), BoxTest::MayContain);
+    let typed = formula("-0.5 - r", Coordinates::Spherical, ThetaRange::Positive);
+    assert_eq!(test(&typed, shell, false, false), BoxTest::Empty);
 }

@@ -23,7 +23,7 @@ const SURFACES: [(&str, Coordinates, &str); 3] = [
 ];
 
 fn value(f: &Formula, p: DVec3, negative: bool) -> f64 {
-    value_at(&f.tape, f.coordinates, p.to_array(), negative)
+    value_at(f, p.to_array(), negative)
 }
 
 /// Points where F changes sign along random rays through [-1, 1]^3, refined by bisection.
@@ -175,4 +175,93 @@ fn normals_are_unit_gradients() {
             );
         }
     }
+}
+
+fn octree(
+    f: &Formula,
+    bounds: f64,
+    resolution: u32,
+    both_signs: bool,
+) -> voxelkit::grid::SparseGrid {
+    let options = OctreeOptions {
+        resolution,
+        both_signs,
+        ..Default::default()
+    };
+    voxelize_implicit(
+        f,
+        DVec3::splat(-bounds),
+        DVec3::splat(bounds),
+        &options,
+        &voxelkit::progress::Progress::none(),
+    )
+    .unwrap()
+    .surface
+}
+
+/// θ in the paper's [0, 2π) (the default): the cylindrical spiral θ - r = 0 makes its whole
+/// turn out to r = 2π, where (-π, π] gives only the half turn out to r = π.
+#[test]
+fn theta_spans_the_papers_full_turn() {
+    use voxelkit::implicit::ThetaRange;
+    let spiral = |theta_range| Formula {
+        theta_range,
+        ..Formula::parse("theta - r + 0*y", Coordinates::Cylindrical).unwrap()
+    };
+    let (full, half) = (spiral(ThetaRange::Positive), spiral(ThetaRange::Symmetric));
+    let (a, b) = (
+        octree(&full, 7.0, 256, false),
+        octree(&half, 7.0, 256, false),
+    );
+    let t = a.transform;
+    // Voxels beyond r = 3.5 (past the half turn), in the lower half plane z < 0.
+    let far = |g: &voxelkit::grid::SparseGrid| {
+        g.voxels()
+            .filter(|&c| {
+                let p = t.index_to_world(c);
+                (p.x * p.x + p.z * p.z).sqrt() > 3.5
+            })
+            .count()
+    };
+    assert!(far(&a) > 1000, "{}", far(&a));
+    assert_eq!(far(&b), 0);
+    // Points of the spiral all along the turn lie in its voxels.
+    let mut rng = SplitMix64(9);
+    for _ in 0..2000 {
+        let theta = rng.range(0.05, 2.0 * std::f64::consts::PI - 0.05);
+        let p = DVec3::new(
+            theta * theta.cos(),
+            rng.range(-6.0, 6.0),
+            theta * theta.sin(),
+        );
+        assert!(a.contains(t.world_to_voxel(p)), "θ = {theta}");
+    }
+}
+
+/// The paper's substitution [G]² - r² = 0: for sin(3θ) sin(4φ), whose value at
+/// (θ + π, -φ) is its own, r = |G| is the surface the typed formula gives with negative r
+/// too: every lobe, twice the typed surface's r = G >= 0. Its roots lie in its voxels.
+#[test]
+fn the_squared_substitution_gives_every_lobe() {
+    let typed = Formula::parse("sin(3*theta)*sin(4*phi) - r", Coordinates::Spherical).unwrap();
+    let squared = Formula {
+        squared: true,
+        ..typed.clone()
+    };
+    let s = octree(&squared, 1.0, 128, false);
+    let both = octree(&typed, 1.0, 128, true);
+    let half = octree(&typed, 1.0, 128, false);
+    let differ = s.voxels().filter(|&c| !both.contains(c)).count()
+        + both.voxels().filter(|&c| !s.contains(c)).count();
+    assert!(
+        differ * 100 <= both.voxel_count() as usize,
+        "{differ} of {}",
+        both.voxel_count()
+    );
+    let ratio = s.voxel_count() as f64 / half.voxel_count() as f64;
+    assert!((1.85..2.15).contains(&ratio), "{ratio}");
+    let points = roots(&squared, false, 500);
+    assert!(points.len() > 300);
+    let t = s.transform;
+    assert!(points.iter().all(|&p| s.contains(t.world_to_voxel(p))));
 }

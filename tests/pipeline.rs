@@ -98,6 +98,8 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
                 max: DVec3::splat(1.0),
                 levels: false,
                 negative_r: false,
+                theta_range: Default::default(),
+                squared: false,
             },
         ),
         (
@@ -122,7 +124,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
             "solid beam",
             Task::Solid {
                 mesh: mesh(),
-                fill: Fill::Beam,
+                fill: Fill::Beam(Default::default()),
                 density: 1.0,
                 topology: true,
             },

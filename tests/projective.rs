@@ -10,7 +10,8 @@ use glam::{DVec3, Vec3};
 use std::collections::{HashMap, HashSet};
 use voxelkit::mesh::generate::{SplitMix64, icosphere, torus};
 use voxelkit::mesh::{GridFit, Mesh, fit_transform};
-use voxelkit::solids::beam::beam_solid;
+use voxelkit::progress::Progress;
+use voxelkit::solids::beam::{BeamFill, beam_solid};
 use voxelkit::voxelize::projective::line::{dominant_axis, voxel_of, voxelize_segment};
 use voxelkit::voxelize::projective::triangle::{is_degenerate, voxelize_triangle};
 use voxelkit::voxelize::projective::{Coloring, LineSource, line_segments, voxelize_triangles};
@@ -311,10 +312,9 @@ fn the_beam_solid_holds_the_exact_volume_of_spheres_tori_and_real_meshes() {
         let volume = mesh.signed_volume().abs();
         for res in [48, 128] {
             let t = fit_transform(&mesh.bbox(), GridFit::Resolution(res)).unwrap();
-            let (surface, solid, _) =
-                beam_solid(mesh, t, &voxelkit::progress::Progress::none()).unwrap();
-            let m = solid.measures;
-            assert_eq!(m.surface_voxels, surface.voxel_count());
+            let parity = beam_solid(mesh, t, BeamFill::Parity, &Progress::none()).unwrap();
+            let m = parity.solid.measures;
+            assert_eq!(m.surface_voxels, parity.surface.voxel_count());
             assert!(
                 m.volume_inside <= volume && volume <= m.volume_with_surface,
                 "{} at {res}: {} .. {} does not hold {volume}",
@@ -322,11 +322,39 @@ fn the_beam_solid_holds_the_exact_volume_of_spheres_tori_and_real_meshes() {
                 m.volume_inside,
                 m.volume_with_surface
             );
+            // The paper's fill, from the face voxels: the same surface, and beams that open and
+            // close on it. On the sphere and the torus it is the parity solid; on real meshes,
+            // where the face voxels of a column need not line up with the exact crossings
+            // (thin parts, steep faces), it differs from it by little (measured at 48 and 128:
+            // at most 1.0% outside it, rocker-arm at 48, and 5.4% of it missed, horse at 48).
+            let paper = beam_solid(mesh, t, BeamFill::Paper, &Progress::none()).unwrap();
+            let p = paper.solid.measures;
+            assert_eq!(p.surface_voxels, m.surface_voxels);
+            let outside = paper
+                .solid
+                .inside
+                .voxels()
+                .filter(|&c| !parity.solid.inside.contains(c))
+                .count();
+            let missed = m.inside_voxels - (p.inside_voxels - outside as u64);
             eprintln!(
-                "{} at {res}: beam {:.6} .. {:.6}, mesh {volume:.6}",
+                "{} at {res}: beam {:.6} .. {:.6}, mesh {volume:.6}; paper fill {} inside ({} outside the parity solid, {} of its voxels missed), {} unclosed",
                 mesh.source.display(),
                 m.volume_inside,
-                m.volume_with_surface
+                m.volume_with_surface,
+                p.inside_voxels,
+                outside,
+                missed,
+                paper.unclosed_beams
+            );
+            if mesh.source.extension().is_none() {
+                assert_eq!((outside, missed), (0, 0), "{}", mesh.source.display());
+            }
+            assert!(outside as u64 * 50 <= m.inside_voxels, "{outside} outside");
+            assert!(
+                missed * 10 <= m.inside_voxels,
+                "{missed} of {}",
+                m.inside_voxels
             );
         }
     }
@@ -339,7 +367,7 @@ fn the_beam_refuses_an_open_mesh() {
     };
     let mesh = Mesh::load(&data.join("meshes/cube_no_bottom.obj")).unwrap();
     let t = fit_transform(&mesh.bbox(), GridFit::Resolution(32)).unwrap();
-    let err = beam_solid(&mesh, t, &voxelkit::progress::Progress::none())
+    let err = beam_solid(&mesh, t, BeamFill::Paper, &Progress::none())
         .err()
         .unwrap()
         .to_string();

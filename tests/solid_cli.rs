@@ -239,3 +239,46 @@ fn depth_layer_solids_report_what_they_cannot_classify() {
     );
     assert!(!dir.path().join("g4.vdb").exists());
 }
+
+/// `solid --method beam --fill paper`: Jegathese et al.'s fill from the face voxels, named in
+/// the metadata; on a torus the same solid as the parity fill.
+#[test]
+fn the_papers_beam_fill_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("torus.obj");
+    generate::torus(DVec3::ZERO, 1.0, 0.35, 64, 32)
+        .write_obj(&obj)
+        .unwrap();
+    let mut counts = Vec::new();
+    for fill in ["parity", "paper"] {
+        let out = dir.path().join(format!("{fill}.vdb"));
+        let o = voxelkit(&[
+            "--json",
+            "solid",
+            obj.to_str().unwrap(),
+            "--method",
+            "beam",
+            "--fill",
+            fill,
+            "-r",
+            "96",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        counts.push(json_field(
+            &String::from_utf8_lossy(&o.stdout),
+            "inside_voxels",
+        ));
+        let info = read_vdb_info(&out).unwrap();
+        let method = info[0].metadata.iter().find(|m| m.key == "method").unwrap();
+        let expected = if fill == "paper" {
+            "projective-beam-paper"
+        } else {
+            "projective-beam"
+        };
+        assert_eq!(method.value, expected);
+    }
+    assert_eq!(counts[0], counts[1]);
+    assert!(counts[0] > 10_000.0);
+}

@@ -92,7 +92,10 @@ fn openvdb_reads_back_the_same_voxels_transform_and_metadata() {
     let normals = read_vdb_grid(&path, Some("normal")).unwrap();
     assert_eq!(sorted_voxels(&normals), sorted_voxels(&grid));
     for leaf in grid.leaves() {
-        let (ours, back) = (leaf.normal.as_ref().unwrap(), normals.leaf(leaf.origin).unwrap());
+        let (ours, back) = (
+            leaf.normal.as_ref().unwrap(),
+            normals.leaf(leaf.origin).unwrap(),
+        );
         let back = back.normal.as_ref().unwrap();
         assert!(leaf.offsets().all(|n| ours[n] == back[n]));
     }

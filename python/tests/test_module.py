@@ -65,6 +65,15 @@ def test_implicit_equals_cli(cli, tmp_path):
         cli, tmp_path, "implicit", formula, "--coords", "spherical", "--bounds", "-1,1", "-r", 64
     )
     assert voxel_set(grid.ijk) == expected and len(expected) > 1000
+    squared = voxelkit.implicit(
+        formula, coords="spherical", bounds=(-1, 1), resolution=64, squared=True,
+        theta_range="symmetric",
+    )
+    expected = cli_voxels(
+        cli, tmp_path, "implicit", formula, "--coords", "spherical", "--bounds", "-1,1", "-r", 64,
+        "--squared", "--theta-range", "symmetric",
+    )
+    assert voxel_set(squared.ijk) == expected and len(expected) > 1.8 * len(grid.ijk)
 
 
 def test_arrays_equal_the_file(data):

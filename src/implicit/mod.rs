@@ -54,31 +54,63 @@ impl std::str::FromStr for Coordinates {
     }
 }
 
+/// The values θ takes: the paper's `[0, 2π)`, measured from +x toward +z with its cut along
+/// the positive x axis, or `(-π, π]`, cut along the negative x axis (`atan2`'s).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ThetaRange {
+    #[default]
+    Positive,
+    Symmetric,
+}
+
+impl std::str::FromStr for ThetaRange {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "positive" => Ok(ThetaRange::Positive),
+            "symmetric" => Ok(ThetaRange::Symmetric),
+            _ => Err(format!(
+                "the theta range is positive ([0, 2pi), the paper's) or symmetric ((-pi, pi]), not `{s}`"
+            )),
+        }
+    }
+}
+
 /// A compiled formula F; the surface is F = 0.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Formula {
     pub text: String,
     pub coordinates: Coordinates,
     pub tape: Tape,
+    /// Where θ lies (spherical and cylindrical coordinates).
+    pub theta_range: ThetaRange,
+    /// Stolte & Kaufman's substitution for F = G - r: the surface [G]² - r² = 0, that is
+    /// r = |G|, instead of r = G (G >= 0) as typed.
+    pub squared: bool,
 }
 
 impl Formula {
-    /// Parses `text`; errors point at the column.
+    /// Parses `text` (θ in the paper's [0, 2π), r as typed); errors point at the column.
     pub fn parse(text: &str, coordinates: Coordinates) -> Result<Formula> {
         Ok(Formula {
             text: text.to_string(),
             coordinates,
             tape: parse::parse(text, coordinates.variables())?,
+            theta_range: ThetaRange::default(),
+            squared: false,
         })
+    }
+
+    /// The coordinates of a Cartesian point (or box, or dual number) in this formula's
+    /// system and θ range.
+    pub fn coordinates_of<N: Number>(&self, p: [N; 3]) -> [N; 3] {
+        to_coordinates(self.coordinates, self.theta_range, p)
     }
 
     /// The Cartesian gradient of F at the world point `p`; `slots` is scratch space.
     pub fn gradient_at(&self, p: [f64; 3], slots: &mut Vec<Dual>) -> glam::DVec3 {
         let vars: [Dual; 3] = std::array::from_fn(|a| Dual::variable(p[a], a));
-        let g = self
-            .tape
-            .eval_with(to_coordinates(self.coordinates, vars), slots)
-            .grad;
+        let g = self.tape.eval_with(self.coordinates_of(vars), slots).grad;
         glam::DVec3::from_array(g)
     }
 }

@@ -234,9 +234,15 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             min,
             max,
             levels,
+            theta_range,
+            squared,
             ..
         } => {
-            let parsed = Formula::parse(formula, *coordinates)?;
+            let parsed = Formula {
+                theta_range: *theta_range,
+                squared: *squared,
+                ..Formula::parse(formula, *coordinates)?
+            };
             let resolution = octree_resolution(fit, *min, *max)?;
             let bbox = Aabb {
                 min: *min,
@@ -346,7 +352,7 @@ fn solid_plan(
             6,
             o.directions.len() as u64 + (b.max[0] - b.min[0] + 1) as u64,
         ),
-        super::Fill::Beam => (5, mesh.face_count() as u64),
+        super::Fill::Beam(_) => (5, mesh.face_count() as u64),
     };
     let bytes =
         surface_bytes(area_in_voxels(&mesh, &t), 0) + solid_bytes(cells(&padded(b, 2)), masks);

@@ -18,11 +18,12 @@ pub use solid::FLOOD_NEEDS_CLOSED;
 
 use crate::error::{Error, Result};
 use crate::grid::{SparseGrid, Transform};
-use crate::implicit::{Coordinates, Formula};
+use crate::implicit::{Coordinates, Formula, ThetaRange};
 use crate::mesh::{GridFit, Mesh, UpAxis};
 use crate::ops::csg::BooleanOp;
 use crate::progress::{Observer, Progress};
 use crate::shapes::{Cylinder, Quadric, Sphere};
+use crate::solids::beam::BeamFill;
 use crate::solids::csg_tree::CsgTree;
 use crate::solids::depth_layers::DepthLayerOptions;
 use crate::solids::exterior_flood::FloodMethod;
@@ -83,7 +84,7 @@ pub enum Fill {
     /// Passalis et al.'s depth layers with a stencil count.
     DepthLayers(DepthLayerOptions),
     /// The projective surface plus beams between front and back faces along z.
-    Beam,
+    Beam(BeamFill),
 }
 
 /// What `measure` measures: a mesh (its flooded 26-separating surface), a `.vdb` surface (a
@@ -148,6 +149,10 @@ pub enum Task {
         max: DVec3,
         levels: bool,
         negative_r: bool,
+        /// Where θ lies: the paper's [0, 2π) by default.
+        theta_range: ThetaRange,
+        /// The paper's substitution [G]² - r² = 0 for F = G - r (r = |G|).
+        squared: bool,
     },
     Solid {
         mesh: MeshSource,

@@ -15,7 +15,7 @@ use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
 use crate::ops::topology::{components, euler_characteristic};
 use crate::progress::Progress;
-use crate::solids::beam::beam_solid;
+use crate::solids::beam::{BeamFill, beam_solid};
 use crate::solids::csg_tree::CsgTree;
 use crate::solids::depth_layers::{Layers, depth_layer_solid};
 use crate::solids::exterior_flood::{FloodMethod, Solid, solid_from_surface};
@@ -32,8 +32,9 @@ pub const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it a
 const FLOOD_RULE: &str =
     "inside = what the exterior flood (from the box corner, no normals needed) cannot reach";
 
-/// What inside means for the beams.
+/// What inside means for the beams, by fill.
 const BEAM_RULE: &str = "inside = the beams between front and back faces along z (centres between crossings 1-2, 3-4, ...)";
+const BEAM_PAPER_RULE: &str = "inside = the beams along z from each back-face voxel up to the next front-face voxel (Jegathese et al.)";
 
 /// The 26-separating surface a flood fills.
 fn flood_surface(mesh: &Mesh, t: Transform, progress: &Progress) -> Result<SparseGrid> {
@@ -154,13 +155,25 @@ pub(super) fn mesh_solid(
                 solid_details(whole, solid, density, FLOOD_RULE, Some(mesh), topology)
             })?
         }
-        Fill::Beam => {
-            let (surface, solid, _) = beam_solid(mesh, t, progress)?;
-            let mut method = meta("projective-beam");
+        Fill::Beam(fill) => {
+            let beam = beam_solid(mesh, t, fill, progress)?;
+            let (name, rule) = match fill {
+                BeamFill::Parity => ("projective-beam", BEAM_RULE),
+                BeamFill::Paper => ("projective-beam-paper", BEAM_PAPER_RULE),
+            };
+            let mut method = meta(name);
             method.push(("color", "none".into()));
-            surface_and_inside(surface, solid, method, |whole, solid| {
-                solid_details(whole, solid, density, BEAM_RULE, Some(mesh), topology)
-            })?
+            let mut outcome =
+                surface_and_inside(beam.surface, beam.solid, method, |whole, solid| {
+                    solid_details(whole, solid, density, rule, Some(mesh), topology)
+                })?;
+            if beam.unclosed_beams > 0 {
+                outcome.report.warnings.push(format!(
+                    "{} beams opened by a back face were not closed by a front face in their column and were left empty",
+                    beam.unclosed_beams
+                ));
+            }
+            outcome
         }
         Fill::DepthLayers(options) => {
             let edges = mesh.edge_counts();

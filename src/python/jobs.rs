@@ -12,6 +12,7 @@ use crate::pipeline::{
     ColorChoice, CsgSource, Fill, GridSource, Job, Limits, MeasureSource, Outcome, SurfaceMethod,
     Task,
 };
+use crate::solids::beam::BeamFill;
 use crate::solids::depth_layers::{DepthLayerOptions, DirectionSet, Layers, Unclassified};
 use crate::solids::exterior_flood::FloodMethod;
 use crate::voxelize::Separability;
@@ -185,11 +186,12 @@ pub fn mesh(
 /// Depth layers: `directions` is a count of the 16 built-in directions (default all) or a
 /// list of integer (x, y, z) triples, each with a component of ±1; `layers` single or double;
 /// `unclassified` "no-direction" (a voxel no direction decides) or "paper" (a voxel on a ray
-/// of any direction crossing more than four times).
+/// of any direction crossing more than four times). Beam: `fill` "parity" (centres between
+/// exact crossings) or "paper" (from each back-face voxel up to the next front-face voxel).
 #[pyfunction]
 #[pyo3(signature = (source, resolution = None, voxel_size = None, method = "flood",
     flood = "blocks", graystack = 1 << 20, directions = None, layers = "double",
-    unclassified = "no-direction", density = 1.0,
+    unclassified = "no-direction", fill = "parity", density = 1.0,
     topology = false, sdf = false, band = 3.0, threads = None, max_memory_mib = None,
     up_axis = "z", progress = None))]
 #[allow(clippy::too_many_arguments)]
@@ -204,6 +206,7 @@ pub fn solid(
     directions: Option<&Bound<'_, PyAny>>,
     layers: &str,
     unclassified: &str,
+    fill: &str,
     density: f64,
     topology: bool,
     sdf: bool,
@@ -244,7 +247,15 @@ pub fn solid(
                     }
                 },
             }),
-            "beam" => Fill::Beam,
+            "beam" => Fill::Beam(match fill {
+                "parity" => BeamFill::Parity,
+                "paper" => BeamFill::Paper,
+                _ => {
+                    return Err(PyValueError::new_err(format!(
+                        "fill must be parity or paper, not `{fill}`"
+                    )));
+                }
+            }),
             _ => {
                 return Err(PyValueError::new_err(format!(
                     "method must be flood, depth-layers or beam, not `{method}`"
@@ -313,11 +324,13 @@ pub fn subdiv(
 
 /// The surface F = 0 of a formula (Stolte & Kaufman's interval octree): `coords` is
 /// cartesian (x, y, z), spherical (r, theta, phi) or cylindrical (r, theta, z); `bounds`
-/// is `(lo, hi)` for a cube or `((x0, y0, z0), (x1, y1, z1))`.
+/// is `(lo, hi)` for a cube or `((x0, y0, z0), (x1, y1, z1))`; `theta_range` "positive"
+/// (the paper's [0, 2pi)) or "symmetric" ((-pi, pi]); `squared`: the paper's [G]^2 - r^2 = 0
+/// for F = G - r (the surface r = |G|).
 #[pyfunction]
 #[pyo3(signature = (formula, coords = "cartesian", bounds = None, resolution = 256,
-    levels = false, negative_r = false, threads = None, max_memory_mib = None,
-    progress = None))]
+    levels = false, negative_r = false, theta_range = "positive", squared = false,
+    threads = None, max_memory_mib = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn implicit(
     py: Python<'_>,
@@ -327,6 +340,8 @@ pub fn implicit(
     resolution: u32,
     levels: bool,
     negative_r: bool,
+    theta_range: &str,
+    squared: bool,
     threads: Option<usize>,
     max_memory_mib: Option<u64>,
     progress: Option<Py<PyAny>>,
@@ -351,6 +366,8 @@ pub fn implicit(
         max,
         levels,
         negative_r,
+        theta_range: parse::<crate::implicit::ThetaRange>(theta_range)?,
+        squared,
     };
     Common::new(threads, max_memory_mib, "z", progress)?.run(
         py,

@@ -5,7 +5,7 @@
 
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
-use crate::implicit::{Formula, to_coordinates};
+use crate::implicit::Formula;
 use crate::mesh::{Aabb, Mesh, index_box};
 use crate::ops::csg::{resample, same_transform};
 use crate::progress::Progress;
@@ -113,7 +113,7 @@ pub fn formula_solid(
         bounds,
         || Vec::with_capacity(f.tape.len()),
         |slots, c| {
-            let vars = to_coordinates(f.coordinates, c.to_array());
+            let vars = f.coordinates_of(c.to_array());
             f.tape.eval_with(vars, slots) < 0.0
         },
     )

@@ -258,11 +258,11 @@ impl Run<'_> {
     fn test(&self, b: [Interval; 3], whole_axis: bool, part: &mut Partial) -> BoxTest {
         part.stats.cells_tested += 1;
         let f = self.formula;
-        let (c, both) = (f.coordinates, self.options.both_signs);
+        let both = self.options.both_signs;
         if self.divides {
-            test_box(&f.tape, c, b, both, whole_axis, &mut part.split_slots)
+            test_box(f, b, both, whole_axis, &mut part.split_slots)
         } else {
-            test_box(&f.tape, c, b, both, whole_axis, &mut part.slots)
+            test_box(f, b, both, whole_axis, &mut part.slots)
         }
     }
 

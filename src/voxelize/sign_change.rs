@@ -26,9 +26,7 @@ pub fn voxelize_sign_change(
         for j in 0..=cells.y {
             for i in 0..=cells.x {
                 let p = min + DVec3::new(i as f64, j as f64, k as f64) * h;
-                out.push(
-                    value_at(&formula.tape, formula.coordinates, p.to_array(), negative) < 0.0,
-                );
+                out.push(value_at(formula, p.to_array(), negative) < 0.0);
             }
         }
         out

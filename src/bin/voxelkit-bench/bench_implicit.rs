@@ -1,5 +1,6 @@
 //! `voxelkit bench implicit`: the paper's Fig. 5 — sin(nθ) sin(mφ) - r by interval octree at
-//! growing resolutions, with the time ratio per doubling (the paper: close to 4, not 8) — and
+//! growing resolutions, as the paper computes it (θ in [0, 2π), the substitution
+//! [G]² - r² = 0, so every lobe of the surface), with the time ratio per doubling (the paper: close to 4, not 8) — and
 //! the naive reference in the same process: F at every voxel corner, voxels with a sign change.
 
 use crate::bench::best_of;
@@ -21,9 +22,12 @@ pub struct ImplicitBenchArgs {
     /// Resolutions at which the naive corner-sign method also runs.
     #[arg(long, value_delimiter = ',', default_value = "256,512")]
     naive: Vec<u32>,
-    /// Also negative r (both signs); by default r >= 0.
+    /// Also negative r (both signs).
     #[arg(long)]
     negative_r: bool,
+    /// r = G as typed (G >= 0: half the lobes) instead of the paper's [G]^2 - r^2 = 0.
+    #[arg(long)]
+    typed: bool,
     #[arg(long, default_value_t = 2)]
     threads: usize,
     /// Runs per measurement; the fastest is reported.
@@ -64,7 +68,10 @@ pub fn run(args: &ImplicitBenchArgs, json: bool) -> Result<()> {
     for nm in &args.nm {
         let (n, m) = parse_nm(nm)?;
         let text = format!("sin({n}*theta)*sin({m}*phi) - r");
-        let formula = Formula::parse(&text, Coordinates::Spherical)?;
+        let formula = Formula {
+            squared: !args.typed,
+            ..Formula::parse(&text, Coordinates::Spherical)?
+        };
         let mut previous: Option<f64> = None;
         for &res in &args.resolutions {
             let options = OctreeOptions {

@@ -4,7 +4,7 @@ use crate::run::{Global, run_and_report};
 use clap::Args;
 use glam::DVec3;
 use std::path::PathBuf;
-use voxelkit::implicit::Coordinates;
+use voxelkit::implicit::{Coordinates, ThetaRange};
 use voxelkit::mesh::GridFit;
 use voxelkit::pipeline::{Job, Task};
 use voxelkit::{Error, Result};
@@ -78,10 +78,22 @@ pub struct ImplicitArgs {
     /// F(-r, theta + pi, -phi) = 0 (cylindrical: F(-r, theta + pi, y) = 0).
     #[arg(long)]
     negative_r: bool,
+    /// Spherical and cylindrical: the values theta takes, `positive` (the paper's
+    /// [0, 2pi), cut along +x) or `symmetric` ((-pi, pi], cut along -x).
+    #[arg(long, default_value = "positive", value_parser = parse_theta_range)]
+    theta_range: ThetaRange,
+    /// For F = G - r: Stolte & Kaufman's substitution [G]^2 - r^2 = 0, the surface r = |G|
+    /// (lobes where G < 0 included) instead of r = G as typed.
+    #[arg(long)]
+    squared: bool,
     /// Output: a .vdb (`density`, `normal`, and the levels), or a .binvox or .vox (the voxels
     /// alone).
     #[arg(short, long)]
     output: PathBuf,
+}
+
+fn parse_theta_range(s: &str) -> std::result::Result<ThetaRange, String> {
+    s.parse()
 }
 
 fn parse_coords(s: &str) -> std::result::Result<Coordinates, String> {
@@ -132,6 +144,8 @@ pub fn run(args: &ImplicitArgs, global: &Global) -> Result<()> {
         max,
         levels: args.levels,
         negative_r: args.negative_r,
+        theta_range: args.theta_range,
+        squared: args.squared,
     };
     let job = Job::new(task, GridFit::Resolution(args.resolution));
     run_and_report(job, &args.output, global)

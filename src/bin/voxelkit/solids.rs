@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use voxelkit::Result;
 use voxelkit::ops::csg::BooleanOp;
 use voxelkit::pipeline::{CsgSource, Fill, GridSource, Job, MeasureSource, MeshSource, Task};
+use voxelkit::solids::beam::BeamFill;
 use voxelkit::solids::exterior_flood::FloodMethod;
 
 /// The floods to choose from.
@@ -67,6 +68,22 @@ pub enum SolidMethod {
     Beam,
 }
 
+/// The beam fills to choose from.
+#[derive(clap::ValueEnum, Clone, Copy)]
+pub enum BeamFillKind {
+    Parity,
+    Paper,
+}
+
+impl From<BeamFillKind> for BeamFill {
+    fn from(k: BeamFillKind) -> Self {
+        match k {
+            BeamFillKind::Parity => BeamFill::Parity,
+            BeamFillKind::Paper => BeamFill::Paper,
+        }
+    }
+}
+
 #[derive(Args)]
 pub struct SolidArgs {
     /// Closed input meshes (.obj, .stl, .ply, .off, .gltf or .glb; several with --out-dir,
@@ -76,6 +93,16 @@ pub struct SolidArgs {
     pub inputs: Vec<PathBuf>,
     #[arg(long, value_enum, default_value = "flood")]
     pub method: SolidMethod,
+    /// --method beam: `parity` fills voxel centres between exact crossings 1-2, 3-4, ... of
+    /// each column; `paper` fills Jegathese et al.'s way, from each back-face voxel up to the
+    /// next front-face voxel.
+    #[arg(
+        long = "fill",
+        value_enum,
+        default_value = "parity",
+        value_name = "RULE"
+    )]
+    pub beam_fill: BeamFillKind,
     #[command(flatten)]
     pub fill: FillArgs,
     /// Also count the solid's components (26-connected) and genus, as `measure` does (a
@@ -156,7 +183,7 @@ pub fn solid(args: &SolidArgs, global: &Global) -> Result<()> {
     let fill = match args.method {
         SolidMethod::Flood => Fill::Flood(args.fill.flood.method()),
         SolidMethod::DepthLayers => Fill::DepthLayers(args.depth.options()),
-        SolidMethod::Beam => Fill::Beam,
+        SolidMethod::Beam => Fill::Beam(args.beam_fill.into()),
     };
     let task = |mesh| {
         if args.sdf {
