@@ -209,6 +209,14 @@ vk_status vk_voxelize_formula(const char *formula, vk_coordinates coordinates,
 vk_status vk_fill_mesh(const vk_mesh *mesh, const vk_options *options, vk_grid **solid,
                        vk_measures *measures);
 
+/* The solid of the closed limit surface of `mesh` taken as a Catmull-Clark control mesh
+ * (Lai & Cheng): its voxels, as vk_voxelize_subdivision makes them, and the inside flooded
+ * from seeds one voxel against the limit normals by FloodingXYZ (GRAYSTACK from
+ * vk_options_set_flood when it asks for FloodingXYZ, else 2^20 entries); `measures` may be
+ * NULL. An open control mesh is refused. */
+vk_status vk_fill_subdivision(const vk_mesh *mesh, const vk_options *options, vk_grid **solid,
+                              vk_measures *measures);
+
 /* The inside of a closed voxel surface by exterior flooding, and its measures. */
 vk_status vk_measure_surface(const vk_grid *surface, vk_measures *measures);
 

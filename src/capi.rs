@@ -16,7 +16,7 @@ use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::BooleanOp;
 use crate::pipeline::{
     ColorChoice, Details, Fill, GridSource, Job, Limits, MeasureSource, MeshSource, Outcome,
-    SurfaceMethod as PipelineSurface, Task,
+    SubdivisionFill, SurfaceMethod as PipelineSurface, Task,
 };
 use crate::progress::Observer;
 use crate::solids::csg_leaves::ALL_DIRECTIONS;
@@ -881,6 +881,7 @@ pub extern "C" fn vk_voxelize_subdivision(
                 adjacency: o.separability.flood_adjacency(),
                 ..o.subdivision
             },
+            solid: None,
         })
     })
 }
@@ -961,6 +962,40 @@ pub extern "C" fn vk_fill_mesh(
         };
         if !measures.is_null() {
             put(measures, found)?;
+        }
+        hand_out(VkGrid::from(outcome), Kind::Grid, solid)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_fill_subdivision(
+    mesh: *const VkMesh,
+    options: *const VkOptions,
+    solid: *mut *mut VkGrid,
+    measures: *mut VkMeasures,
+) -> VkStatus {
+    guard(|| {
+        let o = &options_of(options)?;
+        non_null_out(solid)?;
+        let graystack = match o.flood {
+            FloodMethod::Xyz { capacity } => capacity,
+            _ => 1 << 20,
+        };
+        let task = Task::Subdivision {
+            mesh: mesh_source(mesh)?,
+            options: ParametricOptions {
+                adjacency: o.separability.flood_adjacency(),
+                ..o.subdivision
+            },
+            solid: Some(SubdivisionFill {
+                graystack,
+                density: 1.0,
+                topology: false,
+            }),
+        };
+        let outcome = run_job(o, task)?;
+        if !measures.is_null() {
+            put(measures, solid_measures(&outcome)?)?;
         }
         hand_out(VkGrid::from(outcome), Kind::Grid, solid)
     })

@@ -87,6 +87,19 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
             Task::Subdivision {
                 mesh: MeshSource::File(cube.to_path_buf()),
                 options: ParametricOptions::default(),
+                solid: None,
+            },
+        ),
+        (
+            "subdivision solid",
+            Task::Subdivision {
+                mesh: MeshSource::File(cube.to_path_buf()),
+                options: ParametricOptions::default(),
+                solid: Some(voxelkit::pipeline::SubdivisionFill {
+                    graystack: 1 << 10,
+                    density: 1.0,
+                    topology: true,
+                }),
             },
         ),
         (

@@ -214,3 +214,44 @@ fn bad_points_are_refused_with_their_line() {
         );
     }
 }
+
+/// `subdiv --solid`: the solid written like `voxelkit solid`'s (`density` on the whole solid,
+/// `shell` and `interior`), the exact limit volume in the report between the voxel volumes;
+/// an open control mesh refused with no output.
+#[test]
+fn subdiv_solid_writes_the_filled_limit_surface() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = write(dir.path(), "cube.obj", CUBE);
+    let output = dir.path().join("solid.vdb");
+    let o = voxelkit(&[
+        "--json",
+        "subdiv",
+        &input,
+        "--solid",
+        "-r",
+        "48",
+        "-o",
+        output.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let number = |k: &str| report[k].as_f64().unwrap();
+    assert!(number("volume_inside") <= number("limit_volume"));
+    assert!(number("limit_volume") <= number("volume_with_surface"));
+    assert!(number("line_floods") > 0.0);
+    let grids = read_vdb_info(&output).unwrap();
+    let count = |name: &str| grids.iter().find(|g| g.name == name).unwrap().active_voxels;
+    assert_eq!(grids[0].name, "density");
+    assert_eq!(count("density"), count("shell") + count("interior"));
+    // One face fewer: an open control mesh.
+    let open = CUBE.rsplit_once("f 4 1 5 8\n").unwrap().0;
+    let open = write(dir.path(), "open.obj", open);
+    let refused = dir.path().join("open.vdb");
+    let o = voxelkit(&["subdiv", &open, "--solid", "-o", refused.to_str().unwrap()]);
+    assert!(
+        !o.status.success() && text(&o).contains("closed"),
+        "{}",
+        text(&o)
+    );
+    assert!(!refused.exists());
+}

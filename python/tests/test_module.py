@@ -58,6 +58,18 @@ def test_subdiv_equals_cli(data, cli, tmp_path, name):
     assert voxel_set(grid.ijk) == cli_voxels(cli, tmp_path, "subdiv", path, "-r", 64, "-a", 6)
 
 
+def test_subdiv_solid_equals_cli(data, cli, tmp_path):
+    """A Catmull-Clark solid (seeds, FloodingXYZ) is the CLI's, and its voxel volume brackets
+    the exact limit volume."""
+    path = data / "subd" / "catmark_torus.obj"
+    grid = voxelkit.subdiv(path, resolution=64, solid=True)
+    expected = cli_voxels(cli, tmp_path, "subdiv", path, "-r", 64, "--solid")
+    assert voxel_set(grid.ijk) == expected
+    r = grid.report
+    assert r["volume_inside"] <= r["limit_volume"] <= r["volume_with_surface"]
+    assert set(grid.extras) >= {"shell", "interior"}
+
+
 def test_implicit_equals_cli(cli, tmp_path):
     formula = "sin(3*theta)*sin(4*phi) - r"
     grid = voxelkit.implicit(formula, coords="spherical", bounds=(-1, 1), resolution=64)

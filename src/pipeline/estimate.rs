@@ -216,15 +216,19 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             let p = plan_of(t, &bbox, bytes, (cells(&b) / 512.0).ceil() as u64);
             (Loaded::Shape, p)
         }
-        Task::Subdivision { mesh, .. } => {
+        Task::Subdivision { mesh, solid, .. } => {
             let control = match mesh {
                 super::MeshSource::File(path) => ControlMesh::load(path)?,
                 super::MeshSource::Mesh(m) => ControlMesh::from_mesh(m)?,
             };
             let bbox = control.bbox();
             let t = fit_transform(&bbox, fit)?;
-            checked_box(&bbox, &t)?;
-            let bytes = surface_bytes(area_in_voxels(&control.polygon_mesh(), &t), 1);
+            let b = checked_box(&bbox, &t)?;
+            let mut bytes = surface_bytes(area_in_voxels(&control.polygon_mesh(), &t), 1);
+            if solid.is_some() {
+                // The blocked and flooded bit volumes, the GRAYSTACK and the solid.
+                bytes += solid_bytes(cells(&padded(b, 1)), 3);
+            }
             let p = plan_of(t, &bbox, bytes, control.patch_count() as u64);
             (Loaded::Control(control), p)
         }

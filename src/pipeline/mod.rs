@@ -136,10 +136,12 @@ pub enum Task {
         /// Widen the slabs by the curvature margin (false: the paper's plain rule).
         curvature_margin: bool,
     },
-    /// A Catmull-Clark limit surface from its control mesh.
+    /// A Catmull-Clark limit surface from its control mesh; with `solid`, the solid it
+    /// bounds (seeds from the limit normals, FloodingXYZ from them).
     Subdivision {
         mesh: MeshSource,
         options: ParametricOptions,
+        solid: Option<SubdivisionFill>,
     },
     /// F = 0 inside `[min, max]`, by interval octree.
     Implicit {
@@ -186,6 +188,17 @@ pub enum Task {
         resample: bool,
         curve: bool,
     },
+}
+
+/// How a Catmull-Clark solid is filled and weighed.
+#[derive(Clone, Copy, Debug)]
+pub struct SubdivisionFill {
+    /// GRAYSTACK capacity for FloodingXYZ (entries).
+    pub graystack: usize,
+    /// Mass per unit volume.
+    pub density: f64,
+    /// Also count components and genus.
+    pub topology: bool,
 }
 
 /// Limits the work must respect.
@@ -530,9 +543,22 @@ impl PlannedJob {
                 let margin = *curvature_margin;
                 outcome::shape(shape, t, *separability, *normals, margin, &fit, progress)
             }
-            (Task::Subdivision { options, .. }, Loaded::Control(control)) => {
-                outcome::subdivision(control, t, options, &fit, progress)
-            }
+            (
+                Task::Subdivision {
+                    options,
+                    solid: None,
+                    ..
+                },
+                Loaded::Control(control),
+            ) => outcome::subdivision(control, t, options, &fit, progress),
+            (
+                Task::Subdivision {
+                    options,
+                    solid: Some(fill),
+                    ..
+                },
+                Loaded::Control(control),
+            ) => solid::subdivision_solid(control, t, options, *fill, &fit, progress),
             (
                 Task::Implicit {
                     min,

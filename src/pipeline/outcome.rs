@@ -224,7 +224,11 @@ fn write_to_stdout(write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
 }
 
 /// `method`, `source_file` and `resolution`, the metadata every output carries.
-fn provenance(method: &str, source: &str, resolution: &str) -> Vec<(&'static str, String)> {
+pub(super) fn provenance(
+    method: &str,
+    source: &str,
+    resolution: &str,
+) -> Vec<(&'static str, String)> {
     vec![
         ("method", method.to_string()),
         ("source_file", source.to_string()),

@@ -165,8 +165,12 @@ pub struct SolidDetails {
     pub inside_rule: String,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mesh_signed_volume: Option<f64>,
+    /// The surface's area: a mesh's, or a limit surface's by Gauss quadrature.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mesh_area: Option<f64>,
+    /// The exact volume a Catmull-Clark limit surface encloses (Gauss quadrature).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limit_volume: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none", flatten)]
     pub flooding_xyz: Option<FloodingXyzDetails>,
 }
@@ -363,9 +367,12 @@ impl Report {
 }
 
 fn solid_summary(place: &str, s: &SolidDetails, timing: &str) -> String {
-    let mesh = match (s.mesh_signed_volume, s.mesh_area) {
-        (Some(v), Some(a)) => format!(" (faces: area {a:.6}, signed volume {v:.6})"),
-        (Some(v), None) => format!(" (mesh signed volume {v:.6})"),
+    let mesh = match (s.mesh_signed_volume, s.mesh_area, s.limit_volume) {
+        (_, Some(a), Some(v)) => {
+            format!(" (limit surface, Gauss quadrature: area {a:.6}, volume {v:.6})")
+        }
+        (Some(v), Some(a), None) => format!(" (faces: area {a:.6}, signed volume {v:.6})"),
+        (Some(v), None, None) => format!(" (mesh signed volume {v:.6})"),
         _ => String::new(),
     };
     let xyz = s.flooding_xyz.map_or(String::new(), |x| {

@@ -2,12 +2,13 @@
 //! distance band, measure a mesh or a `.vdb` surface, evaluate a CSG tree; with volumes,
 //! mass, components and genus.
 
-use super::Fill;
 use super::outcome::Outcome;
+use super::outcome::provenance;
 use super::report::{
     CsgDetails, CsgLeafCount, DepthLayerDetails, Details, DirectionCounts, DistanceBandDetails,
     FloodingXyzDetails, SolidDetails,
 };
+use super::{Fill, SubdivisionFill};
 use crate::error::Result;
 use crate::grid::{Adjacency, DenseMask, SparseGrid, Transform};
 use crate::io::vdb::DistanceGrid;
@@ -20,7 +21,9 @@ use crate::solids::csg_tree::CsgTree;
 use crate::solids::depth_layers::{Layers, depth_layer_solid};
 use crate::solids::exterior_flood::{FloodMethod, Solid, solid_from_surface};
 use crate::solids::level_set::{level_set, unsigned_distance};
+use crate::subd::ControlMesh;
 use crate::voxelize::Separability;
+use crate::voxelize::parametric::ParametricOptions;
 use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 use std::time::Instant;
 
@@ -31,6 +34,9 @@ pub const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it a
 /// What inside means for the exterior flood.
 const FLOOD_RULE: &str =
     "inside = what the exterior flood (from the box corner, no normals needed) cannot reach";
+
+/// What inside means for a Catmull-Clark solid.
+const SUBDIVISION_RULE: &str = "inside = what FloodingXYZ reaches from the seeds one voxel against the limit normals (Lai & Cheng)";
 
 /// What inside means for the beams, by fill.
 const BEAM_RULE: &str = "inside = the beams between front and back faces along z (centres between crossings 1-2, 3-4, ...)";
@@ -88,6 +94,7 @@ fn solid_details(
         inside_rule: rule.to_string(),
         mesh_signed_volume: mesh.map(Mesh::signed_volume),
         mesh_area: None,
+        limit_volume: None,
         flooding_xyz: solid.xyz_stats.map(|s| FloodingXyzDetails {
             line_floods: s.line_floods,
             sweeps: s.sweeps,
@@ -344,4 +351,53 @@ pub(super) fn csg_tree(tree: &CsgTree, progress: &Progress) -> Result<Outcome> {
         ("source_file", tree.source.display().to_string()),
     ];
     Ok(centre_solid(&solid, t, meta, Details::Csg(details)).timed(start))
+}
+
+/// Lai & Cheng's Catmull-Clark solid: the limit surface, the inside flooded from seeds by
+/// FloodingXYZ, and the exact limit volume and area beside the voxel volume.
+pub(super) fn subdivision_solid(
+    control: &ControlMesh,
+    t: Transform,
+    options: &ParametricOptions,
+    fill: SubdivisionFill,
+    resolution: &str,
+    progress: &Progress,
+) -> Result<Outcome> {
+    let start = Instant::now();
+    let made = crate::solids::subdivision::subdivision_solid(
+        control,
+        t,
+        options,
+        fill.graystack.max(1),
+        progress,
+    )?;
+    let method = "lai-cheng-parametric-enclosed+seeds+flooding-xyz";
+    let mut meta = provenance(method, &control.source.display().to_string(), resolution);
+    meta.push(("adjacency", options.adjacency.number().to_string()));
+    meta.push(("limit_volume", made.limit_volume.to_string()));
+    meta.push(("limit_area", made.limit_area.to_string()));
+    meta.push(("seeds", made.seeds.to_string()));
+    let (limit_volume, limit_area) = (made.limit_volume, made.limit_area);
+    let outside_seeds = made.outside_seeds;
+    let opposite = made.surface.opposite;
+    let outcome = surface_and_inside(made.surface.surface, made.solid, meta, |whole, solid| {
+        let mut details = solid_details(
+            whole,
+            solid,
+            fill.density,
+            SUBDIVISION_RULE,
+            None,
+            fill.topology,
+        )?;
+        details.limit_volume = Some(limit_volume);
+        details.mesh_area = Some(limit_area);
+        Ok(details)
+    })?;
+    let mut outcome = outcome.with("opposite_normals", opposite).timed(start);
+    if outside_seeds > 0 {
+        outcome.report.warnings.push(format!(
+            "{outside_seeds} seeds lay outside (the solid is thinner than a voxel there): their floods reached the border and were dropped"
+        ));
+    }
+    Ok(outcome)
 }

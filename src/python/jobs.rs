@@ -9,8 +9,8 @@ use crate::implicit::Coordinates;
 use crate::mesh::{GridFit, UpAxis};
 use crate::ops::csg::BooleanOp;
 use crate::pipeline::{
-    ColorChoice, CsgSource, Fill, GridSource, Job, Limits, MeasureSource, Outcome, SurfaceMethod,
-    Task,
+    ColorChoice, CsgSource, Fill, GridSource, Job, Limits, MeasureSource, Outcome, SubdivisionFill,
+    SurfaceMethod, Task,
 };
 use crate::solids::beam::BeamFill;
 use crate::solids::depth_layers::{DepthLayerOptions, DirectionSet, Layers, Unclassified};
@@ -278,11 +278,13 @@ pub fn solid(
 
 /// A Catmull-Clark limit surface from its control mesh (Lai & Cheng): every voxel meets the
 /// `adjacency` (6, 18 or 26) between the corners of its sub-patches; `enclose`: every voxel
-/// the surface touches.
+/// the surface touches. `solid`: the solid of the closed limit surface, its inside flooded
+/// from seeds against the limit normals by FloodingXYZ (`graystack` entries), with its volume
+/// and mass (`density`) beside the exact limit volume in the report.
 #[pyfunction]
 #[pyo3(signature = (source, resolution = None, voxel_size = None, adjacency = 26,
-    enclose = false, presplit = 8, threads = None, max_memory_mib = None, up_axis = "z",
-    progress = None))]
+    enclose = false, presplit = 8, solid = false, graystack = 1 << 20, density = 1.0,
+    topology = false, threads = None, max_memory_mib = None, up_axis = "z", progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn subdiv(
     py: Python<'_>,
@@ -292,6 +294,10 @@ pub fn subdiv(
     adjacency: u32,
     enclose: bool,
     presplit: u32,
+    solid: bool,
+    graystack: usize,
+    density: f64,
+    topology: bool,
     threads: Option<usize>,
     max_memory_mib: Option<u64>,
     up_axis: &str,
@@ -314,6 +320,11 @@ pub fn subdiv(
             presplit,
             enclose,
         },
+        solid: solid.then_some(SubdivisionFill {
+            graystack,
+            density,
+            topology,
+        }),
     };
     Common::new(threads, max_memory_mib, up_axis, progress)?.run(
         py,

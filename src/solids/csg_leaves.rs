@@ -147,6 +147,23 @@ pub fn mesh_solid(
     Ok(s.inside)
 }
 
+/// A closed Catmull-Clark control mesh's solid: its voxelized limit surface and the inside
+/// flooded from seeds (Lai & Cheng), surface voxels included.
+pub fn subdivision_leaf(
+    control: &crate::subd::ControlMesh,
+    transform: &Transform,
+    bbox: CoordBox,
+) -> Result<DenseMask> {
+    let made = crate::solids::subdivision::subdivision_solid(
+        control,
+        *transform,
+        &Default::default(),
+        1 << 20,
+        &Progress::none(),
+    )?;
+    DenseMask::from_grid(&crate::solids::subdivision::whole(&made), bbox)
+}
+
 /// The active voxels of `grid` on `transform` (resampled when the transforms differ) that
 /// lie in `bbox`.
 pub fn grid_solid(grid: &SparseGrid, transform: &Transform, bbox: CoordBox) -> Result<DenseMask> {

@@ -1,5 +1,6 @@
 //! CSG trees read from a small JSON file (Lai & Cheng §7.3 on whole trees): Booleans over
-//! boxes, cylinders, spheres, formulas, closed meshes and .vdb grids, evaluated on one grid.
+//! boxes, cylinders, spheres, formulas, closed meshes, Catmull-Clark solids and .vdb grids,
+//! evaluated on one grid.
 //!
 //! ```json
 //! { "resolution": 256,
@@ -9,12 +10,15 @@
 //!                                    "radius": 0.8, "height": 1 } } ] },
 //!       { "formula": { "text": "(sqrt(x^2 + y^2) - 0.8)^2 + (z - 1)^2 - 0.01",
 //!                      "bounds": { "min": [-1, -1, 0.8], "max": [1, 1, 1.2] } } },
-//!       { "mesh": "bolt.obj" }, { "vdb": { "file": "pocket.vdb", "grid": "voxels" } } ] } }
+//!       { "mesh": "bolt.obj" }, { "subdiv": "knob.obj" },
+//!       { "vdb": { "file": "pocket.vdb", "grid": "voxels" } } ] } }
 //! ```
 //!
 //! Every node is an object with one key, its kind (serde's externally tagged enum): `union`,
 //! `intersection` and `difference` hold lists of nodes; `formula` holds the text, or an
-//! object with `text`, `coordinates` and `bounds`; `vdb` a file name, or `file` and `grid`.
+//! object with `text`, `coordinates` and `bounds`; `vdb` a file name, or `file` and `grid`;
+//! `subdiv` a closed Catmull-Clark control mesh, whose solid is its voxelized limit surface
+//! and the inside flooded from seeds (`solids::subdivision`).
 //! `union` and `intersection` take any number of operands, `difference` removes all later
 //! operands from the first. A formula's solid is where F < 0. `voxel_size` may replace
 //! `resolution` (voxels along the longest axis of the bounds); `bounds` (top level) fixes the
@@ -23,6 +27,7 @@
 
 use super::csg_leaves::{
     ALL_DIRECTIONS, Primitive, formula_solid, grid_bounds, grid_solid, mesh_solid, primitive_solid,
+    subdivision_leaf,
 };
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
@@ -31,6 +36,7 @@ use crate::io::vdb::read_vdb_grid;
 use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
 use crate::ops::csg::BooleanOp;
 use crate::shapes::{Cuboid, Cylinder, Sphere};
+use crate::subd::ControlMesh;
 use glam::DVec3;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -46,6 +52,7 @@ pub enum CsgNode {
         bounds: Option<Aabb>,
     },
     Mesh(Mesh),
+    Subdivision(ControlMesh),
     Grid {
         grid: SparseGrid,
         source: PathBuf,
@@ -79,6 +86,7 @@ impl CsgTree {
                     operands.iter().for_each(|n| collect(n, files));
                 }
                 CsgNode::Mesh(mesh) => files.push(mesh.source.clone()),
+                CsgNode::Subdivision(control) => files.push(control.source.clone()),
                 CsgNode::Grid { source, .. } => files.push(source.clone()),
                 CsgNode::Primitive(_) | CsgNode::Formula { .. } => {}
             }
@@ -123,6 +131,7 @@ enum NodeSpec {
     Sphere(SphereSpec),
     Formula(FormulaSpec),
     Mesh(String),
+    Subdiv(String),
     Vdb(VdbSpec),
 }
 
@@ -327,6 +336,9 @@ impl Reader<'_> {
             NodeSpec::Mesh(file) => Mesh::load(&self.folder.join(file))
                 .map(CsgNode::Mesh)
                 .map_err(|e| self.error(&format!("{at}.mesh"), &e.to_string())),
+            NodeSpec::Subdiv(file) => ControlMesh::load(&self.folder.join(file))
+                .map(CsgNode::Subdivision)
+                .map_err(|e| self.error(&format!("{at}.subdiv"), &e.to_string())),
             NodeSpec::Vdb(v) => {
                 let (file, name) = match v {
                     VdbSpec::File(file) => (file, None),
@@ -361,6 +373,7 @@ impl CsgNode {
             CsgNode::Primitive(p) => Some(p.bounds()),
             CsgNode::Formula { bounds, .. } => *bounds,
             CsgNode::Mesh(m) => Some(m.bbox()),
+            CsgNode::Subdivision(c) => Some(c.bbox()),
             CsgNode::Grid { grid, .. } => grid_bounds(grid),
         }
     }
@@ -393,6 +406,10 @@ impl CsgNode {
             CsgNode::Mesh(m) => (
                 format!("mesh {}", m.source.display()),
                 mesh_solid(m, transform, bbox, &ALL_DIRECTIONS)?,
+            ),
+            CsgNode::Subdivision(c) => (
+                format!("subdiv {}", c.source.display()),
+                subdivision_leaf(c, transform, bbox)?,
             ),
             CsgNode::Grid { grid, source } => (
                 format!("vdb {}", source.display()),

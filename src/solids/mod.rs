@@ -9,3 +9,4 @@ pub mod csg_tree;
 pub mod depth_layers;
 pub mod exterior_flood;
 pub mod level_set;
+pub mod subdivision;

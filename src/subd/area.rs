@@ -1,7 +1,13 @@
-//! The area of the limit surface by Gauss-Legendre quadrature of |P_s x P_t| over every patch:
-//! an independent reference for the area the voxelizer sums from its sub-patch quads.
+//! The area and the enclosed volume of the limit surface by Gauss-Legendre quadrature over
+//! every patch: the area of |P_s x P_t|, an independent reference for the area the voxelizer
+//! sums from its sub-patch quads; the volume, by the divergence theorem, of
+//! (P - o) . (P_s x P_t) / 3 about a reference point o (the centre of the control points'
+//! box, so that a surface far from the origin loses no precision), signed by the surface's
+//! orientation (positive when its normals face outward).
 
+use super::patch::LimitSample;
 use super::surface::LimitSurface;
+use glam::DVec3;
 use rayon::prelude::*;
 
 /// 5-point Gauss-Legendre nodes and weights on [0, 1].
@@ -27,6 +33,18 @@ const CELLS: usize = 8;
 const CORNER_DEPTH: u32 = 30;
 
 pub fn limit_area(surface: &LimitSurface) -> f64 {
+    integrate(surface, |s| s.du.cross(s.dv).length())
+}
+
+/// The signed volume the closed limit surface encloses (see the module docs).
+pub fn limit_volume(surface: &LimitSurface) -> f64 {
+    let b = surface.control().bbox();
+    let o: DVec3 = 0.5 * (b.min + b.max);
+    integrate(surface, |s| (s.position - o).dot(s.du.cross(s.dv)) / 3.0)
+}
+
+/// The integral of `f` over every patch's parameter square.
+fn integrate(surface: &LimitSurface, f: impl Fn(&LimitSample) -> f64 + Sync) -> f64 {
     (0..surface.patch_count())
         .into_par_iter()
         .map(|pid| {
@@ -35,7 +53,8 @@ pub fn limit_area(surface: &LimitSurface) -> f64 {
             let mut sum = 0.0;
             for j in 0..CELLS {
                 for i in 0..CELLS {
-                    sum += cell(surface, pid, &irregular, [i as f64 * h, j as f64 * h], h, 0);
+                    let at = [i as f64 * h, j as f64 * h];
+                    sum += cell(surface, pid, &irregular, at, h, 0, &f);
                 }
             }
             sum
@@ -50,6 +69,7 @@ fn cell(
     at: [f64; 2],
     h: f64,
     depth: u32,
+    f: &impl Fn(&LimitSample) -> f64,
 ) -> f64 {
     let corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
     let touches = corners.iter().zip(irregular).any(|(&(cu, cv), &irr)| {
@@ -68,6 +88,7 @@ fn cell(
                     [at[0] + du, at[1] + dv],
                     g,
                     depth + 1,
+                    f,
                 )
             })
             .sum();
@@ -75,8 +96,7 @@ fn cell(
     let mut sum = 0.0;
     for (a, wa) in NODES.iter().zip(WEIGHTS) {
         for (b, wb) in NODES.iter().zip(WEIGHTS) {
-            let s = surface.eval_patch(pid, at[0] + a * h, at[1] + b * h);
-            sum += wa * wb * s.du.cross(s.dv).length();
+            sum += wa * wb * f(&surface.eval_patch(pid, at[0] + a * h, at[1] + b * h));
         }
     }
     sum * h * h

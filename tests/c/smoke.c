@@ -166,6 +166,11 @@ int main(int argc, char **argv) {
     CHECK(vk_options_set_subdivision(opts, 0, 0) == VK_ERROR_INVALID_ARGUMENT);
     OK(vk_voxelize_subdivision(box, opts, &g));
     OK(vk_grid_free(g));
+    /* The unit cube as a Catmull-Clark solid: a rounded blob inside it. */
+    vk_measures cc;
+    OK(vk_fill_subdivision(box, opts, &g, &cc));
+    CHECK(cc.inside_voxels > 0 && cc.volume_inside < 1.0 && cc.volume_with_surface > 0.1);
+    OK(vk_grid_free(g));
     const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
     OK(vk_voxelize_formula("x^2 + y^2 + z^2 - 0.5", VK_CARTESIAN, lo, hi, opts, &g));
     OK(vk_grid_free(g));

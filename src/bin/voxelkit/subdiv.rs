@@ -6,7 +6,7 @@ use crate::run::{Global, run_and_report};
 use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
 use voxelkit::grid::Adjacency;
-use voxelkit::pipeline::{Job, MeshSource, Task};
+use voxelkit::pipeline::{Job, MeshSource, SubdivisionFill, Task};
 use voxelkit::subd::{ControlMesh, LimitSurface, compare_points, limit_area, read_points};
 use voxelkit::voxelize::parametric::ParametricOptions;
 use voxelkit::{Error, Result};
@@ -40,7 +40,25 @@ pub struct SubdivVoxelizeArgs {
     /// paper's test alone misses voxels the surface passes through).
     #[arg(long)]
     enclose: bool,
-    /// Output: a .vdb (`density`, `normal` and `opposite_normals` grids), or a .binvox or .vox.
+    /// Fill the closed limit surface (Lai & Cheng §6): seeds one voxel against the limit
+    /// normals, the inside flooded from them by FloodingXYZ; written like `voxelkit solid`'s
+    /// (`density` on the whole solid, `shell`, `interior`), with its volume and mass beside
+    /// the exact limit volume (Gauss quadrature). The surface is always refined as --enclose
+    /// refines it, so that no gap lets the inside flood out.
+    #[arg(long)]
+    solid: bool,
+    /// --solid: GRAYSTACK capacity of FloodingXYZ (entries; when full, sweeps resume the
+    /// flood).
+    #[arg(long, default_value_t = 1 << 20, requires = "solid")]
+    graystack: usize,
+    /// --solid: density (mass per unit volume) for the mass.
+    #[arg(long, default_value_t = 1.0, requires = "solid")]
+    density: f64,
+    /// --solid: also count the solid's components (26-connected) and genus.
+    #[arg(long, requires = "solid")]
+    topology: bool,
+    /// Output: a .vdb (`density`, `normal` and `opposite_normals` grids; with --solid,
+    /// `density`, `shell`, `interior` and `opposite_normals`), or a .binvox or .vox.
     #[arg(short, long, required = true)]
     output: Option<PathBuf>,
 }
@@ -106,6 +124,11 @@ fn voxelize(input: &Path, args: &SubdivVoxelizeArgs, global: &Global) -> Result<
             presplit: args.presplit,
             enclose: args.enclose,
         },
+        solid: args.solid.then_some(SubdivisionFill {
+            graystack: args.graystack,
+            density: args.density,
+            topology: args.topology,
+        }),
     };
     run_and_report(Job::new(task, args.fit.grid_fit()), output, global)
 }

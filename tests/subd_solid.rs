@@ -1,0 +1,198 @@
+//! Lai & Cheng's Catmull-Clark solids (§6-7) on the closed control meshes of the data folder:
+//! the exact limit volume (Gauss quadrature, divergence theorem) against a fine tessellation;
+//! the seeds-and-FloodingXYZ solid at 64, 128 and 256 against the exterior flood of the same
+//! surface (identical) and against the limit volume (within area x h); inward-oriented control
+//! meshes fill the same; open ones are refused; and CSG trees over subdivision solids.
+#![cfg(all(feature = "vdb", feature = "fixtures"))]
+
+mod common;
+
+use std::path::Path;
+use voxelkit::mesh::{GridFit, Mesh, fit_transform};
+use voxelkit::progress::Progress;
+use voxelkit::solids::exterior_flood::{FloodMethod, solid_from_surface};
+use voxelkit::solids::subdivision::{SubdivisionSolid, subdivision_solid};
+use voxelkit::subd::{ControlMesh, LimitSurface, limit_volume};
+
+/// Every closed control mesh of the data folder.
+const CLOSED_CONTROL_MESHES: [&str; 12] = [
+    "spot_control_mesh",
+    "fish_control_mesh",
+    "penguin_control_mesh",
+    "catmark_cube",
+    "catmark_cube_creases1",
+    "catmark_gregory_test8",
+    "catmark_pyramid",
+    "catmark_righthanded",
+    "catmark_smoothtris0",
+    "catmark_torus",
+    "catmark_toroidal_tet",
+    "beast",
+];
+
+fn load(data: &Path, name: &str) -> ControlMesh {
+    ControlMesh::load(&data.join(format!("subd/{name}.obj"))).unwrap()
+}
+
+fn solid_at(control: &ControlMesh, resolution: u32) -> (SubdivisionSolid, f64) {
+    let t = fit_transform(
+        &control.polygon_mesh().bbox(),
+        GridFit::Resolution(resolution),
+    )
+    .unwrap();
+    let made =
+        subdivision_solid(control, t, &Default::default(), 1 << 16, &Progress::none()).unwrap();
+    (made, t.voxel_size)
+}
+
+/// The tessellations' volumes converge on the quadrature's at second order (the error falls
+/// about fourfold per doubling of the segments per patch). Beast is left out: its 32k patches
+/// take a minute to tessellate finely; its volume is checked against the voxels below.
+#[test]
+fn the_limit_volume_is_what_fine_tessellations_converge_to() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    for name in CLOSED_CONTROL_MESHES.iter().filter(|&&n| n != "beast") {
+        let surface = LimitSurface::new(load(&data, name));
+        let exact = limit_volume(&surface);
+        let error = |n: usize| {
+            let tessellated = surface.tessellate(|_| n).signed_volume();
+            (exact - tessellated).abs() / exact.abs()
+        };
+        let errors = [error(8), error(16), error(32)];
+        eprintln!("{name}: limit volume {exact:.9}; tessellation errors {errors:?}");
+        assert!(errors[2] < 2e-3, "{name}: {errors:?}");
+        assert!(
+            errors[1] < errors[0] / 3.0 && errors[2] < errors[1] / 3.0,
+            "{name}: {errors:?}"
+        );
+    }
+}
+
+#[test]
+fn seeded_solids_hold_the_limit_volume_and_equal_the_exterior_flood() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    for name in CLOSED_CONTROL_MESHES {
+        let control = load(&data, name);
+        for resolution in [64, 128, 256] {
+            let (made, h) = solid_at(&control, resolution);
+            let m = made.solid.measures;
+            let (exact, area) = (made.limit_volume, made.limit_area);
+            eprintln!(
+                "{name} {resolution}: limit volume {exact:.6} in {:.6} .. {:.6} (area x h {:.6}); \
+                 {} seeds, {} outside",
+                m.volume_inside,
+                m.volume_with_surface,
+                area * h,
+                made.seeds,
+                made.outside_seeds
+            );
+            assert!(m.volume_inside <= exact && exact <= m.volume_with_surface);
+            assert!(exact - m.volume_inside <= area * h, "{name} {resolution}");
+            assert!(
+                m.volume_with_surface - exact <= area * h,
+                "{name} {resolution}"
+            );
+            let exterior =
+                solid_from_surface(&made.surface.surface, FloodMethod::Spans, &Progress::none())
+                    .unwrap();
+            let unseeded =
+                exterior.inside.voxel_count() as i64 - made.solid.inside.voxel_count() as i64;
+            assert_eq!(unseeded, 0, "{name} {resolution}");
+            assert!(
+                made.solid
+                    .inside
+                    .voxels()
+                    .all(|c| exterior.inside.contains(c)),
+                "{name} {resolution}"
+            );
+        }
+    }
+}
+
+#[test]
+fn inward_control_meshes_fill_the_same_and_open_ones_are_refused() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    let control = load(&data, "catmark_torus");
+    let mesh = control.polygon_mesh();
+    let reversed: Vec<Vec<u32>> = (0..mesh.face_count())
+        .map(|f| mesh.face(f).iter().rev().copied().collect())
+        .collect();
+    let inward = ControlMesh::from_mesh(&Mesh::from_polygons(
+        "inward",
+        mesh.positions.clone(),
+        &reversed,
+    ))
+    .unwrap();
+    let (a, _) = solid_at(&control, 96);
+    let (b, _) = solid_at(&inward, 96);
+    assert_eq!(a.solid.inside.voxel_count(), b.solid.inside.voxel_count());
+    assert!((a.limit_volume - b.limit_volume).abs() < 1e-9 * a.limit_volume);
+    let open = load(&data, "catmark_pawn");
+    assert!(!open.is_closed());
+    let t = fit_transform(&open.polygon_mesh().bbox(), GridFit::Resolution(32)).unwrap();
+    let err = subdivision_solid(&open, t, &Default::default(), 1024, &Progress::none())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        err.contains("catmark_pawn") && err.contains("closed"),
+        "{err}"
+    );
+}
+
+/// Booleans of two subdivision solids on one grid: the difference holds |A| - |A ∩ B|, and A
+/// alone holds its limit volume within area x h.
+#[test]
+fn csg_trees_take_subdivision_leaves() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    use voxelkit::pipeline::{CsgSource, Details, Job, Task};
+    let dir = tempfile::tempdir().unwrap();
+    let a = data.join("subd/catmark_torus.obj");
+    let b = data.join("subd/catmark_cube.obj");
+    let (a, b) = (a.display(), b.display());
+    let volume = |tree: String| {
+        let path = dir.path().join("tree.json");
+        let text = format!(
+            r#"{{"resolution": 96, "bounds": {{"min": [-2, -2, -2], "max": [2, 2, 2]}}, "tree": {tree}}}"#
+        );
+        std::fs::write(&path, text).unwrap();
+        let task = Task::CsgTree(CsgSource::File(path));
+        let outcome = Job::new(task, GridFit::Resolution(96))
+            .run(&voxelkit::progress::Unobserved)
+            .unwrap();
+        let Details::Csg(c) = outcome.report.details else {
+            panic!("a CSG report");
+        };
+        c.volume
+    };
+    let va = volume(format!(r#"{{"subdiv": "{a}"}}"#));
+    let both = volume(format!(
+        r#"{{"intersection": [{{"subdiv": "{a}"}}, {{"subdiv": "{b}"}}]}}"#
+    ));
+    let minus = volume(format!(
+        r#"{{"difference": [{{"subdiv": "{a}"}}, {{"subdiv": "{b}"}}]}}"#
+    ));
+    eprintln!("|A| {va}, |A n B| {both}, |A - B| {minus}");
+    assert!(both > 0.0 && both < va);
+    assert!(
+        (minus - (va - both)).abs() <= 1e-9 * va,
+        "{minus} vs {va} - {both}"
+    );
+    let exact = limit_volume(&LimitSurface::new(
+        ControlMesh::load(&data.join("subd/catmark_torus.obj")).unwrap(),
+    ))
+    .abs();
+    let h = 4.0 / 96.0;
+    let area = voxelkit::subd::limit_area(&LimitSurface::new(
+        ControlMesh::load(&data.join("subd/catmark_torus.obj")).unwrap(),
+    ));
+    assert!((va - exact).abs() <= area * h, "{va} vs {exact}");
+}
