@@ -295,3 +295,35 @@ fn sheets_with_opposite_normals_in_one_voxel_are_marked() {
         }
     }
 }
+
+/// Minimality of the parametric surfaces (Huang et al.'s measure applied to Lai & Cheng's
+/// output): the share of 6-simple voxels (removable while the surface stays 6-separating)
+/// never rises as the corner adjacency loosens from 6 to 18 to 26, and falls by about half at
+/// 26, the thinnest surface (measured at 128: 73% -> 36% on spot); none is minimal, and the
+/// enclosed surface, which holds every voxel the surface touches, is the least minimal.
+#[test]
+fn thinner_adjacencies_leave_fewer_removable_voxels() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    use voxelkit::ops::minimality::simple_voxel_count;
+    for name in ["spot_control_mesh", "catmark_torus", "catmark_toroidal_tet"] {
+        let control = load(&data, name);
+        let share = |adjacency, enclose| {
+            let (out, _) = voxelize(&control, 128, adjacency, enclose);
+            let simple = simple_voxel_count(&out.surface, Adjacency::Six).unwrap();
+            simple as f64 / out.stats.voxels as f64
+        };
+        let (six, eighteen, twenty_six) = (
+            share(Adjacency::Six, false),
+            share(Adjacency::Eighteen, false),
+            share(Adjacency::TwentySix, false),
+        );
+        let enclosed = share(Adjacency::TwentySix, true);
+        eprintln!(
+            "{name} 128: 6-simple share N=6 {six:.3}, N=18 {eighteen:.3}, N=26 {twenty_six:.3}, enclosed {enclosed:.3}"
+        );
+        assert!(six >= eighteen && eighteen > 1.5 * twenty_six, "{name}");
+        assert!(twenty_six > 0.0 && enclosed > twenty_six, "{name}");
+    }
+}

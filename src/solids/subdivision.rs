@@ -12,10 +12,10 @@
 //! - "Against the normal" is inward only if the normals face outward; the sign of the exact
 //!   limit volume says which way they face, so inward-oriented control meshes fill the same.
 //! - The flood runs in a box one voxel larger than the surface, from one seed at a time (seeds
-//!   already reached are skipped). Where the solid is thinner than a voxel, a step against the
-//!   normal can land outside: a seed whose flood reaches the border of the box lay outside,
-//!   and its flood is dropped and counted (`outside_seeds`); later seeds in that region are
-//!   skipped. If no seed stays inside, the solid is refused.
+//!   already reached are skipped). A step along an axis only loosely opposed to the normal, or
+//!   through a part thinner than a voxel, can land outside: a seed whose flood reaches the
+//!   border of the box lay outside, and its flood is dropped and counted (`outside_seeds`);
+//!   later seeds in that region are skipped. If no seed stays inside, the solid is refused.
 
 use crate::error::{Error, Result};
 use crate::grid::{Coord, DenseMask, SparseGrid, Transform};
