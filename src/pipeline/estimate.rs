@@ -1,7 +1,8 @@
 //! Planning: read the inputs, place the grid, and estimate the peak memory and the work
 //! items of every task, so that a job that cannot fit is refused before it allocates.
 //!
-//! Peak memory is counted in 8^3 leaves, calibrated on the shared meshes (bunny-closed at
+//! Peak memory is counted in 8^3 leaves. Mesh surfaces and mesh solids have their own
+//! calibration (below); the other tasks are calibrated on the shared meshes (bunny-closed at
 //! 512..4096, spot, the sphere and torus formulas): a leaf of a voxel set costs about 3.5 KB
 //! at the peak (the thread-local grids before their merge, OpenVDB's bool and float leaves
 //! and the flat arrays when writing), one with a normal or colour channel about 20 KB more.
@@ -16,6 +17,7 @@ use crate::io::vdb::read_vdb_grid;
 use crate::mesh::{Aabb, GridFit, Mesh, UpAxis, fit_transform, index_box};
 use crate::ops::flood::padded;
 use crate::solids::csg_tree::{parse_csg_tree, read_csg_tree};
+use crate::solids::exterior_flood::FloodMethod;
 use crate::subd::ControlMesh;
 use crate::voxelize::{projective, separating};
 use glam::DVec3;
@@ -60,6 +62,38 @@ fn solid_bytes(cells: f64, masks: u32) -> f64 {
 /// A mesh's area in voxels^2.
 fn area_in_voxels(mesh: &Mesh, t: &Transform) -> f64 {
     mesh.area() / (t.voxel_size * t.voxel_size)
+}
+
+/// Mesh surfaces and solids, calibrated on the whole process (bunny-closed, igea, armadillo,
+/// skull and horse at 512..2048: the estimate within 30% of the peak for surfaces and block
+/// flood solids; 1.5-1.6 times it for the fills over dense bit volumes): a separating or
+/// projective surface crosses a leaf per 44 voxels^2 of area and costs 2.6 KB per leaf at
+/// the peak, 34 KB more with normals or colours (the channel, its flat copy and OpenVDB's
+/// Vec3 grid); each triangle about 250 bytes (reading the file, the voxelizer's tables). A solid costs 3.7 KB per leaf of its surface
+/// (the surface, the solid's boundary leaves, the grids written) and 16 bytes per 8^3 block of
+/// its box (the block flood's states and the inside's tiles), besides its dense bit volumes.
+const MESH_AREA_PER_LEAF: f64 = 44.0;
+const MESH_LEAF_BYTES: f64 = 2600.0;
+const MESH_VECTOR_LEAF_BYTES: f64 = 34000.0;
+const TRIANGLE_BYTES: f64 = 250.0;
+const SOLID_LEAF_BYTES: f64 = 3700.0;
+const BLOCK_BYTES: f64 = 16.0;
+
+/// Peak bytes of the separating or projective surface of `mesh`.
+fn mesh_surface_bytes(mesh: &Mesh, t: &Transform, vector_channels: u32) -> f64 {
+    let leaves = area_in_voxels(mesh, t) / MESH_AREA_PER_LEAF + 1.0;
+    leaves * (MESH_LEAF_BYTES + f64::from(vector_channels) * MESH_VECTOR_LEAF_BYTES)
+        + mesh.triangle_count() as f64 * TRIANGLE_BYTES
+}
+
+/// Peak bytes of filling `mesh` over the box `b` with `masks` dense bit volumes at once.
+fn mesh_solid_bytes(mesh: &Mesh, t: &Transform, b: &CoordBox, masks: u32) -> f64 {
+    let leaves = area_in_voxels(mesh, t) / MESH_AREA_PER_LEAF + 1.0;
+    let box_cells = cells(b);
+    f64::from(masks) * box_cells / 8.0
+        + leaves * SOLID_LEAF_BYTES
+        + box_cells / 512.0 * BLOCK_BYTES
+        + mesh.triangle_count() as f64 * TRIANGLE_BYTES
 }
 
 /// Bytes per labelled run of clear voxels: its span, label and union-find parent.
@@ -170,7 +204,7 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
                     (u32::from(colour), mesh.face_count() as u64)
                 }
             };
-            let bytes = surface_bytes(area_in_voxels(&mesh, &t), channels);
+            let bytes = mesh_surface_bytes(&mesh, &t, channels);
             let p = plan_of(t, &mesh.bbox(), bytes, items);
             (Loaded::Mesh(mesh), p)
         }
@@ -350,16 +384,17 @@ fn solid_plan(
 ) -> Result<(Loaded, Plan)> {
     let mesh = mesh.load(false, up)?;
     let (t, b) = mesh_plan(&mesh, fit)?;
+    // Dense bit volumes over the box: none for the block flood, which works on 8^3 blocks.
     let (masks, items) = match fill {
-        super::Fill::Flood(_) => (6, separating::work_items(&mesh)),
+        super::Fill::Flood(FloodMethod::Blocks) => (0, separating::work_items(&mesh)),
+        super::Fill::Flood(_) => (2, separating::work_items(&mesh)),
         super::Fill::DepthLayers(o) => (
-            6,
+            12,
             o.directions.len() as u64 + (b.max[0] - b.min[0] + 1) as u64,
         ),
-        super::Fill::Beam(_) => (5, mesh.face_count() as u64),
+        super::Fill::Beam(_) => (2, mesh.face_count() as u64),
     };
-    let bytes =
-        surface_bytes(area_in_voxels(&mesh, &t), 0) + solid_bytes(cells(&padded(b, 2)), masks);
+    let bytes = mesh_solid_bytes(&mesh, &t, &padded(b, 2), masks);
     let p = plan_of(t, &mesh.bbox(), bytes, items);
     Ok((Loaded::Mesh(mesh), p))
 }

@@ -1,0 +1,68 @@
+//! Planning's memory estimates against the measured peak of the whole process (`voxelkit
+//! --json` reports both): mesh surfaces (with and without normals) and block-flood solids on
+//! five shared meshes at 1024, each estimate within 30% of its peak. Every run is its own
+//! process, so that each peak is the run's alone.
+#![cfg(all(feature = "vdb", feature = "fixtures"))]
+
+mod cli_support;
+mod common;
+
+use cli_support::{text, voxelkit};
+
+const MESHES: [&str; 5] = ["bunny-closed", "igea", "horse", "armadillo", "skull"];
+
+/// The estimate over the peak of `voxelkit --json ARGS -o OUT`.
+fn ratio(args: &[&str], out: &std::path::Path) -> f64 {
+    let mut all = vec!["--json"];
+    all.extend(args);
+    all.extend(["-o", out.to_str().unwrap()]);
+    let o = voxelkit(&all);
+    assert!(o.status.success(), "{args:?}: {}", text(&o));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let (estimated, peak) = (
+        report["estimated_mib"].as_f64().unwrap(),
+        report["peak_mib"].as_f64().unwrap(),
+    );
+    eprintln!("{args:?}: estimated {estimated:.0} MiB, peak {peak:.0} MiB");
+    estimated / peak
+}
+
+#[test]
+fn surface_and_solid_estimates_are_within_30_percent_of_the_peak() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.vdb");
+    let mut cases: Vec<Vec<String>> = Vec::new();
+    for name in MESHES {
+        let mesh = data
+            .join(format!("meshes/{name}.obj"))
+            .display()
+            .to_string();
+        for command in ["mesh", "solid"] {
+            cases.push(vec![
+                command.into(),
+                mesh.clone(),
+                "-r".into(),
+                "1024".into(),
+            ]);
+        }
+    }
+    let bunny = data.join("meshes/bunny-closed.obj").display().to_string();
+    cases.push(vec![
+        "mesh".into(),
+        bunny,
+        "-r".into(),
+        "512".into(),
+        "--normals".into(),
+    ]);
+    for case in cases {
+        let args: Vec<&str> = case.iter().map(String::as_str).collect();
+        let r = ratio(&args, &out);
+        assert!(
+            (0.7..=1.3).contains(&r),
+            "{args:?}: estimate / peak = {r:.2}"
+        );
+    }
+}
