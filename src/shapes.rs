@@ -39,6 +39,10 @@ pub struct Quadric {
 }
 
 impl Sphere {
+    pub fn area(&self) -> f64 {
+        4.0 * std::f64::consts::PI * self.radius * self.radius
+    }
+
     pub fn bounds(&self) -> Aabb {
         Aabb {
             min: self.center - self.radius,
@@ -52,6 +56,12 @@ impl Sphere {
 }
 
 impl Cylinder {
+    /// Side and both caps.
+    pub fn area(&self) -> f64 {
+        let r = self.radius;
+        2.0 * std::f64::consts::PI * r * (self.height + r)
+    }
+
     /// The cylinder from `base` along the unit `axis` for `height`.
     pub fn from_base(base: DVec3, axis: DVec3, radius: f64, height: f64) -> Cylinder {
         Cylinder {
@@ -108,5 +118,26 @@ impl Quadric {
             min: DVec3::splat(-self.half_extent),
             max: DVec3::splat(self.half_extent),
         }
+    }
+
+    /// The area inside the cube, by the midpoint rule over (x, y) on a 256 x 256 grid: the
+    /// surface is z = -(x^2 + k y) / k, with area element sqrt(2 + (2x / k)^2), kept where z
+    /// lies in the cube (for planning; within a percent or so).
+    pub fn area(&self) -> f64 {
+        const N: usize = 256;
+        let e = self.half_extent;
+        let step = 2.0 * e / N as f64;
+        let mut sum = 0.0;
+        for i in 0..N {
+            let x = -e + (i as f64 + 0.5) * step;
+            for j in 0..N {
+                let y = -e + (j as f64 + 0.5) * step;
+                let z = -(x * x + self.k * y) / self.k;
+                if z.abs() <= e {
+                    sum += (2.0 + (2.0 * x / self.k).powi(2)).sqrt();
+                }
+            }
+        }
+        sum * step * step
     }
 }

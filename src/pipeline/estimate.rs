@@ -79,16 +79,37 @@ const TRIANGLE_BYTES: f64 = 250.0;
 const SOLID_LEAF_BYTES: f64 = 3700.0;
 const BLOCK_BYTES: f64 = 16.0;
 
+/// A Catmull-Clark surface costs 15 KB per leaf of its control polygons' area (a leaf per 44
+/// voxels^2; the limit surface is smaller than its control polygons), normals included
+/// (measured on spot and catmark_torus at 512 and 1024: estimate 1.06-1.10 of the peak).
+const SUBDIV_LEAF_BYTES: f64 = 15000.0;
+/// Per patch: its evaluation tables and the voxelizer's working set (6 KB; beast's 32k
+/// patches at 1024), and for a solid the quadrature's patches refined towards extraordinary
+/// corners (20 KB more; beast at 64: 728 MB against 131 MB for its surface alone).
+const PATCH_BYTES: f64 = 6000.0;
+const SOLID_PATCH_BYTES: f64 = 20000.0;
+/// The analytic voxelizer's state per 8^3 block of the shape's box.
+const SHAPE_BLOCK_BYTES: f64 = 8.0;
+
+/// Leaves crossed by a surface of `area` voxels^2.
+fn surface_leaves(area: f64) -> f64 {
+    area / MESH_AREA_PER_LEAF + 1.0
+}
+
+/// Peak bytes of `leaves` surface leaves with `vector_channels` normal or colour channels.
+fn surface_leaf_bytes(leaves: f64, vector_channels: u32) -> f64 {
+    leaves * (MESH_LEAF_BYTES + f64::from(vector_channels) * MESH_VECTOR_LEAF_BYTES)
+}
+
 /// Peak bytes of the separating or projective surface of `mesh`.
 fn mesh_surface_bytes(mesh: &Mesh, t: &Transform, vector_channels: u32) -> f64 {
-    let leaves = area_in_voxels(mesh, t) / MESH_AREA_PER_LEAF + 1.0;
-    leaves * (MESH_LEAF_BYTES + f64::from(vector_channels) * MESH_VECTOR_LEAF_BYTES)
-        + mesh.triangle_count() as f64 * TRIANGLE_BYTES
+    let leaves = surface_leaves(area_in_voxels(mesh, t));
+    surface_leaf_bytes(leaves, vector_channels) + mesh.triangle_count() as f64 * TRIANGLE_BYTES
 }
 
 /// Peak bytes of filling `mesh` over the box `b` with `masks` dense bit volumes at once.
 fn mesh_solid_bytes(mesh: &Mesh, t: &Transform, b: &CoordBox, masks: u32) -> f64 {
-    let leaves = area_in_voxels(mesh, t) / MESH_AREA_PER_LEAF + 1.0;
+    let leaves = surface_leaves(area_in_voxels(mesh, t));
     let box_cells = cells(b);
     f64::from(masks) * box_cells / 8.0
         + leaves * SOLID_LEAF_BYTES
@@ -213,7 +234,7 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             let (t, b) = mesh_plan(&mesh, fit)?;
             // A band 2w+1 voxels thick crosses about that many eighths of each leaf it meets;
             // each leaf is held with its values, then twice more by OpenVDB (level set, fog).
-            let leaves = area_in_voxels(&mesh, &t) / AREA_PER_LEAF * (2.0 * band + 1.0) / 4.0;
+            let leaves = surface_leaves(area_in_voxels(&mesh, &t)) * (2.0 * band + 1.0) / 4.0;
             let bytes = leaf_bytes(leaves, 0) * 2.0 + cells(&padded(b, band.ceil() as i64)) / 8.0;
             let p = plan_of(t, &mesh.bbox(), bytes, mesh.face_count() as u64);
             (Loaded::Mesh(mesh), p)
@@ -236,9 +257,15 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
                 .iter()
                 .map(|&[a, b]| mesh.p(a).distance(mesh.p(b)))
                 .sum();
-            let leaves = (length / t.voxel_size + mesh.positions.len() as f64) / LENGTH_PER_LEAF;
+            // A mesh's edges lie on its surface: never more leaves than the surface crosses.
+            let mut leaves =
+                (length / t.voxel_size + mesh.positions.len() as f64) / LENGTH_PER_LEAF;
+            if mesh.face_count() > 0 {
+                leaves = leaves.min(surface_leaves(area_in_voxels(&mesh, &t)));
+            }
             let colour = color.coloring(&mesh) != projective::Coloring::None;
-            let bytes = leaf_bytes(leaves, u32::from(colour));
+            let bytes = surface_leaf_bytes(leaves, u32::from(colour))
+                + mesh.triangle_count() as f64 * TRIANGLE_BYTES;
             let p = plan_of(t, &mesh.bbox(), bytes, segments.len() as u64);
             (Loaded::Mesh(mesh), p)
         }
@@ -246,7 +273,9 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             let bbox = shape.surface().bbox();
             let t = fit_transform(&bbox, fit)?;
             let b = checked_box(&bbox, &t)?;
-            let bytes = surface_bytes(box_area(extent(&bbox, &t)), u32::from(*normals));
+            let area = shape.area() / (t.voxel_size * t.voxel_size);
+            let bytes = surface_leaf_bytes(surface_leaves(area), u32::from(*normals))
+                + cells(&b) / 512.0 * SHAPE_BLOCK_BYTES;
             let p = plan_of(t, &bbox, bytes, (cells(&b) / 512.0).ceil() as u64);
             (Loaded::Shape, p)
         }
@@ -258,10 +287,13 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             let bbox = control.bbox();
             let t = fit_transform(&bbox, fit)?;
             let b = checked_box(&bbox, &t)?;
-            let mut bytes = surface_bytes(area_in_voxels(&control.polygon_mesh(), &t), 1);
+            let patches = control.patch_count() as f64;
+            let mut bytes = surface_leaves(area_in_voxels(&control.polygon_mesh(), &t))
+                * SUBDIV_LEAF_BYTES
+                + patches * PATCH_BYTES;
             if solid.is_some() {
                 // The blocked and flooded bit volumes, the GRAYSTACK and the solid.
-                bytes += solid_bytes(cells(&padded(b, 1)), 3);
+                bytes += solid_bytes(cells(&padded(b, 1)), 3) + patches * SOLID_PATCH_BYTES;
             }
             let p = plan_of(t, &bbox, bytes, control.patch_count() as u64);
             (Loaded::Control(control), p)

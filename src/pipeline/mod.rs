@@ -326,6 +326,15 @@ impl Shape {
         }
     }
 
+    /// The shape's area in world units (for planning).
+    pub fn area(&self) -> f64 {
+        match self {
+            Shape::Sphere(s) => s.area(),
+            Shape::Cylinder(c) => c.area(),
+            Shape::Quadric(q) => q.area(),
+        }
+    }
+
     /// The shape in words, for the report and the `source_file` metadata.
     pub fn describe(&self) -> String {
         match self {
