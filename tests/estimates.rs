@@ -1,7 +1,7 @@
 //! Planning's memory estimates against the measured peak of the whole process (`voxelkit
 //! --json` reports both), each within 30% of its peak: mesh surfaces (with and without
 //! normals) and block-flood solids on five shared meshes, the §7 shapes, Catmull-Clark
-//! surfaces and distance bands. Every run is its own process, so that each peak is the run's
+//! surfaces, distance bands and implicit surfaces (a formula zero everywhere included). Every run is its own process, so that each peak is the run's
 //! alone.
 #![cfg(all(feature = "vdb", feature = "fixtures"))]
 
@@ -84,6 +84,23 @@ fn estimates_are_within_30_percent_of_the_peak() {
             "mesh".into(),
             mesh,
             kind.into(),
+            "-r".into(),
+            "1024".into(),
+        ]);
+    }
+    for formula in ["x^2 + y^2 + z^2 - 0.5", "0*x"] {
+        cases.push(vec![
+            "implicit".into(),
+            formula.into(),
+            "-r".into(),
+            "256".into(),
+        ]);
+    }
+    for example in ["gear", "sinsin"] {
+        cases.push(vec![
+            "implicit".into(),
+            "--example".into(),
+            example.into(),
             "-r".into(),
             "1024".into(),
         ]);
