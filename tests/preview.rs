@@ -63,13 +63,7 @@ fn ball(radius: i64, channels: Channels) -> SparseGrid {
 }
 
 fn draw(grid: &SparseGrid, view: View, size: u32) -> Picture {
-    let channels = grid.channels();
-    let scene = Scene {
-        voxels: grid,
-        normals: channels.normal.then_some(grid),
-        colors: channels.color.then_some(grid),
-    };
-    render(&scene, view, size, size).unwrap()
+    render(&Scene::of(grid), view, size, size).unwrap()
 }
 
 #[test]

@@ -276,3 +276,21 @@ def test_depth_layers_take_the_papers_unclassified_rule(data):
     assert own.report["directions"][2]["direction"] == [2, 1, -1]
     with pytest.raises(ValueError, match="component of 1 or -1"):
         voxelkit.solid(path, resolution=16, method="depth-layers", directions=[(2, 3, 5)])
+
+
+def test_a_grid_draws_a_png(data, tmp_path):
+    """Grid.render writes a PNG of the asked size, as `voxelkit render` does; bad views and
+    names are refused."""
+    import struct
+
+    grid = voxelkit.mesh(data / "meshes" / "torus.obj", resolution=64, normals=True)
+    picture = tmp_path / "torus.png"
+    grid.render(picture, view="z", size=(320, 200))
+    head = picture.read_bytes()[:24]
+    assert head[:8] == b"\x89PNG\r\n\x1a\n"
+    assert struct.unpack(">II", head[16:24]) == (320, 200)
+    with pytest.raises(ValueError, match="iso, x, y or z"):
+        grid.render(tmp_path / "a.png", view="up")
+    with pytest.raises(ValueError, match=".png"):
+        grid.render(tmp_path / "a.jpg")
+    assert not (tmp_path / "a.png").exists()

@@ -47,6 +47,10 @@ class Grid:
         half: bool = False,
     ) -> None:
         """Writes .vdb, .binvox or .vox by extension, atomically, never over an input."""
+    def render(
+        self, path: Path, view: str = "iso", size: Tuple[int, int] = (800, 600)
+    ) -> None:
+        """Draws the voxels into a PNG (each voxel a cube, lit by normals, coloured by Cd)."""
     def write_vdb(
         self,
         path: Path,

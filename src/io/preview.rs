@@ -88,6 +88,18 @@ pub struct Scene<'a> {
     pub colors: Option<&'a SparseGrid>,
 }
 
+impl<'a> Scene<'a> {
+    /// A grid lit and coloured by its own normal and colour channels, where it has them.
+    pub fn of(grid: &'a SparseGrid) -> Scene<'a> {
+        let channels = grid.channels();
+        Scene {
+            voxels: grid,
+            normals: channels.normal.then_some(grid),
+            colors: channels.color.then_some(grid),
+        }
+    }
+}
+
 /// What the nearest hit of a pixel is: its depth (toward the viewer; larger is nearer),
 /// colour, and normal (the voxel's own, or the face of its cube).
 #[derive(Clone, Copy)]

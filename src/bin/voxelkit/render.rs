@@ -150,12 +150,6 @@ pub fn beside(grid: &SparseGrid, output: &Path, picture: PictureArgs) -> Result<
     }
     let png = output.with_extension("png");
     check_png(&png, &[output])?;
-    let channels = grid.channels();
-    let scene = Scene {
-        voxels: grid,
-        normals: channels.normal.then_some(grid),
-        colors: channels.color.then_some(grid),
-    };
-    draw(&scene, picture, &png)?;
+    draw(&Scene::of(grid), picture, &png)?;
     Ok(png)
 }
