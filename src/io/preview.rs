@@ -441,6 +441,21 @@ fn background(width: usize, height: usize) -> Vec<u8> {
     rgb
 }
 
+/// Refuses a picture output that is not a `.png`, or cannot be written, or is an input,
+/// before any drawing.
+pub fn check_picture_output(output: &Path, inputs: &[&Path]) -> Result<()> {
+    if !output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+    {
+        return Err(Error::InvalidArgument(format!(
+            "{}: a picture is written as .png",
+            output.display()
+        )));
+    }
+    super::atomic::check_output(output, inputs)
+}
+
 /// Writes `picture` to `path` as PNG, atomically.
 pub fn write_png(path: &Path, picture: &Picture) -> Result<()> {
     write_atomic(path, |tmp| {

@@ -3,7 +3,7 @@
 
 use super::to_py_err;
 use crate::grid::{SparseGrid, Transform};
-use crate::io::preview::{Scene, View, render, write_png};
+use crate::io::preview::{Scene, View, check_picture_output, render, write_png};
 use crate::io::vdb::{Compression, WriteOptions};
 use crate::pipeline::Outcome;
 use numpy::ndarray::{Array1, Array2, Array3};
@@ -235,19 +235,10 @@ impl Grid {
     #[pyo3(signature = (path, view = "iso", size = (800, 600)))]
     fn render(&self, py: Python<'_>, path: PathBuf, view: &str, size: (u32, u32)) -> PyResult<()> {
         let view = view.parse::<View>().map_err(PyValueError::new_err)?;
-        if !path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("png"))
-        {
-            return Err(PyValueError::new_err(format!(
-                "{}: a picture is written as .png",
-                path.display()
-            )));
-        }
         let inputs: Vec<&std::path::Path> = self.inputs.iter().map(PathBuf::as_path).collect();
         let grid = &self.outcome.grid;
         py.detach(|| {
-            crate::io::atomic::check_output(&path, &inputs)?;
+            check_picture_output(&path, &inputs)?;
             let picture = render(&Scene::of(grid), view, size.0, size.1)?;
             write_png(&path, &picture)
         })

@@ -25,7 +25,7 @@ use crate::ops::measure::SolidMeasures;
 use crate::ops::seed::seeds_from_normals;
 use crate::progress::Progress;
 use crate::solids::exterior_flood::Solid;
-use crate::subd::{ControlMesh, LimitSurface, limit_area, limit_volume};
+use crate::subd::{ControlMesh, LimitSurface, limit_volume};
 use crate::voxelize::parametric::{ParametricOptions, ParametricOutput, voxelize_subdivision};
 
 /// A Catmull-Clark solid and what made it.
@@ -36,9 +36,9 @@ pub struct SubdivisionSolid {
     /// Seeds the rule gave, and those whose flood reached the border (dropped).
     pub seeds: u64,
     pub outside_seeds: u64,
-    /// The exact volume and area of the limit surface (Gauss quadrature), in world units.
+    /// The exact volume the limit surface encloses (Gauss quadrature), in world units: its
+    /// sign tells which way the normals face.
     pub limit_volume: f64,
-    pub limit_area: f64,
 }
 
 /// Why a solid needs a closed control mesh.
@@ -64,8 +64,7 @@ pub fn subdivision_solid(
         ..*options
     };
     let surface = voxelize_subdivision(control, transform, &options, progress)?;
-    let limit = LimitSurface::new(control.clone());
-    let (limit_volume, limit_area) = (limit_volume(&limit), limit_area(&limit));
+    let limit_volume = limit_volume(&LimitSurface::new(control.clone()));
     let outward = limit_volume < 0.0;
     let seeds: Vec<Coord> = seeds_from_normals(&surface.surface, &surface.opposite, outward)
         .map(|choice| choice.seed)
@@ -96,7 +95,9 @@ pub fn subdivision_solid(
         stats.line_floods += s.line_floods;
         stats.sweeps += s.sweeps;
         stats.overflows += s.overflows;
-        if touches_border(&region) {
+        // The box's outer layer holds no surface voxel and is one 6-connected shell: a flood
+        // that reaches the border reaches its corner.
+        if region.get(bbox.min) {
             outside_seeds += 1;
             outside.combine_words(&region, |a, b| a | b);
         } else {
@@ -121,16 +122,6 @@ pub fn subdivision_solid(
         seeds: seeds.len() as u64,
         outside_seeds,
         limit_volume: limit_volume.abs(),
-        limit_area,
-    })
-}
-
-/// Whether any voxel of `mask` lies on the faces of its box.
-fn touches_border(mask: &DenseMask) -> bool {
-    let b = mask.bbox;
-    mask.ones().any(|i| {
-        let c = mask.coord(i);
-        (0..3).any(|a| c[a] == b.min[a] || c[a] == b.max[a])
     })
 }
 

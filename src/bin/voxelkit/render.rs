@@ -6,7 +6,7 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use voxelkit::grid::SparseGrid;
-use voxelkit::io::preview::{Scene, View, render, write_png};
+use voxelkit::io::preview::{Scene, View, check_picture_output, render, write_png};
 use voxelkit::io::vdb::{COLOR_GRID, NORMAL_GRID, read_vdb_grid, read_vdb_info};
 use voxelkit::{Error, Result};
 
@@ -62,20 +62,6 @@ pub struct RenderArgs {
     output: PathBuf,
 }
 
-/// Refuses an output that is not a .png, or cannot be written, before any work.
-fn check_png(output: &Path, inputs: &[&Path]) -> Result<()> {
-    if !output
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
-    {
-        return Err(Error::InvalidArgument(format!(
-            "{}: a picture is written as .png",
-            output.display()
-        )));
-    }
-    voxelkit::io::atomic::check_output(output, inputs)
-}
-
 /// Draws `scene` into `output` and says so.
 fn draw(scene: &Scene, picture: PictureArgs, output: &Path) -> Result<String> {
     let start = Instant::now();
@@ -91,7 +77,7 @@ fn draw(scene: &Scene, picture: PictureArgs, output: &Path) -> Result<String> {
 }
 
 pub fn run(args: &RenderArgs, global: &Global) -> Result<()> {
-    check_png(&args.output, &[&args.input])?;
+    check_picture_output(&args.output, &[&args.input])?;
     let infos = read_vdb_info(&args.input)?;
     let has = |name: &str| {
         infos
@@ -149,7 +135,7 @@ pub fn beside(grid: &SparseGrid, output: &Path, picture: PictureArgs) -> Result<
         ));
     }
     let png = output.with_extension("png");
-    check_png(&png, &[output])?;
+    check_picture_output(&png, &[output])?;
     draw(&Scene::of(grid), picture, &png)?;
     Ok(png)
 }
