@@ -14,6 +14,7 @@
 #include <limits>
 #include <cerrno>
 #include <cstring>
+#include <exception>
 #include <fstream>
 #include <mutex>
 #include <stdexcept>
@@ -32,6 +33,40 @@ openvdb::math::Transform::Ptr make_transform(double voxel_size, const std::array
     return xform;
 }
 
+// The grid types voxelkit reads (src/io/vdb_tree_structure.rs checks the same) and writes.
+using KnownGridTypes =
+    openvdb::NumericGridTypes::Append<openvdb::Vec3GridTypes>::Append<openvdb::BoolGrid, openvdb::MaskGrid>;
+
+// OpenVDB's tree destructor first gathers every node into a vector: an allocation that can
+// throw while memory is short, inside a noexcept destructor (std::terminate). Deleting from
+// the root down allocates nothing, and the destructor then finds an empty tree.
+void free_nodes(openvdb::GridBase& grid) noexcept {
+    auto clear = [](auto& typed) { typed.tree().root().clear(); };
+    grid.apply<KnownGridTypes>(clear);
+}
+
+void free_nodes(const openvdb::GridPtrVec& grids) noexcept {
+    for (const auto& g : grids)
+        if (g && g.use_count() == 1) free_nodes(*g);
+}
+
+// Frees a grid's nodes without allocating when its scope is left by an exception (declare
+// it after the grid's pointer, so that it runs first); a grid owned elsewhere too is left.
+template <typename PtrT>
+class FreeOnThrow {
+public:
+    explicit FreeOnThrow(const PtrT& grid) : grid_(grid), exceptions_(std::uncaught_exceptions()) {}
+    FreeOnThrow(const FreeOnThrow&) = delete;
+    FreeOnThrow& operator=(const FreeOnThrow&) = delete;
+    ~FreeOnThrow() {
+        if (std::uncaught_exceptions() > exceptions_ && grid_ && grid_.use_count() == 1) free_nodes(*grid_);
+    }
+
+private:
+    const PtrT& grid_;
+    int exceptions_;
+};
+
 // Builds one LeafNode per input leaf in parallel, then inserts them serially.
 template <typename GridT, typename SetFn>
 typename GridT::Ptr build_grid(rust::Slice<const int32_t> origins, rust::Slice<const uint64_t> masks,
@@ -41,28 +76,43 @@ typename GridT::Ptr build_grid(rust::Slice<const int32_t> origins, rust::Slice<c
     if (origins.size() != 3 * count || masks.size() != 8 * count)
         throw std::invalid_argument("leaf arrays of inconsistent length");
     std::vector<LeafT*> leaves(count, nullptr);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, count), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) {
-            openvdb::Coord c(origins[3 * i], origins[3 * i + 1], origins[3 * i + 2]);
-            auto* leaf = new LeafT(c, background);
-            for (openvdb::Index w = 0; w < 8; ++w) {
-                uint64_t bits = masks[8 * i + w];
-                while (bits) {
-                    const openvdb::Index n = w * 64 + openvdb::Index(__builtin_ctzll(bits));
-                    set_value(*leaf, i, n);
-                    bits &= bits - 1;
+    size_t inserted = 0;
+    typename GridT::Ptr grid;
+    try {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, count), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i != r.end(); ++i) {
+                openvdb::Coord c(origins[3 * i], origins[3 * i + 1], origins[3 * i + 2]);
+                auto* leaf = new LeafT(c, background);
+                for (openvdb::Index w = 0; w < 8; ++w) {
+                    uint64_t bits = masks[8 * i + w];
+                    while (bits) {
+                        const openvdb::Index n = w * 64 + openvdb::Index(__builtin_ctzll(bits));
+                        set_value(*leaf, i, n);
+                        bits &= bits - 1;
+                    }
                 }
+                leaves[i] = leaf;
             }
-            leaves[i] = leaf;
-        }
-    });
-    auto grid = GridT::create(background);
-    typename GridT::Accessor acc = grid->getAccessor();
-    for (auto* leaf : leaves) acc.addLeaf(leaf);
+        });
+        grid = GridT::create(background);
+        typename GridT::Accessor acc = grid->getAccessor();
+        for (; inserted < count; ++inserted) acc.addLeaf(leaves[inserted]);
+    } catch (...) {
+        // Out of memory part way: free what was built, without allocating.
+        for (size_t i = inserted; i < count; ++i) delete leaves[i];
+        if (grid) free_nodes(*grid);
+        throw;
+    }
     return grid;
 }
 
 }  // namespace
+
+VdbWriter::~VdbWriter() { free_nodes(grids_); }
+
+VdbFile::~VdbFile() {
+    if (grids_) free_nodes(*grids_);
+}
 
 std::unique_ptr<VdbWriter> new_vdb_writer() {
     ensure_initialized();
@@ -76,6 +126,7 @@ void VdbWriter::add_grid(rust::Str kind, rust::Str name, double voxel_size, std:
     const std::string k(kind);
     const size_t count = leaf_origins.size() / 3;
     openvdb::GridBase::Ptr grid;
+    FreeOnThrow free_on_throw(grid);
     if (k == "bool") {
         grid = build_grid<openvdb::BoolGrid>(leaf_origins, masks, false,
                                              [](auto& leaf, size_t, openvdb::Index n) { leaf.setValueOn(n, true); });
@@ -134,6 +185,7 @@ void VdbWriter::add_level_set(rust::Str name, rust::Str density_name, double vox
                                                [&](auto& leaf, size_t i, openvdb::Index n) {
                                                    leaf.setValueOn(n, values[512 * i + n]);
                                                });
+    FreeOnThrow free_on_throw(grid);
     if (is_signed) {
         for (auto leaf = grid->tree().beginLeaf(); leaf; ++leaf) {
             for (auto off = leaf->beginValueOff(); off; ++off) off.setValue(background);
@@ -150,6 +202,7 @@ void VdbWriter::add_level_set(rust::Str name, rust::Str density_name, double vox
     if (is_signed && !density_name.empty()) {
         // Blender's volume object shows `density`: the fog volume of the same solid.
         auto fog = grid->deepCopy();
+        FreeOnThrow free_fog_on_throw(fog);
         openvdb::tools::sdfToFogVolume(*fog, background);
         describe(*fog, std::string(density_name));
         grids_.push_back(fog);

@@ -12,6 +12,10 @@ struct GridInfo;
 
 class VdbWriter {
 public:
+    VdbWriter() = default;
+    VdbWriter(const VdbWriter&) = delete;
+    VdbWriter& operator=(const VdbWriter&) = delete;
+    ~VdbWriter();
     void add_grid(rust::Str kind, rust::Str name, double voxel_size, std::array<double, 3> origin,
                   rust::Slice<const int32_t> leaf_origins, rust::Slice<const uint64_t> masks,
                   rust::Slice<const float> values, rust::Slice<const int32_t> leaf_tiles,
@@ -29,6 +33,9 @@ private:
 class VdbFile {
 public:
     explicit VdbFile(openvdb::GridPtrVecPtr grids) : grids_(std::move(grids)) {}
+    VdbFile(const VdbFile&) = delete;
+    VdbFile& operator=(const VdbFile&) = delete;
+    ~VdbFile();
     size_t grid_count() const;
     GridInfo grid_info(size_t index) const;
     void read_leaves(size_t index, rust::Vec<int32_t>& leaf_origins, rust::Vec<uint64_t>& masks,

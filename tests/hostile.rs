@@ -207,6 +207,105 @@ fn damaged_vdb_files_are_refused_plainly_and_huge_tiles_before_allocating() {
     assert!(start.elapsed() < std::time::Duration::from_secs(2), "{msg}");
 }
 
+/// Where a compressed chunk of node values starts: its signed 64-bit size, then a blosc
+/// header (version 2) repeating that size as its compressed length. Returns the last one.
+fn last_blosc_chunk(bytes: &[u8]) -> usize {
+    let at = |i: usize, n: usize| bytes[i..i + n].to_vec();
+    (0..bytes.len() - 24)
+        .rev()
+        .find(|&i| {
+            let size = i64::from_le_bytes(at(i, 8).try_into().unwrap());
+            let cbytes = u32::from_le_bytes(at(i + 20, 4).try_into().unwrap());
+            (17..1 << 20).contains(&size) && bytes[i + 8] == 2 && cbytes as i64 == size
+        })
+        .expect("a blosc chunk")
+}
+
+#[test]
+fn damaged_chunk_sizes_of_compressed_vdb_files_are_refused_before_openvdb_reads_them() {
+    // OpenVDB 10.0.1 copies a chunk stored raw (negative size) into the node's buffer before
+    // comparing the sizes (heap corruption, SIGABRT), and blosc reads as far as its own
+    // header says (past the chunk).
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("sphere.vdb");
+    let made = voxelkit(&["shape", "sphere", "-r", "48", "-o", good.to_str().unwrap()]);
+    assert!(made.status.success(), "{}", text(&made));
+    let bytes = std::fs::read(&good).unwrap();
+    let chunk = last_blosc_chunk(&bytes);
+    let size = i64::from_le_bytes(bytes[chunk..chunk + 8].try_into().unwrap());
+    let edit = |name: &str, offset: usize, value: &[u8]| {
+        let mut b = bytes.clone();
+        b[chunk + offset..chunk + offset + value.len()].copy_from_slice(value);
+        let path = dir.path().join(name);
+        std::fs::write(&path, b).unwrap();
+        path
+    };
+    for damaged in [
+        edit("raw.vdb", 0, &(-200_000i64).to_le_bytes()),
+        edit("long.vdb", 20, &(size as u32 + 5000).to_le_bytes()),
+        edit("wide.vdb", 12, &(1u32 << 20).to_le_bytes()),
+    ] {
+        let name = damaged.file_name().unwrap().to_str().unwrap();
+        for command in ["info", "measure"] {
+            let o = voxelkit(&[command, damaged.to_str().unwrap()]);
+            let msg = text(&o);
+            assert!(o.status.code() == Some(1), "{name} {command}: {msg}");
+            assert!(msg.contains(name) && msg.contains("chunk at byte"), "{msg}");
+        }
+    }
+    let o = voxelkit(&["info", good.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+}
+
+#[test]
+fn reading_trees_that_cannot_fit_is_refused_before_openvdb_allocates() {
+    // A 10 MB file whose trees take about 400 MB once read (float and vector leaves, blosc):
+    // under a 300 MB address-space cap, OpenVDB's reader ran out of memory inside its trees.
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = dir.path().join("tetra.obj");
+    std::fs::write(&mesh, TETRA).unwrap();
+    let file = dir.path().join("normals.vdb");
+    let made = voxelkit(&[
+        "mesh",
+        mesh.to_str().unwrap(),
+        "-r",
+        "1024",
+        "--normals",
+        "-o",
+        file.to_str().unwrap(),
+    ]);
+    assert!(made.status.success(), "{}", text(&made));
+    let capped = |mib: u64| {
+        let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_voxelkit"));
+        command.args(["info", file.to_str().unwrap()]);
+        let limit = libc::rlimit {
+            rlim_cur: mib << 20,
+            rlim_max: mib << 20,
+        };
+        // SAFETY: setrlimit is async-signal-safe; the child only sets its own limit.
+        unsafe {
+            use std::os::unix::process::CommandExt;
+            command.pre_exec(move || {
+                if libc::setrlimit(libc::RLIMIT_AS, &limit) == 0 {
+                    Ok(())
+                } else {
+                    Err(std::io::Error::last_os_error())
+                }
+            });
+        }
+        command.output().unwrap()
+    };
+    let o = capped(300);
+    let msg = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{msg}");
+    assert!(
+        msg.contains("normals.vdb: reading its trees") && msg.contains("MiB"),
+        "{msg}"
+    );
+    let o = capped(2048);
+    assert!(o.status.success(), "{}", text(&o));
+}
+
 #[test]
 fn huge_faces_and_valences_of_control_meshes_are_refused_at_once() {
     let dir = tempfile::tempdir().unwrap();

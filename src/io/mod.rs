@@ -8,4 +8,5 @@ pub mod preview;
 pub mod vdb;
 #[cfg(feature = "vdb")]
 mod vdb_structure;
+mod vdb_tree_structure;
 pub mod vox;

@@ -325,7 +325,13 @@ fn open(path: &Path) -> Result<cxx::UniquePtr<bridge::VdbFile>> {
     let p = path
         .to_str()
         .ok_or_else(|| vdb_error(path, "path is not UTF-8"))?;
-    super::vdb_structure::check_structure(path)?;
+    // OpenVDB reads every tree whole: plan that memory before it allocates any.
+    let tree_bytes = super::vdb_structure::check_structure(path)?;
+    crate::system::check_fits(
+        tree_bytes,
+        None,
+        &format!("{}: reading its trees", path.display()),
+    )?;
     bridge::open_vdb(p).map_err(|e| unreadable(path, e))
 }
 

@@ -1,32 +1,34 @@
 //! A check of a `.vdb` file's structure before OpenVDB reads it: the header, the file's
-//! metadata and the grid descriptors, every length and offset against the file's size.
-//! OpenVDB trusts these numbers, so a file cut short can make it allocate gigabytes for one
-//! string, and a header alone reads as a file without grids.
+//! metadata, the grid descriptors and each grid's tree (`vdb_tree_structure`), every length
+//! and offset against the file's size. OpenVDB trusts these numbers, so a file cut short can
+//! make it allocate gigabytes for one string, a damaged chunk size overruns a node's buffer,
+//! and a header alone reads as a file without grids.
 
+use super::vdb_tree_structure::{self, TreeFormat};
 use crate::error::{Error, Result};
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
 /// OpenVDB's magic number, the file's first eight bytes.
 const MAGIC: i64 = 0x5644_4220;
-/// The first file version with a 36-character UUID in the header, the oldest read (a
-/// layout older still is refused rather than read on trust).
-const UUID_VERSION: u32 = 218;
-/// The first file version whose grid descriptors name an instance parent.
-const INSTANCING_VERSION: u32 = 216;
 /// The type name of OpenVDB's per-leaf delayed-load table.
 const DELAYED_LOAD: &[u8] = b"__delayedload";
-/// The first file version with compression flags at the start of each grid.
+/// The first file version with compression flags at the start of each grid and a flag before
+/// each node's values (OpenVDB 2.0, 2013), the oldest read: older layouts are refused rather
+/// than read on trust.
 const NODE_MASK_VERSION: u32 = 222;
 
-struct Reader {
+pub(super) struct Reader {
     input: BufReader<std::fs::File>,
-    pos: u64,
-    len: u64,
+    pub(super) pos: u64,
+    pub(super) len: u64,
 }
 
 impl Reader {
-    fn bytes<const N: usize>(&mut self, what: &str) -> std::result::Result<[u8; N], String> {
+    pub(super) fn bytes<const N: usize>(
+        &mut self,
+        what: &str,
+    ) -> std::result::Result<[u8; N], String> {
         if self.pos + N as u64 > self.len {
             return Err(format!("it ends inside {what} (byte {})", self.pos));
         }
@@ -36,16 +38,16 @@ impl Reader {
         Ok(b)
     }
 
-    fn u32(&mut self, what: &str) -> std::result::Result<u32, String> {
+    pub(super) fn u32(&mut self, what: &str) -> std::result::Result<u32, String> {
         self.bytes::<4>(what).map(u32::from_le_bytes)
     }
 
-    fn i64(&mut self, what: &str) -> std::result::Result<i64, String> {
+    pub(super) fn i64(&mut self, what: &str) -> std::result::Result<i64, String> {
         self.bytes::<8>(what).map(i64::from_le_bytes)
     }
 
     /// Skips `n` bytes that must lie inside the file.
-    fn skip(&mut self, n: u64, what: &str) -> std::result::Result<(), String> {
+    pub(super) fn skip(&mut self, n: u64, what: &str) -> std::result::Result<(), String> {
         if n > self.len - self.pos {
             return Err(format!(
                 "{what} at byte {} claims {n} bytes, past its end at byte {}",
@@ -59,13 +61,33 @@ impl Reader {
         Ok(())
     }
 
+    /// `n` bytes that must lie inside the file.
+    pub(super) fn vec(&mut self, n: u64, what: &str) -> std::result::Result<Vec<u8>, String> {
+        if n > self.len - self.pos {
+            return Err(format!("it ends inside {what} (byte {})", self.pos));
+        }
+        let mut v = vec![0u8; n as usize];
+        self.input.read_exact(&mut v).map_err(|e| e.to_string())?;
+        self.pos += n;
+        Ok(v)
+    }
+
+    /// A length-prefixed name of at most 256 bytes.
+    pub(super) fn short_string(&mut self, what: &str) -> std::result::Result<String, String> {
+        let n = self.u32(what)? as u64;
+        if n > 256 {
+            return Err(format!("{what}: a name of {n} bytes"));
+        }
+        Ok(String::from_utf8_lossy(&self.vec(n, what)?).into_owned())
+    }
+
     /// A length-prefixed string, skipped.
     fn string(&mut self, what: &str) -> std::result::Result<(), String> {
         let n = self.u32(what)?;
         self.skip(n as u64, what)
     }
 
-    fn seek(&mut self, to: u64) -> std::result::Result<(), String> {
+    pub(super) fn seek(&mut self, to: u64) -> std::result::Result<(), String> {
         self.input
             .seek(SeekFrom::Start(to))
             .map_err(|e| e.to_string())?;
@@ -74,12 +96,14 @@ impl Reader {
     }
 }
 
-/// Checks the structure of the `.vdb` at `path`; the error says where it breaks.
-pub fn check_structure(path: &Path) -> Result<()> {
+/// Checks the structure of the `.vdb` at `path`; the error says where it breaks. Returns the
+/// bytes OpenVDB allocates to read its trees.
+pub fn check_structure(path: &Path) -> Result<u64> {
     let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
     let mut r = Reader {
-        input: BufReader::new(file),
+        // A large buffer: most skips (compressed chunks of a few hundred bytes) stay inside it.
+        input: BufReader::with_capacity(1 << 20, file),
         pos: 0,
         len,
     };
@@ -199,34 +223,32 @@ fn delayed_load_table(
     r.skip(end - r.pos, what)
 }
 
-fn walk(r: &mut Reader) -> std::result::Result<(), String> {
+fn walk(r: &mut Reader) -> std::result::Result<u64, String> {
     if r.i64("the header")? != MAGIC {
         return Err("it does not start with OpenVDB's magic number".into());
     }
     let version = r.u32("the header")?;
-    if version < UUID_VERSION {
+    if version < NODE_MASK_VERSION {
         return Err(format!(
-            "file format version {version}: voxelkit reads versions {UUID_VERSION} and later"
+            "file format version {version}: voxelkit reads versions {NODE_MASK_VERSION} and later"
         ));
     }
     r.skip(8, "the library version")?;
     let offsets = r.bytes::<1>("the header")?[0] != 0;
-    if (220..222).contains(&version) {
-        r.skip(4, "the compression flags")?;
-    }
     r.skip(36, "the file's UUID")?;
     metadata(r, "the file's metadata", 0)?;
     if !offsets {
-        return Ok(()); // a stream without grid offsets: nothing to check them against
+        // Written as a stream: without grid offsets the trees cannot be checked.
+        return Err("it has no grid offsets (an OpenVDB stream, not a file)".into());
     }
     let grids = r.u32("the grid count")?;
+    let mut memory = 0u64;
     for g in 0..grids {
         let what = format!("the descriptor of grid {g}");
         r.string(&what)?;
-        r.string(&what)?;
-        if version >= INSTANCING_VERSION {
-            r.string(&what)?;
-        }
+        let type_name = r.short_string(&what)?;
+        let instance = !r.short_string(&what)?.is_empty();
+        let format = TreeFormat::of(&type_name).map_err(|e| format!("grid {g} is {e}"))?;
         let (grid, block, end) = (r.i64(&what)?, r.i64(&what)?, r.i64(&what)?);
         let inside = |p: i64| p >= 0 && (p as u64) <= r.len;
         if !(inside(grid) && inside(block) && inside(end) && grid <= block && block <= end) {
@@ -238,17 +260,23 @@ fn walk(r: &mut Reader) -> std::result::Result<(), String> {
         if (end as u64) < r.pos {
             return Err(format!("grid {g} ends before its own descriptor"));
         }
-        // The grid's own metadata (after its compression flags) must end inside the grid.
+        // The grid's compression flags, metadata, transform and topology end by its block
+        // of leaf buffers.
         r.seek(grid as u64)?;
         let file_len = std::mem::replace(&mut r.len, block as u64);
-        if version >= NODE_MASK_VERSION {
-            r.skip(4, &format!("the compression flags of grid {g}"))?;
-        }
+        let compression = r.u32(&format!("the compression flags of grid {g}"))?;
         // A leaf takes at least its 64-byte mask in the file.
         let max_leaves = (end - grid) as u64 / 64 + 1;
         metadata(r, &format!("grid {g}'s metadata"), max_leaves)?;
+        vdb_tree_structure::transform(r, &format!("grid {g}'s transform"))?;
         r.len = file_len;
+        if !instance {
+            let what = format!("grid {g}'s tree");
+            let bytes =
+                vdb_tree_structure::tree(r, format, compression, block as u64, end as u64, &what)?;
+            memory = memory.saturating_add(bytes);
+        }
         r.seek(end as u64)?;
     }
-    Ok(())
+    Ok(memory)
 }
