@@ -1,8 +1,9 @@
 //! Planning's memory estimates against the measured peak of the whole process (`voxelkit
 //! --json` reports both), each within 30% of its peak: mesh surfaces (with and without
-//! normals) and block-flood solids on five shared meshes, the §7 shapes, Catmull-Clark
-//! surfaces, distance bands and implicit surfaces (a formula zero everywhere included). Every run is its own process, so that each peak is the run's
-//! alone.
+//! normals) and block-flood solids on five shared meshes, every other fill (span flood,
+//! FloodingXYZ, beam, depth layers), lines, `check`, `measure`, the §7 shapes, Catmull-Clark
+//! surfaces and solids, distance bands and implicit surfaces (a formula zero everywhere
+//! included). Every run is its own process, so that each peak is the run's alone.
 #![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 mod cli_support;
@@ -16,7 +17,10 @@ const MESHES: [&str; 5] = ["bunny-closed", "igea", "horse", "armadillo", "skull"
 fn ratio(args: &[&str], out: &std::path::Path) -> f64 {
     let mut all = vec!["--json"];
     all.extend(args);
-    all.extend(["-o", out.to_str().unwrap()]);
+    // `check` and `measure` write nothing.
+    if !matches!(args[0], "check" | "measure") {
+        all.extend(["-o", out.to_str().unwrap()]);
+    }
     let o = voxelkit(&all);
     assert!(o.status.success(), "{args:?}: {}", text(&o));
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
@@ -103,6 +107,35 @@ fn estimates_are_within_30_percent_of_the_peak() {
             example.into(),
             "-r".into(),
             "1024".into(),
+        ]);
+    }
+    // Every other way to fill, check, measure or trace a mesh, and Catmull-Clark solids.
+    let meshes = |name: &str| {
+        data.join(format!("meshes/{name}.obj"))
+            .display()
+            .to_string()
+    };
+    for (command, name, resolution, extra) in [
+        ("solid", "bunny-closed", "1024", &["--flood", "spans"][..]),
+        ("solid", "armadillo", "512", &["--flood", "xyz"][..]),
+        ("solid", "igea", "1024", &["--method", "beam"][..]),
+        ("solid", "horse", "1024", &["--method", "depth-layers"][..]),
+        ("lines", "cow", "2048", &[][..]),
+        ("lines", "igea", "512", &[][..]),
+        ("check", "armadillo", "1024", &[][..]),
+        ("measure", "igea", "1024", &[][..]),
+    ] {
+        let mut case = vec![command.into(), meshes(name), "-r".into(), resolution.into()];
+        case.extend(extra.iter().map(|s| s.to_string()));
+        cases.push(case);
+    }
+    for (name, resolution) in [("catmark_cube", "512"), ("spot_control_mesh", "256")] {
+        cases.push(vec![
+            "subdiv".into(),
+            subd(name),
+            "-r".into(),
+            resolution.into(),
+            "--solid".into(),
         ]);
     }
     for case in cases {

@@ -6,8 +6,8 @@
 //! 512..4096, spot, the sphere and torus formulas): a leaf of a voxel set costs about 3.5 KB
 //! at the peak (the thread-local grids before their merge, OpenVDB's bool and float leaves
 //! and the flat arrays when writing), one with a normal or colour channel about 20 KB more.
-//! A surface of area A (in voxels) crosses about A/32 leaves, a line of length L about L/4;
-//! a solid is assumed to fill half its box.
+//! A surface of area A (in voxels) crosses about A/32 leaves; a solid is assumed to fill half
+//! its box.
 
 use super::{CsgSource, Job, Loaded, MeasureSource, MeshSource, Plan, Task, lines_source};
 use crate::error::{Error, Result};
@@ -25,9 +25,8 @@ use glam::DVec3;
 /// Peak bytes per leaf of a voxel set, and per leaf of a normal or colour channel.
 const LEAF_BYTES: f64 = 3500.0;
 const VECTOR_LEAF_BYTES: f64 = 20000.0;
-/// Voxels of surface area, and of line length, per leaf they cross.
+/// Voxels of surface area per leaf they cross.
 const AREA_PER_LEAF: f64 = 32.0;
-const LENGTH_PER_LEAF: f64 = 4.0;
 /// The share of its box a solid is assumed to fill (a ball fills 52%).
 const SOLID_FILL: f64 = 0.5;
 /// The process itself: code, OpenVDB's and the allocator's own memory.
@@ -65,29 +64,103 @@ fn area_in_voxels(mesh: &Mesh, t: &Transform) -> f64 {
 }
 
 /// Mesh surfaces and solids, calibrated on the whole process (bunny-closed, igea, armadillo,
-/// skull and horse at 512..2048: the estimate within 30% of the peak for surfaces and block
-/// flood solids; 1.5-1.6 times it for the fills over dense bit volumes): a separating or
+/// skull and horse at 512..2048, each estimate within 30% of the peak): a separating or
 /// projective surface crosses a leaf per 44 voxels^2 of area and costs 2.6 KB per leaf at
 /// the peak, 34 KB more with normals or colours (the channel, its flat copy and OpenVDB's
-/// Vec3 grid); each triangle about 250 bytes (reading the file, the voxelizer's tables). A solid costs 3.7 KB per leaf of its surface
-/// (the surface, the solid's boundary leaves, the grids written) and 16 bytes per 8^3 block of
-/// its box (the block flood's states and the inside's tiles), besides its dense bit volumes.
+/// Vec3 grid); each triangle about 250 bytes (reading the file, the voxelizer's tables).
 const MESH_AREA_PER_LEAF: f64 = 44.0;
 const MESH_LEAF_BYTES: f64 = 2600.0;
 const MESH_VECTOR_LEAF_BYTES: f64 = 34000.0;
 const TRIANGLE_BYTES: f64 = 250.0;
-const SOLID_LEAF_BYTES: f64 = 3700.0;
-const BLOCK_BYTES: f64 = 16.0;
+
+/// What filling a mesh costs at the peak, besides the process: dense bit volumes over the
+/// padded box and over the mesh's inside, bytes per voxel of the box's faces, per leaf of
+/// the surface, per 8^3 block of the box and per triangle.
+struct FillCost {
+    bit_volumes: f64,
+    /// Bits per voxel of the mesh's inside (the measure's labelling).
+    inside_volumes: f64,
+    /// Bytes per voxel of the box's three faces (depth buffers, one per direction).
+    face_bytes: f64,
+    leaf_bytes: f64,
+    block_bytes: f64,
+    triangle_bytes: f64,
+}
+
+/// The block flood (the default): the surface, the solid's boundary leaves and the grids
+/// written (3.7 KB per surface leaf), the block states and the inside's tiles (16 bytes per
+/// block); no dense volume. Estimate/peak 0.84-1.30 on the five meshes at 512-2048.
+const BLOCK_FLOOD_COST: FillCost = FillCost {
+    bit_volumes: 0.0,
+    inside_volumes: 0.0,
+    face_bytes: 0.0,
+    leaf_bytes: 3700.0,
+    block_bytes: 16.0,
+    triangle_bytes: TRIANGLE_BYTES,
+};
+/// The span flood and FloodingXYZ: two dense volumes (surface and reached) and what scales
+/// with them, the solid's tiles and the scanline queues, half a volume more; the surface's
+/// own leaves are small beside them. Estimate/peak 0.84-1.19 (bunny-closed, igea, armadillo
+/// at 512-2048; it was 1.24-1.48 at 512-1024).
+const DENSE_FLOOD_COST: FillCost = FillCost {
+    bit_volumes: 2.5,
+    inside_volumes: 0.0,
+    face_bytes: 0.0,
+    leaf_bytes: 1000.0,
+    block_bytes: 0.0,
+    triangle_bytes: TRIANGLE_BYTES,
+};
+/// Depth layers: about one dense volume (the counts) and 266 bytes per voxel of the box's
+/// faces (each direction's depth buffer, a few layers deep). Estimate/peak 0.93-1.07
+/// (bunny-closed, igea, armadillo, horse at 512-2048; it was 0.7-3.2).
+const DEPTH_LAYERS_COST: FillCost = FillCost {
+    bit_volumes: 0.9,
+    inside_volumes: 0.0,
+    face_bytes: 266.0,
+    leaf_bytes: 0.0,
+    block_bytes: 0.0,
+    triangle_bytes: TRIANGLE_BYTES,
+};
+/// `measure` of a mesh: the block flood without writing, then components and genus counted
+/// over the solid, whose labels take about two bits per inside voxel and half a bit per
+/// voxel of the box. Estimate/peak 0.88-1.16 (was 0.79-1.44).
+const MEASURE_COST: FillCost = FillCost {
+    bit_volumes: 0.6,
+    inside_volumes: 2.1,
+    face_bytes: 0.0,
+    leaf_bytes: 920.0,
+    block_bytes: 0.0,
+    triangle_bytes: TRIANGLE_BYTES,
+};
+/// The beam fill: two dense volumes and the projective surface, whose per-triangle tables
+/// are smaller than the separating voxelizer's. Estimate/peak 0.82-1.20 (was 1.14-1.82).
+const BEAM_COST: FillCost = FillCost {
+    bit_volumes: 2.2,
+    inside_volumes: 0.0,
+    face_bytes: 0.0,
+    leaf_bytes: 800.0,
+    block_bytes: 0.0,
+    triangle_bytes: 100.0,
+};
 
 /// A Catmull-Clark surface costs 15 KB per leaf of its control polygons' area (a leaf per 44
 /// voxels^2; the limit surface is smaller than its control polygons), normals included
 /// (measured on spot and catmark_torus at 512 and 1024: estimate 1.06-1.10 of the peak).
 const SUBDIV_LEAF_BYTES: f64 = 15000.0;
 /// Per patch: its evaluation tables and the voxelizer's working set (6 KB; beast's 32k
-/// patches at 1024), and for a solid the quadrature's patches refined towards extraordinary
-/// corners (20 KB more; beast at 64: 728 MB against 131 MB for its surface alone).
+/// patches at 1024).
 const PATCH_BYTES: f64 = 6000.0;
-const SOLID_PATCH_BYTES: f64 = 20000.0;
+/// A Catmull-Clark solid, measured on the limit surface's size (the polygons of one
+/// subdivision step at their limit points; the control hull can be far larger): 7.8 KB per
+/// leaf of that area (the enclosed surface with its normals, the seeds, the solid's
+/// boundary); four dense volumes over that box (blocked, inside, outside, one seed's
+/// region); and the exact volume's quadrature, which refines each patch 30 levels deep
+/// towards every extraordinary corner and keeps the refinements (95 KB per corner: beast's
+/// 5,832 corners take about 550 MB). Estimate/peak 0.93-1.05 on spot, catmark_torus,
+/// catmark_cube, beast, fish and penguin at 256-1024 (was up to 5.6).
+const SOLID_SUBDIV_LEAF_BYTES: f64 = 7800.0;
+const SOLID_SUBDIV_VOLUMES: f64 = 4.0;
+const IRREGULAR_CORNER_BYTES: f64 = 95_000.0;
 /// The analytic voxelizer's state per 8^3 block of the shape's box.
 const SHAPE_BLOCK_BYTES: f64 = 8.0;
 
@@ -101,21 +174,45 @@ fn surface_leaf_bytes(leaves: f64, vector_channels: u32) -> f64 {
     leaves * (MESH_LEAF_BYTES + f64::from(vector_channels) * MESH_VECTOR_LEAF_BYTES)
 }
 
+/// Lines: a leaf per 6 voxels of length (a line crosses a leaf in 5-8 voxels), and a mesh's
+/// triangles read but not voxelized (40 bytes each). Calibrated on the edges of nine shared
+/// meshes at 512-2048: estimate/peak 0.89-1.16 (was up to 1.8).
+const LINE_LENGTH_PER_LEAF: f64 = 6.0;
+const LINE_TRIANGLE_BYTES: f64 = 40.0;
+
+/// Leaves crossed by a mesh's edges: `along` their length alone, but edges on a surface
+/// share its leaves: where they are dense (coarse grids) the surface's `surface` leaves
+/// bound them. The two blend as 1/n^2 = 1/along^2 + 1/surface^2 (within 15% of the
+/// measured leaves on the nine meshes).
+fn edge_leaves(along: f64, surface: f64) -> f64 {
+    (along.powi(-2) + surface.powi(-2)).powf(-0.5)
+}
+
 /// Peak bytes of the separating or projective surface of `mesh`.
 fn mesh_surface_bytes(mesh: &Mesh, t: &Transform, vector_channels: u32) -> f64 {
     let leaves = surface_leaves(area_in_voxels(mesh, t));
     surface_leaf_bytes(leaves, vector_channels) + mesh.triangle_count() as f64 * TRIANGLE_BYTES
 }
 
-/// Peak bytes of filling `mesh` over the box `b` with `masks` dense bit volumes at once.
-fn mesh_solid_bytes(mesh: &Mesh, t: &Transform, b: &CoordBox, masks: u32) -> f64 {
+/// Peak bytes of filling `mesh` over the box `b` at `cost`.
+fn mesh_solid_bytes(mesh: &Mesh, t: &Transform, b: &CoordBox, cost: &FillCost) -> f64 {
     let leaves = surface_leaves(area_in_voxels(mesh, t));
     let box_cells = cells(b);
-    f64::from(masks) * box_cells / 8.0
-        + leaves * SOLID_LEAF_BYTES
-        + box_cells / 512.0 * BLOCK_BYTES
-        + mesh.triangle_count() as f64 * TRIANGLE_BYTES
+    let inside_cells = mesh.signed_volume().abs() / t.voxel_size.powi(3);
+    let e: Vec<f64> = (0..3).map(|a| (b.max[a] - b.min[a] + 1) as f64).collect();
+    let faces = e[0] * e[1] + e[1] * e[2] + e[0] * e[2];
+    (cost.bit_volumes * box_cells + cost.inside_volumes * inside_cells) / 8.0
+        + faces * cost.face_bytes
+        + leaves * cost.leaf_bytes
+        + box_cells / 512.0 * cost.block_bytes
+        + mesh.triangle_count() as f64 * cost.triangle_bytes
 }
+
+/// `check`: the surface and its word-wise span floods, about 2.2 dense volumes over the box
+/// at the peak, 900 bytes per surface leaf (normals at the surface's cost). Estimate/peak
+/// 0.91-1.13 (bunny-closed, igea, armadillo at 512-2048; it was up to 2.3).
+const CHECK_VOLUMES: f64 = 2.2;
+const CHECK_LEAF_BYTES: f64 = 900.0;
 
 /// Bytes per labelled run of clear voxels: its span, label and union-find parent.
 const RUN_BYTES: f64 = 16.0;
@@ -280,9 +377,11 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
         Task::SeparationCheck { mesh, options } => {
             let mesh = mesh.load(false, up)?;
             let (t, b) = mesh_plan(&mesh, fit)?;
-            // Four bit volumes over the box: surface, inside centres, flood, minimality.
-            let bytes = surface_bytes(area_in_voxels(&mesh, &t), u32::from(options.normals))
-                + 4.0 * cells(&padded(b, 3)) / 8.0;
+            let leaves = surface_leaves(area_in_voxels(&mesh, &t));
+            let bytes = CHECK_VOLUMES * cells(&padded(b, 3)) / 8.0
+                + leaves * CHECK_LEAF_BYTES
+                + leaves * f64::from(u32::from(options.normals)) * MESH_VECTOR_LEAF_BYTES
+                + mesh.triangle_count() as f64 * TRIANGLE_BYTES;
             let p = plan_of(t, &mesh.bbox(), bytes, separating::work_items(&mesh));
             (Loaded::Mesh(mesh), p)
         }
@@ -295,15 +394,14 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
                 .iter()
                 .map(|&[a, b]| mesh.p(a).distance(mesh.p(b)))
                 .sum();
-            // A mesh's edges lie on its surface: never more leaves than the surface crosses.
             let mut leaves =
-                (length / t.voxel_size + mesh.positions.len() as f64) / LENGTH_PER_LEAF;
+                (length / t.voxel_size + mesh.positions.len() as f64) / LINE_LENGTH_PER_LEAF;
             if mesh.face_count() > 0 {
-                leaves = leaves.min(surface_leaves(area_in_voxels(&mesh, &t)));
+                leaves = edge_leaves(leaves, surface_leaves(area_in_voxels(&mesh, &t)));
             }
             let colour = color.coloring(&mesh) != projective::Coloring::None;
             let bytes = surface_leaf_bytes(leaves, u32::from(colour))
-                + mesh.triangle_count() as f64 * TRIANGLE_BYTES;
+                + mesh.triangle_count() as f64 * LINE_TRIANGLE_BYTES;
             let p = plan_of(t, &mesh.bbox(), bytes, segments.len() as u64);
             (Loaded::Mesh(mesh), p)
         }
@@ -324,15 +422,19 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             };
             let bbox = control.bbox();
             let t = fit_transform(&bbox, fit)?;
-            let b = checked_box(&bbox, &t)?;
+            checked_box(&bbox, &t)?;
             let patches = control.patch_count() as f64;
-            let mut bytes = surface_leaves(area_in_voxels(&control.polygon_mesh(), &t))
-                * SUBDIV_LEAF_BYTES
-                + patches * PATCH_BYTES;
-            if solid.is_some() {
-                // The blocked and flooded bit volumes, the GRAYSTACK and the solid.
-                bytes += solid_bytes(cells(&padded(b, 1)), 3) + patches * SOLID_PATCH_BYTES;
-            }
+            let bytes = patches * PATCH_BYTES
+                + if solid.is_some() {
+                    let limit = control.limit_polygons();
+                    let leaves = surface_leaves(area_in_voxels(&limit, &t));
+                    let limit_box = checked_box(&limit.bbox(), &t)?;
+                    leaves * SOLID_SUBDIV_LEAF_BYTES
+                        + SOLID_SUBDIV_VOLUMES * cells(&padded(limit_box, 1)) / 8.0
+                        + control.irregular_corner_count() as f64 * IRREGULAR_CORNER_BYTES
+                } else {
+                    surface_leaves(area_in_voxels(&control.polygon_mesh(), &t)) * SUBDIV_LEAF_BYTES
+                };
             let p = plan_of(t, &bbox, bytes, control.patch_count() as u64);
             (Loaded::Control(control), p)
         }
@@ -384,7 +486,13 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             source: MeasureSource::Mesh(mesh),
             flood,
             ..
-        } => solid_plan(mesh, fit, up, super::Fill::Flood(*flood))?,
+        } => {
+            let cost = match flood {
+                FloodMethod::Blocks => &MEASURE_COST,
+                _ => &DENSE_FLOOD_COST,
+            };
+            fill_plan(mesh, fit, up, cost, |m, _| separating::work_items(m))?
+        }
         Task::Measure {
             source: MeasureSource::Vdb(path),
             ..
@@ -453,20 +561,33 @@ fn solid_plan(
     up: UpAxis,
     fill: super::Fill,
 ) -> Result<(Loaded, Plan)> {
+    match fill {
+        super::Fill::Flood(method) => {
+            let cost = match method {
+                FloodMethod::Blocks => &BLOCK_FLOOD_COST,
+                _ => &DENSE_FLOOD_COST,
+            };
+            fill_plan(mesh, fit, up, cost, |m, _| separating::work_items(m))
+        }
+        super::Fill::DepthLayers(o) => fill_plan(mesh, fit, up, &DEPTH_LAYERS_COST, |_, b| {
+            o.directions.len() as u64 + (b.max[0] - b.min[0] + 1) as u64
+        }),
+        super::Fill::Beam(_) => fill_plan(mesh, fit, up, &BEAM_COST, |m, _| m.face_count() as u64),
+    }
+}
+
+/// Filling `mesh` at `cost`, with `work_items` for the progress bar.
+fn fill_plan(
+    mesh: &MeshSource,
+    fit: GridFit,
+    up: UpAxis,
+    cost: &FillCost,
+    work_items: impl Fn(&Mesh, &CoordBox) -> u64,
+) -> Result<(Loaded, Plan)> {
     let mesh = mesh.load(false, up)?;
     let (t, b) = mesh_plan(&mesh, fit)?;
-    // Dense bit volumes over the box: none for the block flood, which works on 8^3 blocks.
-    let (masks, items) = match fill {
-        super::Fill::Flood(FloodMethod::Blocks) => (0, separating::work_items(&mesh)),
-        super::Fill::Flood(_) => (2, separating::work_items(&mesh)),
-        super::Fill::DepthLayers(o) => (
-            12,
-            o.directions.len() as u64 + (b.max[0] - b.min[0] + 1) as u64,
-        ),
-        super::Fill::Beam(_) => (2, mesh.face_count() as u64),
-    };
-    let bytes = mesh_solid_bytes(&mesh, &t, &padded(b, 2), masks);
-    let p = plan_of(t, &mesh.bbox(), bytes, items);
+    let bytes = mesh_solid_bytes(&mesh, &t, &padded(b, 2), cost);
+    let p = plan_of(t, &mesh.bbox(), bytes, work_items(&mesh, &b));
     Ok((Loaded::Mesh(mesh), p))
 }
 

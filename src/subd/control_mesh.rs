@@ -178,6 +178,25 @@ impl ControlMesh {
         }
     }
 
+    /// The polygons of one Catmull-Clark step with every vertex at its limit position (exact
+    /// masks: after a step every vertex has only quads around it): their area and box are
+    /// within a few percent of the limit surface's, which the control hull can far exceed (a
+    /// cube's limit surface has about a third of its area).
+    pub fn limit_polygons(&self) -> Mesh {
+        let every = vec![true; self.mesh.points.len()];
+        let child = super::subdivide::subdivide(&self.mesh, &every);
+        let points = child
+            .outgoing()
+            .iter()
+            .enumerate()
+            .map(|(v, &h)| super::limit_masks::vertex_limit(&child, v as u32, h).0)
+            .collect();
+        let faces: Vec<Vec<u32>> = (0..child.face_count())
+            .map(|f| child.face(f).to_vec())
+            .collect();
+        Mesh::from_polygons(self.source.clone(), points, &faces)
+    }
+
     /// The control polygons as a plain mesh (for areas, bounding boxes, fitting).
     pub fn polygon_mesh(&self) -> Mesh {
         let faces: Vec<Vec<u32>> = (0..self.face_count())
@@ -200,6 +219,23 @@ impl ControlMesh {
             b.max = b.max.max(p);
         }
         b
+    }
+
+    /// Patch corners at extraordinary points: each interior vertex of valence n != 4 is a
+    /// corner of n patches, and each n-gon (n != 4) splits into n patches meeting at its centre.
+    pub fn irregular_corner_count(&self) -> usize {
+        let at_vertices: usize = self
+            .outgoing
+            .iter()
+            .map(|&h| self.mesh.ring(h))
+            .filter(|(ring, closed)| *closed && ring.len() != 4)
+            .map(|(ring, _)| ring.len())
+            .sum();
+        let at_centres: usize = (0..self.face_count())
+            .map(|f| self.face_len(f))
+            .filter(|&n| n != 4)
+            .sum();
+        at_vertices + at_centres
     }
 
     pub fn stats(&self) -> ControlStats {
