@@ -1,9 +1,9 @@
 //! Planning's memory estimates against the measured peak of the whole process (`voxelkit
 //! --json` reports both), each within 30% of its peak: mesh surfaces (with and without
 //! normals) and block-flood solids on five shared meshes, every other fill (span flood,
-//! FloodingXYZ, beam, depth layers), lines, `check`, `measure`, the §7 shapes, Catmull-Clark
-//! surfaces and solids, distance bands and implicit surfaces (a formula zero everywhere
-//! included). Every run is its own process, so that each peak is the run's alone.
+//! FloodingXYZ, beam, depth layers), lines, `check`, `measure` of a mesh and of a file, CSG
+//! trees and Booleans of two grids, the §7 shapes, Catmull-Clark surfaces and solids,
+//! distance bands and implicit surfaces (a formula zero everywhere included). Every run is its own process, so that each peak is the run's alone.
 #![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 mod cli_support;
@@ -138,6 +138,40 @@ fn estimates_are_within_30_percent_of_the_peak() {
             "--solid".into(),
         ]);
     }
+    // CSG: a tree of shapes and a formula (the flange at 1024), and two solids on one grid
+    // combined; `measure` of a solid's file.
+    let flange = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/csg/flange.json"),
+    )
+    .unwrap()
+    .replace("\"resolution\": 256", "\"resolution\": 1024");
+    let tree = dir.path().join("flange.json");
+    std::fs::write(&tree, flange).unwrap();
+    cases.push(vec![
+        "csg".into(),
+        "--tree".into(),
+        tree.display().to_string(),
+    ]);
+    let solids = dir.path().join("solids");
+    let made = voxelkit(&[
+        "solid",
+        &meshes("bunny-closed"),
+        &meshes("armadillo"),
+        "--shared-grid",
+        "-r",
+        "1024",
+        "--out-dir",
+        solids.to_str().unwrap(),
+    ]);
+    assert!(made.status.success(), "{}", text(&made));
+    let solid = |name: &str| solids.join(format!("{name}.vdb")).display().to_string();
+    cases.push(vec![
+        "csg".into(),
+        "union".into(),
+        solid("bunny-closed"),
+        solid("armadillo"),
+    ]);
+    cases.push(vec!["measure".into(), solid("bunny-closed")]);
     for case in cases {
         let args: Vec<&str> = case.iter().map(String::as_str).collect();
         let r = ratio(&args, &out);

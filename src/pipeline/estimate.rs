@@ -16,7 +16,7 @@ use crate::implicit::Formula;
 use crate::io::vdb::read_vdb_grid;
 use crate::mesh::{Aabb, GridFit, Mesh, UpAxis, fit_transform, index_box};
 use crate::ops::flood::padded;
-use crate::solids::csg_tree::{parse_csg_tree, read_csg_tree};
+use crate::solids::csg_tree::{CsgNode, parse_csg_tree, read_csg_tree};
 use crate::solids::exterior_flood::FloodMethod;
 use crate::subd::ControlMesh;
 use crate::voxelize::{projective, separating};
@@ -50,12 +50,6 @@ pub(super) fn leaf_budget(limit: Option<u64>, vector_channels: u32) -> u64 {
 /// Peak bytes of a surface of `area` voxels^2.
 fn surface_bytes(area: f64, vector_channels: u32) -> f64 {
     leaf_bytes(area / AREA_PER_LEAF, vector_channels)
-}
-
-/// Bytes to fill and write a solid over `cells` voxels of a box, with `masks` dense bit
-/// volumes over it at once.
-fn solid_bytes(cells: f64, masks: u32) -> f64 {
-    f64::from(masks) * cells / 8.0 + leaf_bytes(cells * SOLID_FILL / 512.0, 0)
 }
 
 /// A mesh's area in voxels^2.
@@ -206,6 +200,47 @@ fn mesh_solid_bytes(mesh: &Mesh, t: &Transform, b: &CoordBox, cost: &FillCost) -
         + leaves * cost.leaf_bytes
         + box_cells / 512.0 * cost.block_bytes
         + mesh.triangle_count() as f64 * cost.triangle_bytes
+}
+
+/// CSG trees evaluate node by node on dense masks over the tree's box, whose pages are
+/// touched only where solids are (1.2 volumes of the box at the peak), and the result's
+/// boundary leaves cost 3 KB each; a result crosses about one leaf per 92 voxels^2 of its
+/// box's faces. Mesh leaves add their fill (13 KB per leaf of their surface, and their
+/// triangles), Catmull-Clark leaves their solid, grid leaves their leaves. Estimate/peak
+/// 0.95-1.15 on the flange, a union of shapes and a mesh minus a slab at 256-1024 (was
+/// 1.2-9.5).
+const CSG_VOLUMES: f64 = 1.2;
+const CSG_FACE_AREA_PER_LEAF: f64 = 92.0;
+const CSG_LEAF_BYTES: f64 = 3000.0;
+const CSG_MESH_LEAF_BYTES: f64 = 13000.0;
+
+/// Peak bytes of evaluating the CSG tree `root` over the box `b`.
+fn csg_tree_bytes(root: &CsgNode, t: &Transform, b: &CoordBox) -> f64 {
+    fn leaves_bytes(node: &CsgNode, t: &Transform, b: &CoordBox) -> f64 {
+        match node {
+            CsgNode::Boolean { operands, .. } => {
+                operands.iter().map(|n| leaves_bytes(n, t, b)).sum()
+            }
+            CsgNode::Mesh(mesh) => {
+                surface_leaves(area_in_voxels(mesh, t)) * CSG_MESH_LEAF_BYTES
+                    + mesh.triangle_count() as f64 * TRIANGLE_BYTES
+            }
+            CsgNode::Subdivision(control) => {
+                let limit = control.limit_polygons();
+                surface_leaves(area_in_voxels(&limit, t)) * SOLID_SUBDIV_LEAF_BYTES
+                    + SOLID_SUBDIV_VOLUMES * cells(b) / 8.0
+                    + control.irregular_corner_count() as f64 * IRREGULAR_CORNER_BYTES
+                    + control.patch_count() as f64 * PATCH_BYTES
+            }
+            CsgNode::Grid { grid, .. } => grid.leaf_count() as f64 * LEAF_BYTES,
+            CsgNode::Primitive(_) | CsgNode::Formula { .. } => 0.0,
+        }
+    }
+    let e: Vec<f64> = (0..3).map(|a| (b.max[a] - b.min[a] + 1) as f64).collect();
+    let faces = 2.0 * (e[0] * e[1] + e[1] * e[2] + e[0] * e[2]);
+    CSG_VOLUMES * cells(b) / 8.0
+        + faces / CSG_FACE_AREA_PER_LEAF * CSG_LEAF_BYTES
+        + leaves_bytes(root, t, b)
 }
 
 /// `check`: the surface and its word-wise span floods, about 2.2 dense volumes over the box
@@ -510,9 +545,7 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             };
             let (t, bounds) = tree.transform()?;
             let b = checked_box(&bounds, &t)?;
-            // Two masks per node at most (its own and its result), and the result's boundary.
-            let masks = 2 * tree.node_count() as u32 + 3;
-            let bytes = solid_bytes(cells(&b), masks);
+            let bytes = csg_tree_bytes(&tree.root, &t, &b);
             let p = plan_of(t, &bounds, bytes, tree.node_count() as u64);
             (Loaded::Tree(Box::new(tree)), p)
         }
@@ -536,9 +569,14 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
                 gb.leaf_count() as f64
             };
             let leaves = ga.leaf_count() as f64 + second;
+            // Grids read with values (`density`) also held OpenVDB's float leaves and the
+            // copied values: 2.2 KB more per leaf (estimate/peak 1.0-1.07 on two solids at
+            // 512 and 1024; it was 0.63-0.78).
+            let values = [&ga, &gb].iter().any(|g| g.channels().value);
+            let read_bytes = if values { 2200.0 * leaves } else { 0.0 };
             let t = ga.transform;
             let bbox = world_box(&ga);
-            let p = plan_of(t, &bbox, leaf_bytes(leaves, 0), 1);
+            let p = plan_of(t, &bbox, leaf_bytes(leaves, 0) + read_bytes, 1);
             (Loaded::Grids(ga, gb), p)
         }
     })
@@ -613,9 +651,16 @@ fn world_box(grid: &SparseGrid) -> Aabb {
     }
 }
 
-/// Measuring a surface grid: its box filled.
+/// Measuring a surface grid: filled and labelled as a mesh's (`MEASURE_COST`, the inside
+/// taken as 30% of the box: bunny-closed fills 26%, igea 41%), plus what reading it left:
+/// OpenVDB's float leaves and their copied values (4.3 KB per leaf of a grid with values,
+/// 300 bytes of a bool grid). Estimate/peak 0.88-0.99 on solids' shells and a surface at
+/// 512-1024 (was 5-14).
 fn grid_plan(grid: SparseGrid) -> (Loaded, Plan) {
-    let bytes = solid_bytes(cells(&padded(grid_box(&grid), 2)), 6);
+    let box_cells = cells(&padded(grid_box(&grid), 2));
+    let read_bytes = if grid.channels().value { 4300.0 } else { 300.0 };
+    let bytes = (MEASURE_COST.bit_volumes + 0.3 * MEASURE_COST.inside_volumes) * box_cells / 8.0
+        + grid.leaf_count() as f64 * (MEASURE_COST.leaf_bytes + read_bytes);
     let p = plan_of(grid.transform, &world_box(&grid), bytes, 1);
     (Loaded::Grid(grid), p)
 }
