@@ -13,13 +13,16 @@ pub struct DenseMask {
     bits: Vec<u64>,
 }
 
+/// The most voxels a dense volume holds (2 GiB of bits).
+pub const MAX_DENSE_VOXELS: u64 = 1 << 34;
+
 impl DenseMask {
-    /// An all-clear volume over `bbox`; refuses boxes over `2^34` voxels (2 GiB of bits).
+    /// An all-clear volume over `bbox`; refuses boxes over `MAX_DENSE_VOXELS`.
     pub fn new(bbox: CoordBox) -> Result<Self> {
         let d = bbox.dim();
         let total = d[0].checked_mul(d[1]).and_then(|v| v.checked_mul(d[2]));
         match total {
-            Some(n) if n <= 1 << 34 => Ok(DenseMask {
+            Some(n) if n <= MAX_DENSE_VOXELS => Ok(DenseMask {
                 bbox,
                 dims: d.map(|v| v as usize),
                 bits: vec![0; (n as usize).div_ceil(64)],

@@ -18,4 +18,4 @@ pub use transform::Transform;
 mod adjacency;
 mod dense;
 pub use adjacency::Adjacency;
-pub use dense::DenseMask;
+pub use dense::{DenseMask, MAX_DENSE_VOXELS};

@@ -11,7 +11,7 @@
 
 use super::{CsgSource, Job, Loaded, MeasureSource, MeshSource, Plan, Task, lines_source};
 use crate::error::{Error, Result};
-use crate::grid::{CoordBox, SparseGrid, Transform};
+use crate::grid::{CoordBox, MAX_DENSE_VOXELS, SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::io::vdb::read_vdb_grid;
 use crate::mesh::{Aabb, GridFit, Mesh, UpAxis, fit_transform, index_box};
@@ -531,11 +531,11 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
         Task::Measure {
             source: MeasureSource::Vdb(path),
             ..
-        } => grid_plan(read_surface(path)?),
+        } => grid_plan(read_surface(path)?, &path.display().to_string())?,
         Task::Measure {
             source: MeasureSource::Grid(grid),
             ..
-        } => grid_plan(grid.clone()),
+        } => grid_plan(grid.clone(), "the grid")?,
         Task::CsgTree(source) => {
             let tree = match source {
                 CsgSource::File(path) => read_csg_tree(path)?,
@@ -652,15 +652,28 @@ fn world_box(grid: &SparseGrid) -> Aabb {
 }
 
 /// Measuring a surface grid: filled and labelled as a mesh's (`MEASURE_COST`, the inside
-/// taken as 30% of the box: bunny-closed fills 26%, igea 41%), plus what reading it left:
-/// OpenVDB's float leaves and their copied values (4.3 KB per leaf of a grid with values,
-/// 300 bytes of a bool grid). Estimate/peak 0.88-0.99 on solids' shells and a surface at
-/// 512-1024 (was 5-14).
-fn grid_plan(grid: SparseGrid) -> (Loaded, Plan) {
+/// taken as 30% of the box: bunny-closed fills 26%, igea 41%) in a dense volume over the
+/// grid's box, allocated whole (it counts against an address-space limit), plus what reading
+/// it left: OpenVDB's float leaves and their copied values (4.3 KB per leaf of a grid with
+/// values, 300 bytes of a bool grid). Estimate/peak 0.93-1.13 on solids' shells and a
+/// surface at 512-1024 (was 5-14). A box past the dense volume's limit is refused here,
+/// with the input's name.
+fn grid_plan(grid: SparseGrid, what: &str) -> Result<(Loaded, Plan)> {
     let box_cells = cells(&padded(grid_box(&grid), 2));
     let read_bytes = if grid.channels().value { 4300.0 } else { 300.0 };
-    let bytes = (MEASURE_COST.bit_volumes + 0.3 * MEASURE_COST.inside_volumes) * box_cells / 8.0
+    let bytes = (1.0 + 0.3 * MEASURE_COST.inside_volumes) * box_cells / 8.0
         + grid.leaf_count() as f64 * (MEASURE_COST.leaf_bytes + read_bytes);
     let p = plan_of(grid.transform, &world_box(&grid), bytes, 1);
-    (Loaded::Grid(grid), p)
+    if box_cells > MAX_DENSE_VOXELS as f64 {
+        return Err(Error::TooLarge {
+            estimated_mib: p.estimated_bytes >> 20,
+            available_mib: (MAX_DENSE_VOXELS / 8) >> 20,
+            detail: format!(
+                "{what} at {} voxels: measuring fills a dense volume over the grid's box, at \
+                 most 2^34 voxels",
+                p.describe_extent()
+            ),
+        });
+    }
+    Ok((Loaded::Grid(grid), p))
 }
