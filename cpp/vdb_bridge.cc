@@ -78,6 +78,7 @@ typename GridT::Ptr build_grid(rust::Slice<const int32_t> origins, rust::Slice<c
     std::vector<LeafT*> leaves(count, nullptr);
     size_t inserted = 0;
     typename GridT::Ptr grid;
+    FreeOnThrow free_on_throw(grid);
     try {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, count), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i != r.end(); ++i) {
@@ -98,9 +99,8 @@ typename GridT::Ptr build_grid(rust::Slice<const int32_t> origins, rust::Slice<c
         typename GridT::Accessor acc = grid->getAccessor();
         for (; inserted < count; ++inserted) acc.addLeaf(leaves[inserted]);
     } catch (...) {
-        // Out of memory part way: free what was built, without allocating.
+        // Out of memory part way: the leaves not in the tree yet (the guard frees the tree).
         for (size_t i = inserted; i < count; ++i) delete leaves[i];
-        if (grid) free_nodes(*grid);
         throw;
     }
     return grid;

@@ -541,6 +541,27 @@ fn grid_from_job(
     })
 }
 
+/// The common shape of an export that fills a solid: `grid_from_job`'s, with the solid's
+/// measures (by `measures_of`) put where `measures` points, when it is not null.
+fn solid_from_job(
+    options: *const VkOptions,
+    out: *mut *mut VkGrid,
+    measures: *mut VkMeasures,
+    task: impl FnOnce(&Options) -> std::result::Result<Task, Failure>,
+    measures_of: impl FnOnce(&Outcome) -> std::result::Result<VkMeasures, Failure>,
+) -> VkStatus {
+    guard(|| {
+        let o = &options_of(options)?;
+        non_null_out(out)?;
+        let outcome = run_job(o, task(o)?)?;
+        let found = measures_of(&outcome)?;
+        if !measures.is_null() {
+            put(measures, found)?;
+        }
+        hand_out(VkGrid::from(outcome), Kind::Grid, out)
+    })
+}
+
 // ---- exports ---------------------------------------------------------------------------------
 
 #[unsafe(no_mangle)]
@@ -929,42 +950,34 @@ pub extern "C" fn vk_fill_mesh(
     solid: *mut *mut VkGrid,
     measures: *mut VkMeasures,
 ) -> VkStatus {
-    guard(|| {
-        let o = &options_of(options)?;
-        non_null_out(solid)?;
+    let task = |o: &Options| {
         let fill = match o.fill {
             FillMethod::Flood => Fill::Flood(o.flood),
             FillMethod::DepthLayers => Fill::DepthLayers(o.depth),
             FillMethod::Beam => Fill::Beam(Default::default()),
         };
-        let task = Task::Solid {
+        Ok(Task::Solid {
             mesh: mesh_source(mesh)?,
             fill,
             density: 1.0,
             topology: false,
-        };
-        let outcome = run_job(o, task)?;
-        let found = match &outcome.report.details {
-            Details::DepthLayers(d) if d.unclassified_voxels > 0 => {
-                return Err(invalid(format!(
-                    "{} voxels cannot be classified by depth layers (crossed more than four times \
-                     along every direction, or on rays that cross an open mesh an odd number of times)",
-                    d.unclassified_voxels
-                )));
-            }
-            Details::DepthLayers(d) => VkMeasures {
-                inside_voxels: d.inside_voxels,
-                surface_voxels: 0,
-                volume_inside: d.volume,
-                volume_with_surface: d.volume,
-            },
-            _ => solid_measures(&outcome)?,
-        };
-        if !measures.is_null() {
-            put(measures, found)?;
-        }
-        hand_out(VkGrid::from(outcome), Kind::Grid, solid)
-    })
+        })
+    };
+    let measures_of = |outcome: &Outcome| match &outcome.report.details {
+        Details::DepthLayers(d) if d.unclassified_voxels > 0 => Err(invalid(format!(
+            "{} voxels cannot be classified by depth layers (crossed more than four times \
+             along every direction, or on rays that cross an open mesh an odd number of times)",
+            d.unclassified_voxels
+        ))),
+        Details::DepthLayers(d) => Ok(VkMeasures {
+            inside_voxels: d.inside_voxels,
+            surface_voxels: 0,
+            volume_inside: d.volume,
+            volume_with_surface: d.volume,
+        }),
+        _ => solid_measures(outcome),
+    };
+    solid_from_job(options, solid, measures, task, measures_of)
 }
 
 #[unsafe(no_mangle)]
@@ -974,14 +987,12 @@ pub extern "C" fn vk_fill_subdivision(
     solid: *mut *mut VkGrid,
     measures: *mut VkMeasures,
 ) -> VkStatus {
-    guard(|| {
-        let o = &options_of(options)?;
-        non_null_out(solid)?;
+    let task = |o: &Options| {
         let graystack = match o.flood {
             FloodMethod::Xyz { capacity } => capacity,
             _ => 1 << 20,
         };
-        let task = Task::Subdivision {
+        Ok(Task::Subdivision {
             mesh: mesh_source(mesh)?,
             options: ParametricOptions {
                 adjacency: o.separability.flood_adjacency(),
@@ -992,13 +1003,9 @@ pub extern "C" fn vk_fill_subdivision(
                 density: 1.0,
                 topology: false,
             }),
-        };
-        let outcome = run_job(o, task)?;
-        if !measures.is_null() {
-            put(measures, solid_measures(&outcome)?)?;
-        }
-        hand_out(VkGrid::from(outcome), Kind::Grid, solid)
-    })
+        })
+    };
+    solid_from_job(options, solid, measures, task, solid_measures)
 }
 
 #[unsafe(no_mangle)]

@@ -94,8 +94,8 @@ const BLOCK_FLOOD_COST: FillCost = FillCost {
 };
 /// The span flood and FloodingXYZ: two dense volumes (surface and reached) and what scales
 /// with them, the solid's tiles and the scanline queues, half a volume more; the surface's
-/// own leaves are small beside them. Estimate/peak 0.84-1.19 (bunny-closed, igea, armadillo
-/// at 512-2048; it was 1.24-1.48 at 512-1024).
+/// own leaves are small beside them. Estimate/peak 0.86-1.17 (bunny-closed, igea, armadillo,
+/// skull, horse at 512-1024, four of them at 2048; it was 1.24-1.48 at 512-1024).
 const DENSE_FLOOD_COST: FillCost = FillCost {
     bit_volumes: 2.5,
     inside_volumes: 0.0,
@@ -105,8 +105,9 @@ const DENSE_FLOOD_COST: FillCost = FillCost {
     triangle_bytes: TRIANGLE_BYTES,
 };
 /// Depth layers: about one dense volume (the counts) and 266 bytes per voxel of the box's
-/// faces (each direction's depth buffer, a few layers deep). Estimate/peak 0.93-1.07
-/// (bunny-closed, igea, armadillo, horse at 512-2048; it was 0.7-3.2).
+/// faces (each direction's depth buffer, a few layers deep). Estimate/peak 0.94-1.12
+/// (bunny-closed, igea, armadillo, skull, horse at 512-1024, three of them at 2048; it was
+/// 0.7-3.2).
 const DEPTH_LAYERS_COST: FillCost = FillCost {
     bit_volumes: 0.9,
     inside_volumes: 0.0,
@@ -117,7 +118,8 @@ const DEPTH_LAYERS_COST: FillCost = FillCost {
 };
 /// `measure` of a mesh: the block flood without writing, then components and genus counted
 /// over the solid, whose labels take about two bits per inside voxel and half a bit per
-/// voxel of the box. Estimate/peak 0.88-1.16 (was 0.79-1.44).
+/// voxel of the box. Estimate/peak 0.93-1.14 (bunny-closed, igea, armadillo, horse at
+/// 512-2048; was 0.79-1.44).
 const MEASURE_COST: FillCost = FillCost {
     bit_volumes: 0.6,
     inside_volumes: 2.1,
@@ -127,7 +129,8 @@ const MEASURE_COST: FillCost = FillCost {
     triangle_bytes: TRIANGLE_BYTES,
 };
 /// The beam fill: two dense volumes and the projective surface, whose per-triangle tables
-/// are smaller than the separating voxelizer's. Estimate/peak 0.82-1.20 (was 1.14-1.82).
+/// are smaller than the separating voxelizer's. Estimate/peak 0.82-1.21 (five meshes at
+/// 512-1024, four of them at 2048; was 1.14-1.82).
 const BEAM_COST: FillCost = FillCost {
     bit_volumes: 2.2,
     inside_volumes: 0.0,
@@ -150,8 +153,8 @@ const PATCH_BYTES: f64 = 6000.0;
 /// boundary); four dense volumes over that box (blocked, inside, outside, one seed's
 /// region); and the exact volume's quadrature, which refines each patch 30 levels deep
 /// towards every extraordinary corner and keeps the refinements (95 KB per corner: beast's
-/// 5,832 corners take about 550 MB). Estimate/peak 0.93-1.05 on spot, catmark_torus,
-/// catmark_cube, beast, fish and penguin at 256-1024 (was up to 5.6).
+/// 5,832 corners take about 550 MB). Estimate/peak 0.94-1.07 on spot, catmark_torus,
+/// catmark_cube, beast, fish and penguin at 256 and 1024 (was up to 5.6).
 const SOLID_SUBDIV_LEAF_BYTES: f64 = 7800.0;
 const SOLID_SUBDIV_VOLUMES: f64 = 4.0;
 const IRREGULAR_CORNER_BYTES: f64 = 95_000.0;
@@ -193,10 +196,8 @@ fn mesh_solid_bytes(mesh: &Mesh, t: &Transform, b: &CoordBox, cost: &FillCost) -
     let leaves = surface_leaves(area_in_voxels(mesh, t));
     let box_cells = cells(b);
     let inside_cells = mesh.signed_volume().abs() / t.voxel_size.powi(3);
-    let e: Vec<f64> = (0..3).map(|a| (b.max[a] - b.min[a] + 1) as f64).collect();
-    let faces = e[0] * e[1] + e[1] * e[2] + e[0] * e[2];
     (cost.bit_volumes * box_cells + cost.inside_volumes * inside_cells) / 8.0
-        + faces * cost.face_bytes
+        + face_cells(b) * cost.face_bytes
         + leaves * cost.leaf_bytes
         + box_cells / 512.0 * cost.block_bytes
         + mesh.triangle_count() as f64 * cost.triangle_bytes
@@ -207,7 +208,7 @@ fn mesh_solid_bytes(mesh: &Mesh, t: &Transform, b: &CoordBox, cost: &FillCost) -
 /// boundary leaves cost 3 KB each; a result crosses about one leaf per 92 voxels^2 of its
 /// box's faces. Mesh leaves add their fill (13 KB per leaf of their surface, and their
 /// triangles), Catmull-Clark leaves their solid, grid leaves their leaves. Estimate/peak
-/// 0.95-1.15 on the flange, a union of shapes and a mesh minus a slab at 256-1024 (was
+/// 0.89-1.15 on the flange, a union of shapes and a mesh minus a slab at 256-1024 (was
 /// 1.2-9.5).
 const CSG_VOLUMES: f64 = 1.2;
 const CSG_FACE_AREA_PER_LEAF: f64 = 92.0;
@@ -216,36 +217,38 @@ const CSG_MESH_LEAF_BYTES: f64 = 13000.0;
 
 /// Peak bytes of evaluating the CSG tree `root` over the box `b`.
 fn csg_tree_bytes(root: &CsgNode, t: &Transform, b: &CoordBox) -> f64 {
-    fn leaves_bytes(node: &CsgNode, t: &Transform, b: &CoordBox) -> f64 {
+    fn leaves_bytes(node: &CsgNode, t: &Transform) -> f64 {
         match node {
-            CsgNode::Boolean { operands, .. } => {
-                operands.iter().map(|n| leaves_bytes(n, t, b)).sum()
-            }
+            CsgNode::Boolean { operands, .. } => operands.iter().map(|n| leaves_bytes(n, t)).sum(),
             CsgNode::Mesh(mesh) => {
                 surface_leaves(area_in_voxels(mesh, t)) * CSG_MESH_LEAF_BYTES
                     + mesh.triangle_count() as f64 * TRIANGLE_BYTES
             }
             CsgNode::Subdivision(control) => {
-                let limit = control.limit_polygons();
-                surface_leaves(area_in_voxels(&limit, t)) * SOLID_SUBDIV_LEAF_BYTES
-                    + SOLID_SUBDIV_VOLUMES * cells(b) / 8.0
-                    + control.irregular_corner_count() as f64 * IRREGULAR_CORNER_BYTES
-                    + control.patch_count() as f64 * PATCH_BYTES
+                subdivision_solid_bytes(control, t) + control.patch_count() as f64 * PATCH_BYTES
             }
             CsgNode::Grid { grid, .. } => grid.leaf_count() as f64 * LEAF_BYTES,
             CsgNode::Primitive(_) | CsgNode::Formula { .. } => 0.0,
         }
     }
-    let e: Vec<f64> = (0..3).map(|a| (b.max[a] - b.min[a] + 1) as f64).collect();
-    let faces = 2.0 * (e[0] * e[1] + e[1] * e[2] + e[0] * e[2]);
     CSG_VOLUMES * cells(b) / 8.0
-        + faces / CSG_FACE_AREA_PER_LEAF * CSG_LEAF_BYTES
-        + leaves_bytes(root, t, b)
+        + 2.0 * face_cells(b) / CSG_FACE_AREA_PER_LEAF * CSG_LEAF_BYTES
+        + leaves_bytes(root, t)
+}
+
+/// Peak bytes of a Catmull-Clark solid besides its patches (see `SOLID_SUBDIV_LEAF_BYTES`),
+/// sized on the limit surface.
+fn subdivision_solid_bytes(control: &ControlMesh, t: &Transform) -> f64 {
+    let limit = control.limit_polygons();
+    let limit_box = index_box(&limit.bbox(), t);
+    surface_leaves(area_in_voxels(&limit, t)) * SOLID_SUBDIV_LEAF_BYTES
+        + SOLID_SUBDIV_VOLUMES * cells(&padded(limit_box, 1)) / 8.0
+        + control.irregular_corner_count() as f64 * IRREGULAR_CORNER_BYTES
 }
 
 /// `check`: the surface and its word-wise span floods, about 2.2 dense volumes over the box
 /// at the peak, 900 bytes per surface leaf (normals at the surface's cost). Estimate/peak
-/// 0.91-1.13 (bunny-closed, igea, armadillo at 512-2048; it was up to 2.3).
+/// 0.92-1.17 (bunny-closed, igea, armadillo, horse at 512-2048; it was up to 2.3).
 const CHECK_VOLUMES: f64 = 2.2;
 const CHECK_LEAF_BYTES: f64 = 900.0;
 
@@ -268,7 +271,17 @@ pub(super) fn brick_bytes(faces: &Mesh, t: &Transform, size: u32, solid: bool) -
 
 /// Voxels of a box, as a float (boxes past 2^64 voxels must still be refused, not wrap).
 fn cells(b: &CoordBox) -> f64 {
-    (0..3).map(|a| (b.max[a] - b.min[a] + 1) as f64).product()
+    box_edges(b).iter().product()
+}
+
+/// Voxels of three of a box's faces, one of each orientation.
+fn face_cells(b: &CoordBox) -> f64 {
+    let [x, y, z] = box_edges(b);
+    x * y + y * z + z * x
+}
+
+fn box_edges(b: &CoordBox) -> [f64; 3] {
+    std::array::from_fn(|a| (b.max[a] - b.min[a] + 1) as f64)
 }
 
 fn extent(bbox: &Aabb, t: &Transform) -> [f64; 3] {
@@ -461,12 +474,7 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             let patches = control.patch_count() as f64;
             let bytes = patches * PATCH_BYTES
                 + if solid.is_some() {
-                    let limit = control.limit_polygons();
-                    let leaves = surface_leaves(area_in_voxels(&limit, &t));
-                    let limit_box = checked_box(&limit.bbox(), &t)?;
-                    leaves * SOLID_SUBDIV_LEAF_BYTES
-                        + SOLID_SUBDIV_VOLUMES * cells(&padded(limit_box, 1)) / 8.0
-                        + control.irregular_corner_count() as f64 * IRREGULAR_CORNER_BYTES
+                    subdivision_solid_bytes(&control, &t)
                 } else {
                     surface_leaves(area_in_voxels(&control.polygon_mesh(), &t)) * SUBDIV_LEAF_BYTES
                 };
@@ -521,13 +529,9 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             source: MeasureSource::Mesh(mesh),
             flood,
             ..
-        } => {
-            let cost = match flood {
-                FloodMethod::Blocks => &MEASURE_COST,
-                _ => &DENSE_FLOOD_COST,
-            };
-            fill_plan(mesh, fit, up, cost, |m, _| separating::work_items(m))?
-        }
+        } => fill_plan(mesh, fit, up, flood_cost(*flood, &MEASURE_COST), |m, _| {
+            separating::work_items(m)
+        })?,
         Task::Measure {
             source: MeasureSource::Vdb(path),
             ..
@@ -570,7 +574,7 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             };
             let leaves = ga.leaf_count() as f64 + second;
             // Grids read with values (`density`) also held OpenVDB's float leaves and the
-            // copied values: 2.2 KB more per leaf (estimate/peak 1.0-1.07 on two solids at
+            // copied values: 2.2 KB more per leaf (estimate/peak 0.96-1.04 on two solids at
             // 512 and 1024; it was 0.63-0.78).
             let values = [&ga, &gb].iter().any(|g| g.channels().value);
             let read_bytes = if values { 2200.0 * leaves } else { 0.0 };
@@ -601,16 +605,22 @@ fn solid_plan(
 ) -> Result<(Loaded, Plan)> {
     match fill {
         super::Fill::Flood(method) => {
-            let cost = match method {
-                FloodMethod::Blocks => &BLOCK_FLOOD_COST,
-                _ => &DENSE_FLOOD_COST,
-            };
+            let cost = flood_cost(method, &BLOCK_FLOOD_COST);
             fill_plan(mesh, fit, up, cost, |m, _| separating::work_items(m))
         }
         super::Fill::DepthLayers(o) => fill_plan(mesh, fit, up, &DEPTH_LAYERS_COST, |_, b| {
             o.directions.len() as u64 + (b.max[0] - b.min[0] + 1) as u64
         }),
         super::Fill::Beam(_) => fill_plan(mesh, fit, up, &BEAM_COST, |m, _| m.face_count() as u64),
+    }
+}
+
+/// The cost of a flood: `blocks` for the block flood (writing a solid or measuring it), the
+/// dense volumes' for the others.
+fn flood_cost(method: FloodMethod, blocks: &'static FillCost) -> &'static FillCost {
+    match method {
+        FloodMethod::Blocks => blocks,
+        _ => &DENSE_FLOOD_COST,
     }
 }
 
@@ -655,7 +665,7 @@ fn world_box(grid: &SparseGrid) -> Aabb {
 /// taken as 30% of the box: bunny-closed fills 26%, igea 41%) in a dense volume over the
 /// grid's box, allocated whole (it counts against an address-space limit), plus what reading
 /// it left: OpenVDB's float leaves and their copied values (4.3 KB per leaf of a grid with
-/// values, 300 bytes of a bool grid). Estimate/peak 0.93-1.13 on solids' shells and a
+/// values, 300 bytes of a bool grid). Estimate/peak 0.93-1.17 on solids' shells and a
 /// surface at 512-1024 (was 5-14). A box past the dense volume's limit is refused here,
 /// with the input's name.
 fn grid_plan(grid: SparseGrid, what: &str) -> Result<(Loaded, Plan)> {

@@ -472,6 +472,22 @@ impl Job {
     }
 }
 
+/// Runs `work` on a pool of `threads` workers (1 to `MAX_THREADS`), or without one on the
+/// global pool (all cores).
+pub fn on_threads<T: Send>(
+    threads: Option<usize>,
+    work: impl FnOnce() -> Result<T> + Send,
+) -> Result<T> {
+    match threads.map(|n| n.clamp(1, MAX_THREADS)) {
+        None => work(),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| Error::InvalidArgument(format!("cannot start {n} threads: {e}")))?
+            .install(work),
+    }
+}
+
 impl PlannedJob {
     pub fn plan(&self) -> &Plan {
         &self.plan
@@ -494,15 +510,7 @@ impl PlannedJob {
     pub fn run(self, observer: &dyn Observer) -> Result<Outcome> {
         let progress = Progress::new(observer);
         progress.stage(self.stage_name(), self.plan.work_items);
-        let threads = self.job.limits.threads.map(|n| n.min(MAX_THREADS));
-        let mut outcome = match threads {
-            None => self.run_here(&progress),
-            Some(n) => rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|e| Error::InvalidArgument(format!("cannot start {n} threads: {e}")))?
-                .install(|| self.run_here(&progress)),
-        }?;
+        let mut outcome = on_threads(self.job.limits.threads, || self.run_here(&progress))?;
         progress.check()?;
         outcome.report.warnings.splice(0..0, self.warnings);
         outcome.report.input = self.job.describe_input();

@@ -375,14 +375,12 @@ pub(super) fn subdivision_solid(
     let mut meta = provenance(method, &control.source.display().to_string(), resolution);
     meta.push(("adjacency", options.adjacency.number().to_string()));
     meta.push(("limit_volume", made.limit_volume.to_string()));
-    // The area only reports; the solid itself needs the volume's sign alone.
-    let limit_area = crate::subd::limit_area(&crate::subd::LimitSurface::new(control.clone()));
-    meta.push(("limit_area", limit_area.to_string()));
+    meta.push(("limit_area", made.limit_area.to_string()));
     meta.push(("seeds", made.seeds.to_string()));
     // Steps along tilted normals can leave the solid; their floods reach the border and are
     // dropped (`solids::subdivision`).
     meta.push(("outside_seeds", made.outside_seeds.to_string()));
-    let limit_volume = made.limit_volume;
+    let (limit_volume, limit_area) = (made.limit_volume, made.limit_area);
     let opposite = made.surface.opposite;
     let outcome = surface_and_inside(made.surface.surface, made.solid, meta, |whole, solid| {
         let mut details = solid_details(

@@ -247,15 +247,7 @@ pub fn solid(
                     }
                 },
             }),
-            "beam" => Fill::Beam(match fill {
-                "parity" => BeamFill::Parity,
-                "paper" => BeamFill::Paper,
-                _ => {
-                    return Err(PyValueError::new_err(format!(
-                        "fill must be parity or paper, not `{fill}`"
-                    )));
-                }
-            }),
+            "beam" => Fill::Beam(parse::<BeamFill>(fill)?),
             _ => {
                 return Err(PyValueError::new_err(format!(
                     "method must be flood, depth-layers or beam, not `{method}`"

@@ -42,6 +42,17 @@ pub enum BeamFill {
     Paper,
 }
 
+impl std::str::FromStr for BeamFill {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "parity" => Ok(BeamFill::Parity),
+            "paper" => Ok(BeamFill::Paper),
+            _ => Err(format!("fill must be parity or paper, not `{s}`")),
+        }
+    }
+}
+
 /// The beam solid and what its fill met.
 pub struct Beam {
     pub surface: SparseGrid,

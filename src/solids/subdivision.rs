@@ -25,7 +25,7 @@ use crate::ops::measure::SolidMeasures;
 use crate::ops::seed::seeds_from_normals;
 use crate::progress::Progress;
 use crate::solids::exterior_flood::Solid;
-use crate::subd::{ControlMesh, LimitSurface, limit_volume};
+use crate::subd::{ControlMesh, LimitSurface, limit_volume_and_area};
 use crate::voxelize::parametric::{ParametricOptions, ParametricOutput, voxelize_subdivision};
 
 /// A Catmull-Clark solid and what made it.
@@ -39,6 +39,8 @@ pub struct SubdivisionSolid {
     /// The exact volume the limit surface encloses (Gauss quadrature), in world units: its
     /// sign tells which way the normals face.
     pub limit_volume: f64,
+    /// The limit surface's exact area, from the same quadrature.
+    pub limit_area: f64,
 }
 
 /// Why a solid needs a closed control mesh.
@@ -64,7 +66,7 @@ pub fn subdivision_solid(
         ..*options
     };
     let surface = voxelize_subdivision(control, transform, &options, progress)?;
-    let limit_volume = limit_volume(&LimitSurface::new(control.clone()));
+    let (limit_volume, limit_area) = limit_volume_and_area(&LimitSurface::new(control.clone()));
     let outward = limit_volume < 0.0;
     let seeds: Vec<Coord> = seeds_from_normals(&surface.surface, &surface.opposite, outward)
         .map(|choice| choice.seed)
@@ -122,6 +124,7 @@ pub fn subdivision_solid(
         seeds: seeds.len() as u64,
         outside_seeds,
         limit_volume: limit_volume.abs(),
+        limit_area,
     })
 }
 

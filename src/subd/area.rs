@@ -7,8 +7,10 @@
 
 use super::patch::LimitSample;
 use super::surface::LimitSurface;
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
+use std::iter::Sum;
+use std::ops::{Add, Mul};
 
 /// 5-point Gauss-Legendre nodes and weights on [0, 1].
 const NODES: [f64; 5] = [
@@ -33,28 +35,54 @@ const CELLS: usize = 8;
 const CORNER_DEPTH: u32 = 30;
 
 pub fn limit_area(surface: &LimitSurface) -> f64 {
-    integrate(surface, |s| s.du.cross(s.dv).length())
+    integrate(surface, area_element)
 }
 
 /// The signed volume the closed limit surface encloses (see the module docs).
 pub fn limit_volume(surface: &LimitSurface) -> f64 {
+    let o = reference_point(surface);
+    integrate(surface, |s| volume_element(s, o))
+}
+
+/// The signed volume and the area in one pass over the same samples (the refinements
+/// towards extraordinary corners are the costly part, and they serve both).
+pub fn limit_volume_and_area(surface: &LimitSurface) -> (f64, f64) {
+    let o = reference_point(surface);
+    let both = integrate(surface, |s| {
+        DVec2::new(volume_element(s, o), area_element(s))
+    });
+    (both.x, both.y)
+}
+
+fn area_element(s: &LimitSample) -> f64 {
+    s.du.cross(s.dv).length()
+}
+
+fn volume_element(s: &LimitSample, o: DVec3) -> f64 {
+    (s.position - o).dot(s.du.cross(s.dv)) / 3.0
+}
+
+/// The centre of the control points' box.
+fn reference_point(surface: &LimitSurface) -> DVec3 {
     let b = surface.control().bbox();
-    let o: DVec3 = 0.5 * (b.min + b.max);
-    integrate(surface, |s| (s.position - o).dot(s.du.cross(s.dv)) / 3.0)
+    0.5 * (b.min + b.max)
 }
 
 /// The integral of `f` over every patch's parameter square.
-fn integrate(surface: &LimitSurface, f: impl Fn(&LimitSample) -> f64 + Sync) -> f64 {
+fn integrate<T>(surface: &LimitSurface, f: impl Fn(&LimitSample) -> T + Sync) -> T
+where
+    T: Copy + Default + Send + Sum + Add<Output = T> + Mul<f64, Output = T>,
+{
     (0..surface.patch_count())
         .into_par_iter()
         .map(|pid| {
             let irregular = surface.irregular_corners(pid);
             let h = 1.0 / CELLS as f64;
-            let mut sum = 0.0;
+            let mut sum = T::default();
             for j in 0..CELLS {
                 for i in 0..CELLS {
                     let at = [i as f64 * h, j as f64 * h];
-                    sum += cell(surface, pid, &irregular, at, h, 0, &f);
+                    sum = sum + cell(surface, pid, &irregular, at, h, 0, &f);
                 }
             }
             sum
@@ -62,15 +90,18 @@ fn integrate(surface: &LimitSurface, f: impl Fn(&LimitSample) -> f64 + Sync) -> 
         .sum()
 }
 
-fn cell(
+fn cell<T>(
     surface: &LimitSurface,
     pid: usize,
     irregular: &[bool; 4],
     at: [f64; 2],
     h: f64,
     depth: u32,
-    f: &impl Fn(&LimitSample) -> f64,
-) -> f64 {
+    f: &impl Fn(&LimitSample) -> T,
+) -> T
+where
+    T: Copy + Default + Sum + Add<Output = T> + Mul<f64, Output = T>,
+{
     let corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
     let touches = corners.iter().zip(irregular).any(|(&(cu, cv), &irr)| {
         irr && (at[0] - cu).abs().min((at[0] + h - cu).abs()) == 0.0
@@ -93,10 +124,10 @@ fn cell(
             })
             .sum();
     }
-    let mut sum = 0.0;
+    let mut sum = T::default();
     for (a, wa) in NODES.iter().zip(WEIGHTS) {
         for (b, wb) in NODES.iter().zip(WEIGHTS) {
-            sum += wa * wb * f(&surface.eval_patch(pid, at[0] + a * h, at[1] + b * h));
+            sum = sum + f(&surface.eval_patch(pid, at[0] + a * h, at[1] + b * h)) * (wa * wb);
         }
     }
     sum * h * h

@@ -15,7 +15,7 @@ mod poly_mesh;
 mod subdivide;
 mod surface;
 
-pub use area::{limit_area, limit_volume};
+pub use area::{limit_area, limit_volume, limit_volume_and_area};
 pub use compare::{Comparison, angle_between, compare_points};
 pub use control_mesh::{ControlMesh, ControlStats};
 pub use patch::LimitSample;

@@ -8,6 +8,7 @@ use std::time::Instant;
 use voxelkit::grid::SparseGrid;
 use voxelkit::io::preview::{Scene, View, check_picture_output, render, write_png};
 use voxelkit::io::vdb::{COLOR_GRID, NORMAL_GRID, read_vdb_grid, read_vdb_info};
+use voxelkit::pipeline::on_threads;
 use voxelkit::{Error, Result};
 
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
@@ -103,14 +104,7 @@ pub fn run(args: &RenderArgs, global: &Global) -> Result<()> {
         normals: normals.as_ref(),
         colors: colors.as_ref(),
     };
-    let said = match global.threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n.clamp(1, voxelkit::pipeline::MAX_THREADS))
-            .build()
-            .map_err(|e| Error::InvalidArgument(format!("cannot start {n} threads: {e}")))?
-            .install(|| draw(&scene, args.picture, &args.output)),
-        None => draw(&scene, args.picture, &args.output),
-    }?;
+    let said = on_threads(global.threads, || draw(&scene, args.picture, &args.output))?;
     if global.json {
         println!(
             "{}",

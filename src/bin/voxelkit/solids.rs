@@ -68,20 +68,10 @@ pub enum SolidMethod {
     Beam,
 }
 
-/// The beam fills to choose from.
-#[derive(clap::ValueEnum, Clone, Copy)]
-pub enum BeamFillKind {
-    Parity,
-    Paper,
-}
-
-impl From<BeamFillKind> for BeamFill {
-    fn from(k: BeamFillKind) -> Self {
-        match k {
-            BeamFillKind::Parity => BeamFill::Parity,
-            BeamFillKind::Paper => BeamFill::Paper,
-        }
-    }
+/// The beam fills to choose from, parsed by the library.
+fn beam_fill_parser() -> impl clap::builder::TypedValueParser<Value = BeamFill> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(["parity", "paper"]).try_map(|s| s.parse::<BeamFill>())
 }
 
 #[derive(Args)]
@@ -98,11 +88,11 @@ pub struct SolidArgs {
     /// next front-face voxel.
     #[arg(
         long = "fill",
-        value_enum,
+        value_parser = beam_fill_parser(),
         default_value = "parity",
         value_name = "RULE"
     )]
-    pub beam_fill: BeamFillKind,
+    pub beam_fill: BeamFill,
     #[command(flatten)]
     pub fill: FillArgs,
     /// Also count the solid's components (26-connected) and genus, as `measure` does (a
@@ -183,7 +173,7 @@ pub fn solid(args: &SolidArgs, global: &Global) -> Result<()> {
     let fill = match args.method {
         SolidMethod::Flood => Fill::Flood(args.fill.flood.method()),
         SolidMethod::DepthLayers => Fill::DepthLayers(args.depth.options()),
-        SolidMethod::Beam => Fill::Beam(args.beam_fill.into()),
+        SolidMethod::Beam => Fill::Beam(args.beam_fill),
     };
     let task = |mesh| {
         if args.sdf {
