@@ -50,6 +50,33 @@ impl SparseGrid {
         g
     }
 
+    /// Builds a grid from leaves of distinct origins, without tiles.
+    pub fn from_distinct_leaves(
+        transform: Transform,
+        channels: Channels,
+        leaves: Vec<Leaf>,
+    ) -> Self {
+        let mut index = FxHashMap::default();
+        index.reserve(leaves.len());
+        for (i, leaf) in leaves.iter().enumerate() {
+            let before = index.insert(leaf.origin, i as u32);
+            debug_assert!(before.is_none(), "leaf origins are distinct");
+        }
+        SparseGrid {
+            transform,
+            channels,
+            leaves,
+            index,
+            tiles: Tiles::default(),
+        }
+    }
+
+    /// The leaves, for a grid without tiles.
+    pub fn into_leaves(self) -> Vec<Leaf> {
+        debug_assert!(self.tiles.is_empty(), "a grid without tiles");
+        self.leaves
+    }
+
     /// The leaves (blocks held voxel by voxel); whole blocks are in `tiles`.
     pub fn leaves(&self) -> &[Leaf] {
         &self.leaves

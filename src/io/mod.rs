@@ -7,6 +7,11 @@ pub mod preview;
 #[cfg(feature = "vdb")]
 pub mod vdb;
 #[cfg(feature = "vdb")]
+mod vdb_chunks;
+#[cfg(feature = "vdb")]
 mod vdb_structure;
+#[cfg(feature = "vdb")]
 mod vdb_tree_structure;
+#[cfg(feature = "vdb")]
+mod vdb_writer;
 pub mod vox;

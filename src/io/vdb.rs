@@ -7,6 +7,7 @@
 //! then rename).
 
 use super::atomic::write_atomic;
+use super::vdb_writer::{Encoding, GridOut, GridValues, compression_flags, write_grids};
 use crate::error::{Error, Result};
 use crate::ffi::vdb::bridge::{self, MetaEntry};
 use crate::grid::{Channels, LEAF_VOXELS, Leaf, SparseGrid, Transform};
@@ -113,8 +114,8 @@ pub fn write_vdb(path: &Path, grid: &SparseGrid, metadata: &[(&str, String)]) ->
     write_vdb_as(path, grid, &[], metadata, &WriteOptions::default())
 }
 
-/// `write_vdb`, plus one bool grid per `(name, mask)`, each with its own transform, writing
-/// as `options` say; a grid not written is not built.
+/// `write_vdb`, plus one bool grid per `(name, mask)`, each with its own transform, written
+/// as `options` say.
 pub fn write_vdb_as(
     path: &Path,
     grid: &SparseGrid,
@@ -123,56 +124,64 @@ pub fn write_vdb_as(
     options: &WriteOptions,
 ) -> Result<()> {
     check_voxel_size(path, grid.transform.voxel_size)?;
-    let flat = flatten(path, grid)?;
     let meta = meta_entries(metadata);
-    let mut writer = bridge::new_vdb_writer();
-    let mut add = |kind: &str, name: &str, flat: &Flat, t: Transform, values: &[f32]| {
-        if !options.wants(name) {
-            return Ok(());
-        }
-        // Tiles carry no normals or colours.
-        let plain = matches!(kind, "bool" | "fog");
-        writer
-            .pin_mut()
-            .add_grid(
-                kind,
-                name,
-                t.voxel_size,
-                t.origin.to_array(),
-                &flat.origins,
-                &flat.masks,
-                values,
-                if plain { &flat.leaf_tiles } else { &[] },
-                if plain { &flat.node_tiles } else { &[] },
-                &meta,
-            )
-            .map_err(|e| vdb_error(path, e))
+    let grid_out = |name, grid, values, class, vector_type| GridOut {
+        name,
+        grid,
+        values,
+        class,
+        vector_type,
+        metadata: &meta,
     };
-    let t = grid.transform;
-    add("fog", DENSITY_GRID, &flat, t, &[])?;
-    add("bool", VOXELS_GRID, &flat, t, &[])?;
-    if grid.channels().normal && options.wants(NORMAL_GRID) {
-        let mut normals = Vec::with_capacity(flat.leaves.len() * LEAF_VOXELS * 3);
-        for leaf in &flat.leaves {
-            let n = leaf.normal.as_ref().expect("grid with normal channel");
-            normals.extend(n.iter().flatten());
-        }
-        add("normal", NORMAL_GRID, &flat, t, &normals)?;
+    let mut candidates = vec![
+        grid_out(
+            DENSITY_GRID,
+            grid,
+            GridValues::Constant(1.0),
+            Some("fog volume"),
+            None,
+        ),
+        grid_out(VOXELS_GRID, grid, GridValues::Bool, None, None),
+    ];
+    if grid.channels().normal {
+        // Normals transform covariantly; colours are plain triples.
+        let normals = grid_out(NORMAL_GRID, grid, GridValues::Normals, None, None);
+        candidates.push(GridOut {
+            vector_type: Some("covariant normalize"),
+            ..normals
+        });
     }
-    if grid.channels().color && options.wants(COLOR_GRID) {
-        let mut colors = Vec::with_capacity(flat.leaves.len() * LEAF_VOXELS * 3);
-        for leaf in &flat.leaves {
-            let c = leaf.color.as_ref().expect("grid with colour channel");
-            colors.extend(c.iter().flatten());
-        }
-        add("color", COLOR_GRID, &flat, t, &colors)?;
+    if grid.channels().color {
+        let colors = grid_out(COLOR_GRID, grid, GridValues::Colors, None, None);
+        candidates.push(GridOut {
+            vector_type: Some("invariant"),
+            ..colors
+        });
     }
     for (name, mask) in masks_to_add {
-        if options.wants(name) {
-            add("bool", name, &flatten(path, mask)?, mask.transform, &[])?;
-        }
+        check_voxel_size(path, mask.transform.voxel_size)?;
+        candidates.push(grid_out(name, mask, GridValues::Bool, None, None));
     }
-    write_file(path, &writer, options)
+    if let Some(missing) = options
+        .grids
+        .iter()
+        .find(|n| !candidates.iter().any(|g| g.name == n.as_str()))
+    {
+        let names: Vec<&str> = candidates.iter().map(|g| g.name).collect();
+        return Err(vdb_error(
+            path,
+            format!(
+                "no grid `{missing}` to write; this output has {}",
+                names.join(", ")
+            ),
+        ));
+    }
+    candidates.retain(|g| options.wants(g.name));
+    let encoding = Encoding {
+        compression: compression_flags(options.compression),
+        half: options.half,
+    };
+    write_atomic(path, |tmp| write_grids(tmp, path, &candidates, encoding))
 }
 
 /// How a `.vdb` is written: which grids, compressed how, floats at what precision.
@@ -237,18 +246,12 @@ fn write_file(path: &Path, writer: &bridge::VdbWriter, options: &WriteOptions) -
 }
 
 /// The metadata entries of every grid: the caller's plus `voxelkit_version`.
-fn meta_entries(metadata: &[(&str, String)]) -> Vec<MetaEntry> {
-    let mut meta: Vec<MetaEntry> = metadata
+fn meta_entries(metadata: &[(&str, String)]) -> Vec<(String, String)> {
+    let mut meta: Vec<(String, String)> = metadata
         .iter()
-        .map(|(k, v)| MetaEntry {
-            key: k.to_string(),
-            value: v.clone(),
-        })
+        .map(|(k, v)| (k.to_string(), v.clone()))
         .collect();
-    meta.push(MetaEntry {
-        key: "voxelkit_version".into(),
-        value: env!("CARGO_PKG_VERSION").into(),
-    });
+    meta.push(("voxelkit_version".into(), env!("CARGO_PKG_VERSION").into()));
     meta
 }
 
@@ -282,7 +285,10 @@ pub fn write_distance_band(
             .ok_or_else(|| vdb_error(path, "a distance band needs distances"))?;
         values.extend_from_slice(&v[..]);
     }
-    let meta = meta_entries(metadata);
+    let meta: Vec<MetaEntry> = meta_entries(metadata)
+        .into_iter()
+        .map(|(key, value)| MetaEntry { key, value })
+        .collect();
     let t = grid.transform;
     let (name, density, signed) = match kind {
         DistanceGrid::LevelSet => (LEVEL_SET_GRID, DENSITY_GRID, true),

@@ -4,15 +4,12 @@
 //! the buffer's size, and blosc trusts the sizes in its own chunk header. Every chunk is
 //! checked here against what the node holds, and every node against the bytes of the grid.
 
+use super::vdb_chunks::{COMPRESS_ACTIVE_MASK, COMPRESS_BLOSC, COMPRESS_ZIP};
 use super::vdb_structure::Reader;
 use std::collections::HashSet;
 
 type Check = std::result::Result<(), String>;
 
-/// Per-grid compression flags (OpenVDB's `COMPRESS_*`).
-const COMPRESS_ZIP: u32 = 0x1;
-const COMPRESS_ACTIVE_MASK: u32 = 0x2;
-const COMPRESS_BLOSC: u32 = 0x4;
 /// OpenVDB pads buffers shorter than this before blosc compresses them.
 const BLOSC_PAD_BYTES: u64 = 128;
 /// The suffix OpenVDB adds to a grid type saved at half precision.
@@ -141,16 +138,21 @@ pub(super) fn tree(
         .try_for_each(|&active| leaf_buffer(r, format, compression, active, what));
     r.len = file_len;
     buffers?;
-    Ok(memory(&nodes, format))
+    Ok(tree_memory(
+        format,
+        nodes.internal,
+        nodes.leaves.len() as u64,
+    ))
 }
 
-/// OpenVDB's memory for the nodes: a slot (child pointer or value) per internal-node entry
-/// and two masks, a leaf's values (a bit mask for bool and mask leaves) and its mask.
-fn memory(nodes: &Nodes, format: TreeFormat) -> u64 {
+/// OpenVDB's memory for a tree of `internal` nodes (by depth) and `leaves` leaves: a slot
+/// (child pointer or value) per internal-node entry and two masks, a leaf's values (a bit
+/// mask for bool and mask leaves) and its mask.
+pub(super) fn tree_memory(format: TreeFormat, internal: [u64; 2], leaves: u64) -> u64 {
     let slot = format.value.max(8).next_multiple_of(8);
     let internal: u64 = NODE_LOG2
         .iter()
-        .zip(nodes.internal)
+        .zip(internal)
         .map(|(&log2, count)| {
             let entries = 1u64 << (3 * log2);
             count.saturating_mul(entries * slot + entries / 4 + 64)
@@ -161,7 +163,7 @@ fn memory(nodes: &Nodes, format: TreeFormat) -> u64 {
         LeafKind::Bool => 2 * LEAF_MASK_BYTES + 48,
         LeafKind::Mask => LEAF_MASK_BYTES + 48,
     };
-    internal.saturating_add((nodes.leaves.len() as u64).saturating_mul(leaf))
+    internal.saturating_add(leaves.saturating_mul(leaf))
 }
 
 /// The root's tiles and children, each child's nodes down to the leaves' masks. Leaves are

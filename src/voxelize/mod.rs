@@ -1,5 +1,6 @@
 //! Voxelization methods, one file each, named for what they do.
 
+mod brick_bins;
 pub mod distance_band;
 pub mod interval_octree;
 pub mod parametric;

@@ -43,9 +43,10 @@
 
 use super::Progress;
 use super::Separability;
-use super::sink::{Sink, merge_grids, nearest_channels, voxelize_parallel};
+use super::brick_bins::{BrickSink, voxelize_in_bricks};
+use super::sink::nearest_channels;
 use crate::error::{Error, Result};
-use crate::grid::{SparseGrid, Transform};
+use crate::grid::{CoordBox, SparseGrid, Transform};
 use crate::mesh::Mesh;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -218,47 +219,55 @@ pub fn voxelize_mesh(
         Criterion::Clipped => adjacency.in_face_slab(p, &triangles, sep, x),
     };
 
-    let vertex_grid = voxelize_parallel(&vertices, transform, channels, progress, |v, s| {
-        vertex_sphere(v, sep.vertex_edge_radius(), &keep, s)
-    });
-    let edge_grid = voxelize_parallel(&edges, transform, channels, progress, |e, s| {
-        edge_cylinder(e, sep.vertex_edge_radius(), &keep, s)
-    });
-    let body_grid = voxelize_parallel(&triangles, transform, channels, progress, |t, s| {
-        face_body(t, sep, s)
-    });
-    progress.check()?;
-
-    let vertex_voxels = vertex_grid.voxel_count();
-    let edge_only = count_outside(&edge_grid, &[&vertex_grid]);
-    let body_only = count_outside(&body_grid, &[&vertex_grid, &edge_grid]);
+    let r = sep.vertex_edge_radius();
+    // Classes in the paper's counting order: vertices, edges, bodies.
+    let candidates = |class: usize, i: usize| match class {
+        0 => reach_box(vertices[i].a, vertices[i].a, r + MARGIN),
+        1 => reach_box(
+            edges[i].a.min(edges[i].b),
+            edges[i].a.max(edges[i].b),
+            r + MARGIN,
+        ),
+        _ => {
+            let [a, b, c] = triangles[i].corners;
+            reach_box(
+                a.min(b).min(c),
+                a.max(b).max(c),
+                sep.slab_half_thickness(triangles[i].normal) + MARGIN,
+            )
+        }
+    };
+    let (grid, [vertex_voxels, edge_voxels, body_voxels]) = voxelize_in_bricks(
+        [vertices.len(), edges.len(), triangles.len()],
+        transform,
+        channels,
+        progress,
+        candidates,
+        |class, i, clip, sink| match class {
+            0 => vertex_sphere(&vertices[i], r, &keep, clip, sink),
+            1 => edge_cylinder(&edges[i], r, &keep, clip, sink),
+            _ => face_body(&triangles[i], sep, clip, sink),
+        },
+    )?;
     let stats = SeparatingStats {
         vertex_voxels,
-        edge_voxels: edge_only,
-        body_voxels: body_only,
+        edge_voxels,
+        body_voxels,
         vertices: vertices.len(),
         edges: edges.len(),
         triangles: triangles.len(),
         degenerate_faces,
     };
-    let grid = merge_grids(merge_grids(vertex_grid, edge_grid), body_grid);
     Ok((grid, stats))
 }
 
-/// Voxels of `grid` in none of `others`.
-fn count_outside(grid: &SparseGrid, others: &[&SparseGrid]) -> u64 {
-    grid.leaves()
-        .iter()
-        .map(|leaf| {
-            let mut mask = leaf.mask;
-            for o in others {
-                if let Some(ol) = o.leaf(leaf.origin) {
-                    (0..8).for_each(|w| mask[w] &= !ol.mask[w]);
-                }
-            }
-            mask.iter().map(|w| w.count_ones() as u64).sum::<u64>()
-        })
-        .sum()
+/// The voxels within `reach` of the box from `lo` to `hi`.
+fn reach_box(lo: DVec3, hi: DVec3, reach: f64) -> CoordBox {
+    let (lo, hi) = (lo - DVec3::splat(reach), hi + DVec3::splat(reach));
+    CoordBox {
+        min: [lo.x, lo.y, lo.z].map(|v| v.floor() as i64),
+        max: [hi.x, hi.y, hi.z].map(|v| v.ceil() as i64),
+    }
 }
 
 /// Twice the vector area of a polygon's fan (its normal, weighted by area).
@@ -490,20 +499,35 @@ fn quadratic_range(a: f64, b: f64, c: f64) -> std::ops::RangeInclusive<i64> {
     int_range((-b - root) / a - MARGIN, (-b + root) / a + MARGIN)
 }
 
-/// S_v: voxel centres within `r` of the vertex (that `keep` accepts).
-fn vertex_sphere(
+/// `range` clipped to `clip`'s extent along `axis`.
+#[inline]
+fn clipped(
+    range: std::ops::RangeInclusive<i64>,
+    clip: &CoordBox,
+    axis: usize,
+) -> std::ops::RangeInclusive<i64> {
+    (*range.start()).max(clip.min[axis])..=(*range.end()).min(clip.max[axis])
+}
+
+/// S_v: voxel centres within `r` of the vertex (that `keep` accepts), in `clip`.
+fn vertex_sphere<const C: usize>(
     v: &Primitive,
     r: f64,
     keep: &impl Fn(&Primitive, DVec3) -> bool,
-    sink: &mut Sink,
+    clip: &CoordBox,
+    sink: &mut BrickSink<C>,
 ) {
     let p = v.a;
     let r2 = (r + MARGIN) * (r + MARGIN);
-    for x in int_range(p.x - r - MARGIN, p.x + r + MARGIN) {
-        for y in int_range(p.y - r - MARGIN, p.y + r + MARGIN) {
+    for x in clipped(int_range(p.x - r - MARGIN, p.x + r + MARGIN), clip, 0) {
+        for y in clipped(int_range(p.y - r - MARGIN, p.y + r + MARGIN), clip, 1) {
             let (dx, dy) = (x as f64 - p.x, y as f64 - p.y);
             // (z - p.z)^2 <= r2 - dx^2 - dy^2
-            for z in quadratic_range(1.0, -p.z, p.z * p.z + dx * dx + dy * dy - r2) {
+            for z in clipped(
+                quadratic_range(1.0, -p.z, p.z * p.z + dx * dx + dy * dy - r2),
+                clip,
+                2,
+            ) {
                 let c = DVec3::new(x as f64, y as f64, z as f64);
                 let d2 = (c - p).length_squared();
                 if d2 <= r2 && keep(v, c) {
@@ -515,12 +539,13 @@ fn vertex_sphere(
 }
 
 /// S_e: voxel centres within `r` of the edge whose projection falls on the edge (and that
-/// `keep` accepts).
-fn edge_cylinder(
+/// `keep` accepts), in `clip`.
+fn edge_cylinder<const C: usize>(
     e: &Primitive,
     r: f64,
     keep: &impl Fn(&Primitive, DVec3) -> bool,
-    sink: &mut Sink,
+    clip: &CoordBox,
+    sink: &mut BrickSink<C>,
 ) {
     let (p, d) = (e.a, e.b - e.a);
     let len2 = d.length_squared();
@@ -534,9 +559,13 @@ fn edge_cylinder(
     let reach = r * len2.sqrt() / d[w].abs();
     let tau_margin = MARGIN / len2.sqrt();
     let dn = d / len2.sqrt();
-    for k in int_range(p[w].min(e.b[w]) - r, p[w].max(e.b[w]) + r) {
+    for k in clipped(
+        int_range(p[w].min(e.b[w]) - r, p[w].max(e.b[w]) + r),
+        clip,
+        w,
+    ) {
         let c = p + d * ((k as f64 - p[w]) / d[w]);
-        for iu in int_range(c[u] - reach, c[u] + reach) {
+        for iu in clipped(int_range(c[u] - reach, c[u] + reach), clip, u) {
             // y = x - p with x_v = 0; dist^2(v) = |y + v e_v|^2 - ((y + v e_v)·dn)^2 <= r^2.
             let mut y0 = -p;
             y0[w] += k as f64;
@@ -545,7 +574,7 @@ fn edge_cylinder(
             let a = 1.0 - dn[v] * dn[v];
             let b = y0[v] - along * dn[v];
             let cc = y0.length_squared() - along * along - r * r;
-            for iv in quadratic_range(a, b, cc) {
+            for iv in clipped(quadratic_range(a, b, cc), clip, v) {
                 let mut x = DVec3::ZERO;
                 x[w] = k as f64;
                 x[u] = iu as f64;
@@ -564,8 +593,13 @@ fn edge_cylinder(
 }
 
 /// S_b: voxel centres in the triangle's half-open slab (see the module docs) whose projection
-/// lies inside it.
-fn face_body(tri: &Triangle, sep: Separability, sink: &mut Sink) {
+/// lies inside it, in `clip`.
+fn face_body<const C: usize>(
+    tri: &Triangle,
+    sep: Separability,
+    clip: &CoordBox,
+    sink: &mut BrickSink<C>,
+) {
     // The slab is measured along the turned normal; the row bounds below do not depend on
     // the normal's sign, the edge planes do (they point inwards for the face's own normal).
     let n = turned(tri.normal);
@@ -582,7 +616,7 @@ fn face_body(tri: &Triangle, sep: Separability, sink: &mut Sink) {
     let lo = a.min(b).min(c) - DVec3::splat(t);
     let hi = a.max(b).max(c) + DVec3::splat(t);
     let half = t / n[w].abs();
-    for iu in int_range(lo[u], hi[u]) {
+    for iu in clipped(int_range(lo[u], hi[u]), clip, u) {
         // Clip the row to the columns whose slab segment can reach inside every edge plane:
         // the best k of the slab turns each plane test into a linear bound on iv.
         let (mut v_lo, mut v_hi) = (lo[v], hi[v]);
@@ -603,12 +637,12 @@ fn face_body(tri: &Triangle, sep: Separability, sink: &mut Sink) {
         if v_lo > v_hi {
             continue;
         }
-        for iv in int_range(v_lo, v_hi) {
+        for iv in clipped(int_range(v_lo, v_hi), clip, v) {
             let s = n[u] * (iu as f64 - a[u]) + n[v] * (iv as f64 - a[v]);
             // d_lo <= s + n_w (k - a_w) < d_hi with n_w > 0, solved for k.
             let k0 = a[w] + (d_lo - s) / n[w];
             let k1 = a[w] + (d_hi - s) / n[w];
-            for k in half_open_range(k0, k1) {
+            for k in clipped(half_open_range(k0, k1), clip, w) {
                 let mut x = DVec3::ZERO;
                 x[w] = k as f64;
                 x[u] = iu as f64;
