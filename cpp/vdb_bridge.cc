@@ -119,60 +119,6 @@ std::unique_ptr<VdbWriter> new_vdb_writer() {
     return std::make_unique<VdbWriter>();
 }
 
-void VdbWriter::add_grid(rust::Str kind, rust::Str name, double voxel_size, std::array<double, 3> origin,
-                         rust::Slice<const int32_t> leaf_origins, rust::Slice<const uint64_t> masks,
-                         rust::Slice<const float> values, rust::Slice<const int32_t> leaf_tiles,
-                         rust::Slice<const int32_t> node_tiles, rust::Slice<const MetaEntry> metadata) {
-    const std::string k(kind);
-    const size_t count = leaf_origins.size() / 3;
-    openvdb::GridBase::Ptr grid;
-    FreeOnThrow free_on_throw(grid);
-    if (k == "bool") {
-        grid = build_grid<openvdb::BoolGrid>(leaf_origins, masks, false,
-                                             [](auto& leaf, size_t, openvdb::Index n) { leaf.setValueOn(n, true); });
-    } else if (k == "fog") {
-        if (!values.empty() && values.size() != 512 * count)
-            throw std::invalid_argument("fog grid: expected 512 values per leaf");
-        auto g = build_grid<openvdb::FloatGrid>(leaf_origins, masks, 0.0f, [&](auto& leaf, size_t i, openvdb::Index n) {
-            leaf.setValueOn(n, values.empty() ? 1.0f : values[512 * i + n]);
-        });
-        g->setGridClass(openvdb::GRID_FOG_VOLUME);
-        grid = g;
-    } else if (k == "normal" || k == "color") {
-        if (values.size() != 3 * 512 * count)
-            throw std::invalid_argument(k + " grid: expected 3 x 512 values per leaf");
-        auto g = build_grid<openvdb::Vec3SGrid>(
-            leaf_origins, masks, openvdb::Vec3s(0.0f), [&](auto& leaf, size_t i, openvdb::Index n) {
-                const float* v = &values[3 * (512 * i + n)];
-                leaf.setValueOn(n, openvdb::Vec3s(v[0], v[1], v[2]));
-            });
-        // Normals transform covariantly; colours are plain triples.
-        g->setVectorType(k == "normal" ? openvdb::VEC_COVARIANT_NORMALIZE : openvdb::VEC_INVARIANT);
-        grid = g;
-    } else {
-        throw std::invalid_argument("unknown grid kind " + k);
-    }
-    // Whole blocks as active tiles: level 1 holds 8^3, level 2 holds 128^3.
-    auto add_tiles = [&](auto& typed, typename std::decay_t<decltype(typed)>::ValueType on) {
-        if (leaf_tiles.size() % 3 != 0 || node_tiles.size() % 3 != 0)
-            throw std::invalid_argument("tile origins of inconsistent length");
-        auto& tree = typed.tree();
-        for (size_t i = 0; i < leaf_tiles.size(); i += 3)
-            tree.addTile(1, openvdb::Coord(leaf_tiles[i], leaf_tiles[i + 1], leaf_tiles[i + 2]), on, true);
-        for (size_t i = 0; i < node_tiles.size(); i += 3)
-            tree.addTile(2, openvdb::Coord(node_tiles[i], node_tiles[i + 1], node_tiles[i + 2]), on, true);
-    };
-    if (auto b = openvdb::gridPtrCast<openvdb::BoolGrid>(grid)) add_tiles(*b, true);
-    else if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(grid)) add_tiles(*f, 1.0f);
-    else if (!leaf_tiles.empty() || !node_tiles.empty())
-        throw std::invalid_argument(k + " grid: tiles carry no " + k);
-    grid->setName(std::string(name));
-    grid->setTransform(make_transform(voxel_size, origin));
-    for (const auto& m : metadata)
-        grid->insertMeta(std::string(m.key), openvdb::StringMetadata(std::string(m.value)));
-    grids_.push_back(grid);
-}
-
 void VdbWriter::add_level_set(rust::Str name, rust::Str density_name, double voxel_size,
                               std::array<double, 3> origin, rust::Slice<const int32_t> leaf_origins,
                               rust::Slice<const uint64_t> masks, rust::Slice<const float> values,

@@ -16,10 +16,6 @@ public:
     VdbWriter(const VdbWriter&) = delete;
     VdbWriter& operator=(const VdbWriter&) = delete;
     ~VdbWriter();
-    void add_grid(rust::Str kind, rust::Str name, double voxel_size, std::array<double, 3> origin,
-                  rust::Slice<const int32_t> leaf_origins, rust::Slice<const uint64_t> masks,
-                  rust::Slice<const float> values, rust::Slice<const int32_t> leaf_tiles,
-                  rust::Slice<const int32_t> node_tiles, rust::Slice<const MetaEntry> metadata);
     void add_level_set(rust::Str name, rust::Str density_name, double voxel_size, std::array<double, 3> origin,
                        rust::Slice<const int32_t> leaf_origins, rust::Slice<const uint64_t> masks,
                        rust::Slice<const float> values, float background, bool is_signed,

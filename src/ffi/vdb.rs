@@ -3,7 +3,7 @@
 //! and, for value grids, its 512 values (or 3 x 512 for vectors) in OpenVDB's voxel order.
 //! Every C++ function catches its exceptions and turns them into `Result` errors.
 
-#[allow(clippy::too_many_arguments)] // add_grid carries a whole grid in one call
+#[allow(clippy::too_many_arguments)] // add_level_set carries a whole grid in one call
 #[cxx::bridge(namespace = "voxelkit")]
 pub mod bridge {
     /// One string metadata item of a grid.
@@ -38,23 +38,6 @@ pub mod bridge {
         type VdbFile;
 
         fn new_vdb_writer() -> UniquePtr<VdbWriter>;
-        /// Adds a BoolGrid (`kind` = "bool"), fog-volume FloatGrid ("fog": `values` per voxel,
-        /// or 1 where empty) or Vec3SGrid of normals ("normal": 3 values per voxel), plus
-        /// active tiles (true, or 1 in a fog volume) at `leaf_tiles` (8^3) and `node_tiles`
-        /// (128^3) origins.
-        fn add_grid(
-            self: Pin<&mut VdbWriter>,
-            kind: &str,
-            name: &str,
-            voxel_size: f64,
-            origin: [f64; 3],
-            leaf_origins: &[i32],
-            masks: &[u64],
-            values: &[f32],
-            leaf_tiles: &[i32],
-            node_tiles: &[i32],
-            metadata: &[MetaEntry],
-        ) -> Result<()>;
         /// Adds a narrow-band distance FloatGrid: `values` per active voxel (world units), the
         /// rest `background`; signed: class LEVEL_SET with the interior flood-filled to
         /// -background, preceded by its fog volume as `density_name` (unless empty).

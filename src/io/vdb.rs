@@ -38,9 +38,6 @@ struct Flat<'g> {
     /// Leaf masks, u64 x 8 per leaf.
     masks: Vec<u64>,
     leaves: Vec<&'g Leaf>,
-    /// Origins of the 8^3 and the 128^3 tiles, i32 x 3 each.
-    leaf_tiles: Vec<i32>,
-    node_tiles: Vec<i32>,
 }
 
 /// A coordinate in OpenVDB's 32-bit index range (with room for a 128^3 block past it).
@@ -66,21 +63,10 @@ fn flatten<'g>(path: &Path, grid: &'g SparseGrid) -> Result<Flat<'g>> {
         origins.extend(index_coord(path, leaf.origin)?);
         masks.extend_from_slice(&leaf.mask);
     }
-    let (mut leaf_tiles, mut node_tiles) = (Vec::new(), Vec::new());
-    for (o, edge) in grid.tiles().with_edges() {
-        let list = if edge == 8 {
-            &mut leaf_tiles
-        } else {
-            &mut node_tiles
-        };
-        list.extend(index_coord(path, o)?);
-    }
     Ok(Flat {
         origins,
         masks,
         leaves,
-        leaf_tiles,
-        node_tiles,
     })
 }
 

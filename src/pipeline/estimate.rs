@@ -29,8 +29,9 @@ const VECTOR_LEAF_BYTES: f64 = 20000.0;
 const AREA_PER_LEAF: f64 = 32.0;
 /// The share of its box a solid is assumed to fill (a ball fills 52%).
 const SOLID_FILL: f64 = 0.5;
-/// The process itself: code, OpenVDB's and the allocator's own memory.
-const BASE_BYTES: f64 = 48.0 * (1 << 20) as f64;
+/// The process itself: code, OpenVDB's and the allocator's own memory (39 MiB measured for
+/// a surface of 211 leaves).
+const BASE_BYTES: f64 = 40.0 * (1 << 20) as f64;
 
 /// Peak bytes of a set of `leaves` leaves with `vector_channels` normal or colour channels.
 fn leaf_bytes(leaves: f64, vector_channels: u32) -> f64 {
@@ -58,14 +59,15 @@ fn area_in_voxels(mesh: &Mesh, t: &Transform) -> f64 {
 }
 
 /// Mesh surfaces and solids, calibrated on the whole process (bunny-closed, igea, armadillo,
-/// skull and horse at 512..2048, each estimate within 30% of the peak): a separating or
-/// projective surface crosses a leaf per 44 voxels^2 of area and costs 2.6 KB per leaf at
-/// the peak, 34 KB more with normals or colours (the channel, its flat copy and OpenVDB's
-/// Vec3 grid); each triangle about 250 bytes (reading the file, the voxelizer's tables).
+/// skull and horse at 1024, estimate/peak 0.94-1.10): a separating or projective surface
+/// crosses a leaf per 44 voxels^2 of area and costs 470 bytes per leaf at the peak (the leaf
+/// and its encoded buffers; the file is written straight from the grid), 8.3 KB more with
+/// normals or colours (the channel and its encoded values); each triangle about 330 bytes
+/// (reading the file, the voxelizer's tables and bins).
 const MESH_AREA_PER_LEAF: f64 = 44.0;
-const MESH_LEAF_BYTES: f64 = 2600.0;
-const MESH_VECTOR_LEAF_BYTES: f64 = 34000.0;
-const TRIANGLE_BYTES: f64 = 250.0;
+const MESH_LEAF_BYTES: f64 = 470.0;
+const MESH_VECTOR_LEAF_BYTES: f64 = 8300.0;
+const TRIANGLE_BYTES: f64 = 330.0;
 
 /// What filling a mesh costs at the peak, besides the process: dense bit volumes over the
 /// padded box and over the mesh's inside, bytes per voxel of the box's faces, per leaf of
@@ -82,13 +84,13 @@ struct FillCost {
 }
 
 /// The block flood (the default): the surface, the solid's boundary leaves and the grids
-/// written (3.7 KB per surface leaf), the block states and the inside's tiles (16 bytes per
-/// block); no dense volume. Estimate/peak 0.84-1.30 on the five meshes at 512-2048.
+/// written (750 bytes per surface leaf), the block states and the inside's tiles (16 bytes
+/// per block); no dense volume. Estimate/peak 0.88-1.26 on the five meshes at 1024.
 const BLOCK_FLOOD_COST: FillCost = FillCost {
     bit_volumes: 0.0,
     inside_volumes: 0.0,
     face_bytes: 0.0,
-    leaf_bytes: 3700.0,
+    leaf_bytes: 750.0,
     block_bytes: 16.0,
     triangle_bytes: TRIANGLE_BYTES,
 };
@@ -140,10 +142,10 @@ const BEAM_COST: FillCost = FillCost {
     triangle_bytes: 100.0,
 };
 
-/// A Catmull-Clark surface costs 15 KB per leaf of its control polygons' area (a leaf per 44
-/// voxels^2; the limit surface is smaller than its control polygons), normals included
-/// (measured on spot and catmark_torus at 512 and 1024: estimate 1.06-1.10 of the peak).
-const SUBDIV_LEAF_BYTES: f64 = 15000.0;
+/// A Catmull-Clark surface costs 4.75 KB per leaf of its control polygons' area (a leaf per
+/// 44 voxels^2; the limit surface is smaller than its control polygons), normals included
+/// (fitted on spot and catmark_torus at 1024).
+const SUBDIV_LEAF_BYTES: f64 = 4750.0;
 /// Per patch: its evaluation tables and the voxelizer's working set (6 KB; beast's 32k
 /// patches at 1024).
 const PATCH_BYTES: f64 = 6000.0;
@@ -158,8 +160,9 @@ const PATCH_BYTES: f64 = 6000.0;
 const SOLID_SUBDIV_LEAF_BYTES: f64 = 7800.0;
 const SOLID_SUBDIV_VOLUMES: f64 = 4.0;
 const IRREGULAR_CORNER_BYTES: f64 = 95_000.0;
-/// The analytic voxelizer's state per 8^3 block of the shape's box.
-const SHAPE_BLOCK_BYTES: f64 = 8.0;
+/// The analytic voxelizer's state per 8^3 block of the shape's box (fitted on the sphere,
+/// cylinder and quadric at 1024).
+const SHAPE_BLOCK_BYTES: f64 = 20.0;
 
 /// Leaves crossed by a surface of `area` voxels^2.
 fn surface_leaves(area: f64) -> f64 {
@@ -322,11 +325,11 @@ fn checked_box(bbox: &Aabb, t: &Transform) -> Result<CoordBox> {
 /// voxels along the bounds counts its voxels, scaled by the square of the resolution ratio (a
 /// surface's voxels grow fourfold per doubling) in leaves of about 64 voxels; where the coarse
 /// pass fills more than a quarter of its box (`0*x`), by the cube, in full leaves. A leaf costs
-/// 21 KB at the peak, normals included (the sphere, torus, gear, sinsin and crankshaft
-/// examples at 512..2048: estimate 0.91-1.23 of the peak).
+/// 6.5 KB at the peak, normals included (fitted on the sphere and `0*x` at 256, the gear
+/// and sinsin examples at 1024).
 const COARSE_OCTREE: u32 = 64;
 const IMPLICIT_VOXELS_PER_LEAF: f64 = 64.0;
-const IMPLICIT_LEAF_BYTES: f64 = 21000.0;
+const IMPLICIT_LEAF_BYTES: f64 = 6500.0;
 
 /// The leaves the surface of `formula` in `[min, max]` will fill at `resolution`.
 fn implicit_leaves(
