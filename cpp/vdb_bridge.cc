@@ -1,21 +1,16 @@
-// OpenVDB side of the bridge: builds LeafNodes from bulk leaf arrays in parallel, writes and
-// reads .vdb files, and runs OpenVDB's own mesh conversions for benchmarks. Every exception becomes a
-// Rust Err through cxx (see the trycatch override in vdb_bridge.h).
+// OpenVDB side of the bridge: reads .vdb files into bulk leaf arrays, and runs OpenVDB's own tools
+// (levelSetVolume, mesh conversions) for tests and benchmarks; voxelkit writes .vdb files itself
+// (src/io/vdb_writer.rs). Every exception becomes a Rust Err through cxx (see the trycatch override
+// in vdb_bridge.h).
 #include "voxelkit/cpp/vdb_bridge.h"
 #include "voxelkit/src/ffi/vdb.rs.h"
 
 #include <openvdb/tools/LevelSetMeasure.h>
-#include <openvdb/tools/LevelSetUtil.h>
 #include <openvdb/tools/MeshToVolume.h>
-#include <openvdb/tools/SignedFloodFill.h>
 #include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
 #include <algorithm>
 #include <limits>
-#include <cerrno>
-#include <cstring>
 #include <exception>
-#include <fstream>
 #include <mutex>
 #include <stdexcept>
 
@@ -27,13 +22,7 @@ std::once_flag init_flag;
 
 void ensure_initialized() { std::call_once(init_flag, [] { openvdb::initialize(); }); }
 
-openvdb::math::Transform::Ptr make_transform(double voxel_size, const std::array<double, 3>& origin) {
-    auto xform = openvdb::math::Transform::createLinearTransform(voxel_size);
-    xform->postTranslate(openvdb::Vec3d(origin[0], origin[1], origin[2]));
-    return xform;
-}
-
-// The grid types voxelkit reads (src/io/vdb_tree_structure.rs checks the same) and writes.
+// The grid types voxelkit reads (src/io/vdb_tree_structure.rs checks the same).
 using KnownGridTypes =
     openvdb::NumericGridTypes::Append<openvdb::Vec3GridTypes>::Append<openvdb::BoolGrid, openvdb::MaskGrid>;
 
@@ -50,111 +39,10 @@ void free_nodes(const openvdb::GridPtrVec& grids) noexcept {
         if (g && g.use_count() == 1) free_nodes(*g);
 }
 
-// Frees a grid's nodes without allocating when its scope is left by an exception (declare
-// it after the grid's pointer, so that it runs first); a grid owned elsewhere too is left.
-template <typename PtrT>
-class FreeOnThrow {
-public:
-    explicit FreeOnThrow(const PtrT& grid) : grid_(grid), exceptions_(std::uncaught_exceptions()) {}
-    FreeOnThrow(const FreeOnThrow&) = delete;
-    FreeOnThrow& operator=(const FreeOnThrow&) = delete;
-    ~FreeOnThrow() {
-        if (std::uncaught_exceptions() > exceptions_ && grid_ && grid_.use_count() == 1) free_nodes(*grid_);
-    }
-
-private:
-    const PtrT& grid_;
-    int exceptions_;
-};
-
-// Builds one LeafNode per input leaf in parallel, then inserts them serially.
-template <typename GridT, typename SetFn>
-typename GridT::Ptr build_grid(rust::Slice<const int32_t> origins, rust::Slice<const uint64_t> masks,
-                               typename GridT::ValueType background, SetFn set_value) {
-    using LeafT = typename GridT::TreeType::LeafNodeType;
-    const size_t count = origins.size() / 3;
-    if (origins.size() != 3 * count || masks.size() != 8 * count)
-        throw std::invalid_argument("leaf arrays of inconsistent length");
-    std::vector<LeafT*> leaves(count, nullptr);
-    size_t inserted = 0;
-    typename GridT::Ptr grid;
-    FreeOnThrow free_on_throw(grid);
-    try {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, count), [&](const tbb::blocked_range<size_t>& r) {
-            for (size_t i = r.begin(); i != r.end(); ++i) {
-                openvdb::Coord c(origins[3 * i], origins[3 * i + 1], origins[3 * i + 2]);
-                auto* leaf = new LeafT(c, background);
-                for (openvdb::Index w = 0; w < 8; ++w) {
-                    uint64_t bits = masks[8 * i + w];
-                    while (bits) {
-                        const openvdb::Index n = w * 64 + openvdb::Index(__builtin_ctzll(bits));
-                        set_value(*leaf, i, n);
-                        bits &= bits - 1;
-                    }
-                }
-                leaves[i] = leaf;
-            }
-        });
-        grid = GridT::create(background);
-        typename GridT::Accessor acc = grid->getAccessor();
-        for (; inserted < count; ++inserted) acc.addLeaf(leaves[inserted]);
-    } catch (...) {
-        // Out of memory part way: the leaves not in the tree yet (the guard frees the tree).
-        for (size_t i = inserted; i < count; ++i) delete leaves[i];
-        throw;
-    }
-    return grid;
-}
-
 }  // namespace
-
-VdbWriter::~VdbWriter() { free_nodes(grids_); }
 
 VdbFile::~VdbFile() {
     if (grids_) free_nodes(*grids_);
-}
-
-std::unique_ptr<VdbWriter> new_vdb_writer() {
-    ensure_initialized();
-    return std::make_unique<VdbWriter>();
-}
-
-void VdbWriter::add_level_set(rust::Str name, rust::Str density_name, double voxel_size,
-                              std::array<double, 3> origin, rust::Slice<const int32_t> leaf_origins,
-                              rust::Slice<const uint64_t> masks, rust::Slice<const float> values,
-                              float background, bool is_signed, rust::Slice<const MetaEntry> metadata) {
-    const size_t count = leaf_origins.size() / 3;
-    if (values.size() != 512 * count) throw std::invalid_argument("level set: expected 512 values per leaf");
-    // Voxels outside the band keep the background: +background outside, and, after the
-    // signed flood fill, -background inside (tiles included), as OpenVDB's tools expect.
-    auto grid = build_grid<openvdb::FloatGrid>(leaf_origins, masks, background,
-                                               [&](auto& leaf, size_t i, openvdb::Index n) {
-                                                   leaf.setValueOn(n, values[512 * i + n]);
-                                               });
-    FreeOnThrow free_on_throw(grid);
-    if (is_signed) {
-        for (auto leaf = grid->tree().beginLeaf(); leaf; ++leaf) {
-            for (auto off = leaf->beginValueOff(); off; ++off) off.setValue(background);
-        }
-        openvdb::tools::signedFloodFill(grid->tree());
-        grid->setGridClass(openvdb::GRID_LEVEL_SET);
-    }
-    auto xform = make_transform(voxel_size, origin);
-    auto describe = [&](openvdb::GridBase& g, const std::string& n) {
-        g.setName(n);
-        g.setTransform(xform);
-        for (const auto& m : metadata) g.insertMeta(std::string(m.key), openvdb::StringMetadata(std::string(m.value)));
-    };
-    if (is_signed && !density_name.empty()) {
-        // Blender's volume object shows `density`: the fog volume of the same solid.
-        auto fog = grid->deepCopy();
-        FreeOnThrow free_fog_on_throw(fog);
-        openvdb::tools::sdfToFogVolume(*fog, background);
-        describe(*fog, std::string(density_name));
-        grids_.push_back(fog);
-    }
-    describe(*grid, std::string(name));
-    grids_.push_back(grid);
 }
 
 double openvdb_level_set_volume(rust::Str path, rust::Str name) {
@@ -166,54 +54,6 @@ double openvdb_level_set_volume(rust::Str path, rust::Str name) {
     auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
     if (!grid) throw std::invalid_argument("grid " + std::string(name) + " is not a FloatGrid");
     return openvdb::tools::levelSetVolume(*grid);
-}
-
-namespace {
-
-// io::File writes through a stream whose errors it never checks, so a full disk gives a
-// truncated file; this archive writes the same seekable format to a stream we check.
-class CheckedArchive : public openvdb::io::Archive {
-public:
-    explicit CheckedArchive(uint32_t compression) { setCompression(compression); }
-    void write_to(const std::string& path, const openvdb::GridPtrVec& grids) const {
-        std::ofstream out(path, std::ios_base::out | std::ios_base::binary | std::ios_base::trunc);
-        if (!out) throw std::runtime_error("cannot open for writing: " + std::string(std::strerror(errno)));
-        Archive::write(out, grids, /*seekable=*/true);
-        out.flush();
-        if (!out) throw std::runtime_error("writing failed: " + std::string(std::strerror(errno)));
-        out.close();
-        if (out.fail()) throw std::runtime_error("closing failed: " + std::string(std::strerror(errno)));
-    }
-};
-
-}  // namespace
-
-void VdbWriter::write(rust::Str path, rust::Str compression, bool half, rust::Slice<const rust::String> only) const {
-    const std::string c(compression);
-    uint32_t flags = openvdb::io::COMPRESS_ACTIVE_MASK;
-    if (c == "blosc") flags |= openvdb::io::COMPRESS_BLOSC;
-    else if (c == "zip") flags |= openvdb::io::COMPRESS_ZIP;
-    else if (c != "none") throw std::invalid_argument("unknown compression " + c + " (blosc, zip or none)");
-    openvdb::GridPtrVec chosen;
-    for (const auto& name : only) {
-        const std::string n(name);
-        auto found = std::find_if(grids_.begin(), grids_.end(), [&](const auto& g) { return g->getName() == n; });
-        if (found == grids_.end()) {
-            std::string names;
-            for (const auto& g : grids_) names += (names.empty() ? "" : ", ") + g->getName();
-            throw std::invalid_argument("no grid `" + n + "` to write; this output has " + names);
-        }
-    }
-    for (const auto& g : grids_) {
-        const bool wanted = only.empty() || std::any_of(only.begin(), only.end(), [&](const rust::String& n) {
-                                                return std::string(n) == g->getName();
-                                            });
-        if (!wanted) continue;
-        // Half precision applies to float and vector grids; bool grids have no floats.
-        g->setSaveFloatAsHalf(half);
-        chosen.push_back(g);
-    }
-    CheckedArchive(flags).write_to(std::string(path), chosen);
 }
 
 std::unique_ptr<VdbFile> open_vdb(rust::Str path) {

@@ -1,4 +1,4 @@
-// The C++ half of src/ffi/vdb.rs: OpenVDB file I/O and OpenVDB's own mesh conversions for benchmarks.
+// The C++ half of src/ffi/vdb.rs: reading .vdb files and OpenVDB's own tools for tests and benchmarks.
 #pragma once
 #include "rust/cxx.h"
 #include "voxelkit/cpp/trycatch.h"
@@ -9,22 +9,6 @@ namespace voxelkit {
 
 struct MetaEntry;
 struct GridInfo;
-
-class VdbWriter {
-public:
-    VdbWriter() = default;
-    VdbWriter(const VdbWriter&) = delete;
-    VdbWriter& operator=(const VdbWriter&) = delete;
-    ~VdbWriter();
-    void add_level_set(rust::Str name, rust::Str density_name, double voxel_size, std::array<double, 3> origin,
-                       rust::Slice<const int32_t> leaf_origins, rust::Slice<const uint64_t> masks,
-                       rust::Slice<const float> values, float background, bool is_signed,
-                       rust::Slice<const MetaEntry> metadata);
-    void write(rust::Str path, rust::Str compression, bool half, rust::Slice<const rust::String> only) const;
-
-private:
-    openvdb::GridPtrVec grids_;
-};
 
 class VdbFile {
 public:
@@ -42,7 +26,6 @@ private:
     openvdb::GridPtrVecPtr grids_;
 };
 
-std::unique_ptr<VdbWriter> new_vdb_writer();
 std::unique_ptr<VdbFile> open_vdb(rust::Str path);
 double openvdb_level_set_volume(rust::Str path, rust::Str name);
 uint64_t openvdb_reference(rust::Str kind, rust::Slice<const float> points, rust::Slice<const uint32_t> triangles,

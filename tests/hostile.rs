@@ -367,7 +367,7 @@ fn a_formula_zero_everywhere_stops_at_the_memory_limit() {
         "-r",
         "256",
         "--max-memory",
-        "400",
+        "200",
         "-o",
         out.to_str().unwrap(),
     ]);
@@ -386,7 +386,7 @@ fn a_formula_zero_everywhere_stops_at_the_memory_limit() {
         "-r",
         "256",
         "--max-memory",
-        "400",
+        "200",
         "-o",
         out.to_str().unwrap(),
     ]);

@@ -1,9 +1,10 @@
-//! The cxx bridge to OpenVDB (`cpp/vdb_bridge.cc`). Leaves cross in bulk: per grid one call
-//! with, for every 8^3 leaf, its origin (3 x i32), its mask (8 x u64, OpenVDB's word order)
-//! and, for value grids, its 512 values (or 3 x 512 for vectors) in OpenVDB's voxel order.
-//! Every C++ function catches its exceptions and turns them into `Result` errors.
+//! The cxx bridge to OpenVDB (`cpp/vdb_bridge.cc`), for reading `.vdb` files (writing is
+//! native: `io::vdb_writer`) and OpenVDB's own tools for tests and benchmarks. Leaves cross in
+//! bulk: per grid one call with, for every 8^3 leaf, its origin (3 x i32), its mask (8 x u64,
+//! OpenVDB's word order) and, for value grids, its 512 values (or 3 x 512 for vectors) in
+//! OpenVDB's voxel order. Every C++ function catches its exceptions and turns them into
+//! `Result` errors.
 
-#[allow(clippy::too_many_arguments)] // add_level_set carries a whole grid in one call
 #[cxx::bridge(namespace = "voxelkit")]
 pub mod bridge {
     /// One string metadata item of a grid.
@@ -34,36 +35,7 @@ pub mod bridge {
     unsafe extern "C++" {
         include!("voxelkit/cpp/vdb_bridge.h");
 
-        type VdbWriter;
         type VdbFile;
-
-        fn new_vdb_writer() -> UniquePtr<VdbWriter>;
-        /// Adds a narrow-band distance FloatGrid: `values` per active voxel (world units), the
-        /// rest `background`; signed: class LEVEL_SET with the interior flood-filled to
-        /// -background, preceded by its fog volume as `density_name` (unless empty).
-        fn add_level_set(
-            self: Pin<&mut VdbWriter>,
-            name: &str,
-            density_name: &str,
-            voxel_size: f64,
-            origin: [f64; 3],
-            leaf_origins: &[i32],
-            masks: &[u64],
-            values: &[f32],
-            background: f32,
-            is_signed: bool,
-            metadata: &[MetaEntry],
-        ) -> Result<()>;
-        /// Writes the grids named in `only` (all when empty) to `path` (the caller renames it
-        /// into place), compressed by `compression` (blosc, zip or none), floats as 16-bit
-        /// halves when `half`.
-        fn write(
-            self: &VdbWriter,
-            path: &str,
-            compression: &str,
-            half: bool,
-            only: &[String],
-        ) -> Result<()>;
 
         fn open_vdb(path: &str) -> Result<UniquePtr<VdbFile>>;
         fn grid_count(self: &VdbFile) -> usize;

@@ -82,6 +82,11 @@ impl SparseGrid {
         &self.leaves
     }
 
+    /// The leaves, to change their voxels and channels (not their origins).
+    pub fn leaves_mut(&mut self) -> &mut [Leaf] {
+        &mut self.leaves
+    }
+
     /// The whole 8^3 and 128^3 blocks.
     pub fn tiles(&self) -> &Tiles {
         &self.tiles

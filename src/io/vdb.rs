@@ -9,7 +9,7 @@
 use super::atomic::write_atomic;
 use super::vdb_writer::{Encoding, GridOut, GridValues, compression_flags, write_grids};
 use crate::error::{Error, Result};
-use crate::ffi::vdb::bridge::{self, MetaEntry};
+use crate::ffi::vdb::bridge;
 use crate::grid::{Channels, LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use glam::DVec3;
 use std::path::Path;
@@ -30,45 +30,6 @@ pub const NORMAL_GRID: &str = "normal";
 
 /// The per-voxel colours (Vec3S), Houdini's name.
 pub const COLOR_GRID: &str = "Cd";
-
-/// A grid's leaves and tiles as the bridge's flat arrays.
-struct Flat<'g> {
-    /// Leaf origins, i32 x 3 per leaf.
-    origins: Vec<i32>,
-    /// Leaf masks, u64 x 8 per leaf.
-    masks: Vec<u64>,
-    leaves: Vec<&'g Leaf>,
-}
-
-/// A coordinate in OpenVDB's 32-bit index range (with room for a 128^3 block past it).
-fn index_coord(path: &Path, c: [i64; 3]) -> Result<[i32; 3]> {
-    let mut out = [0; 3];
-    for (o, &v) in out.iter_mut().zip(&c) {
-        *o = i32::try_from(v)
-            .ok()
-            .filter(|v| v.checked_add(127).is_some())
-            .ok_or_else(|| Error::Vdb {
-                path: path.to_path_buf(),
-                message: format!("block {c:?} is outside OpenVDB's 32-bit index range"),
-            })?;
-    }
-    Ok(out)
-}
-
-fn flatten<'g>(path: &Path, grid: &'g SparseGrid) -> Result<Flat<'g>> {
-    let leaves: Vec<&Leaf> = grid.leaves().iter().filter(|l| !l.is_empty()).collect();
-    let mut origins = Vec::with_capacity(leaves.len() * 3);
-    let mut masks = Vec::with_capacity(leaves.len() * 8);
-    for leaf in &leaves {
-        origins.extend(index_coord(path, leaf.origin)?);
-        masks.extend_from_slice(&leaf.mask);
-    }
-    Ok(Flat {
-        origins,
-        masks,
-        leaves,
-    })
-}
 
 /// OpenVDB 10 refuses transforms whose voxel volume is within about 3e-15 of zero ("Non-zero
 /// scale values required"; measured: it writes 1.4423e-5 and refuses 1.4422e-5).
@@ -214,23 +175,6 @@ impl std::str::FromStr for Compression {
     }
 }
 
-/// Writes the writer's grids to `path` atomically, as `options` say.
-fn write_file(path: &Path, writer: &bridge::VdbWriter, options: &WriteOptions) -> Result<()> {
-    let compression = match options.compression {
-        Compression::Blosc => "blosc",
-        Compression::Zip => "zip",
-        Compression::None => "none",
-    };
-    write_atomic(path, |tmp| {
-        let tmp_str = tmp
-            .to_str()
-            .ok_or_else(|| vdb_error(path, "path is not UTF-8"))?;
-        writer
-            .write(tmp_str, compression, options.half, &options.grids)
-            .map_err(|e| vdb_error(path, e))
-    })
-}
-
 /// The metadata entries of every grid: the caller's plus `voxelkit_version`.
 fn meta_entries(metadata: &[(&str, String)]) -> Vec<(String, String)> {
     let mut meta: Vec<(String, String)> = metadata
@@ -242,11 +186,10 @@ fn meta_entries(metadata: &[(&str, String)]) -> Vec<(String, String)> {
 }
 
 /// How a distance band is written.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum DistanceGrid {
-    /// Signed distances: a LEVEL_SET FloatGrid `surface` (Houdini's name) whose interior
-    /// is -background, after its fog volume `density`.
-    LevelSet,
+pub enum DistanceGrid<'g> {
+    /// Signed distances: a LEVEL_SET FloatGrid `surface` (Houdini's name) whose inactive
+    /// voxels and tiles in `interior` are -background, after its fog volume `density`.
+    LevelSet { interior: &'g SparseGrid },
     /// Unsigned distances: a FloatGrid `distance`.
     Unsigned,
 }
@@ -262,41 +205,67 @@ pub fn write_distance_band(
     options: &WriteOptions,
 ) -> Result<()> {
     check_voxel_size(path, grid.transform.voxel_size)?;
-    let flat = flatten(path, grid)?;
-    let mut values = Vec::with_capacity(flat.leaves.len() * LEAF_VOXELS);
-    for leaf in &flat.leaves {
-        let v = leaf
-            .value
-            .as_ref()
-            .ok_or_else(|| vdb_error(path, "a distance band needs distances"))?;
-        values.extend_from_slice(&v[..]);
+    if grid.leaves().iter().any(|l| l.value.is_none()) {
+        return Err(vdb_error(path, "a distance band needs distances"));
     }
-    let meta: Vec<MetaEntry> = meta_entries(metadata)
-        .into_iter()
-        .map(|(key, value)| MetaEntry { key, value })
-        .collect();
-    let t = grid.transform;
-    let (name, density, signed) = match kind {
-        DistanceGrid::LevelSet => (LEVEL_SET_GRID, DENSITY_GRID, true),
-        DistanceGrid::Unsigned => ("distance", "", false),
+    let meta = meta_entries(metadata);
+    let grid_out = |name, grid, values, class| GridOut {
+        name,
+        grid,
+        values,
+        class,
+        vector_type: None,
+        metadata: &meta,
     };
-    let mut writer = bridge::new_vdb_writer();
-    writer
-        .pin_mut()
-        .add_level_set(
-            name,
-            density,
-            t.voxel_size,
-            t.origin.to_array(),
-            &flat.origins,
-            &flat.masks,
-            &values,
-            background,
-            signed,
-            &meta,
-        )
-        .map_err(|e| vdb_error(path, e))?;
-    write_file(path, &writer, options)
+    let mut grids = match kind {
+        DistanceGrid::LevelSet { interior } => vec![
+            // Blender's volume object shows `density`: the fog volume of the same solid.
+            grid_out(
+                DENSITY_GRID,
+                interior,
+                GridValues::Fog {
+                    band: grid,
+                    background,
+                },
+                Some("fog volume"),
+            ),
+            grid_out(
+                LEVEL_SET_GRID,
+                grid,
+                GridValues::LevelSet {
+                    background,
+                    interior,
+                },
+                Some("level set"),
+            ),
+        ],
+        DistanceGrid::Unsigned => vec![grid_out(
+            "distance",
+            grid,
+            GridValues::Distances { background },
+            None,
+        )],
+    };
+    if let Some(missing) = options
+        .grids
+        .iter()
+        .find(|n| !grids.iter().any(|g| g.name == n.as_str()))
+    {
+        let names: Vec<&str> = grids.iter().map(|g| g.name).collect();
+        return Err(vdb_error(
+            path,
+            format!(
+                "no grid `{missing}` to write; this output has {}",
+                names.join(", ")
+            ),
+        ));
+    }
+    grids.retain(|g| options.grids.is_empty() || options.grids.iter().any(|n| n == g.name));
+    let encoding = Encoding {
+        compression: compression_flags(options.compression),
+        half: options.half,
+    };
+    write_atomic(path, |tmp| write_grids(tmp, path, &grids, encoding))
 }
 
 /// OpenVDB's own volume (`tools::levelSetVolume`) of the level set `name` in a file.

@@ -25,9 +25,9 @@ const LIBRARY_VERSION: [u32; 2] = [10, 0];
 /// Leaves per parallel batch of leaf buffers.
 const BATCH: usize = 2048;
 
-/// What a grid's active voxels hold.
+/// What a grid's voxels hold.
 #[derive(Clone, Copy)]
-pub(super) enum GridValues {
+pub(super) enum GridValues<'g> {
     /// A BoolGrid, true on every active voxel and tile.
     Bool,
     /// A FloatGrid holding this value on every active voxel and tile (a fog volume's 1).
@@ -36,14 +36,28 @@ pub(super) enum GridValues {
     Normals,
     /// A Vec3SGrid of every leaf's colours.
     Colors,
+    /// A FloatGrid of every leaf's values with `background` elsewhere (an unsigned band).
+    Distances { background: f32 },
+    /// A level set: every leaf's signed values; its inactive voxels and tiles `-background`
+    /// where `interior` holds them (its tiles are written, inactive), `background` elsewhere.
+    LevelSet {
+        background: f32,
+        interior: &'g SparseGrid,
+    },
+    /// The fog volume of a level set (written from its interior): 1 on whole blocks and
+    /// inside voxels off the band, `-d / background` on the band's inside voxels.
+    Fog {
+        band: &'g SparseGrid,
+        background: f32,
+    },
 }
 
-impl GridValues {
+impl GridValues<'_> {
     fn tree_type(self) -> &'static str {
         match self {
             GridValues::Bool => "Tree_bool_5_4_3",
-            GridValues::Constant(_) => "Tree_float_5_4_3",
             GridValues::Normals | GridValues::Colors => "Tree_vec3s_5_4_3",
+            _ => "Tree_float_5_4_3",
         }
     }
 
@@ -51,8 +65,8 @@ impl GridValues {
     fn value_bytes(self) -> usize {
         match self {
             GridValues::Bool => 1,
-            GridValues::Constant(_) => 4,
             GridValues::Normals | GridValues::Colors => 12,
+            _ => 4,
         }
     }
 
@@ -60,14 +74,28 @@ impl GridValues {
         !matches!(self, GridValues::Bool)
     }
 
+    /// The value of voxels and slots outside the tree.
+    fn background(self) -> f32 {
+        match self {
+            GridValues::Distances { background } | GridValues::LevelSet { background, .. } => {
+                background
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Whether the grid's tiles are active (a level set's interior tiles are not).
+    fn active_tiles(self) -> bool {
+        !matches!(self, GridValues::LevelSet { .. })
+    }
+
     /// The value of a tile, as stored (half precision when `half`).
     fn push_tile_value(self, out: &mut Vec<u8>, half: bool) {
         match self {
             GridValues::Bool => out.push(1),
             GridValues::Constant(v) => push_real(out, v, half),
-            GridValues::Normals | GridValues::Colors => {
-                unreachable!("vector grids are written without tiles")
-            }
+            GridValues::Fog { .. } => push_real(out, 1.0, half),
+            _ => unreachable!("only voxel sets and fog volumes have active tiles"),
         }
     }
 
@@ -79,12 +107,39 @@ impl GridValues {
                 leaf.offsets().for_each(|_| push_real(out, v, half));
                 return;
             }
+            GridValues::Distances { .. } | GridValues::LevelSet { .. } => {
+                let values = leaf.value.as_deref().expect("a distance grid's leaves carry values");
+                leaf.offsets().for_each(|n| push_real(out, values[n], half));
+                return;
+            }
+            GridValues::Fog { band, background } => {
+                let on_band = band.leaf(leaf.origin);
+                for n in leaf.offsets() {
+                    let v = match on_band {
+                        Some(b) if b.is_on(n) => {
+                            let d = b.value.as_deref().expect("distances")[n];
+                            (-d / background).clamp(0.0, 1.0)
+                        }
+                        _ => 1.0,
+                    };
+                    push_real(out, v, half);
+                }
+                return;
+            }
             GridValues::Normals => leaf.normal.as_deref(),
             GridValues::Colors => leaf.color.as_deref(),
         };
         let vectors = vectors.expect("a vector grid's leaves carry its channel");
         for n in leaf.offsets() {
             vectors[n].iter().for_each(|&c| push_real(out, c, half));
+        }
+    }
+
+    /// The inside voxels of a level set's leaf at `origin` (the others are outside).
+    fn inside(self, origin: [i64; 3]) -> [u64; 8] {
+        match self {
+            GridValues::LevelSet { interior, .. } => interior.leaf(origin).map_or([0; 8], |l| l.mask),
+            _ => [0; 8],
         }
     }
 }
@@ -101,7 +156,7 @@ fn push_real(out: &mut Vec<u8>, v: f32, half: bool) {
 pub(super) struct GridOut<'g> {
     pub name: &'g str,
     pub grid: &'g SparseGrid,
-    pub values: GridValues,
+    pub values: GridValues<'g>,
     /// OpenVDB's grid class (`fog volume`), when it has one.
     pub class: Option<&'static str>,
     /// OpenVDB's vector type of a Vec3 grid (`covariant normalize`, `invariant`).
@@ -253,7 +308,11 @@ fn encode_grid(path: &Path, g: &GridOut, encoding: Encoding) -> Result<EncodedGr
         .filter(|l| !l.is_empty())
         .map(|l| Ok((key(path, l.origin)?, Entry::Leaf(l))))
         .collect::<Result<_>>()?;
-    for (origin, edge) in grid.tiles().with_edges() {
+    let tiles_of = match g.values {
+        GridValues::LevelSet { interior, .. } => interior,
+        _ => grid,
+    };
+    for (origin, edge) in tiles_of.tiles().with_edges() {
         let entry = if edge == 8 {
             Entry::LeafTile
         } else {
@@ -299,7 +358,11 @@ fn encode_grid(path: &Path, g: &GridOut, encoding: Encoding) -> Result<EncodedGr
     push_metadata(&mut head, g, encoding, internal, leaves.len() as u64);
     push_transform(&mut head, grid.transform);
     head.extend_from_slice(&1u32.to_le_bytes()); // one buffer per leaf
-    head.extend(std::iter::repeat_n(0u8, g.values.value_bytes())); // background
+    match g.values {
+        GridValues::Bool => head.push(0),
+        GridValues::Normals | GridValues::Colors => head.extend_from_slice(&[0; 12]),
+        values => head.extend_from_slice(&values.background().to_le_bytes()),
+    }
     head.extend_from_slice(&0u32.to_le_bytes()); // no root tiles
     head.extend_from_slice(&(roots.len() as u32).to_le_bytes());
     for (bytes, _, _) in &encoded {
@@ -357,9 +420,7 @@ fn root_child_topology<'g>(
         push_internal_values(&mut out, &children, &tiles, values, compression, half);
         for (_, entry) in node {
             if let Entry::Leaf(leaf) = entry {
-                leaf.mask
-                    .iter()
-                    .for_each(|w| out.extend_from_slice(&w.to_le_bytes()));
+                push_mask(&mut out, &leaf.mask);
             }
         }
     }
@@ -376,34 +437,59 @@ fn push_internal_values(
     compression: u32,
     half: bool,
 ) {
-    for mask in [children, tiles] {
-        mask.iter()
-            .for_each(|w| out.extend_from_slice(&w.to_le_bytes()));
+    let none = vec![0u64; tiles.len()];
+    let (active, inside) = if values.active_tiles() {
+        (tiles, &none[..])
+    } else {
+        (&none[..], tiles)
+    };
+    for mask in [children, active] {
+        push_mask(out, mask);
     }
-    out.push(0); // inactive slots hold the background
-    let count: u32 = tiles.iter().map(|w| w.count_ones()).sum();
+    let outside: Vec<u64> = (0..tiles.len())
+        .map(|w| !(children[w] | tiles[w]))
+        .collect();
+    push_inactive(out, inside, &outside);
+    let count: u32 = active.iter().map(|w| w.count_ones()).sum();
     let mut data = Vec::new();
     (0..count).for_each(|_| values.push_tile_value(&mut data, half));
     push_values(out, &data, values, compression, half);
 }
 
+fn push_mask(out: &mut Vec<u8>, mask: &[u64]) {
+    mask.iter()
+        .for_each(|w| out.extend_from_slice(&w.to_le_bytes()));
+}
+
+/// What a node's inactive values are, as OpenVDB flags them: `-background` on the slots of
+/// `inside`, the background on those of `outside` (a selection mask picks where both occur).
+fn push_inactive(out: &mut Vec<u8>, inside: &[u64], outside: &[u64]) {
+    let any = |m: &[u64]| m.iter().any(|&w| w != 0);
+    match (any(inside), any(outside)) {
+        (false, _) => out.push(0), // all the background
+        (true, false) => out.push(1), // all minus the background
+        (true, true) => {
+            out.push(3); // selected: the background; the others minus it
+            push_mask(out, outside);
+        }
+    }
+}
+
 /// A leaf's buffer: its mask, then a bool leaf's origin and value bits, or another leaf's
 /// active values.
 fn leaf_buffer(out: &mut Vec<u8>, leaf: &Leaf, values: GridValues, compression: u32, half: bool) {
-    let mask = |out: &mut Vec<u8>| {
-        leaf.mask
-            .iter()
-            .for_each(|w| out.extend_from_slice(&w.to_le_bytes()))
-    };
-    mask(out);
+    push_mask(out, &leaf.mask);
     if let GridValues::Bool = values {
         leaf.origin
             .iter()
             .for_each(|&v| out.extend_from_slice(&(v as i32).to_le_bytes()));
-        mask(out); // every active voxel is true
+        push_mask(out, &leaf.mask); // every active voxel is true
         return;
     }
-    out.push(0); // inactive voxels hold the background
+    let inside = values.inside(leaf.origin);
+    let inactive_inside: [u64; 8] = std::array::from_fn(|w| inside[w] & !leaf.mask[w]);
+    let inactive_outside: [u64; 8] = std::array::from_fn(|w| !(inside[w] | leaf.mask[w]));
+    push_inactive(out, &inactive_inside, &inactive_outside);
     let mut data = Vec::with_capacity(leaf.count() as usize * values.value_bytes());
     values.push_leaf_values(&mut data, leaf, half);
     push_values(out, &data, values, compression, half);

@@ -1,45 +1,102 @@
 //! Which voxel centres lie inside a closed mesh, by ray parity along z: every column of
 //! centres `(i, j)` casts one ray along +z (exact crossings, see `crossings`), and a centre is
-//! inside when an odd number of crossings lies below it.
+//! inside when it lies between crossings 2m and 2m+1 (sorted).
 
 use super::crossings::{RayWindow, for_each_crossing};
 use crate::error::Result;
 use crate::grid::{CoordBox, DenseMask, Transform};
 use crate::mesh::Mesh;
 use glam::DVec3;
+use rayon::prelude::*;
+
+/// The crossings of a mesh with the z rays of a box's columns, sorted by column, then z.
+pub struct ColumnCrossings {
+    window: RayWindow,
+    /// (ray, z) of every crossing.
+    crossings: Vec<(usize, f64)>,
+}
+
+/// Triangles per parallel batch of crossings.
+const TRIANGLE_BATCH: usize = 4096;
+
+impl ColumnCrossings {
+    /// The crossings of the closed `mesh` (world units) with the columns of `bbox`.
+    pub fn new(mesh: &Mesh, transform: &Transform, bbox: CoordBox) -> Self {
+        let pos: Vec<DVec3> = mesh
+            .positions
+            .par_iter()
+            .map(|&p| transform.world_to_index(p))
+            .collect();
+        let [nx, ny, _] = bbox.dim().map(|v| v as usize);
+        let window = RayWindow {
+            a0: bbox.min[0],
+            b0: bbox.min[1],
+            width: nx,
+            height: ny,
+        };
+        let triangles: Vec<[u32; 3]> = mesh.triangles().map(|(_, t)| t).collect();
+        let mut crossings: Vec<(usize, f64)> = triangles
+            .par_chunks(TRIANGLE_BATCH)
+            .flat_map_iter(|batch| {
+                let mut found = Vec::new();
+                for_each_crossing(&pos, batch.iter().copied(), &window, |ray, z| {
+                    found.push((ray, z))
+                });
+                found
+            })
+            .collect();
+        crossings.par_sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        ColumnCrossings { window, crossings }
+    }
+
+    /// The inside centres of column `(x, y)` (inside the box's columns) as inclusive z spans,
+    /// ascending; some may be empty (`first > last`).
+    pub fn spans(&self, x: i64, y: i64) -> impl Iterator<Item = (i64, i64)> + '_ {
+        let ray = self.window.ray(x, y);
+        let start = self.crossings.partition_point(|c| c.0 < ray);
+        let end = start + self.crossings[start..].partition_point(|c| c.0 == ray);
+        self.crossings[start..end]
+            .chunks_exact(2)
+            .map(|pair| (pair[0].1.ceil() as i64, pair[1].1.floor() as i64))
+    }
+
+    /// Every column's spans of inside centres, as `(x, y, first z, last z)`.
+    pub fn all_spans(&self) -> impl Iterator<Item = (i64, i64, i64, i64)> + '_ {
+        let height = self.window.height;
+        self.crossings
+            .chunk_by(|a, b| a.0 == b.0)
+            .flat_map(move |column| {
+                let (x, y) = (column[0].0 / height, column[0].0 % height);
+                column.chunks_exact(2).map(move |pair| {
+                    (
+                        self.window.a0 + x as i64,
+                        self.window.b0 + y as i64,
+                        pair[0].1.ceil() as i64,
+                        pair[1].1.floor() as i64,
+                    )
+                })
+            })
+    }
+
+    /// The columns' x range and y range, inclusive.
+    pub fn columns(&self) -> ([i64; 2], [i64; 2]) {
+        let w = &self.window;
+        (
+            [w.a0, w.a0 + w.width as i64 - 1],
+            [w.b0, w.b0 + w.height as i64 - 1],
+        )
+    }
+}
 
 /// Voxel centres inside the closed `mesh` (world units) over `bbox`, with `transform`.
 pub fn inside_centres(mesh: &Mesh, transform: &Transform, bbox: CoordBox) -> Result<DenseMask> {
     let mut inside = DenseMask::new(bbox)?;
-    let pos: Vec<DVec3> = mesh
-        .positions
-        .iter()
-        .map(|&p| transform.world_to_index(p))
-        .collect();
-    let [nx, ny, _] = inside.dims();
-    let window = RayWindow {
-        a0: bbox.min[0],
-        b0: bbox.min[1],
-        width: nx,
-        height: ny,
-    };
-    let mut crossings: Vec<(u32, f64)> = Vec::new();
-    for_each_crossing(&pos, mesh.triangles().map(|(_, t)| t), &window, |ray, z| {
-        crossings.push((ray as u32, z))
-    });
-    crossings.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    for column in crossings.chunk_by(|a, b| a.0 == b.0) {
-        let ray = column[0].0 as usize;
-        let (x, y) = (ray / ny, ray % ny);
-        // Between crossing 2m and 2m+1 (sorted) the ray is inside.
-        for pair in column.chunks_exact(2) {
-            let z0 = (pair[0].1.ceil() as i64).max(bbox.min[2]);
-            let z1 = (pair[1].1.floor() as i64).min(bbox.max[2]);
-            if z0 <= z1 {
-                let column = [bbox.min[0] + x as i64, bbox.min[1] + y as i64];
-                let first = inside.index([column[0], column[1], z0]);
-                inside.set_index_range(first, first + (z1 - z0) as usize);
-            }
+    let columns = ColumnCrossings::new(mesh, transform, bbox);
+    for (x, y, z0, z1) in columns.all_spans() {
+        let (z0, z1) = (z0.max(bbox.min[2]), z1.min(bbox.max[2]));
+        if z0 <= z1 {
+            let first = inside.index([x, y, z0]);
+            inside.set_index_range(first, first + (z1 - z0) as usize);
         }
     }
     Ok(inside)

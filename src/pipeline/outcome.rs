@@ -42,9 +42,16 @@ pub struct Outcome {
     /// The metadata every written grid carries (`method`, `source_file`, ...).
     pub metadata: Vec<(String, String)>,
     pub report: Report,
-    /// Set when `grid` holds distances (world units) to write as a narrow band with this
-    /// background, instead of a voxel set.
-    pub distances: Option<(DistanceGrid, f32)>,
+    /// Set when `grid` holds distances (world units) to write as a narrow band, instead of a
+    /// voxel set.
+    pub distances: Option<Distances>,
+}
+
+/// How a distance band is written: its background, and for a level set the interior it
+/// bounds (its inactive voxels and tiles there are -background).
+pub struct Distances {
+    pub background: f32,
+    pub interior: Option<SparseGrid>,
 }
 
 /// Output formats by extension; `-` is standard output (as `.vdb`).
@@ -190,9 +197,13 @@ impl Outcome {
             .collect();
         let extra: Vec<(&str, &SparseGrid)> =
             self.extra.iter().map(|(n, g)| (n.as_str(), g)).collect();
-        let write = |file: &Path| match self.distances {
-            Some((kind, background)) => {
-                write_distance_band(file, &self.grid, background, kind, &meta, options)
+        let write = |file: &Path| match &self.distances {
+            Some(d) => {
+                let kind = match &d.interior {
+                    Some(interior) => DistanceGrid::LevelSet { interior },
+                    None => DistanceGrid::Unsigned,
+                };
+                write_distance_band(file, &self.grid, d.background, kind, &meta, options)
             }
             None => write_vdb_as(file, &self.grid, &extra, &meta, options),
         };

@@ -2,7 +2,7 @@
 //! distance band, measure a mesh or a `.vdb` surface, evaluate a CSG tree; with volumes,
 //! mass, components and genus.
 
-use super::outcome::Outcome;
+use super::outcome::{Distances, Outcome};
 use super::outcome::provenance;
 use super::report::{
     CsgDetails, CsgLeafCount, DepthLayerDetails, Details, DirectionCounts, DistanceBandDetails,
@@ -11,7 +11,6 @@ use super::report::{
 use super::{Fill, SubdivisionFill};
 use crate::error::Result;
 use crate::grid::{Adjacency, DenseMask, SparseGrid, Transform};
-use crate::io::vdb::DistanceGrid;
 use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
 use crate::ops::topology::{components, euler_characteristic};
@@ -244,10 +243,11 @@ pub(super) fn distance_band(
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
-    let grid = if signed {
-        level_set(mesh, t, band, progress)?
+    let (grid, interior) = if signed {
+        let set = level_set(mesh, t, band, progress)?;
+        (set.band, Some(set.interior))
     } else {
-        unsigned_distance(mesh, t, band, progress)?
+        (unsigned_distance(mesh, t, band, progress)?, None)
     };
     let inside_band_voxels = grid
         .leaves()
@@ -276,12 +276,10 @@ pub(super) fn distance_band(
         background,
     };
     let mut outcome = Outcome::new(grid, meta, Details::DistanceBand(details));
-    let kind = if signed {
-        DistanceGrid::LevelSet
-    } else {
-        DistanceGrid::Unsigned
-    };
-    outcome.distances = Some((kind, background as f32));
+    outcome.distances = Some(Distances {
+        background: background as f32,
+        interior,
+    });
     Ok(outcome.timed(start))
 }
 

@@ -3,35 +3,115 @@
 //! (`mesh::inside`), which needs no consistent orientation: inward-facing or mixed normals
 //! give the same level set. Values are in world units, negative inside, as OpenVDB's level
 //! sets are.
+//!
+//! Beside the band, the level set keeps its interior: the inside centres of the band's leaves,
+//! and every 8^3 block wholly inside as a tile (128^3 where whole). A block without band
+//! voxels holds no surface (any surface in it lies within sqrt(3)/2 of a centre, inside the
+//! band), so one centre decides it.
 
 use crate::error::Result;
-use crate::grid::{SparseGrid, Transform};
+use crate::grid::{Channels, Coord, Leaf, SparseGrid, Transform};
 use crate::mesh::Mesh;
-use crate::mesh::inside::inside_centres;
+use crate::mesh::inside::ColumnCrossings;
 use crate::progress::Progress;
 use crate::voxelize::distance_band::distance_band;
+use rayon::prelude::*;
 
 /// Why a signed distance needs a closed mesh, for the error that refuses an open one.
 const SIGN_NEEDS_CLOSED: &str = "a signed distance needs an inside, which an open surface does \
      not have (--udf writes unsigned distances)";
 
+/// A narrow-band level set and the inside it bounds.
+pub struct LevelSet {
+    /// Signed distances (world units, negative inside) on the band's voxels.
+    pub band: SparseGrid,
+    /// The inside centres: the band leaves' as leaves, whole inside blocks as tiles.
+    pub interior: SparseGrid,
+}
+
 /// Signed distances (world units, negative inside) on every voxel within `band` voxels of
-/// the closed `mesh`.
+/// the closed `mesh`, and its interior.
 pub fn level_set(
     mesh: &Mesh,
     transform: Transform,
     band: f64,
     progress: &Progress,
-) -> Result<SparseGrid> {
+) -> Result<LevelSet> {
     mesh.require_closed(SIGN_NEEDS_CLOSED)?;
     let mut grid = distance_band(mesh, transform, band, progress)?;
+    let mut interior = SparseGrid::new(transform, Channels::NONE);
     let Some(bbox) = grid.bbox() else {
-        return Ok(grid);
+        return Ok(LevelSet {
+            band: grid,
+            interior,
+        });
     };
-    let inside = inside_centres(mesh, &transform, bbox)?;
+    let columns = ColumnCrossings::new(mesh, &transform, bbox);
     let h = transform.voxel_size as f32;
-    grid.map_values(|c, d| if inside.get(c) { -d * h } else { d * h });
-    Ok(grid)
+    let inside: Vec<Leaf> = grid
+        .leaves_mut()
+        .par_iter_mut()
+        .filter_map(|leaf| {
+            let mask = inside_mask(&columns, leaf.origin);
+            let values = leaf.value.as_mut().expect("distances");
+            for n in crate::grid::bits::ones(&leaf.mask) {
+                let sign = if mask[n / 64] >> (n % 64) & 1 == 1 { -h } else { h };
+                values[n] *= sign;
+            }
+            let mut inside = Leaf::new(leaf.origin, Channels::NONE);
+            inside.mask = mask;
+            (!inside.is_empty()).then_some(inside)
+        })
+        .collect();
+    interior = SparseGrid::from_distinct_leaves(transform, Channels::NONE, inside);
+    for origin in inside_blocks(&columns, &grid) {
+        interior.fill_leaf_block(origin);
+    }
+    interior.compact();
+    Ok(LevelSet {
+        band: grid,
+        interior,
+    })
+}
+
+/// The inside centres of the leaf at `origin`, as a leaf mask.
+fn inside_mask(columns: &ColumnCrossings, origin: Coord) -> [u64; 8] {
+    let mut mask = [0u64; 8];
+    for (x, word) in mask.iter_mut().enumerate() {
+        for y in 0..8 {
+            for (z0, z1) in columns.spans(origin[0] + x as i64, origin[1] + y as i64) {
+                let (z0, z1) = ((z0 - origin[2]).max(0), (z1 - origin[2]).min(7));
+                if z0 <= z1 {
+                    let run = (1u64 << (z1 - z0 + 1)) - 1;
+                    *word |= run << (y * 8 + z0 as usize);
+                }
+            }
+        }
+    }
+    mask
+}
+
+/// The origins of the 8^3 blocks wholly inside: those without band voxels whose first
+/// centre is inside (only blocks in the columns' box can be).
+fn inside_blocks(columns: &ColumnCrossings, band: &SparseGrid) -> Vec<Coord> {
+    let ([x0, x1], [y0, y1]) = columns.columns();
+    let first = |v: i64| (v + 7) & !7;
+    let xs: Vec<i64> = (first(x0)..=x1).step_by(8).collect();
+    xs.par_iter()
+        .flat_map_iter(|&x| {
+            let mut found = Vec::new();
+            for y in (first(y0)..=y1).step_by(8) {
+                for (z0, z1) in columns.spans(x, y) {
+                    for z in (first(z0)..=z1).step_by(8) {
+                        if band.leaf([x, y, z]).is_none() {
+                            found.push([x, y, z]);
+                        }
+                    }
+                }
+            }
+            found
+        })
+        .collect()
 }
 
 /// Unsigned distances (world units) on every voxel within `band` voxels of `mesh`, open or

@@ -57,6 +57,14 @@ impl<const CLASSES: usize> BrickSink<'_, '_, CLASSES> {
     /// is `normal`.
     #[inline]
     pub fn add(&mut self, c: Coord, distance: f64, normal: DVec3) {
+        self.mark(c);
+        if let Some(sink) = self.nearest.as_deref_mut() {
+            sink.add(c, distance, normal);
+        }
+    }
+
+    #[inline]
+    fn mark(&mut self, c: Coord) {
         let l = [
             c[0] - self.origin[0],
             c[1] - self.origin[1],
@@ -71,8 +79,14 @@ impl<const CLASSES: usize> BrickSink<'_, '_, CLASSES> {
         let word = leaf * 8 + (l[0] & 7) as usize;
         self.bits.classes[self.class][word] |= 1 << (((l[1] & 7) << 3) | (l[2] & 7));
         self.bits.touched[leaf / 64] |= 1 << (leaf % 64);
+    }
+
+    /// Marks voxel `c` (inside the brick), keeping the smallest distance given for it.
+    #[inline]
+    pub fn add_distance(&mut self, c: Coord, distance: f64) {
+        self.mark(c);
         if let Some(sink) = self.nearest.as_deref_mut() {
-            sink.add(c, distance, normal);
+            sink.add_distance(c, distance);
         }
     }
 }

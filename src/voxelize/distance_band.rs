@@ -4,9 +4,9 @@
 //! voxel units. The sign (inside or outside) is not decided here: see `solids::level_set`.
 
 use super::Progress;
-use super::sink::{Sink, voxelize_indexed};
+use super::brick_bins::{BrickSink, voxelize_in_bricks};
 use crate::error::{Error, Result};
-use crate::grid::{Channels, SparseGrid, Transform};
+use crate::grid::{Channels, CoordBox, SparseGrid, Transform};
 use crate::mesh::Mesh;
 use glam::DVec3;
 
@@ -44,7 +44,7 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec
 }
 
 /// Unsigned distances in voxels (value channel) on every voxel within `band` voxels of a
-/// triangle of `mesh`; `progress` counts faces.
+/// triangle of `mesh`, computed in 64^3 bricks on all threads; `progress` counts triangles.
 pub fn distance_band(
     mesh: &Mesh,
     transform: Transform,
@@ -62,53 +62,72 @@ pub fn distance_band(
         .iter()
         .map(|&p| transform.world_to_index(p))
         .collect();
+    let triangles: Vec<[DVec3; 3]> = mesh
+        .triangles()
+        .map(|(_, t)| t.map(|i| pos[i as usize]))
+        .collect();
     let channels = Channels {
         value: true,
         ..Channels::NONE
     };
-    let grid = voxelize_indexed(
-        mesh.face_count(),
+    let candidates = |_, i: usize| {
+        let [a, b, c] = triangles[i];
+        CoordBox {
+            min: (a.min(b).min(c) - band).ceil().as_i64vec3().to_array(),
+            max: (a.max(b).max(c) + band).floor().as_i64vec3().to_array(),
+        }
+    };
+    let (grid, _) = voxelize_in_bricks(
+        [triangles.len()],
         transform,
         channels,
         progress,
-        |f, sink| {
-            for t in mesh.fan(f) {
-                let [a, b, c] = t.map(|i| pos[i as usize]);
-                triangle_band(a, b, c, band, sink);
-            }
-        },
-    );
-    progress.check()?;
+        candidates,
+        |_, i, clip, sink| triangle_band(triangles[i], band, clip, sink),
+    )?;
     Ok(grid)
 }
 
-/// The voxels within `band` of triangle `abc` (index space), with their distances.
-fn triangle_band(a: DVec3, b: DVec3, c: DVec3, band: f64, sink: &mut Sink) {
-    let lo = (a.min(b).min(c) - band).ceil().as_i64vec3();
-    let hi = (a.max(b).max(c) + band).floor().as_i64vec3();
-    let unit = (b - a).cross(c - a).try_normalize();
-    // Every point of the triangle lies within `radius` of its centroid: a voxel farther than
-    // band + radius from the centroid, or than the band from its plane, is out of the band.
-    let centroid = (a + b + c) / 3.0;
-    let radius = centroid
-        .distance_squared(a)
-        .max(centroid.distance_squared(b))
-        .max(centroid.distance_squared(c))
-        .sqrt();
-    let reach = (band + radius) * (band + radius);
+/// The voxels in `clip` within `band` of triangle `abc` (index space), with their distances.
+/// Columns run along the normal's largest axis, each limited to the slab within `band` of
+/// the triangle's plane.
+fn triangle_band(
+    [a, b, c]: [DVec3; 3],
+    band: f64,
+    clip: &CoordBox,
+    sink: &mut BrickSink<1>,
+) {
+    let lo = (a.min(b).min(c) - band).ceil().as_i64vec3().to_array();
+    let hi = (a.max(b).max(c) + band).floor().as_i64vec3().to_array();
+    let range = |axis: usize| lo[axis].max(clip.min[axis])..=hi[axis].min(clip.max[axis]);
+    let normal = (b - a).cross(c - a).try_normalize();
+    // Degenerate triangles have no plane: their columns are not limited.
+    let w = normal.map_or(2, |n| n.abs().max_position());
+    let (u, v) = ((w + 1) % 3, (w + 2) % 3);
     let band2 = band * band;
-    for x in lo.x..=hi.x {
-        for y in lo.y..=hi.y {
-            for z in lo.z..=hi.z {
-                let p = DVec3::new(x as f64, y as f64, z as f64);
-                if p.distance_squared(centroid) > reach
-                    || unit.is_some_and(|n| (p - a).dot(n).abs() > band)
-                {
-                    continue;
-                }
+    for iu in range(u) {
+        for iv in range(v) {
+            let mut column = range(w);
+            if let Some(n) = normal {
+                // |n·(p - a)| <= band, solved for p_w, widened so rounding drops no voxel.
+                let rest = n[u] * (iu as f64 - a[u]) + n[v] * (iv as f64 - a[v]) - n[w] * a[w];
+                let (k0, k1) = ((-band - rest) / n[w], (band - rest) / n[w]);
+                let slack = 1e-9 * (1.0 + k0.abs().max(k1.abs()));
+                let (k0, k1) = (k0.min(k1) - slack, k0.max(k1) + slack);
+                column = (*column.start()).max(k0.ceil() as i64)..=(*column.end()).min(k1.floor() as i64);
+            }
+            for k in column {
+                let mut p = DVec3::ZERO;
+                p[u] = iu as f64;
+                p[v] = iv as f64;
+                p[w] = k as f64;
                 let d2 = p.distance_squared(closest_point_on_triangle(p, a, b, c));
                 if d2 <= band2 {
-                    sink.add_distance([x, y, z], d2.sqrt());
+                    let mut coord = [0i64; 3];
+                    coord[u] = iu;
+                    coord[v] = iv;
+                    coord[w] = k;
+                    sink.add_distance(coord, d2.sqrt());
                 }
             }
         }
