@@ -6,6 +6,7 @@
 #include "voxelkit/src/ffi/vdb.rs.h"
 
 #include <openvdb/tools/LevelSetMeasure.h>
+#include <openvdb/tools/LevelSetUtil.h>
 #include <openvdb/tools/MeshToVolume.h>
 #include <tbb/global_control.h>
 #include <algorithm>

@@ -54,7 +54,7 @@ fn winding(mesh: &Mesh, p: DVec3) -> f64 {
 fn check(name: &str, mesh: &Mesh, resolution: u32) {
     let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
     let h = t.voxel_size;
-    let grid = level_set(mesh, t, BAND, &Progress::none()).unwrap();
+    let grid = level_set(mesh, t, BAND, &Progress::none()).unwrap().band;
     let active: Vec<([i64; 3], f32)> = grid
         .leaves()
         .iter()

@@ -431,6 +431,11 @@ impl SparseGrid {
             .collect();
     }
 
+    /// Complete 128^3 groups of 8^3 tiles become node tiles (leaves are left as they are).
+    pub fn promote_tiles(&mut self) {
+        self.tiles.promote();
+    }
+
     /// Whole leaves become tiles (when the grid has no channels) and complete 128^3 groups
     /// of tiles become node tiles.
     pub fn compact(&mut self) {

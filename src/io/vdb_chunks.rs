@@ -38,39 +38,38 @@ unsafe extern "C" {
         source_len: c_ulong,
         level: c_int,
     ) -> c_int;
-    fn compressBound(source_len: c_ulong) -> c_ulong;
 }
 
 /// Appends `data` (values of `value_size` bytes each) to `out` as the grid's `compression`
-/// flags store it.
+/// flags store it. Compressed bytes are written in place, after room for their size.
 pub(super) fn push_chunk(out: &mut Vec<u8>, data: &[u8], value_size: usize, compression: u32) {
-    let compressed = if compression & COMPRESS_BLOSC != 0 {
-        blosc(data, value_size)
-    } else if compression & COMPRESS_ZIP != 0 {
-        zip(data)
-    } else {
+    if compression & (COMPRESS_BLOSC | COMPRESS_ZIP) == 0 {
         out.extend_from_slice(data);
         return;
-    };
-    match compressed {
-        Some(bytes) if bytes.len() < data.len() => {
-            out.extend_from_slice(&(bytes.len() as i64).to_le_bytes());
-            out.extend_from_slice(&bytes);
-        }
-        _ => {
-            out.extend_from_slice(&(-(data.len() as i64)).to_le_bytes());
-            out.extend_from_slice(data);
-        }
     }
+    let at = out.len();
+    if !data.is_empty() {
+        out.resize(at + 8 + data.len() + BLOSC_OVERHEAD, 0);
+        let room = &mut out[at + 8..];
+        let written = if compression & COMPRESS_BLOSC != 0 {
+            blosc(data, value_size, room)
+        } else {
+            zip(data, room)
+        };
+        if let Some(n) = written.filter(|&n| n < data.len()) {
+            out.truncate(at + 8 + n);
+            out[at..at + 8].copy_from_slice(&(n as i64).to_le_bytes());
+            return;
+        }
+        out.truncate(at);
+    }
+    out.extend_from_slice(&(-(data.len() as i64)).to_le_bytes());
+    out.extend_from_slice(data);
 }
 
-/// A blosc chunk of `data` (LZ4 with byte shuffling by value, OpenVDB's settings), or `None`
-/// when blosc cannot compress it.
-fn blosc(data: &[u8], value_size: usize) -> Option<Vec<u8>> {
-    if data.is_empty() {
-        return None;
-    }
-    let mut out = vec![0u8; data.len() + BLOSC_OVERHEAD];
+/// Compresses `data` into `out` as a blosc chunk (LZ4 with byte shuffling by value,
+/// OpenVDB's settings); its length, or `None` when blosc cannot compress it into `out`.
+fn blosc(data: &[u8], value_size: usize, out: &mut [u8]) -> Option<usize> {
     // SAFETY: both buffers are valid for the lengths given; blosc writes at most `destsize`.
     let written = unsafe {
         blosc_compress_ctx(
@@ -86,31 +85,24 @@ fn blosc(data: &[u8], value_size: usize) -> Option<Vec<u8>> {
             1,
         )
     };
-    (written > 0).then(|| {
-        out.truncate(written as usize);
-        out
-    })
+    (written > 0).then_some(written as usize)
 }
 
-/// A zlib stream of `data` at zlib's default level, or `None` when zlib fails.
-fn zip(data: &[u8]) -> Option<Vec<u8>> {
-    // SAFETY: compressBound is a pure function; compress2 writes at most `len` bytes to `out`
-    // and reads `data.len()` bytes from `data`.
-    unsafe {
-        let mut len = compressBound(data.len() as c_ulong);
-        let mut out = vec![0u8; len as usize];
-        let status = compress2(
+/// Compresses `data` into `out` as a zlib stream at zlib's default level; its length, or
+/// `None` when it does not fit `out`.
+fn zip(data: &[u8], out: &mut [u8]) -> Option<usize> {
+    let mut len = out.len() as c_ulong;
+    // SAFETY: compress2 writes at most `len` bytes to `out` and reads `data.len()` from `data`.
+    let status = unsafe {
+        compress2(
             out.as_mut_ptr(),
             &mut len,
             data.as_ptr(),
             data.len() as c_ulong,
             -1,
-        );
-        (status == 0).then(|| {
-            out.truncate(len as usize);
-            out
-        })
-    }
+        )
+    };
+    (status == 0).then_some(len as usize)
 }
 
 /// OpenVDB's name of a compression setting (the `file_compression` metadata).

@@ -12,7 +12,7 @@ use super::vdb_chunks::{
 };
 use super::vdb_tree_structure::{TreeFormat, tree_memory};
 use crate::error::{Error, Result};
-use crate::grid::{Leaf, SparseGrid, Transform};
+use crate::grid::{LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -61,15 +61,6 @@ impl GridValues<'_> {
         }
     }
 
-    /// Bytes of one value at full precision.
-    fn value_bytes(self) -> usize {
-        match self {
-            GridValues::Bool => 1,
-            GridValues::Normals | GridValues::Colors => 12,
-            _ => 4,
-        }
-    }
-
     fn is_real(self) -> bool {
         !matches!(self, GridValues::Bool)
     }
@@ -101,45 +92,74 @@ impl GridValues<'_> {
 
     /// The active values of `leaf`, in offset order, as stored.
     fn push_leaf_values(self, out: &mut Vec<u8>, leaf: &Leaf, half: bool) {
-        let vectors = match self {
+        let mut values = [0f32; 3 * LEAF_VOXELS];
+        let mut count = 0;
+        let mut put = |v: f32| {
+            values[count] = v;
+            count += 1;
+        };
+        match self {
             GridValues::Bool => unreachable!("bool leaves store a mask"),
-            GridValues::Constant(v) => {
-                leaf.offsets().for_each(|_| push_real(out, v, half));
-                return;
-            }
+            GridValues::Constant(v) => for_each_on(&leaf.mask, |_| put(v)),
             GridValues::Distances { .. } | GridValues::LevelSet { .. } => {
-                let values = leaf.value.as_deref().expect("a distance grid's leaves carry values");
-                leaf.offsets().for_each(|n| push_real(out, values[n], half));
-                return;
+                let d = leaf
+                    .value
+                    .as_deref()
+                    .expect("a distance grid's leaves carry values");
+                for_each_on(&leaf.mask, |n| put(d[n]));
             }
             GridValues::Fog { band, background } => {
                 let on_band = band.leaf(leaf.origin);
-                for n in leaf.offsets() {
-                    let v = match on_band {
+                for_each_on(&leaf.mask, |n| {
+                    put(match on_band {
                         Some(b) if b.is_on(n) => {
                             let d = b.value.as_deref().expect("distances")[n];
                             (-d / background).clamp(0.0, 1.0)
                         }
                         _ => 1.0,
-                    };
-                    push_real(out, v, half);
-                }
-                return;
+                    })
+                });
             }
-            GridValues::Normals => leaf.normal.as_deref(),
-            GridValues::Colors => leaf.color.as_deref(),
-        };
-        let vectors = vectors.expect("a vector grid's leaves carry its channel");
-        for n in leaf.offsets() {
-            vectors[n].iter().for_each(|&c| push_real(out, c, half));
+            GridValues::Normals | GridValues::Colors => {
+                let vectors = match self {
+                    GridValues::Normals => leaf.normal.as_deref(),
+                    _ => leaf.color.as_deref(),
+                };
+                let vectors = vectors.expect("a vector grid's leaves carry its channel");
+                for_each_on(&leaf.mask, |n| vectors[n].iter().for_each(|&c| put(c)));
+            }
+        }
+        let values = &values[..count];
+        if half {
+            out.extend(
+                values
+                    .iter()
+                    .flat_map(|&v| half::f16::from_f32(v).to_le_bytes()),
+            );
+        } else {
+            out.extend(values.iter().flat_map(|&v| v.to_le_bytes()));
         }
     }
 
     /// The inside voxels of a level set's leaf at `origin` (the others are outside).
     fn inside(self, origin: [i64; 3]) -> [u64; 8] {
         match self {
-            GridValues::LevelSet { interior, .. } => interior.leaf(origin).map_or([0; 8], |l| l.mask),
+            GridValues::LevelSet { interior, .. } => {
+                interior.leaf(origin).map_or([0; 8], |l| l.mask)
+            }
             _ => [0; 8],
+        }
+    }
+}
+
+/// Calls `f` with every set bit of `mask`, ascending.
+#[inline]
+fn for_each_on(mask: &[u64; 8], mut f: impl FnMut(usize)) {
+    for (w, &word) in mask.iter().enumerate() {
+        let mut bits = word;
+        while bits != 0 {
+            f(w * 64 + bits.trailing_zeros() as usize);
+            bits &= bits - 1;
         }
     }
 }
@@ -329,6 +349,20 @@ fn encode_grid(path: &Path, g: &GridOut, encoding: Encoding) -> Result<EncodedGr
         });
     }
     entries.par_sort_unstable_by_key(|e| e.0);
+    // A block is a leaf or a tile, and a 128^3 tile holds nothing else.
+    let clash = entries.windows(2).find(|w| {
+        w[0].0 == w[1].0
+            || (w[0].0.0 == w[1].0.0 && w[0].0.1 == w[1].0.1 && matches!(w[0].1, Entry::NodeTile))
+    });
+    if let Some(w) = clash {
+        return Err(Error::Vdb {
+            path: path.to_path_buf(),
+            message: format!(
+                "grid {}: a tile and another node in one place (root child {:?}, slot {})",
+                g.name, w[0].0.0, w[0].0.1
+            ),
+        });
+    }
 
     let half = encoding.half && g.values.is_real();
     let compression = encoding.compression | COMPRESS_ACTIVE_MASK;
@@ -343,8 +377,9 @@ fn encode_grid(path: &Path, g: &GridOut, encoding: Encoding) -> Result<EncodedGr
         .par_chunks(BATCH)
         .map(|batch| {
             let mut out = Vec::with_capacity(batch.len() * 200);
+            let mut scratch = Vec::new();
             for leaf in batch {
-                leaf_buffer(&mut out, leaf, g.values, compression, half);
+                leaf_buffer(&mut out, &mut scratch, leaf, g.values, compression, half);
             }
             out
         })
@@ -466,7 +501,7 @@ fn push_mask(out: &mut Vec<u8>, mask: &[u64]) {
 fn push_inactive(out: &mut Vec<u8>, inside: &[u64], outside: &[u64]) {
     let any = |m: &[u64]| m.iter().any(|&w| w != 0);
     match (any(inside), any(outside)) {
-        (false, _) => out.push(0), // all the background
+        (false, _) => out.push(0),    // all the background
         (true, false) => out.push(1), // all minus the background
         (true, true) => {
             out.push(3); // selected: the background; the others minus it
@@ -477,7 +512,14 @@ fn push_inactive(out: &mut Vec<u8>, inside: &[u64], outside: &[u64]) {
 
 /// A leaf's buffer: its mask, then a bool leaf's origin and value bits, or another leaf's
 /// active values.
-fn leaf_buffer(out: &mut Vec<u8>, leaf: &Leaf, values: GridValues, compression: u32, half: bool) {
+fn leaf_buffer(
+    out: &mut Vec<u8>,
+    scratch: &mut Vec<u8>,
+    leaf: &Leaf,
+    values: GridValues,
+    compression: u32,
+    half: bool,
+) {
     push_mask(out, &leaf.mask);
     if let GridValues::Bool = values {
         leaf.origin
@@ -490,9 +532,9 @@ fn leaf_buffer(out: &mut Vec<u8>, leaf: &Leaf, values: GridValues, compression: 
     let inactive_inside: [u64; 8] = std::array::from_fn(|w| inside[w] & !leaf.mask[w]);
     let inactive_outside: [u64; 8] = std::array::from_fn(|w| !(inside[w] | leaf.mask[w]));
     push_inactive(out, &inactive_inside, &inactive_outside);
-    let mut data = Vec::with_capacity(leaf.count() as usize * values.value_bytes());
-    values.push_leaf_values(&mut data, leaf, half);
-    push_values(out, &data, values, compression, half);
+    scratch.clear();
+    values.push_leaf_values(scratch, leaf, half);
+    push_values(out, scratch, values, compression, half);
 }
 
 /// Stored values as a chunk; at half precision no values are no bytes at all.

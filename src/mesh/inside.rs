@@ -14,6 +14,8 @@ pub struct ColumnCrossings {
     window: RayWindow,
     /// (ray, z) of every crossing.
     crossings: Vec<(usize, f64)>,
+    /// Where each x row of columns starts in `crossings` (and where the last ends).
+    row_starts: Vec<usize>,
 }
 
 /// Triangles per parallel batch of crossings.
@@ -46,18 +48,58 @@ impl ColumnCrossings {
             })
             .collect();
         crossings.par_sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-        ColumnCrossings { window, crossings }
+        let mut row_starts = vec![0usize; nx + 1];
+        for c in &crossings {
+            row_starts[c.0 / ny + 1] += 1;
+        }
+        for x in 0..nx {
+            row_starts[x + 1] += row_starts[x];
+        }
+        ColumnCrossings {
+            window,
+            crossings,
+            row_starts,
+        }
+    }
+
+    /// The crossings of columns `(x, y)` for `y` in `ys`, which must lie in the window.
+    fn columns_of(&self, x: i64, ys: std::ops::RangeInclusive<i64>) -> &[(usize, f64)] {
+        let row = (x - self.window.a0) as usize;
+        let in_row = &self.crossings[self.row_starts[row]..self.row_starts[row + 1]];
+        let (first, last) = (
+            self.window.ray(x, *ys.start()),
+            self.window.ray(x, *ys.end()),
+        );
+        let start = in_row.partition_point(|c| c.0 < first);
+        let end = start + in_row[start..].partition_point(|c| c.0 <= last);
+        &in_row[start..end]
     }
 
     /// The inside centres of column `(x, y)` (inside the box's columns) as inclusive z spans,
     /// ascending; some may be empty (`first > last`).
     pub fn spans(&self, x: i64, y: i64) -> impl Iterator<Item = (i64, i64)> + '_ {
-        let ray = self.window.ray(x, y);
-        let start = self.crossings.partition_point(|c| c.0 < ray);
-        let end = start + self.crossings[start..].partition_point(|c| c.0 == ray);
-        self.crossings[start..end]
+        self.columns_of(x, y..=y)
             .chunks_exact(2)
             .map(|pair| (pair[0].1.ceil() as i64, pair[1].1.floor() as i64))
+    }
+
+    /// The spans of inside centres of the `count` columns `(x, y0 + i)`, as `span(i, first z,
+    /// last z)`: one search for the row.
+    pub fn row_spans(&self, x: i64, y0: i64, count: usize, mut span: impl FnMut(usize, i64, i64)) {
+        let (ys, ye) = (
+            y0.max(self.window.b0),
+            (y0 + count as i64 - 1).min(self.window.b0 + self.window.height as i64 - 1),
+        );
+        if x < self.window.a0 || x >= self.window.a0 + self.window.width as i64 || ys > ye {
+            return;
+        }
+        let first = self.window.ray(x, ys);
+        for column in self.columns_of(x, ys..=ye).chunk_by(|a, b| a.0 == b.0) {
+            let i = (column[0].0 - first) + (ys - y0) as usize;
+            for pair in column.chunks_exact(2) {
+                span(i, pair[0].1.ceil() as i64, pair[1].1.floor() as i64);
+            }
+        }
     }
 
     /// Every column's spans of inside centres, as `(x, y, first z, last z)`.

@@ -2,8 +2,8 @@
 //! distance band, measure a mesh or a `.vdb` surface, evaluate a CSG tree; with volumes,
 //! mass, components and genus.
 
-use super::outcome::{Distances, Outcome};
 use super::outcome::provenance;
+use super::outcome::{Distances, Outcome};
 use super::report::{
     CsgDetails, CsgLeafCount, DepthLayerDetails, Details, DirectionCounts, DistanceBandDetails,
     FloodingXyzDetails, SolidDetails,

@@ -55,7 +55,11 @@ pub fn level_set(
             let mask = inside_mask(&columns, leaf.origin);
             let values = leaf.value.as_mut().expect("distances");
             for n in crate::grid::bits::ones(&leaf.mask) {
-                let sign = if mask[n / 64] >> (n % 64) & 1 == 1 { -h } else { h };
+                let sign = if mask[n / 64] >> (n % 64) & 1 == 1 {
+                    -h
+                } else {
+                    h
+                };
                 values[n] *= sign;
             }
             let mut inside = Leaf::new(leaf.origin, Channels::NONE);
@@ -67,7 +71,8 @@ pub fn level_set(
     for origin in inside_blocks(&columns, &grid) {
         interior.fill_leaf_block(origin);
     }
-    interior.compact();
+    // Band leaves stay leaves, even wholly inside: the level set writes its tiles.
+    interior.promote_tiles();
     Ok(LevelSet {
         band: grid,
         interior,
@@ -78,15 +83,13 @@ pub fn level_set(
 fn inside_mask(columns: &ColumnCrossings, origin: Coord) -> [u64; 8] {
     let mut mask = [0u64; 8];
     for (x, word) in mask.iter_mut().enumerate() {
-        for y in 0..8 {
-            for (z0, z1) in columns.spans(origin[0] + x as i64, origin[1] + y as i64) {
-                let (z0, z1) = ((z0 - origin[2]).max(0), (z1 - origin[2]).min(7));
-                if z0 <= z1 {
-                    let run = (1u64 << (z1 - z0 + 1)) - 1;
-                    *word |= run << (y * 8 + z0 as usize);
-                }
+        columns.row_spans(origin[0] + x as i64, origin[1], 8, |y, z0, z1| {
+            let (z0, z1) = ((z0 - origin[2]).max(0), (z1 - origin[2]).min(7));
+            if z0 <= z1 {
+                let run = (1u64 << (z1 - z0 + 1)) - 1;
+                *word |= run << (y * 8 + z0 as usize);
             }
-        }
+        });
     }
     mask
 }

@@ -1,12 +1,12 @@
 //! Surface voxelization in 64^3 bricks. Primitives are binned by the bricks their candidate
 //! boxes overlap; each brick is then voxelized on its own thread, clipped to the brick, into
-//! dense bit sets (one per class of primitive) from which its leaves are cut. Bricks never
+//! dense bit sets (one per class of primitive) and, with channels, dense nearest distances and
+//! normals, from which its leaves are cut. Bricks never
 //! share a leaf, so there are no thread-local grids to merge and no hashing per voxel: the
 //! grid-per-thread fold it replaces spent most of its time looking up and merging leaves.
 
-use super::sink::Sink;
 use crate::error::{Error, Result};
-use crate::grid::{Channels, Coord, CoordBox, Leaf, SparseGrid, Transform};
+use crate::grid::{Channels, Coord, CoordBox, LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use crate::progress::Progress;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -22,18 +22,28 @@ const BRICK_LEAVES: usize = EDGE_LEAVES * EDGE_LEAVES * EDGE_LEAVES;
 const CLASS_SHIFT: u32 = 30;
 
 /// One brick's voxels as dense bit sets, one per class, in leaf order: leaf `l` holds words
-/// `8l..8l+8`, laid out as a leaf's mask.
+/// `8l..8l+8`, laid out as a leaf's mask. With channels, the nearest primitive's distance
+/// (and normal) per voxel, voxel `n` of leaf `l` at `512 l + n`.
 pub(crate) struct BrickBits<const CLASSES: usize> {
     classes: [Box<[u64]>; CLASSES],
     /// The leaves any class touched.
     touched: [u64; BRICK_LEAVES / 64],
+    distance: Option<Box<[f32]>>,
+    normal: Option<Box<[[f32; 3]]>>,
 }
 
 impl<const CLASSES: usize> BrickBits<CLASSES> {
-    fn new() -> Self {
+    fn new(channels: Channels) -> Self {
+        let voxels = BRICK_LEAVES * LEAF_VOXELS;
         BrickBits {
             classes: std::array::from_fn(|_| vec![0u64; BRICK_LEAVES * 8].into_boxed_slice()),
             touched: [0; BRICK_LEAVES / 64],
+            distance: channels
+                .value
+                .then(|| vec![f32::INFINITY; voxels].into_boxed_slice()),
+            normal: channels
+                .normal
+                .then(|| vec![[0.0; 3]; voxels].into_boxed_slice()),
         }
     }
 
@@ -44,27 +54,49 @@ impl<const CLASSES: usize> BrickBits<CLASSES> {
 }
 
 /// Where a primitive's voxels go: its class's bits in a brick, and with channels the nearest
-/// primitive's distance and normal per voxel, in a grid of the brick's own.
-pub(crate) struct BrickSink<'b, 'g, const CLASSES: usize> {
+/// primitive's distance and normal per voxel.
+pub(crate) struct BrickSink<'b, const CLASSES: usize> {
     bits: &'b mut BrickBits<CLASSES>,
     class: usize,
     origin: Coord,
-    nearest: Option<&'b mut Sink<'g>>,
 }
 
-impl<const CLASSES: usize> BrickSink<'_, '_, CLASSES> {
+impl<const CLASSES: usize> BrickSink<'_, CLASSES> {
     /// Marks voxel `c` (inside the brick), `distance` voxels from the primitive whose normal
     /// is `normal`.
     #[inline]
     pub fn add(&mut self, c: Coord, distance: f64, normal: DVec3) {
-        self.mark(c);
-        if let Some(sink) = self.nearest.as_deref_mut() {
-            sink.add(c, distance, normal);
+        let i = self.mark(c);
+        if self.nearer(i, distance)
+            && let Some(normals) = self.bits.normal.as_deref_mut()
+        {
+            normals[i] = normal.as_vec3().into();
         }
     }
 
+    /// Marks voxel `c` (inside the brick), keeping the smallest distance given for it.
     #[inline]
-    fn mark(&mut self, c: Coord) {
+    pub fn add_distance(&mut self, c: Coord, distance: f64) {
+        let i = self.mark(c);
+        self.nearer(i, distance);
+    }
+
+    /// Keeps `distance` for voxel `i` when the brick keeps distances and it is the nearest
+    /// yet; whether it was.
+    #[inline]
+    fn nearer(&mut self, i: usize, distance: f64) -> bool {
+        match self.bits.distance.as_deref_mut() {
+            Some(d) if (distance as f32) < d[i] => {
+                d[i] = distance as f32;
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// Sets voxel `c`'s bit in its class; returns its index in the brick's channels.
+    #[inline]
+    fn mark(&mut self, c: Coord) -> usize {
         let l = [
             c[0] - self.origin[0],
             c[1] - self.origin[1],
@@ -77,17 +109,10 @@ impl<const CLASSES: usize> BrickSink<'_, '_, CLASSES> {
         let leaf = (((l[0] >> 3) as usize * EDGE_LEAVES) + (l[1] >> 3) as usize) * EDGE_LEAVES
             + (l[2] >> 3) as usize;
         let word = leaf * 8 + (l[0] & 7) as usize;
-        self.bits.classes[self.class][word] |= 1 << (((l[1] & 7) << 3) | (l[2] & 7));
+        let bit = ((l[1] & 7) << 3) | (l[2] & 7);
+        self.bits.classes[self.class][word] |= 1 << bit;
         self.bits.touched[leaf / 64] |= 1 << (leaf % 64);
-    }
-
-    /// Marks voxel `c` (inside the brick), keeping the smallest distance given for it.
-    #[inline]
-    pub fn add_distance(&mut self, c: Coord, distance: f64) {
-        self.mark(c);
-        if let Some(sink) = self.nearest.as_deref_mut() {
-            sink.add_distance(c, distance);
-        }
+        leaf * LEAF_VOXELS + (l[0] & 7) as usize * 64 + bit as usize
     }
 }
 
@@ -114,10 +139,19 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
         )));
     }
     let (bricks, bins) = bin_primitives(counts, &candidates);
+    let scratch: Vec<std::sync::Mutex<BrickBits<CLASSES>>> = (0..rayon::current_num_threads())
+        .map(|_| std::sync::Mutex::new(BrickBits::new(channels)))
+        .collect();
     let work: Vec<(Vec<Leaf>, [u64; CLASSES])> = bins
         .par_iter()
         .zip(&bricks)
-        .map_init(BrickBits::<CLASSES>::new, |bits, (entries, &brick)| {
+        .map(|(entries, &brick)| {
+            // Each worker keeps its own scratch (rayon may split the work into many more
+            // tasks than workers, and a brick's scratch is a megabyte with distances).
+            let mut scratch = scratch[rayon::current_thread_index().unwrap_or(0)]
+                .lock()
+                .unwrap_or_else(|poisoned| poisoned.into_inner());
+            let bits = &mut *scratch;
             if progress.stopped() {
                 return (Vec::new(), [0; CLASSES]);
             }
@@ -126,8 +160,6 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
                 min: origin,
                 max: origin.map(|v| v + BRICK - 1),
             };
-            let mut local = channels.value.then(|| SparseGrid::new(transform, channels));
-            let mut nearest = local.as_mut().map(Sink::new);
             let mut firsts = 0;
             for &entry in entries {
                 let (class, i) = (
@@ -138,7 +170,6 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
                     bits,
                     class,
                     origin,
-                    nearest: nearest.as_mut(),
                 };
                 emit(class, i, &clip, &mut sink);
                 // Each primitive counts once, in the first brick it overlaps.
@@ -146,8 +177,7 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
                 firsts += u64::from(first == brick);
             }
             progress.advance(firsts);
-            drop(nearest);
-            let leaves = cut_leaves(bits, origin, local);
+            let leaves = cut_leaves(bits, origin, channels);
             let counts = class_counts(bits);
             clear(bits);
             (leaves, counts)
@@ -201,20 +231,20 @@ fn bin_primitives<const CLASSES: usize>(
     (bricks, bins)
 }
 
-/// The brick's leaves: from its grid when it keeps channels, else from the union of its bits.
+/// The brick's leaves: the union of its classes' bits, with the channels kept.
 fn cut_leaves<const CLASSES: usize>(
     bits: &BrickBits<CLASSES>,
     origin: Coord,
-    local: Option<SparseGrid>,
+    channels: Channels,
 ) -> Vec<Leaf> {
-    if let Some(grid) = local {
-        return grid.into_leaves();
-    }
     bits.touched_leaves()
         .filter_map(|l| {
             let mut mask = [0u64; 8];
             for class in &bits.classes {
                 (0..8).for_each(|w| mask[w] |= class[8 * l + w]);
+            }
+            if mask == [0; 8] {
+                return None;
             }
             let at = [
                 l / (EDGE_LEAVES * EDGE_LEAVES),
@@ -223,10 +253,17 @@ fn cut_leaves<const CLASSES: usize>(
             ];
             let mut leaf = Leaf::new(
                 std::array::from_fn(|a| origin[a] + 8 * at[a] as i64),
-                Channels::NONE,
+                channels,
             );
             leaf.mask = mask;
-            (!leaf.is_empty()).then_some(leaf)
+            let first = l * LEAF_VOXELS;
+            if let (Some(d), Some(v)) = (bits.distance.as_deref(), leaf.value.as_deref_mut()) {
+                crate::grid::bits::ones(&mask).for_each(|n| v[n] = d[first + n]);
+            }
+            if let (Some(d), Some(v)) = (bits.normal.as_deref(), leaf.normal.as_deref_mut()) {
+                crate::grid::bits::ones(&mask).for_each(|n| v[n] = d[first + n]);
+            }
+            Some(leaf)
         })
         .collect()
 }
@@ -252,6 +289,11 @@ fn clear<const CLASSES: usize>(bits: &mut BrickBits<CLASSES>) {
     for class in &mut bits.classes {
         for &l in &touched {
             class[8 * l..8 * l + 8].fill(0);
+        }
+    }
+    if let Some(d) = bits.distance.as_deref_mut() {
+        for &l in &touched {
+            d[l * LEAF_VOXELS..(l + 1) * LEAF_VOXELS].fill(f32::INFINITY);
         }
     }
     bits.touched = [0; BRICK_LEAVES / 64];

@@ -90,38 +90,79 @@ pub fn distance_band(
 
 /// The voxels in `clip` within `band` of triangle `abc` (index space), with their distances.
 /// Columns run along the normal's largest axis, each limited to the slab within `band` of
-/// the triangle's plane.
-fn triangle_band(
-    [a, b, c]: [DVec3; 3],
-    band: f64,
-    clip: &CoordBox,
-    sink: &mut BrickSink<1>,
-) {
+/// the triangle's plane and to the prism within `band` of its edges. Along a column the
+/// plane distance and the edge functions are linear: where all edge functions are
+/// non-negative the nearest point is the centre's projection and the distance the plane
+/// distance; elsewhere the closest point is computed.
+fn triangle_band([a, b, c]: [DVec3; 3], band: f64, clip: &CoordBox, sink: &mut BrickSink<1>) {
     let lo = (a.min(b).min(c) - band).ceil().as_i64vec3().to_array();
     let hi = (a.max(b).max(c) + band).floor().as_i64vec3().to_array();
     let range = |axis: usize| lo[axis].max(clip.min[axis])..=hi[axis].min(clip.max[axis]);
-    let normal = (b - a).cross(c - a).try_normalize();
-    // Degenerate triangles have no plane: their columns are not limited.
-    let w = normal.map_or(2, |n| n.abs().max_position());
-    let (u, v) = ((w + 1) % 3, (w + 2) % 3);
     let band2 = band * band;
+    let Some(n) = (b - a).cross(c - a).try_normalize() else {
+        // No plane: every centre of the box is tried.
+        for x in range(0) {
+            for y in range(1) {
+                for z in range(2) {
+                    let p = DVec3::new(x as f64, y as f64, z as f64);
+                    let d2 = p.distance_squared(closest_point_on_triangle(p, a, b, c));
+                    if d2 <= band2 {
+                        sink.add_distance([x, y, z], d2.sqrt());
+                    }
+                }
+            }
+        }
+        return;
+    };
+    let w = n.abs().max_position();
+    let (u, v) = ((w + 1) % 3, (w + 2) % 3);
+    // Linear functions f(p) = g·p + h: the plane distance, and the edge functions (in-plane
+    // inward normals of length |edge|, positive inside).
+    let plane = (n, -n.dot(a));
+    let edges = [(a, b), (b, c), (c, a)].map(|(p, q)| {
+        let m = n.cross(q - p);
+        (m, -m.dot(p), m.length())
+    });
     for iu in range(u) {
         for iv in range(v) {
-            let mut column = range(w);
-            if let Some(n) = normal {
-                // |n·(p - a)| <= band, solved for p_w, widened so rounding drops no voxel.
-                let rest = n[u] * (iu as f64 - a[u]) + n[v] * (iv as f64 - a[v]) - n[w] * a[w];
-                let (k0, k1) = ((-band - rest) / n[w], (band - rest) / n[w]);
-                let slack = 1e-9 * (1.0 + k0.abs().max(k1.abs()));
-                let (k0, k1) = (k0.min(k1) - slack, k0.max(k1) + slack);
-                column = (*column.start()).max(k0.ceil() as i64)..=(*column.end()).min(k1.floor() as i64);
+            // Each function along the column: f(k) = f0 + k g_w.
+            let at = |(g, h): (DVec3, f64)| g[u] * iu as f64 + g[v] * iv as f64 + h;
+            let s0 = at(plane);
+            // The slab |s| <= band and the prism e_i >= -band |m_i|, widened so rounding
+            // drops no voxel (the exact test below decides).
+            let (mut k0, mut k1) = {
+                let (x0, x1) = ((-band - s0) / n[w], (band - s0) / n[w]);
+                (x0.min(x1), x0.max(x1))
+            };
+            let mut empty = false;
+            for &(m, h, len) in &edges {
+                let e0 = at((m, h)) + band * len;
+                if m[w] > 0.0 {
+                    k0 = k0.max(-e0 / m[w]);
+                } else if m[w] < 0.0 {
+                    k1 = k1.min(-e0 / m[w]);
+                } else if e0 < 0.0 {
+                    empty = true;
+                }
             }
-            for k in column {
+            if empty || k0 > k1 {
+                continue;
+            }
+            let slack = 1e-9 * (1.0 + k0.abs().max(k1.abs()));
+            let first = (k0 - slack).ceil().max(*range(w).start() as f64) as i64;
+            let last = (k1 + slack).floor().min(*range(w).end() as f64) as i64;
+            for k in first..=last {
                 let mut p = DVec3::ZERO;
                 p[u] = iu as f64;
                 p[v] = iv as f64;
                 p[w] = k as f64;
-                let d2 = p.distance_squared(closest_point_on_triangle(p, a, b, c));
+                let projected_inside = edges.iter().all(|&(m, h, _)| m.dot(p) + h >= 0.0);
+                let d2 = if projected_inside {
+                    let s = n.dot(p) + plane.1;
+                    s * s
+                } else {
+                    p.distance_squared(closest_point_on_triangle(p, a, b, c))
+                };
                 if d2 <= band2 {
                     let mut coord = [0i64; 3];
                     coord[u] = iu;

@@ -57,12 +57,6 @@ impl<'g> Sink<'g> {
         }
     }
 
-    /// Marks voxel `c`, keeping the smallest distance given for it.
-    #[inline]
-    pub fn add_distance(&mut self, c: Coord, distance: f64) {
-        self.claim(c, distance);
-    }
-
     /// Marks voxel `c`; with channels, keeps the nearest primitive's distance and colour.
     #[inline]
     pub fn add_color(&mut self, c: Coord, distance: f64, color: Vec3) {
