@@ -249,6 +249,13 @@ fn subdivision_solid_bytes(control: &ControlMesh, t: &Transform) -> f64 {
         + control.irregular_corner_count() as f64 * IRREGULAR_CORNER_BYTES
 }
 
+/// A distance band's leaf with its values and encoded buffers: 2.2 KB; a level set's also
+/// holds its interior's leaf and the fog volume's buffers, 3 KB. Each triangle 150 bytes
+/// (its corners, the bins). Fitted on bunny-closed (`--sdf`) and igea (`--udf`) at 1024.
+const UNSIGNED_BAND_LEAF_BYTES: f64 = 2200.0;
+const SIGNED_BAND_LEAF_BYTES: f64 = 3000.0;
+const BAND_TRIANGLE_BYTES: f64 = 150.0;
+
 /// `check`: the surface and its word-wise span floods, about 2.2 dense volumes over the box
 /// at the peak, 900 bytes per surface leaf (normals at the surface's cost). Estimate/peak
 /// 0.92-1.17 (bunny-closed, igea, armadillo, horse at 512-2048; it was up to 2.3).
@@ -415,13 +422,17 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             let p = plan_of(t, &mesh.bbox(), bytes, items);
             (Loaded::Mesh(mesh), p)
         }
-        Task::DistanceBand { mesh, band, .. } => {
+        Task::DistanceBand { mesh, band, signed } => {
             let mesh = mesh.load(false, up)?;
-            let (t, b) = mesh_plan(&mesh, fit)?;
-            // A band 2w+1 voxels thick crosses about that many eighths of each leaf it meets;
-            // each leaf is held with its values, then twice more by OpenVDB (level set, fog).
+            let (t, _) = mesh_plan(&mesh, fit)?;
+            // A band 2w+1 voxels thick crosses about that many eighths of each leaf it meets.
             let leaves = surface_leaves(area_in_voxels(&mesh, &t)) * (2.0 * band + 1.0) / 4.0;
-            let bytes = leaf_bytes(leaves, 0) * 2.0 + cells(&padded(b, band.ceil() as i64)) / 8.0;
+            let per_leaf = if *signed {
+                SIGNED_BAND_LEAF_BYTES
+            } else {
+                UNSIGNED_BAND_LEAF_BYTES
+            };
+            let bytes = leaves * per_leaf + mesh.triangle_count() as f64 * BAND_TRIANGLE_BYTES;
             let p = plan_of(t, &mesh.bbox(), bytes, mesh.face_count() as u64);
             (Loaded::Mesh(mesh), p)
         }
