@@ -62,12 +62,13 @@ pub(crate) struct BrickSink<'b, const CLASSES: usize> {
 }
 
 impl<const CLASSES: usize> BrickSink<'_, CLASSES> {
-    /// Marks voxel `c` (inside the brick), `distance` voxels from the primitive whose normal
-    /// is `normal`.
+    /// Marks voxel `c` (inside the brick), `distance()` voxels from the primitive whose
+    /// normal is `normal` (computed only when the brick keeps distances).
     #[inline]
-    pub fn add(&mut self, c: Coord, distance: f64, normal: DVec3) {
+    pub fn add(&mut self, c: Coord, distance: impl FnOnce() -> f64, normal: DVec3) {
         let i = self.mark(c);
-        if self.nearer(i, distance)
+        if self.bits.distance.is_some()
+            && self.nearer(i, distance())
             && let Some(normals) = self.bits.normal.as_deref_mut()
         {
             normals[i] = normal.as_vec3().into();

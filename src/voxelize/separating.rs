@@ -488,15 +488,17 @@ fn half_open_range(lo: f64, hi: f64) -> std::ops::RangeInclusive<i64> {
     ceil_int(lo)..=ceil_int(hi) - 1
 }
 
-/// Values of `v` with `a v^2 + 2 b v + c <= 0` (`a > 0`), widened by `MARGIN`; empty when none.
+/// Values of `v` with `a v^2 + 2 b v + c <= 0` (`a > 0`, `inv_a = 1 / a`), widened by
+/// `MARGIN`; empty when none. A candidate range: the caller tests each value exactly, and
+/// the reciprocal's rounding is far below the margin.
 #[inline]
-fn quadratic_range(a: f64, b: f64, c: f64) -> std::ops::RangeInclusive<i64> {
+fn quadratic_range(a: f64, inv_a: f64, b: f64, c: f64) -> std::ops::RangeInclusive<i64> {
     let disc = b * b - a * c;
     if disc < 0.0 {
         return int_range(0.0, -1.0);
     }
     let root = disc.sqrt();
-    int_range((-b - root) / a - MARGIN, (-b + root) / a + MARGIN)
+    int_range((-b - root) * inv_a - MARGIN, (-b + root) * inv_a + MARGIN)
 }
 
 /// `range` clipped to `clip`'s extent along `axis`.
@@ -524,14 +526,14 @@ fn vertex_sphere<const C: usize>(
             let (dx, dy) = (x as f64 - p.x, y as f64 - p.y);
             // (z - p.z)^2 <= r2 - dx^2 - dy^2
             for z in clipped(
-                quadratic_range(1.0, -p.z, p.z * p.z + dx * dx + dy * dy - r2),
+                quadratic_range(1.0, 1.0, -p.z, p.z * p.z + dx * dx + dy * dy - r2),
                 clip,
                 2,
             ) {
                 let c = DVec3::new(x as f64, y as f64, z as f64);
                 let d2 = (c - p).length_squared();
                 if d2 <= r2 && keep(v, c) {
-                    sink.add([x, y, z], d2.sqrt(), v.normal);
+                    sink.add([x, y, z], || d2.sqrt(), v.normal);
                 }
             }
         }
@@ -559,6 +561,10 @@ fn edge_cylinder<const C: usize>(
     let reach = r * len2.sqrt() / d[w].abs();
     let tau_margin = MARGIN / len2.sqrt();
     let dn = d / len2.sqrt();
+    // The quadratic's leading coefficient is the edge's: 1 - dn_v^2 >= 2/3, as v is not
+    // its longest axis.
+    let a = 1.0 - dn[v] * dn[v];
+    let inv_a = 1.0 / a;
     for k in clipped(
         int_range(p[w].min(e.b[w]) - r, p[w].max(e.b[w]) + r),
         clip,
@@ -571,10 +577,9 @@ fn edge_cylinder<const C: usize>(
             y0[w] += k as f64;
             y0[u] += iu as f64;
             let along = y0.dot(dn);
-            let a = 1.0 - dn[v] * dn[v];
             let b = y0[v] - along * dn[v];
             let cc = y0.length_squared() - along * along - r * r;
-            for iv in clipped(quadratic_range(a, b, cc), clip, v) {
+            for iv in clipped(quadratic_range(a, inv_a, b, cc), clip, v) {
                 let mut x = DVec3::ZERO;
                 x[w] = k as f64;
                 x[u] = iu as f64;
@@ -585,7 +590,7 @@ fn edge_cylinder<const C: usize>(
                 }
                 let d2 = (x - p - d * tau).length_squared();
                 if d2 <= r * r && keep(e, x) {
-                    sink.add(to_coord(x), d2.sqrt(), e.normal);
+                    sink.add(to_coord(x), || d2.sqrt(), e.normal);
                 }
             }
         }
@@ -648,7 +653,7 @@ fn face_body<const C: usize>(
                 x[u] = iu as f64;
                 x[v] = iv as f64;
                 if sides.iter().all(|(m, p)| m.dot(x - *p) >= -MARGIN) {
-                    sink.add(to_coord(x), n.dot(x - a).abs(), tri.normal);
+                    sink.add(to_coord(x), || n.dot(x - a).abs(), tri.normal);
                 }
             }
         }
