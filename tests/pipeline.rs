@@ -160,7 +160,7 @@ fn every_task_refuses_an_impossible_grid_at_planning() {
     let mut all = tasks(&torus, &cube);
     all.push(("csg tree", Task::CsgTree(CsgSource::File(tree))));
     for (name, task) in all {
-        for fit in [GridFit::Resolution(1 << 20), GridFit::VoxelSize(1e-30)] {
+        for fit in [GridFit::Resolution(1 << 22), GridFit::VoxelSize(1e-30)] {
             let start = Instant::now();
             let refused = Job::new(task.clone(), fit).plan();
             let elapsed = start.elapsed();

@@ -12,35 +12,75 @@ use glam::DVec3;
 
 /// The closest point of triangle `abc` to `p` (Ericson, Real-Time Collision Detection §5.1.5).
 pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
+    TriangleQuery::new(a, b, c).closest_point(p)
+}
+
+/// A triangle prepared for many distance queries: its corners, edges and their dot products.
+struct TriangleQuery {
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+    ab: DVec3,
+    ac: DVec3,
+    /// The edges' dot products: ab·ab, ab·ac, ac·ac.
+    ab_ab: f64,
+    ab_ac: f64,
+    ac_ac: f64,
+}
+
+impl TriangleQuery {
+    fn new(a: DVec3, b: DVec3, c: DVec3) -> Self {
+        let (ab, ac) = (b - a, c - a);
+        TriangleQuery {
+            a,
+            b,
+            c,
+            ab,
+            ac,
+            ab_ab: ab.dot(ab),
+            ab_ac: ab.dot(ac),
+            ac_ac: ac.dot(ac),
+        }
     }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
+
+    /// The closest point of the triangle to `p`, by its Voronoi regions (vertices, edges,
+    /// face), tested with the dot products of `p - a` with the two edges from `a`: those of
+    /// `p - b` and `p - c` differ from them by the edges' own dot products.
+    #[inline]
+    fn closest_point(&self, p: DVec3) -> DVec3 {
+        let ap = p - self.a;
+        let (d1, d2) = (self.ab.dot(ap), self.ac.dot(ap));
+        if d1 <= 0.0 && d2 <= 0.0 {
+            return self.a;
+        }
+        let (d3, d4) = (d1 - self.ab_ab, d2 - self.ab_ac);
+        if d3 >= 0.0 && d4 <= d3 {
+            return self.b;
+        }
+        let vc = d1 * d4 - d3 * d2;
+        if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+            return self.a + self.ab * (d1 / (d1 - d3));
+        }
+        let (d5, d6) = (d1 - self.ab_ac, d2 - self.ac_ac);
+        if d6 >= 0.0 && d5 <= d6 {
+            return self.c;
+        }
+        let vb = d5 * d2 - d1 * d6;
+        if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+            return self.a + self.ac * (d2 / (d2 - d6));
+        }
+        let va = d3 * d6 - d5 * d4;
+        if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+            return self.b + (self.c - self.b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+        }
+        let denom = 1.0 / (va + vb + vc);
+        self.a + self.ab * (vb * denom) + self.ac * (vc * denom)
     }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
+
+    #[inline]
+    fn distance_squared(&self, p: DVec3) -> f64 {
+        p.distance_squared(self.closest_point(p))
     }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    a + ab * (vb * denom) + ac * (vc * denom)
 }
 
 /// Unsigned distances in voxels (value channel) on every voxel within `band` voxels of a
@@ -99,13 +139,23 @@ fn triangle_band([a, b, c]: [DVec3; 3], band: f64, clip: &CoordBox, sink: &mut B
     let hi = (a.max(b).max(c) + band).floor().as_i64vec3().to_array();
     let range = |axis: usize| lo[axis].max(clip.min[axis])..=hi[axis].min(clip.max[axis]);
     let band2 = band * band;
+    let query = TriangleQuery::new(a, b, c);
+    // Every point of the triangle lies within `radius` of its centroid: a centre farther than
+    // band + radius from it is out of the band.
+    let centroid = (a + b + c) / 3.0;
+    let radius = centroid
+        .distance_squared(a)
+        .max(centroid.distance_squared(b))
+        .max(centroid.distance_squared(c))
+        .sqrt();
+    let reach2 = (band + radius) * (band + radius) * (1.0 + 1e-12);
     let Some(n) = (b - a).cross(c - a).try_normalize() else {
         // No plane: every centre of the box is tried.
         for x in range(0) {
             for y in range(1) {
                 for z in range(2) {
                     let p = DVec3::new(x as f64, y as f64, z as f64);
-                    let d2 = p.distance_squared(closest_point_on_triangle(p, a, b, c));
+                    let d2 = query.distance_squared(p);
                     if d2 <= band2 {
                         sink.add_distance([x, y, z], d2.sqrt());
                     }
@@ -160,8 +210,10 @@ fn triangle_band([a, b, c]: [DVec3; 3], band: f64, clip: &CoordBox, sink: &mut B
                 let d2 = if projected_inside {
                     let s = n.dot(p) + plane.1;
                     s * s
+                } else if p.distance_squared(centroid) > reach2 {
+                    continue;
                 } else {
-                    p.distance_squared(closest_point_on_triangle(p, a, b, c))
+                    query.distance_squared(p)
                 };
                 if d2 <= band2 {
                     let mut coord = [0i64; 3];
