@@ -1,4 +1,5 @@
-//! OpenVDB files through the bridge. A voxel set is written as `density` (a fog volume: 1 on
+//! OpenVDB files: written by voxelkit itself (`vdb_writer`), read through the bridge after
+//! their structure is checked (`vdb_structure`). A voxel set is written as `density` (a fog volume: 1 on
 //! every voxel of the set, what Blender's volume object reads), `normal` (Vec3s,
 //! covariant-normalize) when the grid carries normals, `Cd` (Vec3s, the Houdini name for
 //! colour) when it carries colours, and on request `voxels` (the same set as a BoolGrid);
@@ -109,6 +110,12 @@ pub fn write_vdb_as(
         check_voxel_size(path, mask.transform.voxel_size)?;
         candidates.push(grid_out(name, mask, GridValues::Bool, None, None));
     }
+    write_chosen(path, candidates, options)
+}
+
+/// Writes the grids of `candidates` that `options` asks for to `path`, atomically; a grid
+/// asked for that is not among them is an error naming those there are.
+fn write_chosen(path: &Path, mut candidates: Vec<GridOut>, options: &WriteOptions) -> Result<()> {
     if let Some(missing) = options
         .grids
         .iter()
@@ -185,22 +192,16 @@ fn meta_entries(metadata: &[(&str, String)]) -> Vec<(String, String)> {
     meta
 }
 
-/// How a distance band is written.
-pub enum DistanceGrid<'g> {
-    /// Signed distances: a LEVEL_SET FloatGrid `surface` (Houdini's name) whose inactive
-    /// voxels and tiles in `interior` are -background, after its fog volume `density`.
-    LevelSet { interior: &'g SparseGrid },
-    /// Unsigned distances: a FloatGrid `distance`.
-    Unsigned,
-}
-
 /// Writes the value channel of `grid` (distances in world units on its active voxels) as a
-/// narrow band with `background` outside it, atomically, with `metadata`.
+/// narrow band with `background` outside it, atomically, with `metadata`. With its
+/// `interior`, signed distances: a LEVEL_SET FloatGrid `surface` (Houdini's name) whose
+/// inactive voxels and tiles in the interior are -background, after its fog volume
+/// `density`; without, unsigned distances: a FloatGrid `distance`.
 pub fn write_distance_band(
     path: &Path,
     grid: &SparseGrid,
     background: f32,
-    kind: DistanceGrid,
+    interior: Option<&SparseGrid>,
     metadata: &[(&str, String)],
     options: &WriteOptions,
 ) -> Result<()> {
@@ -217,8 +218,8 @@ pub fn write_distance_band(
         vector_type: None,
         metadata: &meta,
     };
-    let mut grids = match kind {
-        DistanceGrid::LevelSet { interior } => vec![
+    let grids = match interior {
+        Some(interior) => vec![
             // Blender's volume object shows `density`: the fog volume of the same solid.
             grid_out(
                 DENSITY_GRID,
@@ -239,33 +240,14 @@ pub fn write_distance_band(
                 Some("level set"),
             ),
         ],
-        DistanceGrid::Unsigned => vec![grid_out(
+        None => vec![grid_out(
             "distance",
             grid,
             GridValues::Distances { background },
             None,
         )],
     };
-    if let Some(missing) = options
-        .grids
-        .iter()
-        .find(|n| !grids.iter().any(|g| g.name == n.as_str()))
-    {
-        let names: Vec<&str> = grids.iter().map(|g| g.name).collect();
-        return Err(vdb_error(
-            path,
-            format!(
-                "no grid `{missing}` to write; this output has {}",
-                names.join(", ")
-            ),
-        ));
-    }
-    grids.retain(|g| options.grids.is_empty() || options.grids.iter().any(|n| n == g.name));
-    let encoding = Encoding {
-        compression: compression_flags(options.compression),
-        half: options.half,
-    };
-    write_atomic(path, |tmp| write_grids(tmp, path, &grids, encoding))
+    write_chosen(path, grids, options)
 }
 
 /// OpenVDB's own volume (`tools::levelSetVolume`) of the level set `name` in a file.

@@ -100,17 +100,17 @@ impl GridValues<'_> {
         };
         match self {
             GridValues::Bool => unreachable!("bool leaves store a mask"),
-            GridValues::Constant(v) => for_each_on(&leaf.mask, |_| put(v)),
+            GridValues::Constant(v) => leaf.offsets().for_each(|_| put(v)),
             GridValues::Distances { .. } | GridValues::LevelSet { .. } => {
                 let d = leaf
                     .value
                     .as_deref()
                     .expect("a distance grid's leaves carry values");
-                for_each_on(&leaf.mask, |n| put(d[n]));
+                leaf.offsets().for_each(|n| put(d[n]));
             }
             GridValues::Fog { band, background } => {
                 let on_band = band.leaf(leaf.origin);
-                for_each_on(&leaf.mask, |n| {
+                leaf.offsets().for_each(|n| {
                     put(match on_band {
                         Some(b) if b.is_on(n) => {
                             let d = b.value.as_deref().expect("distances")[n];
@@ -126,7 +126,8 @@ impl GridValues<'_> {
                     _ => leaf.color.as_deref(),
                 };
                 let vectors = vectors.expect("a vector grid's leaves carry its channel");
-                for_each_on(&leaf.mask, |n| vectors[n].iter().for_each(|&c| put(c)));
+                leaf.offsets()
+                    .for_each(|n| vectors[n].iter().for_each(|&c| put(c)));
             }
         }
         let values = &values[..count];
@@ -148,18 +149,6 @@ impl GridValues<'_> {
                 interior.leaf(origin).map_or([0; 8], |l| l.mask)
             }
             _ => [0; 8],
-        }
-    }
-}
-
-/// Calls `f` with every set bit of `mask`, ascending.
-#[inline]
-fn for_each_on(mask: &[u64; 8], mut f: impl FnMut(usize)) {
-    for (w, &word) in mask.iter().enumerate() {
-        let mut bits = word;
-        while bits != 0 {
-            f(w * 64 + bits.trailing_zeros() as usize);
-            bits &= bits - 1;
         }
     }
 }

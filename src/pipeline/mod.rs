@@ -512,6 +512,7 @@ impl PlannedJob {
         progress.stage(self.stage_name(), self.plan.work_items);
         let mut outcome = on_threads(self.job.limits.threads, || self.run_here(&progress))?;
         progress.check()?;
+        outcome.threads = self.job.limits.threads;
         outcome.report.warnings.splice(0..0, self.warnings);
         outcome.report.input = self.job.describe_input();
         outcome.report.estimated_mib = self.plan.estimated_bytes as f64 / (1 << 20) as f64;

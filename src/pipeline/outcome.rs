@@ -5,16 +5,14 @@ use super::report::{
     Details, ImplicitDetails, ProjectiveDetails, Report, SeparatingClasses, SeparationCheckDetails,
     SubdivisionDetails,
 };
-use super::{Shape, SurfaceMethod};
+use super::{Shape, SurfaceMethod, on_threads};
 use crate::error::{Error, Result};
 use crate::grid::{SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::io::atomic::check_output;
 use crate::io::binvox::write_binvox;
 use crate::io::brick_set::{BrickSet, is_brick_set};
-use crate::io::vdb::{
-    DistanceGrid, WriteOptions, read_vdb_grid, write_distance_band, write_vdb_as,
-};
+use crate::io::vdb::{WriteOptions, read_vdb_grid, write_distance_band, write_vdb_as};
 use crate::io::vox::write_vox;
 use crate::mesh::Mesh;
 use crate::ops::csg::{BooleanOp, combine as combine_grids};
@@ -45,6 +43,8 @@ pub struct Outcome {
     /// Set when `grid` holds distances (world units) to write as a narrow band, instead of a
     /// voxel set.
     pub distances: Option<Distances>,
+    /// The threads the job ran on (all when `None`): writing encodes on them too.
+    pub threads: Option<usize>,
 }
 
 /// How a distance band is written: its background, and for a level set the interior it
@@ -120,6 +120,7 @@ impl Outcome {
                 .collect(),
             report,
             distances: None,
+            threads: None,
         }
     }
 
@@ -156,6 +157,7 @@ impl Outcome {
             metadata: parent.metadata.clone(),
             report,
             distances: None,
+            threads: parent.threads,
         }
     }
 
@@ -198,26 +200,31 @@ impl Outcome {
         let extra: Vec<(&str, &SparseGrid)> =
             self.extra.iter().map(|(n, g)| (n.as_str(), g)).collect();
         let write = |file: &Path| match &self.distances {
-            Some(d) => {
-                let kind = match &d.interior {
-                    Some(interior) => DistanceGrid::LevelSet { interior },
-                    None => DistanceGrid::Unsigned,
-                };
-                write_distance_band(file, &self.grid, d.background, kind, &meta, options)
-            }
+            Some(d) => write_distance_band(
+                file,
+                &self.grid,
+                d.background,
+                d.interior.as_ref(),
+                &meta,
+                options,
+            ),
             None => write_vdb_as(file, &self.grid, &extra, &meta, options),
         };
-        if path == Path::new("-") {
-            write_to_stdout(write)?;
-        } else {
-            write(path)?;
-        }
+        // The writer encodes in parallel: on the job's threads, as the work was.
+        on_threads(self.threads, || {
+            if path == Path::new("-") {
+                write_to_stdout(write)
+            } else {
+                write(path)
+            }
+        })?;
         self.report.output = Some(path.display().to_string());
         Ok(())
     }
 }
 
-/// OpenVDB writes to files: `write` a private temporary file, then copy it to stdout.
+/// `.vdb` files are written whole, then renamed into place: `write` a private temporary
+/// file, then copy it to stdout.
 fn write_to_stdout(write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     let dir = std::env::temp_dir().join(format!("voxelkit-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;

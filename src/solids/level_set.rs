@@ -39,11 +39,10 @@ pub fn level_set(
 ) -> Result<LevelSet> {
     mesh.require_closed(SIGN_NEEDS_CLOSED)?;
     let mut grid = distance_band(mesh, transform, band, progress)?;
-    let mut interior = SparseGrid::new(transform, Channels::NONE);
     let Some(bbox) = grid.bbox() else {
         return Ok(LevelSet {
             band: grid,
-            interior,
+            interior: SparseGrid::new(transform, Channels::NONE),
         });
     };
     let columns = ColumnCrossings::new(mesh, &transform, bbox);
@@ -67,7 +66,7 @@ pub fn level_set(
             (!inside.is_empty()).then_some(inside)
         })
         .collect();
-    interior = SparseGrid::from_distinct_leaves(transform, Channels::NONE, inside);
+    let mut interior = SparseGrid::from_distinct_leaves(transform, Channels::NONE, inside);
     for origin in inside_blocks(&columns, &grid) {
         interior.fill_leaf_block(origin);
     }

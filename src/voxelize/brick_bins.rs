@@ -139,14 +139,13 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
             1u64 << CLASS_SHIFT
         )));
     }
-    let (bricks, bins) = bin_primitives(counts, &candidates);
+    let bins = bin_primitives(counts, &candidates);
     let scratch: Vec<std::sync::Mutex<BrickBits<CLASSES>>> = (0..rayon::current_num_threads())
         .map(|_| std::sync::Mutex::new(BrickBits::new(channels)))
         .collect();
     let work: Vec<(Vec<Leaf>, [u64; CLASSES])> = bins
         .par_iter()
-        .zip(&bricks)
-        .map(|(entries, &brick)| {
+        .map(|bin| {
             // Each worker keeps its own scratch (rayon may split the work into many more
             // tasks than workers, and a brick's scratch is a megabyte with distances).
             let mut scratch = scratch[rayon::current_thread_index().unwrap_or(0)]
@@ -156,13 +155,12 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
             if progress.stopped() {
                 return (Vec::new(), [0; CLASSES]);
             }
-            let origin = brick.map(|v| v << BRICK_LOG2);
+            let origin = bin.brick.map(|v| v << BRICK_LOG2);
             let clip = CoordBox {
                 min: origin,
                 max: origin.map(|v| v + BRICK - 1),
             };
-            let mut firsts = 0;
-            for &entry in entries {
+            for &entry in &bin.entries {
                 let (class, i) = (
                     (entry >> CLASS_SHIFT) as usize,
                     (entry & ((1 << CLASS_SHIFT) - 1)) as usize,
@@ -173,11 +171,8 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
                     origin,
                 };
                 emit(class, i, &clip, &mut sink);
-                // Each primitive counts once, in the first brick it overlaps.
-                let first = brick_range(&candidates(class, i)).map(|r| *r.start());
-                firsts += u64::from(first == brick);
             }
-            progress.advance(firsts);
+            progress.advance(bin.first_of);
             let leaves = cut_leaves(bits, origin, channels);
             let counts = class_counts(bits);
             clear(bits);
@@ -197,19 +192,29 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
     ))
 }
 
-/// Bricks in use (by brick coordinate) and the primitives of each, packed with their class.
+/// A brick in use and its primitives.
+struct Bin {
+    /// Brick coordinate (origin / 64).
+    brick: Coord,
+    /// The primitives overlapping it, packed with their class.
+    entries: Vec<u32>,
+    /// How many of them it is the first brick of (progress counts each primitive once).
+    first_of: u64,
+}
+
+/// The bricks in use, each with its primitives.
 fn bin_primitives<const CLASSES: usize>(
     counts: [usize; CLASSES],
     candidates: &(impl Fn(usize, usize) -> CoordBox + Sync),
-) -> (Vec<Coord>, Vec<Vec<u32>>) {
+) -> Vec<Bin> {
     let mut index: FxHashMap<Coord, u32> = FxHashMap::default();
-    let mut bricks: Vec<Coord> = Vec::new();
-    let mut bins: Vec<Vec<u32>> = Vec::new();
+    let mut bins: Vec<Bin> = Vec::new();
     let mut last = ([i64::MIN; 3], 0usize);
     for (class, &count) in counts.iter().enumerate() {
         for i in 0..count {
             let entry = ((class as u32) << CLASS_SHIFT) | i as u32;
             let [xs, ys, zs] = brick_range(&candidates(class, i));
+            let mut first = true;
             for x in xs {
                 for y in ys.clone() {
                     for z in zs.clone() {
@@ -217,19 +222,24 @@ fn bin_primitives<const CLASSES: usize>(
                         // Consecutive primitives mostly share a brick: skip the lookup.
                         if b != last.0 {
                             let n = *index.entry(b).or_insert_with(|| {
-                                bricks.push(b);
-                                bins.push(Vec::new());
-                                (bricks.len() - 1) as u32
+                                bins.push(Bin {
+                                    brick: b,
+                                    entries: Vec::new(),
+                                    first_of: 0,
+                                });
+                                (bins.len() - 1) as u32
                             });
                             last = (b, n as usize);
                         }
-                        bins[last.1].push(entry);
+                        let bin = &mut bins[last.1];
+                        bin.entries.push(entry);
+                        bin.first_of += u64::from(std::mem::take(&mut first));
                     }
                 }
             }
         }
     }
-    (bricks, bins)
+    bins
 }
 
 /// The brick's leaves: the union of its classes' bits, with the channels kept.

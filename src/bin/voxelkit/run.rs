@@ -9,7 +9,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 use voxelkit::Result;
 use voxelkit::io::vdb::{WriteOptions, check_voxel_size};
-use voxelkit::pipeline::{Job, Limits, Outcome, PlannedJob, check_output_path, on_threads};
+use voxelkit::pipeline::{Job, Limits, Outcome, PlannedJob, check_output_path};
 use voxelkit::progress::Observer;
 
 /// What every command shares: threads, memory limit, output style.
@@ -106,11 +106,9 @@ pub fn finish_job(
 ) -> Result<Outcome> {
     let inputs = planned.input_files();
     let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
-    let threads = planned.job().limits.threads;
     let mut outcome = planned.run(observer)?;
     if let Some(out) = output {
-        // Writing encodes in parallel: on the job's threads, as the work was.
-        on_threads(threads, || outcome.write(out, &inputs, &global.write))?;
+        outcome.write(out, &inputs, &global.write)?;
         if global.preview {
             let png = crate::render::beside(&outcome.grid, out, Default::default())?;
             outcome.report.preview = Some(png.display().to_string());
