@@ -1,6 +1,7 @@
-//! Builds the C++ side of the bridges. With feature `vdb` it compiles cpp/vdb_bridge.cc
-//! against OpenVDB (C++17, TBB, Imath); with `osd` it links OpenSubdiv. When a library is
-//! missing the build stops with one line naming the Debian packages to install.
+//! Builds the C++ side of the OpenSubdiv bridge (feature `osd`) and checks for the C
+//! libraries the `.vdb` writer and reader call (feature `vdb`: blosc and zlib). When a library
+//! is missing the build stops with one line naming the Debian packages to install. OpenVDB
+//! itself is not linked: its own tools, for tests and benchmarks, live in `openvdb/`.
 
 use std::path::Path;
 use std::process::Command;
@@ -13,16 +14,10 @@ fn main() {
     let osd = std::env::var_os("CARGO_FEATURE_OSD").is_some();
     if vdb {
         require(
-            &[
-                "openvdb/openvdb.h",
-                "boost/version.hpp",
-                "tbb/tbb.h",
-                "Imath/ImathVec.h",
-            ],
-            &["openvdb"],
-            "OpenVDB is missing: install it with `apt-get install libopenvdb-dev libboost-dev libtbb-dev pkg-config`, or build with --no-default-features",
+            &[],
+            &["blosc", "z"],
+            "blosc or zlib is missing: install them with `apt-get install libblosc-dev zlib1g-dev`, or build with --no-default-features",
         );
-        build_vdb_bridge();
     }
     if osd {
         require(
@@ -64,52 +59,6 @@ fn lib_search_dirs() -> Vec<String> {
         }
     }
     dirs
-}
-
-/// `pkg-config` output split into words (empty when pkg-config or the package is missing).
-fn pkg_config(args: &[&str]) -> Vec<String> {
-    Command::new("pkg-config")
-        .args(args)
-        .output()
-        .ok()
-        .filter(|o| o.status.success())
-        .map(|o| {
-            String::from_utf8_lossy(&o.stdout)
-                .split_whitespace()
-                .map(String::from)
-                .collect()
-        })
-        .unwrap_or_default()
-}
-
-fn build_vdb_bridge() {
-    let mut build = cxx_build::bridge("src/ffi/vdb.rs");
-    build
-        .file("cpp/vdb_bridge.cc")
-        .std("c++17")
-        .flag_if_supported("-Wno-deprecated-declarations")
-        .opt_level(2);
-    for flag in pkg_config(&["--cflags", "tbb", "Imath"]) {
-        build.flag(&flag);
-    }
-    build.compile("voxelkit_vdb_bridge");
-    for flag in pkg_config(&["--libs", "tbb", "Imath"]) {
-        if let Some(lib) = flag.strip_prefix("-l") {
-            println!("cargo:rustc-link-lib={lib}");
-        } else if let Some(dir) = flag.strip_prefix("-L") {
-            println!("cargo:rustc-link-search=native={dir}");
-        }
-    }
-    println!("cargo:rustc-link-lib=openvdb");
-    println!("cargo:rustc-link-lib=tbb");
-    for f in [
-        "cpp/vdb_bridge.cc",
-        "cpp/vdb_bridge.h",
-        "cpp/trycatch.h",
-        "src/ffi/vdb.rs",
-    ] {
-        println!("cargo:rerun-if-changed={f}");
-    }
 }
 
 fn build_osd_bridge() {

@@ -13,7 +13,7 @@ install -m 644 include/voxelkit.h "$prefix/include/"
 install -m 644 "$target/libvoxelkit.a" "$prefix/lib/"
 install -m 755 "$target/libvoxelkit.so" "$prefix/lib/"
 # What the static library needs besides itself (rustc --print native-static-libs).
-private="-lopenvdb -lblosc -lz -ltbb -losdCPU -lImath-3_1 -lstdc++ -lgcc_s -lutil -lrt -lpthread -lm -ldl"
+private="-lblosc -lz -losdCPU -lstdc++ -lgcc_s -lutil -lrt -lpthread -lm -ldl"
 for name in voxelkit voxelkit-static; do
     sed -e "s|@PREFIX@|$prefix|" -e "s|@VERSION@|$version|" -e "s|@PRIVATE@|$private|" \
         "cmake/$name.pc.in" > "$prefix/lib/pkgconfig/$name.pc"

@@ -12,7 +12,7 @@ mod cli_support;
 mod common;
 
 use cli_support::{run_pyopenvdb, text, voxelkit};
-use voxelkit::io::vdb::{openvdb_level_set_volume, read_vdb_grid};
+use voxelkit::io::vdb::read_vdb_grid;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
 use voxelkit::progress::Progress;
 use voxelkit::random::SplitMix64;
@@ -145,11 +145,14 @@ fn openvdb_reads_a_negative_interior_and_measures_the_volume() {
     ]);
     assert!(run.status.success(), "{}", text(&run));
     let exact_volume = torus.signed_volume().abs();
-    let openvdb = openvdb_level_set_volume(&out, "surface").unwrap();
+    let openvdb = voxelkit_openvdb::level_set_volume(out.to_str().unwrap(), "surface").unwrap();
     assert!(
         (openvdb - exact_volume).abs() < 0.01 * exact_volume,
         "OpenVDB's levelSetVolume {openvdb} against the mesh's {exact_volume}"
     );
+    // voxelkit's reader takes the band, the fog and their inactive values as OpenVDB does.
+    common::assert_read_as_openvdb_reads(&out, "surface");
+    common::assert_read_as_openvdb_reads(&out, "density");
     let band = read_vdb_grid(&out, Some("surface")).unwrap();
     assert!(band.voxel_count() > 0);
     // pyopenvdb, an independent reader: class, the value deep in the tube (inactive, a tile

@@ -1,5 +1,5 @@
 //! A .vdb written by voxelkit reads back with the same active voxels and transform, through
-//! OpenVDB itself (the bridge) and through the independent reader pyopenvdb.
+//! voxelkit's reader, OpenVDB itself (voxelkit-openvdb) and the independent reader pyopenvdb.
 #![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 use glam::DVec3;
@@ -78,6 +78,9 @@ fn openvdb_reads_back_the_same_voxels_transform_and_metadata() {
     }
     let density = infos.iter().find(|i| i.name == "density").unwrap();
     assert_eq!(density.grid_class, "fog volume");
+    for name in ["voxels", "density", "normal"] {
+        common::assert_read_as_openvdb_reads(&path, name);
+    }
     for name in ["voxels", "density"] {
         let back = read_vdb_grid(&path, Some(name)).unwrap();
         assert_eq!(sorted_voxels(&back), sorted_voxels(&grid), "{name}");

@@ -1,6 +1,7 @@
-//! voxelkit writes `.vdb` files itself (`io::vdb_writer`): whatever the compression and
-//! precision, OpenVDB reads back every grid it writes with the same voxels, tiles, values and
-//! normals, leaves at negative coordinates and past a root node's 4096 voxels included.
+//! voxelkit writes and reads `.vdb` files itself (`io::vdb_writer`, `io::vdb_reader`): whatever
+//! the compression and precision, OpenVDB reads back every grid it writes with the same
+//! voxels, tiles, values and normals, leaves at negative coordinates and past a root node's
+//! 4096 voxels included, and voxelkit's reader reads them as OpenVDB does.
 #![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 use glam::DVec3;
@@ -75,6 +76,7 @@ fn openvdb_reads_back_every_grid_in_every_compression_and_precision() {
             write_vdb_as(&with_normals, &surface, &[], &[], &options).unwrap();
 
             for name in ["density", "voxels"] {
+                common::assert_read_as_openvdb_reads(&tiled, name);
                 let back = read_vdb_grid(&tiled, Some(name)).unwrap();
                 assert_eq!(sorted_voxels(&back), sorted_voxels(&set), "{what}: {name}");
                 assert_eq!(
@@ -89,6 +91,8 @@ fn openvdb_reads_back_every_grid_in_every_compression_and_precision() {
                 assert!(leaf.offsets().all(|n| values[n] == 1.0), "{what}: density");
             }
 
+            common::assert_read_as_openvdb_reads(&with_normals, "density");
+            common::assert_read_as_openvdb_reads(&with_normals, "normal");
             let normals = read_vdb_grid(&with_normals, Some("normal")).unwrap();
             assert_eq!(sorted_voxels(&normals), sorted_voxels(&surface), "{what}");
             let tolerance = if half { 1e-3 } else { 0.0 };

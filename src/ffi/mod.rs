@@ -1,5 +1,3 @@
 //! cxx bridges to the C++ libraries. No algorithm code lives here.
 #[cfg(feature = "osd")]
 pub mod osd;
-#[cfg(feature = "vdb")]
-pub mod vdb;

@@ -9,6 +9,8 @@ pub mod vdb;
 #[cfg(feature = "vdb")]
 mod vdb_chunks;
 #[cfg(feature = "vdb")]
+mod vdb_reader;
+#[cfg(feature = "vdb")]
 mod vdb_structure;
 #[cfg(feature = "vdb")]
 mod vdb_tree_structure;

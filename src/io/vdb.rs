@@ -1,5 +1,5 @@
-//! OpenVDB files: written by voxelkit itself (`vdb_writer`), read through the bridge after
-//! their structure is checked (`vdb_structure`). A voxel set is written as `density` (a fog volume: 1 on
+//! OpenVDB files, written (`vdb_writer`) and read (`vdb_reader`, after `vdb_structure` has
+//! checked the file) by voxelkit itself. A voxel set is written as `density` (a fog volume: 1 on
 //! every voxel of the set, what Blender's volume object reads), `normal` (Vec3s,
 //! covariant-normalize) when the grid carries normals, `Cd` (Vec3s, the Houdini name for
 //! colour) when it carries colours, and on request `voxels` (the same set as a BoolGrid);
@@ -10,12 +10,13 @@
 use super::atomic::write_atomic;
 use super::vdb_writer::{Encoding, GridOut, GridValues, compression_flags, write_grids};
 use crate::error::{Error, Result};
-use crate::ffi::vdb::bridge;
 use crate::grid::{Channels, LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use glam::DVec3;
 use std::path::Path;
 
-pub use crate::ffi::vdb::bridge::GridInfo;
+use super::vdb_reader::VdbFile;
+pub use super::vdb_reader::{GridInfo, MetaEntry};
+use rayon::prelude::*;
 
 /// The boolean voxel set's name in a `.vdb`.
 pub const VOXELS_GRID: &str = "voxels";
@@ -250,36 +251,28 @@ pub fn write_distance_band(
     write_chosen(path, grids, options)
 }
 
-/// OpenVDB's own volume (`tools::levelSetVolume`) of the level set `name` in a file.
-pub fn openvdb_level_set_volume(path: &Path, name: &str) -> Result<f64> {
-    let p = path
-        .to_str()
-        .ok_or_else(|| vdb_error(path, "path is not UTF-8"))?;
-    bridge::openvdb_level_set_volume(p, name).map_err(|e| vdb_error(path, e))
-}
-
-fn open(path: &Path) -> Result<cxx::UniquePtr<bridge::VdbFile>> {
+fn open(path: &Path) -> Result<VdbFile> {
     if !path.exists() {
         return Err(Error::io(
             path,
             std::io::Error::from(std::io::ErrorKind::NotFound),
         ));
     }
-    let p = path
-        .to_str()
-        .ok_or_else(|| vdb_error(path, "path is not UTF-8"))?;
-    // OpenVDB reads every tree whole: plan that memory before it allocates any.
+    // The whole file is held while its grids are read: plan that memory before any is taken.
     let tree_bytes = super::vdb_structure::check_structure(path)?;
+    let file_bytes = std::fs::metadata(path)
+        .map_err(|e| Error::io(path, e))?
+        .len();
     crate::system::check_fits(
-        tree_bytes,
+        tree_bytes.saturating_add(file_bytes),
         None,
         &format!("{}: reading its trees", path.display()),
     )?;
-    bridge::open_vdb(p).map_err(|e| unreadable(path, e))
+    let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    VdbFile::parse(data).map_err(|e| unreadable(path, e))
 }
 
-/// A file OpenVDB cannot read: say so plainly, with OpenVDB's own words cut short (a damaged
-/// file can make them very long).
+/// A file that cannot be read: say so plainly, with the reason cut short.
 fn unreadable(path: &Path, e: impl std::fmt::Display) -> Error {
     let mut detail = e.to_string();
     if detail.len() > 300 {
@@ -300,7 +293,7 @@ fn unreadable(path: &Path, e: impl std::fmt::Display) -> Error {
 pub fn read_vdb_info(path: &Path) -> Result<Vec<GridInfo>> {
     let file = open(path)?;
     (0..file.grid_count())
-        .map(|i| file.grid_info(i).map_err(|e| vdb_error(path, e)))
+        .map(|i| file.grid_info(i).map_err(|e| unreadable(path, e)))
         .collect()
 }
 
@@ -312,7 +305,7 @@ pub fn read_vdb_info(path: &Path) -> Result<Vec<GridInfo>> {
 pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
     let file = open(path)?;
     let infos: Vec<GridInfo> = (0..file.grid_count())
-        .map(|i| file.grid_info(i).map_err(|e| vdb_error(path, e)))
+        .map(|i| file.grid_info(i).map_err(|e| unreadable(path, e)))
         .collect::<Result<_>>()?;
     let readable = |i: &GridInfo| matches!(i.value_type.as_str(), "bool" | "mask" | "float");
     let named = |n: &str| infos.iter().position(|i| i.name == n && readable(i));
@@ -356,29 +349,24 @@ pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
             info.active_voxels
         ),
     )?;
-    let (mut origins, mut masks, mut values, mut tiles) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    file.read_leaves(index, &mut origins, &mut masks, &mut values, &mut tiles)
-        .map_err(|e| unreadable(path, e))?;
+    let tree = file.read_tree(index).map_err(|e| unreadable(path, e))?;
     let vectors = info.value_type == "vec3s";
     let channels = Channels {
-        value: !values.is_empty() && !vectors,
+        value: info.value_type == "float",
         normal: vectors && info.name == NORMAL_GRID,
         color: vectors && info.name != NORMAL_GRID,
     };
-    let leaves = origins
-        .chunks_exact(3)
-        .zip(masks.chunks_exact(8))
-        .enumerate()
-        .map(|(i, (o, m))| {
-            let mut leaf = Leaf::new([o[0] as i64, o[1] as i64, o[2] as i64], channels);
-            leaf.mask.copy_from_slice(m);
+    let leaves = tree
+        .leaves
+        .into_par_iter()
+        .map(|read| {
+            let mut leaf = Leaf::new(read.origin.map(i64::from), channels);
+            leaf.mask = read.mask;
             if let Some(v) = leaf.value.as_mut() {
-                v.copy_from_slice(&values[i * LEAF_VOXELS..(i + 1) * LEAF_VOXELS]);
+                v.copy_from_slice(&read.values);
             }
             if let Some(v) = leaf.normal.as_mut().or(leaf.color.as_mut()) {
-                let chunk = &values[3 * i * LEAF_VOXELS..3 * (i + 1) * LEAF_VOXELS];
-                for (n, xyz) in chunk.chunks_exact(3).enumerate() {
+                for (n, xyz) in read.values.chunks_exact(3).enumerate() {
                     v[n] = [xyz[0], xyz[1], xyz[2]];
                 }
             }
@@ -387,50 +375,12 @@ pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
         .collect();
     let transform = Transform::new(DVec3::from_array(info.origin), info.voxel_size[0]);
     let mut grid = SparseGrid::from_leaves(transform, channels, leaves);
-    for t in tiles.chunks_exact(4) {
-        let origin = [t[0] as i64, t[1] as i64, t[2] as i64];
-        match t[3] {
+    for (origin, edge) in tree.tiles {
+        let origin = origin.map(i64::from);
+        match edge {
             8 => grid.fill_leaf_block(origin),
-            128 => grid.fill_node_block(origin),
-            edge => return Err(unreadable(path, format!("a tile of edge {edge}"))),
+            _ => grid.fill_node_block(origin),
         }
     }
     Ok(grid)
-}
-
-/// Which of OpenVDB's own mesh conversions a benchmark compares against.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum OpenVdbReference {
-    /// `meshToUnsignedDistanceField`: the unsigned band a surface voxelization matches.
-    Unsigned,
-    /// `meshToLevelSet`: a narrow-band level set.
-    LevelSet,
-    /// `meshToLevelSet` then `sdfInteriorMask`: a solid.
-    Solid,
-    /// `meshToVolume` with the interior filled (a slower path to a solid).
-    Filled,
-}
-
-/// OpenVDB's conversion `kind` of a triangle mesh given in index space, `band` voxels wide,
-/// on at most `threads` threads: returns its active voxel count.
-pub fn openvdb_reference(
-    kind: OpenVdbReference,
-    index_points: &[f32],
-    triangles: &[u32],
-    voxel_size: f64,
-    band: f32,
-    threads: usize,
-) -> Result<u64> {
-    let name = match kind {
-        OpenVdbReference::Unsigned => "unsigned",
-        OpenVdbReference::LevelSet => "level-set",
-        OpenVdbReference::Solid => "solid",
-        OpenVdbReference::Filled => "filled",
-    };
-    bridge::openvdb_reference(name, index_points, triangles, voxel_size, band, threads).map_err(
-        |e| Error::Vdb {
-            path: format!("<OpenVDB {name}>").into(),
-            message: e.to_string(),
-        },
-    )
 }

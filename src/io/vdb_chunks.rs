@@ -10,6 +10,9 @@ pub(super) const COMPRESS_ZIP: u32 = 0x1;
 pub(super) const COMPRESS_ACTIVE_MASK: u32 = 0x2;
 pub(super) const COMPRESS_BLOSC: u32 = 0x4;
 
+/// OpenVDB pads buffers shorter than this before blosc compresses them.
+pub(super) const BLOSC_PAD_BYTES: usize = 128;
+
 /// Blosc's chunk header, in bytes: the most compressing can add.
 const BLOSC_OVERHEAD: usize = 16;
 
@@ -114,5 +117,89 @@ pub(super) fn compression_name(compression: u32) -> &'static str {
         (true, _) => "blosc + active values",
         (false, true) => "zip + active values",
         (false, false) => "active values",
+    }
+}
+
+#[link(name = "blosc")]
+unsafe extern "C" {
+    fn blosc_decompress_ctx(
+        src: *const c_void,
+        dest: *mut c_void,
+        destsize: usize,
+        numinternalthreads: c_int,
+    ) -> c_int;
+}
+
+#[link(name = "z")]
+unsafe extern "C" {
+    fn uncompress(
+        dest: *mut u8,
+        dest_len: *mut c_ulong,
+        source: *const u8,
+        source_len: c_ulong,
+    ) -> c_int;
+}
+
+/// Reads a chunk of `bytes` bytes that `push_chunk` (or OpenVDB) stored with the grid's
+/// `compression` flags from the start of `input`: the bytes and how much of `input` it took.
+pub(super) fn read_chunk(
+    input: &[u8],
+    bytes: usize,
+    compression: u32,
+) -> std::result::Result<(Vec<u8>, usize), String> {
+    let take = |n: usize, from: usize| {
+        input
+            .get(from..from + n)
+            .ok_or_else(|| format!("a chunk of {n} bytes runs past its grid"))
+    };
+    if compression & (COMPRESS_BLOSC | COMPRESS_ZIP) == 0 {
+        return Ok((take(bytes, 0)?.to_vec(), bytes));
+    }
+    let size = i64::from_le_bytes(take(8, 0)?.try_into().expect("8 bytes"));
+    if size <= 0 {
+        if size.unsigned_abs() != bytes as u64 {
+            return Err(format!(
+                "a raw chunk of {} bytes where its node holds {bytes}",
+                size.unsigned_abs()
+            ));
+        }
+        return Ok((take(bytes, 8)?.to_vec(), 8 + bytes));
+    }
+    let packed = take(usize::try_from(size).map_err(|e| e.to_string())?, 8)?;
+    // Room for blosc's padding of short buffers: it never writes past `destsize`.
+    let mut out = vec![0u8; bytes.max(BLOSC_PAD_BYTES)];
+    let unpacked = if compression & COMPRESS_BLOSC != 0 {
+        // SAFETY: blosc reads the chunk (its header's sizes were checked against `packed`'s
+        // length by the structure check) and writes at most `out.len()` bytes.
+        let n = unsafe {
+            blosc_decompress_ctx(
+                packed.as_ptr().cast(),
+                out.as_mut_ptr().cast(),
+                out.len(),
+                1,
+            )
+        };
+        usize::try_from(n).ok()
+    } else {
+        let mut len = out.len() as c_ulong;
+        // SAFETY: uncompress reads `packed.len()` bytes and writes at most `len` to `out`.
+        let status = unsafe {
+            uncompress(
+                out.as_mut_ptr(),
+                &mut len,
+                packed.as_ptr(),
+                packed.len() as c_ulong,
+            )
+        };
+        (status == 0).then_some(len as usize)
+    };
+    match unpacked {
+        Some(n) if n == bytes || (bytes < BLOSC_PAD_BYTES && n == BLOSC_PAD_BYTES) => {
+            out.truncate(bytes);
+            Ok((out, 8 + packed.len()))
+        }
+        _ => Err(format!(
+            "a compressed chunk that does not unpack to the {bytes} bytes of its node"
+        )),
     }
 }

@@ -4,14 +4,12 @@
 //! the buffer's size, and blosc trusts the sizes in its own chunk header. Every chunk is
 //! checked here against what the node holds, and every node against the bytes of the grid.
 
-use super::vdb_chunks::{COMPRESS_ACTIVE_MASK, COMPRESS_BLOSC, COMPRESS_ZIP};
+use super::vdb_chunks::{BLOSC_PAD_BYTES, COMPRESS_ACTIVE_MASK, COMPRESS_BLOSC, COMPRESS_ZIP};
 use super::vdb_structure::Reader;
 use std::collections::HashSet;
 
 type Check = std::result::Result<(), String>;
 
-/// OpenVDB pads buffers shorter than this before blosc compresses them.
-const BLOSC_PAD_BYTES: u64 = 128;
 /// The suffix OpenVDB adds to a grid type saved at half precision.
 const HALF_SUFFIX: &str = "_HalfFloat";
 /// Log2 of the node edges of OpenVDB's standard trees (5, 4, 3), from the root's children down.
@@ -23,16 +21,16 @@ const LEAF_MASK_BYTES: u64 = 64;
 #[derive(Clone, Copy)]
 pub(super) struct TreeFormat {
     /// Bytes of one value at full precision (root tiles, background, inactive values).
-    value: u64,
+    pub(super) value: u64,
     /// Bytes of one value in node and leaf buffers (half precision where saved so).
-    stored: u64,
+    pub(super) stored: u64,
     /// Values stored at half precision.
-    half: bool,
-    leaf: LeafKind,
+    pub(super) half: bool,
+    pub(super) leaf: LeafKind,
 }
 
 #[derive(Clone, Copy, PartialEq)]
-enum LeafKind {
+pub(super) enum LeafKind {
     /// Compressed values after the voxel mask (float, double, integer and vector trees).
     Values,
     /// Voxel mask, origin, value mask: bool trees.
@@ -339,7 +337,7 @@ fn chunk(r: &mut Reader, compression: u32, bytes: u64, what: &str) -> Check {
     }
     let header = r.bytes::<16>(what)?;
     let word = |i: usize| u32::from_le_bytes(header[i..i + 4].try_into().expect("4 bytes")) as u64;
-    if word(4) > bytes.max(BLOSC_PAD_BYTES) || word(12) != size {
+    if word(4) > bytes.max(BLOSC_PAD_BYTES as u64) || word(12) != size {
         return Err(format!(
             "{what}: a compressed chunk at byte {at} whose sizes disagree with its node"
         ));

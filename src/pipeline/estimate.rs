@@ -29,9 +29,9 @@ const VECTOR_LEAF_BYTES: f64 = 20000.0;
 const AREA_PER_LEAF: f64 = 32.0;
 /// The share of its box a solid is assumed to fill (a ball fills 52%).
 const SOLID_FILL: f64 = 0.5;
-/// The process itself: code, OpenVDB's and the allocator's own memory (39 MiB measured for
-/// a surface of 211 leaves).
-const BASE_BYTES: f64 = 40.0 * (1 << 20) as f64;
+/// The process itself: code and the allocator's own memory (9 MiB measured for a surface of
+/// 211 leaves; 39 MiB while OpenVDB was loaded).
+const BASE_BYTES: f64 = 10.0 * (1 << 20) as f64;
 
 /// Peak bytes of a set of `leaves` leaves with `vector_channels` normal or colour channels.
 fn leaf_bytes(leaves: f64, vector_channels: u32) -> f64 {
@@ -84,14 +84,15 @@ struct FillCost {
 }
 
 /// The block flood (the default): the surface, the solid's boundary leaves and the grids
-/// written (750 bytes per surface leaf), the block states and the inside's tiles (16 bytes
-/// per block); no dense volume. Estimate/peak 0.88-1.26 on the five meshes at 1024.
+/// written (750 bytes per surface leaf), the block states (8 bytes per block of the box) and
+/// the inside's tiles (0.4 bits per inside voxel); no dense volume. Estimate/peak 0.81-1.27
+/// on the five meshes at 1024.
 const BLOCK_FLOOD_COST: FillCost = FillCost {
     bit_volumes: 0.0,
-    inside_volumes: 0.0,
+    inside_volumes: 0.4,
     face_bytes: 0.0,
     leaf_bytes: 750.0,
-    block_bytes: 16.0,
+    block_bytes: 8.0,
     triangle_bytes: TRIANGLE_BYTES,
 };
 /// The span flood and FloodingXYZ: two dense volumes (surface and reached) and what scales
@@ -175,10 +176,10 @@ fn surface_leaf_bytes(leaves: f64, vector_channels: u32) -> f64 {
 }
 
 /// Lines: a leaf per 6 voxels of length (a line crosses a leaf in 5-8 voxels), and a mesh's
-/// triangles read but not voxelized (40 bytes each). Calibrated on the edges of nine shared
+/// triangles read but not voxelized (85 bytes each). Calibrated on the edges of nine shared
 /// meshes at 512-2048: estimate/peak 0.89-1.16 (was up to 1.8).
 const LINE_LENGTH_PER_LEAF: f64 = 6.0;
-const LINE_TRIANGLE_BYTES: f64 = 40.0;
+const LINE_TRIANGLE_BYTES: f64 = 85.0;
 
 /// Leaves crossed by a mesh's edges: `along` their length alone, but edges on a surface
 /// share its leaves: where they are dense (coarse grids) the surface's `surface` leaves
@@ -587,14 +588,9 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
                 gb.leaf_count() as f64
             };
             let leaves = ga.leaf_count() as f64 + second;
-            // Grids read with values (`density`) also held OpenVDB's float leaves and the
-            // copied values: 2.2 KB more per leaf (estimate/peak 0.96-1.04 on two solids at
-            // 512 and 1024; it was 0.63-0.78).
-            let values = [&ga, &gb].iter().any(|g| g.channels().value);
-            let read_bytes = if values { 2200.0 * leaves } else { 0.0 };
             let t = ga.transform;
             let bbox = world_box(&ga);
-            let p = plan_of(t, &bbox, leaf_bytes(leaves, 0) + read_bytes, 1);
+            let p = plan_of(t, &bbox, leaf_bytes(leaves, 0), 1);
             (Loaded::Grids(ga, gb), p)
         }
     })

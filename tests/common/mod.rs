@@ -86,3 +86,73 @@ pub fn assert_limit_match(what: &str, c: &voxelkit::subd::Comparison) {
         c.worst_normal_at
     );
 }
+
+/// Asserts that voxelkit's own reader and OpenVDB read grid `name` of the `.vdb` at `path`
+/// alike: the same leaves (origin, mask and all 512 values, inactive ones included), the same
+/// tiles, voxel count and transform.
+#[cfg(feature = "vdb")]
+pub fn assert_read_as_openvdb_reads(path: &std::path::Path, name: &str) {
+    use std::collections::{BTreeMap, BTreeSet};
+    let ours = voxelkit::io::vdb::read_vdb_grid(path, Some(name)).unwrap();
+    let theirs = voxelkit_openvdb::read_grid(path.to_str().unwrap(), name).unwrap();
+    let what = format!("{}: grid {name}", path.display());
+    let per_leaf = theirs.values.len() / (theirs.origins.len() / 3).max(1);
+    let mut leaves = BTreeMap::new();
+    for (i, o) in theirs.origins.chunks_exact(3).enumerate() {
+        let origin = [o[0] as i64, o[1] as i64, o[2] as i64];
+        let mask: [u64; 8] = theirs.masks[8 * i..8 * i + 8].try_into().unwrap();
+        let values = theirs
+            .values
+            .get(i * per_leaf..(i + 1) * per_leaf)
+            .unwrap_or(&[]);
+        leaves.insert(origin, (mask, values.to_vec()));
+    }
+    assert_eq!(ours.leaf_count(), leaves.len(), "{what}: leaf count");
+    for leaf in ours.leaves() {
+        let (mask, values) = leaves
+            .get(&leaf.origin)
+            .unwrap_or_else(|| panic!("{what}: OpenVDB has no leaf at {:?}", leaf.origin));
+        assert_eq!(
+            &leaf.mask, mask,
+            "{what}: mask of the leaf at {:?}",
+            leaf.origin
+        );
+        let ours_values: Vec<f32> =
+            match (&leaf.value, leaf.normal.as_ref().or(leaf.color.as_ref())) {
+                (Some(v), _) => v.to_vec(),
+                (None, Some(v)) => v.iter().flatten().copied().collect(),
+                (None, None) => Vec::new(),
+            };
+        assert!(
+            ours_values
+                .iter()
+                .zip(values)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+                && ours_values.len() == values.len(),
+            "{what}: values of the leaf at {:?}",
+            leaf.origin
+        );
+    }
+    let their_tiles: BTreeSet<([i64; 3], i64)> = theirs
+        .tiles
+        .chunks_exact(4)
+        .map(|t| ([t[0] as i64, t[1] as i64, t[2] as i64], t[3] as i64))
+        .collect();
+    let our_tiles: BTreeSet<([i64; 3], i64)> = ours.tiles().with_edges().collect();
+    assert_eq!(our_tiles, their_tiles, "{what}: tiles");
+    assert_eq!(
+        ours.voxel_count(),
+        theirs.info.active_voxels,
+        "{what}: voxel count"
+    );
+    assert_eq!(
+        ours.transform.voxel_size, theirs.info.voxel_size[0],
+        "{what}: voxel size"
+    );
+    let origin = ours.transform.origin.to_array();
+    assert!(
+        (0..3)
+            .all(|a| (origin[a] - theirs.info.origin[a]).abs() <= 1e-12 * origin[a].abs().max(1.0)),
+        "{what}: origin"
+    );
+}

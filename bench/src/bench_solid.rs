@@ -5,17 +5,18 @@
 
 use crate::bench::{best_of, data_folder};
 use crate::json::Json;
+use crate::openvdb_reference;
 use clap::Args;
 use std::path::PathBuf;
 use voxelkit::Result;
 use voxelkit::grid::DenseMask;
-use voxelkit::io::vdb::{OpenVdbReference, openvdb_reference};
 use voxelkit::mesh::{GridFit, Mesh, fit_transform};
 use voxelkit::ops::flood::padded;
 use voxelkit::ops::flood_linear::flood_linear;
 use voxelkit::solids::exterior_flood::{FloodMethod, solid_from_surface};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
+use voxelkit_openvdb::Reference as OpenVdbReference;
 
 #[derive(Args)]
 pub struct SolidBenchArgs {

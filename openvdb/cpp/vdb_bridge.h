@@ -1,7 +1,7 @@
-// The C++ half of src/ffi/vdb.rs: reading .vdb files and OpenVDB's own tools for tests and benchmarks.
+// The C++ half of src/bridge.rs: reading .vdb files and OpenVDB's own tools for tests and benchmarks.
 #pragma once
 #include "rust/cxx.h"
-#include "voxelkit/cpp/trycatch.h"
+#include "trycatch.h"
 #include <memory>
 #include <openvdb/openvdb.h>
 

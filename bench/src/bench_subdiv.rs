@@ -7,14 +7,15 @@
 
 use crate::bench::{best_of, data_folder};
 use crate::json::Json;
+use crate::openvdb_reference;
 use clap::Args;
 use std::path::PathBuf;
 use voxelkit::grid::Adjacency;
-use voxelkit::io::vdb::{OpenVdbReference, openvdb_reference};
 use voxelkit::mesh::{GridFit, fit_transform};
 use voxelkit::subd::{ControlMesh, LimitSurface};
 use voxelkit::voxelize::parametric::{ParametricOptions, voxelize_subdivision};
 use voxelkit::{Error, Result};
+use voxelkit_openvdb::Reference as OpenVdbReference;
 
 #[derive(Args)]
 pub struct SubdivBenchArgs {

@@ -1,12 +1,12 @@
-//! The cxx bridge to OpenVDB (`cpp/vdb_bridge.cc`), for reading `.vdb` files (writing is
-//! native: `io::vdb_writer`) and OpenVDB's own tools for tests and benchmarks. Leaves cross in
+//! The cxx bridge to OpenVDB (`cpp/vdb_bridge.cc`): OpenVDB reading `.vdb` files, and its own
+//! tools. Leaves cross in
 //! bulk: per grid one call with, for every 8^3 leaf, its origin (3 x i32), its mask (8 x u64,
 //! OpenVDB's word order) and, for value grids, its 512 values (or 3 x 512 for vectors) in
 //! OpenVDB's voxel order. Every C++ function catches its exceptions and turns them into
 //! `Result` errors.
 
 #[cxx::bridge(namespace = "voxelkit")]
-pub mod bridge {
+pub mod ffi {
     /// One string metadata item of a grid.
     struct MetaEntry {
         key: String,
@@ -33,7 +33,7 @@ pub mod bridge {
     }
 
     unsafe extern "C++" {
-        include!("voxelkit/cpp/vdb_bridge.h");
+        include!("voxelkit-openvdb/cpp/vdb_bridge.h");
 
         type VdbFile;
 

@@ -1,9 +1,9 @@
-// OpenVDB side of the bridge: reads .vdb files into bulk leaf arrays, and runs OpenVDB's own tools
-// (levelSetVolume, mesh conversions) for tests and benchmarks; voxelkit writes .vdb files itself
-// (src/io/vdb_writer.rs). Every exception becomes a Rust Err through cxx (see the trycatch override
-// in vdb_bridge.h).
-#include "voxelkit/cpp/vdb_bridge.h"
-#include "voxelkit/src/ffi/vdb.rs.h"
+// OpenVDB side of the bridge, for voxelkit's tests and benchmarks: reads .vdb files into bulk leaf
+// arrays (an independent check of voxelkit's own reader and writer) and runs OpenVDB's own tools
+// (levelSetVolume, mesh conversions). Every exception becomes a Rust Err through cxx (see the
+// trycatch override in trycatch.h).
+#include "voxelkit-openvdb/cpp/vdb_bridge.h"
+#include "voxelkit-openvdb/src/bridge.rs.h"
 
 #include <openvdb/tools/LevelSetMeasure.h>
 #include <openvdb/tools/LevelSetUtil.h>
@@ -23,7 +23,7 @@ std::once_flag init_flag;
 
 void ensure_initialized() { std::call_once(init_flag, [] { openvdb::initialize(); }); }
 
-// The grid types voxelkit reads (src/io/vdb_tree_structure.rs checks the same).
+// The grid types voxelkit reads (voxelkit's src/io/vdb_tree_structure.rs checks the same).
 using KnownGridTypes =
     openvdb::NumericGridTypes::Append<openvdb::Vec3GridTypes>::Append<openvdb::BoolGrid, openvdb::MaskGrid>;
 

@@ -8,13 +8,14 @@
 
 use crate::bench::{best_of, data_folder};
 use crate::json::Json;
+use crate::openvdb_reference;
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
-use voxelkit::io::vdb::{OpenVdbReference, openvdb_reference};
 use voxelkit::mesh::{GridFit, Mesh, fit_transform};
 use voxelkit::{Error, Result};
+use voxelkit_openvdb::Reference as OpenVdbReference;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum WholeTask {

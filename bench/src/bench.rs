@@ -3,14 +3,15 @@
 //! thread count, in the same process.
 
 use crate::json::Json;
+use crate::openvdb_reference;
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
-use voxelkit::io::vdb::{OpenVdbReference, openvdb_reference};
 use voxelkit::mesh::{GridFit, Mesh, fit_transform};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{Criterion, SeparatingOptions, voxelize_mesh};
 use voxelkit::{Error, Result};
+use voxelkit_openvdb::Reference as OpenVdbReference;
 
 #[derive(Args)]
 #[command(args_conflicts_with_subcommands = true)]

@@ -36,6 +36,24 @@ pub fn parse_criterion(s: &str) -> Result<Criterion, String> {
     s.parse()
 }
 
+/// OpenVDB's conversion `kind` of a mesh in index space (`voxelkit_openvdb::reference`), its
+/// errors as voxelkit's.
+pub fn openvdb_reference(
+    kind: voxelkit_openvdb::Reference,
+    index_points: &[f32],
+    triangles: &[u32],
+    voxel_size: f64,
+    band: f32,
+    threads: usize,
+) -> voxelkit::Result<u64> {
+    voxelkit_openvdb::reference(kind, index_points, triangles, voxel_size, band, threads).map_err(
+        |message| voxelkit::Error::Vdb {
+            path: "<OpenVDB>".into(),
+            message,
+        },
+    )
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match bench::run(&cli.args, cli.json) {
