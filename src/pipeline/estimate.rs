@@ -434,7 +434,7 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
                 UNSIGNED_BAND_LEAF_BYTES
             };
             let bytes = leaves * per_leaf + mesh.triangle_count() as f64 * BAND_TRIANGLE_BYTES;
-            let p = plan_of(t, &mesh.bbox(), bytes, mesh.face_count() as u64);
+            let p = plan_of(t, &mesh.bbox(), bytes, separating::work_items(&mesh));
             (Loaded::Mesh(mesh), p)
         }
         Task::SeparationCheck { mesh, options } => {

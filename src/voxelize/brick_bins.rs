@@ -75,13 +75,6 @@ impl<const CLASSES: usize> BrickSink<'_, CLASSES> {
         }
     }
 
-    /// Marks voxel `c` (inside the brick), keeping the smallest distance given for it.
-    #[inline]
-    pub fn add_distance(&mut self, c: Coord, distance: f64) {
-        let i = self.mark(c);
-        self.nearer(i, distance);
-    }
-
     /// Keeps `distance` for voxel `i` when the brick keeps distances and it is the nearest
     /// yet; whether it was.
     #[inline]

@@ -52,7 +52,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 /// Tolerance, in voxels, added to every inclusion test.
-const MARGIN: f64 = 1e-9;
+pub(super) const MARGIN: f64 = 1e-9;
 
 /// The slab's bounds on `d = n·(x - p)` for the turned normal (see the module docs): the
 /// voxel is in when `lo <= d < hi`.
@@ -133,25 +133,66 @@ impl SeparatingStats {
     }
 }
 
-struct Triangle {
-    corners: [DVec3; 3],
-    normal: DVec3,
+pub(super) struct Triangle {
+    pub(super) corners: [DVec3; 3],
+    pub(super) normal: DVec3,
 }
 
 /// A vertex (`a == b`) or an edge, with the faces around it.
-struct Primitive {
-    a: DVec3,
-    b: DVec3,
+pub(super) struct Primitive {
+    pub(super) a: DVec3,
+    pub(super) b: DVec3,
     normal: DVec3,
     /// Range of `Adjacency::faces` holding the faces around it.
-    faces: std::ops::Range<usize>,
+    pub(super) faces: std::ops::Range<usize>,
+}
+
+/// A half-space `g·x + h <= 0` that limits a sphere or a cylinder to where its primitive can
+/// be the nearest part of the mesh (the distance band's clipping; the separating surface
+/// uses whole spheres and cylinders and passes none).
+#[derive(Clone, Copy)]
+pub(super) struct HalfSpace {
+    pub(super) g: DVec3,
+    pub(super) h: f64,
+}
+
+/// `range`, the values of coordinate `axis` with the others as in `x`, narrowed to where
+/// every half-space holds (widened by `ROW_SLACK`: a candidate range).
+#[inline]
+fn within(
+    range: std::ops::RangeInclusive<i64>,
+    mut x: DVec3,
+    axis: usize,
+    halves: &[HalfSpace],
+) -> std::ops::RangeInclusive<i64> {
+    let (mut lo, mut hi) = (*range.start(), *range.end());
+    x[axis] = 0.0;
+    for half in halves {
+        // g_axis t <= rhs
+        let rhs = -(half.g.dot(x) + half.h);
+        let ga = half.g[axis];
+        if ga > 0.0 {
+            let bound = rhs / ga + ROW_SLACK;
+            if bound < hi as f64 {
+                hi = *int_range(f64::NEG_INFINITY, bound.max(lo as f64 - 1.0)).end();
+            }
+        } else if ga < 0.0 {
+            let bound = rhs / ga - ROW_SLACK;
+            if bound > lo as f64 {
+                lo = ceil_int(bound.min(hi as f64 + 1.0));
+            }
+        } else if rhs < 0.0 {
+            return int_range(0.0, -1.0);
+        }
+    }
+    lo..=hi
 }
 
 /// Faces around edges and vertices, and each face's fan triangles.
-struct Adjacency {
-    faces: Vec<u32>,
+pub(super) struct Adjacency {
+    pub(super) faces: Vec<u32>,
     /// `triangle_starts[f]..triangle_starts[f+1]`: the kept triangles of face `f`.
-    triangle_starts: Vec<usize>,
+    pub(super) triangle_starts: Vec<usize>,
 }
 
 impl Adjacency {
@@ -174,6 +215,50 @@ impl Adjacency {
     }
 }
 
+/// A mesh's primitives in index space: its fan triangles, its edges and its vertices.
+pub(super) struct Primitives {
+    pub(super) triangles: Vec<Triangle>,
+    pub(super) edges: Vec<Primitive>,
+    pub(super) vertices: Vec<Primitive>,
+    pub(super) adjacency: Adjacency,
+    degenerate_faces: usize,
+}
+
+/// The primitives of `mesh` (world units) on `transform`'s voxels, edges and vertices with
+/// their faces' mean normal when `normals` is set.
+pub(super) fn primitives(mesh: &Mesh, transform: Transform, normals: bool) -> Result<Primitives> {
+    mesh.validate()?;
+    if !(transform.voxel_size > 0.0 && transform.voxel_size.is_finite()) {
+        return Err(Error::InvalidArgument(format!(
+            "voxel size must be positive, got {}",
+            transform.voxel_size
+        )));
+    }
+    let pos: Vec<DVec3> = mesh
+        .positions
+        .par_iter()
+        .map(|&p| transform.world_to_index(p))
+        .collect();
+    let face_normals: Vec<DVec3> = (0..mesh.face_count())
+        .into_par_iter()
+        .map(|f| fan_area_normal(mesh.face(f), &pos))
+        .collect();
+    let ((triangles, triangle_starts, degenerate_faces), (edges, vertices, faces)) = rayon::join(
+        || triangles_of(mesh, &pos),
+        || edges_and_vertices(mesh, &pos, &face_normals, normals),
+    );
+    Ok(Primitives {
+        triangles,
+        edges,
+        vertices,
+        adjacency: Adjacency {
+            faces,
+            triangle_starts,
+        },
+        degenerate_faces,
+    })
+}
+
 /// Work items, as `progress` counts them: vertices, edges and triangles (edges estimated as
 /// half the face corners, exact for closed meshes).
 pub fn work_items(mesh: &Mesh) -> u64 {
@@ -187,33 +272,15 @@ pub fn voxelize_mesh(
     opts: &SeparatingOptions,
     progress: &Progress,
 ) -> Result<(SparseGrid, SeparatingStats)> {
-    mesh.validate()?;
-    if !(transform.voxel_size > 0.0 && transform.voxel_size.is_finite()) {
-        return Err(Error::InvalidArgument(format!(
-            "voxel size must be positive, got {}",
-            transform.voxel_size
-        )));
-    }
-    let pos: Vec<DVec3> = mesh
-        .positions
-        .par_iter()
-        .map(|&p| transform.world_to_index(p))
-        .collect();
     let sep = opts.separability;
     let channels = nearest_channels(opts.normals);
-
-    let face_normals: Vec<DVec3> = (0..mesh.face_count())
-        .into_par_iter()
-        .map(|f| fan_area_normal(mesh.face(f), &pos))
-        .collect();
-    let ((triangles, triangle_starts, degenerate_faces), (edges, vertices, faces)) = rayon::join(
-        || triangles_of(mesh, &pos),
-        || edges_and_vertices(mesh, &pos, &face_normals, opts.normals),
-    );
-    let adjacency = Adjacency {
-        faces,
-        triangle_starts,
-    };
+    let Primitives {
+        triangles,
+        edges,
+        vertices,
+        adjacency,
+        degenerate_faces,
+    } = primitives(mesh, transform, opts.normals)?;
     let keep = |p: &Primitive, x: DVec3| match opts.criterion {
         Criterion::Huang => true,
         Criterion::Clipped => adjacency.in_face_slab(p, &triangles, sep, x),
@@ -244,9 +311,17 @@ pub fn voxelize_mesh(
         progress,
         candidates,
         |class, i, clip, sink| match class {
-            0 => vertex_sphere(&vertices[i], r, &keep, clip, sink),
-            1 => edge_cylinder(&edges[i], r, &keep, clip, sink),
-            _ => face_body(&triangles[i], sep, clip, sink),
+            0 => vertex_sphere(&vertices[i], r, &keep, &[], clip, sink),
+            1 => edge_cylinder(&edges[i], r, &keep, &[], clip, sink),
+            _ => {
+                let tri = &triangles[i];
+                face_body(
+                    tri,
+                    slab_bounds(sep.slab_half_thickness(tri.normal)),
+                    clip,
+                    sink,
+                )
+            }
         },
     )?;
     let stats = SeparatingStats {
@@ -262,7 +337,7 @@ pub fn voxelize_mesh(
 }
 
 /// The voxels within `reach` of the box from `lo` to `hi`.
-fn reach_box(lo: DVec3, hi: DVec3, reach: f64) -> CoordBox {
+pub(super) fn reach_box(lo: DVec3, hi: DVec3, reach: f64) -> CoordBox {
     let (lo, hi) = (lo - DVec3::splat(reach), hi + DVec3::splat(reach));
     CoordBox {
         min: [lo.x, lo.y, lo.z].map(|v| v.floor() as i64),
@@ -512,10 +587,11 @@ fn clipped(
 }
 
 /// S_v: voxel centres within `r` of the vertex (that `keep` accepts), in `clip`.
-fn vertex_sphere<const C: usize>(
+pub(super) fn vertex_sphere<const C: usize>(
     v: &Primitive,
     r: f64,
     keep: &impl Fn(&Primitive, DVec3) -> bool,
+    halves: &[HalfSpace],
     clip: &CoordBox,
     sink: &mut BrickSink<C>,
 ) {
@@ -523,13 +599,23 @@ fn vertex_sphere<const C: usize>(
     let r2 = (r + MARGIN) * (r + MARGIN);
     for x in clipped(int_range(p.x - r - MARGIN, p.x + r + MARGIN), clip, 0) {
         for y in clipped(int_range(p.y - r - MARGIN, p.y + r + MARGIN), clip, 1) {
+            let column = within(
+                clip.min[2]..=clip.max[2],
+                DVec3::new(x as f64, y as f64, 0.0),
+                2,
+                halves,
+            );
+            if column.is_empty() {
+                continue;
+            }
             let (dx, dy) = (x as f64 - p.x, y as f64 - p.y);
             // (z - p.z)^2 <= r2 - dx^2 - dy^2
-            for z in clipped(
-                quadratic_range(1.0, 1.0, -p.z, p.z * p.z + dx * dx + dy * dy - r2),
-                clip,
-                2,
-            ) {
+            let near = quadratic_range(1.0, 1.0, -p.z, p.z * p.z + dx * dx + dy * dy - r2);
+            let (first, last) = (
+                (*near.start()).max(*column.start()),
+                (*near.end()).min(*column.end()),
+            );
+            for z in first..=last {
                 let c = DVec3::new(x as f64, y as f64, z as f64);
                 let d2 = (c - p).length_squared();
                 if d2 <= r2 && keep(v, c) {
@@ -542,10 +628,11 @@ fn vertex_sphere<const C: usize>(
 
 /// S_e: voxel centres within `r` of the edge whose projection falls on the edge (and that
 /// `keep` accepts), in `clip`.
-fn edge_cylinder<const C: usize>(
+pub(super) fn edge_cylinder<const C: usize>(
     e: &Primitive,
     r: f64,
     keep: &impl Fn(&Primitive, DVec3) -> bool,
+    halves: &[HalfSpace],
     clip: &CoordBox,
     sink: &mut BrickSink<C>,
 ) {
@@ -557,32 +644,59 @@ fn edge_cylinder<const C: usize>(
     let w = d.abs().max_position();
     let (u, v) = ((w + 1) % 3, (w + 2) % 3);
     let r = r + MARGIN;
-    // In a plane across axis w, the cylinder's section stays within r / |unit d_w| of the axis.
-    let reach = r * len2.sqrt() / d[w].abs();
-    let tau_margin = MARGIN / len2.sqrt();
     let dn = d / len2.sqrt();
+    // In a plane across axis w the cylinder's section is an ellipse reaching
+    // r sqrt(1 - dn_v^2) / |dn_w| from the axis along u; the caps, discs of radius r across
+    // the edge, reach r sqrt(1 - dn_w^2) beyond its ends along w.
+    let reach = r * (1.0 - dn[v] * dn[v]).sqrt() / dn[w].abs() + ROW_SLACK;
+    let cap = r * (1.0 - dn[w] * dn[w]).max(0.0).sqrt() + ROW_SLACK;
+    let tau_margin = MARGIN / len2.sqrt();
     // The quadratic's leading coefficient is the edge's: 1 - dn_v^2 >= 2/3, as v is not
     // its longest axis.
     let a = 1.0 - dn[v] * dn[v];
     let inv_a = 1.0 / a;
+    let columns = clip.min[v]..=clip.max[v];
     for k in clipped(
-        int_range(p[w].min(e.b[w]) - r, p[w].max(e.b[w]) + r),
+        int_range(p[w].min(e.b[w]) - cap, p[w].max(e.b[w]) + cap),
         clip,
         w,
     ) {
         let c = p + d * ((k as f64 - p[w]) / d[w]);
         for iu in clipped(int_range(c[u] - reach, c[u] + reach), clip, u) {
+            let mut row = DVec3::ZERO;
+            row[w] = k as f64;
+            row[u] = iu as f64;
+            let span = within(columns.clone(), row, v, halves);
+            if span.is_empty() {
+                continue;
+            }
             // y = x - p with x_v = 0; dist^2(v) = |y + v e_v|^2 - ((y + v e_v)·dn)^2 <= r^2.
-            let mut y0 = -p;
-            y0[w] += k as f64;
-            y0[u] += iu as f64;
+            let y0 = row - p;
+            // tau is linear along the row: keep the values of iv whose projection can fall on
+            // the edge (most of a short edge's rows lie beyond its ends).
+            let (t0, dt) = (y0.dot(d) / len2, d[v] / len2);
+            let on_edge = if dt == 0.0 {
+                if (-tau_margin..=1.0 + tau_margin).contains(&t0) {
+                    span
+                } else {
+                    continue;
+                }
+            } else {
+                let (e0, e1) = ((-tau_margin - t0) / dt, (1.0 + tau_margin - t0) / dt);
+                let along = int_range(e0.min(e1) - ROW_SLACK, e0.max(e1) + ROW_SLACK);
+                (*span.start()).max(*along.start())..=(*span.end()).min(*along.end())
+            };
+            if on_edge.is_empty() {
+                continue;
+            }
             let along = y0.dot(dn);
             let b = y0[v] - along * dn[v];
             let cc = y0.length_squared() - along * along - r * r;
-            for iv in clipped(quadratic_range(a, inv_a, b, cc), clip, v) {
-                let mut x = DVec3::ZERO;
-                x[w] = k as f64;
-                x[u] = iu as f64;
+            let near = quadratic_range(a, inv_a, b, cc);
+            let first = (*near.start()).max(*on_edge.start());
+            let last = (*near.end()).min(*on_edge.end());
+            for iv in first..=last {
+                let mut x = row;
                 x[v] = iv as f64;
                 let tau = (x - p).dot(d) / len2;
                 if !(-tau_margin..=1.0 + tau_margin).contains(&tau) {
@@ -597,11 +711,11 @@ fn edge_cylinder<const C: usize>(
     }
 }
 
-/// S_b: voxel centres in the triangle's half-open slab (see the module docs) whose projection
-/// lies inside it, in `clip`.
-fn face_body<const C: usize>(
+/// S_b: voxel centres in the triangle's slab `d_lo <= d < d_hi` (`d` along the turned normal:
+/// see the module docs) whose projection lies inside it, in `clip`.
+pub(super) fn face_body<const C: usize>(
     tri: &Triangle,
-    sep: Separability,
+    (d_lo, d_hi): (f64, f64),
     clip: &CoordBox,
     sink: &mut BrickSink<C>,
 ) {
@@ -609,8 +723,7 @@ fn face_body<const C: usize>(
     // the normal's sign, the edge planes do (they point inwards for the face's own normal).
     let n = turned(tri.normal);
     let [a, b, c] = tri.corners;
-    let (d_lo, d_hi) = slab_bounds(sep.slab_half_thickness(n));
-    let t = sep.slab_half_thickness(n) + MARGIN;
+    let t = (-d_lo).max(d_hi);
     let w = n.abs().max_position();
     let (u, v) = ((w + 1) % 3, (w + 2) % 3);
     // In-plane inward normals of the edges: the planes E_i of the paper.
@@ -618,6 +731,18 @@ fn face_body<const C: usize>(
         let m = tri.normal.cross(q - p);
         (m / m.length(), p)
     });
+    // The same planes as half-spaces, to cut each column to the prism before the exact test:
+    // worth it where columns are long (a thick slab, as the distance band's), not for the
+    // one or two voxels of a separating surface's.
+    let inside_sides = sides.map(|(m, p)| HalfSpace {
+        g: -m,
+        h: m.dot(p) - MARGIN,
+    });
+    let column_cut: &[HalfSpace] = if (d_hi - d_lo) / n[w] > 4.0 {
+        &inside_sides
+    } else {
+        &[]
+    };
     let lo = a.min(b).min(c) - DVec3::splat(t);
     let hi = a.max(b).max(c) + DVec3::splat(t);
     let half = t / n[w].abs();
@@ -647,11 +772,13 @@ fn face_body<const C: usize>(
             // d_lo <= s + n_w (k - a_w) < d_hi with n_w > 0, solved for k.
             let k0 = a[w] + (d_lo - s) / n[w];
             let k1 = a[w] + (d_hi - s) / n[w];
-            for k in clipped(half_open_range(k0, k1), clip, w) {
-                let mut x = DVec3::ZERO;
+            let mut column = DVec3::ZERO;
+            column[u] = iu as f64;
+            column[v] = iv as f64;
+            let slab = clipped(half_open_range(k0, k1), clip, w);
+            for k in within(slab, column, w, column_cut) {
+                let mut x = column;
                 x[w] = k as f64;
-                x[u] = iu as f64;
-                x[v] = iv as f64;
                 if sides.iter().all(|(m, p)| m.dot(x - *p) >= -MARGIN) {
                     sink.add(to_coord(x), || n.dot(x - a).abs(), tri.normal);
                 }
