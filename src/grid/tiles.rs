@@ -8,6 +8,8 @@ use rustc_hash::FxHashSet;
 
 /// Edge of a node tile in voxels (16 leaves of 8).
 pub const NODE_DIM: i64 = 128;
+/// The 8^3 blocks of a node tile.
+pub const NODE_LEAVES: usize = 4096;
 
 /// Origin of the 128^3 node holding `c`: each coordinate rounded down to a multiple of 128.
 #[inline]
@@ -94,7 +96,7 @@ impl Tiles {
     /// Makes the 128^3 block at `origin` whole, absorbing its 8^3 tiles.
     pub fn insert_node(&mut self, origin: Coord) {
         if self.nodes.insert(origin) {
-            if self.leaves.len() < 4096 {
+            if self.leaves.len() < NODE_LEAVES {
                 self.leaves.retain(|&o| node_origin(o) != origin);
             } else {
                 for o in node_leaf_origins(origin) {
@@ -132,7 +134,7 @@ impl Tiles {
             *per_node.entry(node_origin(o)).or_default() += 1;
         }
         for (node, n) in per_node {
-            if n == 4096 {
+            if n as usize == NODE_LEAVES {
                 self.insert_node(node);
             }
         }

@@ -30,7 +30,15 @@ unsafe extern "C" {
         blocksize: usize,
         numinternalthreads: c_int,
     ) -> c_int;
+    fn blosc_set_splitmode(splitmode: c_int);
 }
+
+/// Blosc's `BLOSC_NEVER_SPLIT`: compress each block in one stream, not one per byte of a
+/// value. Blosc's default splits a float leaf into four LZ4 streams, and LZ4 clears its
+/// 16 KB state for each: most of the time spent compressing a leaf. Readers (OpenVDB
+/// included) take either form, as the chunk's header says which.
+const BLOSC_NEVER_SPLIT: c_int = 2;
+static BLOSC_SPLIT_MODE: std::sync::Once = std::sync::Once::new();
 
 #[link(name = "z")]
 unsafe extern "C" {
@@ -73,6 +81,8 @@ pub(super) fn push_chunk(out: &mut Vec<u8>, data: &[u8], value_size: usize, comp
 /// Compresses `data` into `out` as a blosc chunk (LZ4 with byte shuffling by value,
 /// OpenVDB's settings); its length, or `None` when blosc cannot compress it into `out`.
 fn blosc(data: &[u8], value_size: usize, out: &mut [u8]) -> Option<usize> {
+    // SAFETY: sets a global blosc reads when compressing, once, before any compression.
+    BLOSC_SPLIT_MODE.call_once(|| unsafe { blosc_set_splitmode(BLOSC_NEVER_SPLIT) });
     // SAFETY: both buffers are valid for the lengths given; blosc writes at most `destsize`.
     let written = unsafe {
         blosc_compress_ctx(

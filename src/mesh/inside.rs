@@ -16,6 +16,9 @@ pub struct ColumnCrossings {
     crossings: Vec<(usize, f64)>,
     /// Where each x row of columns starts in `crossings` (and where the last ends).
     row_starts: Vec<usize>,
+    /// Per row, where each of its columns starts, from the row's start (`height + 1` entries
+    /// a row, the last the row's length): a column's crossings without a search.
+    column_starts: Vec<u32>,
 }
 
 /// Triangles per parallel batch of crossings.
@@ -55,24 +58,37 @@ impl ColumnCrossings {
         for x in 0..nx {
             row_starts[x + 1] += row_starts[x];
         }
+        let mut column_starts = vec![0u32; nx * (ny + 1)];
+        column_starts
+            .par_chunks_mut(ny + 1)
+            .enumerate()
+            .for_each(|(x, starts)| {
+                // A row's crossings number far below 2^32: each takes 16 bytes in memory.
+                for c in &crossings[row_starts[x]..row_starts[x + 1]] {
+                    starts[c.0 % ny + 1] += 1;
+                }
+                for y in 0..ny {
+                    starts[y + 1] += starts[y];
+                }
+            });
         ColumnCrossings {
             window,
             crossings,
             row_starts,
+            column_starts,
         }
     }
 
     /// The crossings of columns `(x, y)` for `y` in `ys`, which must lie in the window.
     fn columns_of(&self, x: i64, ys: std::ops::RangeInclusive<i64>) -> &[(usize, f64)] {
         let row = (x - self.window.a0) as usize;
-        let in_row = &self.crossings[self.row_starts[row]..self.row_starts[row + 1]];
+        let starts = &self.column_starts[row * (self.window.height + 1)..];
         let (first, last) = (
-            self.window.ray(x, *ys.start()),
-            self.window.ray(x, *ys.end()),
+            (*ys.start() - self.window.b0) as usize,
+            (*ys.end() - self.window.b0) as usize,
         );
-        let start = in_row.partition_point(|c| c.0 < first);
-        let end = start + in_row[start..].partition_point(|c| c.0 <= last);
-        &in_row[start..end]
+        let base = self.row_starts[row];
+        &self.crossings[base + starts[first] as usize..base + starts[last + 1] as usize]
     }
 
     /// The inside centres of column `(x, y)` (inside the box's columns) as inclusive z spans,

@@ -8,6 +8,7 @@
 use crate::error::{Error, Result};
 use crate::grid::{Block, Channels, Coord, CoordBox, SparseGrid};
 use crate::progress::Progress;
+use rayon::prelude::*;
 
 const FULL: [u64; 8] = [u64::MAX; 8];
 /// The bits of a mask word with z = 0, and with z = 7.
@@ -199,11 +200,12 @@ pub fn inside_by_blocks(surface: &SparseGrid, progress: &Progress) -> Result<Spa
         }
     }
     progress.advance(1);
-    for (i, &slot) in blocks.slot.iter().enumerate() {
-        if slot == 0 && !exterior[i] {
-            inside.fill_leaf_block(blocks.coord(i).map(|v| v * 8));
-        }
-    }
+    let whole: Vec<Coord> = (0..blocks.slot.len())
+        .into_par_iter()
+        .filter(|&i| blocks.slot[i] == 0 && !exterior[i])
+        .map(|i| blocks.coord(i).map(|v| v * 8))
+        .collect();
+    inside.fill_leaf_blocks(whole);
     for (s, origin) in blocks.origins.iter().enumerate() {
         let mask: [u64; 8] = std::array::from_fn(|x| blocks.free[s][x] & !reached[s][x]);
         if mask != [0; 8] {

@@ -24,6 +24,7 @@ use crate::subd::ControlMesh;
 use crate::voxelize::Separability;
 use crate::voxelize::parametric::ParametricOptions;
 use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// Why the flood needs a closed mesh, for the error that refuses an open one.
@@ -251,7 +252,7 @@ pub(super) fn distance_band(
     };
     let inside_band_voxels = grid
         .leaves()
-        .iter()
+        .par_iter()
         .map(|l| {
             let values = l.value.as_ref().expect("distances");
             l.offsets().filter(|&n| values[n] < 0.0).count() as u64

@@ -67,11 +67,8 @@ pub fn level_set(
         })
         .collect();
     let mut interior = SparseGrid::from_distinct_leaves(transform, Channels::NONE, inside);
-    for origin in inside_blocks(&columns, &grid) {
-        interior.fill_leaf_block(origin);
-    }
     // Band leaves stay leaves, even wholly inside: the level set writes its tiles.
-    interior.promote_tiles();
+    interior.fill_leaf_blocks(inside_blocks(&columns, &grid));
     Ok(LevelSet {
         band: grid,
         interior,

@@ -122,9 +122,10 @@ impl Halves {
         }
     }
 
-    /// Keeps the points `x` with `g·(x - p) <= MARGIN` (`g` a unit vector).
+    /// Keeps the points `x` with `g·(x - p) <= MARGIN` (`g` a unit vector); a repeated one
+    /// (an edge seen from both its triangles) is kept once.
     fn push(&mut self, g: DVec3, p: DVec3) {
-        if self.len < MOST_HALVES {
+        if self.len < MOST_HALVES && !self.as_slice().iter().any(|h| h.g == g) {
             self.list[self.len] = HalfSpace {
                 g,
                 h: -g.dot(p) - MARGIN,

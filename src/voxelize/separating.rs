@@ -184,6 +184,9 @@ fn within(
         } else if rhs < 0.0 {
             return int_range(0.0, -1.0);
         }
+        if lo > hi {
+            break;
+        }
     }
     lo..=hi
 }
@@ -779,7 +782,9 @@ pub(super) fn face_body<const C: usize>(
             for k in within(slab, column, w, column_cut) {
                 let mut x = column;
                 x[w] = k as f64;
-                if sides.iter().all(|(m, p)| m.dot(x - *p) >= -MARGIN) {
+                // A cut column is exact to 1e-6 voxels, which moves a plane distance by less
+                // than 1e-12: the distance band needs no test per voxel.
+                if !column_cut.is_empty() || sides.iter().all(|(m, p)| m.dot(x - *p) >= -MARGIN) {
                     sink.add(to_coord(x), || n.dot(x - a).abs(), tri.normal);
                 }
             }
