@@ -12,7 +12,7 @@ use super::vdb_chunks::{
 };
 use super::vdb_tree_structure::{TreeFormat, tree_memory};
 use crate::error::{Error, Result};
-use crate::grid::{LEAF_VOXELS, Leaf, SparseGrid, Transform};
+use crate::grid::{Leaf, SparseGrid, Transform};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -92,12 +92,13 @@ impl GridValues<'_> {
 
     /// The active values of `leaf`, in offset order, as stored.
     fn push_leaf_values(self, out: &mut Vec<u8>, leaf: &Leaf, half: bool) {
-        let mut values = [0f32; 3 * LEAF_VOXELS];
-        let mut count = 0;
-        let mut put = |v: f32| {
-            values[count] = v;
-            count += 1;
+        let components = if matches!(self, GridValues::Normals | GridValues::Colors) {
+            3
+        } else {
+            1
         };
+        out.reserve(leaf.count() as usize * components * if half { 2 } else { 4 });
+        let mut put = |v: f32| push_real(out, v, half);
         match self {
             GridValues::Bool => unreachable!("bool leaves store a mask"),
             GridValues::Constant(v) => leaf.offsets().for_each(|_| put(v)),
@@ -129,16 +130,6 @@ impl GridValues<'_> {
                 leaf.offsets()
                     .for_each(|n| vectors[n].iter().for_each(|&c| put(c)));
             }
-        }
-        let values = &values[..count];
-        if half {
-            out.extend(
-                values
-                    .iter()
-                    .flat_map(|&v| half::f16::from_f32(v).to_le_bytes()),
-            );
-        } else {
-            out.extend(values.iter().flat_map(|&v| v.to_le_bytes()));
         }
     }
 

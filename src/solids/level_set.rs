@@ -10,9 +10,9 @@
 //! band), so one centre decides it.
 
 use crate::error::Result;
-use crate::grid::{Channels, Coord, Leaf, SparseGrid, Transform};
-use crate::mesh::Mesh;
+use crate::grid::{Channels, Coord, CoordBox, Leaf, SparseGrid, Transform};
 use crate::mesh::inside::ColumnCrossings;
+use crate::mesh::{Mesh, index_box};
 use crate::progress::Progress;
 use crate::voxelize::distance_band::distance_band;
 use rayon::prelude::*;
@@ -38,14 +38,25 @@ pub fn level_set(
     progress: &Progress,
 ) -> Result<LevelSet> {
     mesh.require_closed(SIGN_NEEDS_CLOSED)?;
-    let mut grid = distance_band(mesh, transform, band, progress)?;
-    let Some(bbox) = grid.bbox() else {
+    // The crossings cover the band's columns: the mesh's box widened by the band. They are
+    // found beside the band, filling the threads in its serial steps.
+    let reach = band.ceil() as i64;
+    let mesh_box = index_box(&mesh.bbox(), &transform);
+    let columns_box = CoordBox {
+        min: mesh_box.min.map(|v| v - reach),
+        max: mesh_box.max.map(|v| v + reach),
+    };
+    let (grid, columns) = rayon::join(
+        || distance_band(mesh, transform, band, progress),
+        || ColumnCrossings::new(mesh, &transform, columns_box),
+    );
+    let mut grid = grid?;
+    if grid.leaf_count() == 0 {
         return Ok(LevelSet {
             band: grid,
             interior: SparseGrid::new(transform, Channels::NONE),
         });
-    };
-    let columns = ColumnCrossings::new(mesh, &transform, bbox);
+    }
     let h = transform.voxel_size as f32;
     let inside: Vec<Leaf> = grid
         .leaves_mut()
