@@ -658,6 +658,10 @@ pub(super) fn edge_cylinder<const C: usize>(
     // its longest axis.
     let a = 1.0 - dn[v] * dn[v];
     let inv_a = 1.0 / a;
+    // Reciprocals for the candidate ranges (the exact tests below divide).
+    let inv_len2 = 1.0 / len2;
+    let dt = d[v] * inv_len2;
+    let inv_dt = 1.0 / dt;
     let columns = clip.min[v]..=clip.max[v];
     for k in clipped(
         int_range(p[w].min(e.b[w]) - cap, p[w].max(e.b[w]) + cap),
@@ -677,7 +681,7 @@ pub(super) fn edge_cylinder<const C: usize>(
             let y0 = row - p;
             // tau is linear along the row: keep the values of iv whose projection can fall on
             // the edge (most of a short edge's rows lie beyond its ends).
-            let (t0, dt) = (y0.dot(d) / len2, d[v] / len2);
+            let t0 = y0.dot(d) * inv_len2;
             let on_edge = if dt == 0.0 {
                 if (-tau_margin..=1.0 + tau_margin).contains(&t0) {
                     span
@@ -685,7 +689,10 @@ pub(super) fn edge_cylinder<const C: usize>(
                     continue;
                 }
             } else {
-                let (e0, e1) = ((-tau_margin - t0) / dt, (1.0 + tau_margin - t0) / dt);
+                let (e0, e1) = (
+                    (-tau_margin - t0) * inv_dt,
+                    (1.0 + tau_margin - t0) * inv_dt,
+                );
                 let along = int_range(e0.min(e1) - ROW_SLACK, e0.max(e1) + ROW_SLACK);
                 (*span.start()).max(*along.start())..=(*span.end()).min(*along.end())
             };
@@ -749,16 +756,24 @@ pub(super) fn face_body<const C: usize>(
     let lo = a.min(b).min(c) - DVec3::splat(t);
     let hi = a.max(b).max(c) + DVec3::splat(t);
     let half = t / n[w].abs();
+    let inv_nw = 1.0 / n[w];
+    // Clip each row to the columns whose slab segment can reach inside every edge plane: the
+    // best k of the slab turns each plane test into a linear bound on iv, `at(iu) + slope iv
+    // >= 0` with `at(iu) = at0 + at1 iu`, set up once per triangle.
+    let bounds = sides.map(|(m, p)| {
+        let slope = m[v] - m[w] * n[v] / n[w];
+        let at1 = m[u] - m[w] * n[u] / n[w];
+        let at0 = -m[u] * p[u] - m[v] * p[v]
+            + m[w] * (a[w] - p[w])
+            + m[w] * (n[u] * a[u] + n[v] * a[v]) / n[w]
+            + m[w].abs() * half
+            + ROW_SLACK;
+        (slope, at0, at1)
+    });
     for iu in clipped(int_range(lo[u], hi[u]), clip, u) {
-        // Clip the row to the columns whose slab segment can reach inside every edge plane:
-        // the best k of the slab turns each plane test into a linear bound on iv.
         let (mut v_lo, mut v_hi) = (lo[v], hi[v]);
-        for (m, p) in &sides {
-            let slope = m[v] - m[w] * n[v] / n[w];
-            let at_zero = m[u] * (iu as f64 - p[u]) - m[v] * p[v] + m[w] * (a[w] - p[w])
-                - m[w] * (n[u] * (iu as f64 - a[u]) - n[v] * a[v]) / n[w]
-                + m[w].abs() * half
-                + ROW_SLACK;
+        for &(slope, at0, at1) in &bounds {
+            let at_zero = at0 + at1 * iu as f64;
             if slope > 0.0 {
                 v_lo = v_lo.max(-at_zero / slope);
             } else if slope < 0.0 {
@@ -772,9 +787,10 @@ pub(super) fn face_body<const C: usize>(
         }
         for iv in clipped(int_range(v_lo, v_hi), clip, v) {
             let s = n[u] * (iu as f64 - a[u]) + n[v] * (iv as f64 - a[v]);
-            // d_lo <= s + n_w (k - a_w) < d_hi with n_w > 0, solved for k.
-            let k0 = a[w] + (d_lo - s) / n[w];
-            let k1 = a[w] + (d_hi - s) / n[w];
+            // d_lo <= s + n_w (k - a_w) < d_hi with n_w > 0, solved for k (the slab's
+            // margins dwarf the reciprocal's rounding).
+            let k0 = a[w] + (d_lo - s) * inv_nw;
+            let k1 = a[w] + (d_hi - s) * inv_nw;
             let mut column = DVec3::ZERO;
             column[u] = iu as f64;
             column[v] = iv as f64;
