@@ -12,11 +12,12 @@ use super::vdb_chunks::{
 };
 use super::vdb_tree_structure::{TreeFormat, tree_memory};
 use crate::error::{Error, Result};
-use crate::grid::{Leaf, SparseGrid, Transform};
+use crate::grid::{LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::Path;
+use std::sync::OnceLock;
 
 /// OpenVDB's magic number and the file format version written (OpenVDB 10's).
 const MAGIC: i64 = 0x5644_4220;
@@ -353,13 +354,24 @@ fn encode_grid(path: &Path, g: &GridOut, encoding: Encoding) -> Result<EncodedGr
         .map(|child| root_child_topology(child, g.values, compression, half))
         .collect();
     let leaves: Vec<&Leaf> = encoded.iter().flat_map(|e| e.1.iter().copied()).collect();
+    let constant_chunks: Vec<OnceLock<Vec<u8>>> =
+        (0..=LEAF_VOXELS).map(|_| OnceLock::new()).collect();
     let buffers: Vec<Vec<u8>> = leaves
         .par_chunks(BATCH)
         .map(|batch| {
             let mut out = Vec::with_capacity(batch.len() * 200);
             let mut scratch = Vec::new();
             for leaf in batch {
-                leaf_buffer(&mut out, &mut scratch, leaf, g.values, compression, half);
+                let chunks = &constant_chunks;
+                leaf_buffer(
+                    &mut out,
+                    &mut scratch,
+                    leaf,
+                    g.values,
+                    chunks,
+                    compression,
+                    half,
+                );
             }
             out
         })
@@ -497,6 +509,7 @@ fn leaf_buffer(
     scratch: &mut Vec<u8>,
     leaf: &Leaf,
     values: GridValues,
+    constant_chunks: &[OnceLock<Vec<u8>>],
     compression: u32,
     half: bool,
 ) {
@@ -512,6 +525,19 @@ fn leaf_buffer(
     let inactive_inside: [u64; 8] = std::array::from_fn(|w| inside[w] & !leaf.mask[w]);
     let inactive_outside: [u64; 8] = std::array::from_fn(|w| !(inside[w] | leaf.mask[w]));
     push_inactive(out, &inactive_inside, &inactive_outside);
+    if let GridValues::Constant(_) = values {
+        // A constant grid's chunk depends on the leaf's voxel count alone: each count is
+        // compressed once.
+        let chunk = constant_chunks[leaf.count() as usize].get_or_init(|| {
+            let mut data = Vec::new();
+            values.push_leaf_values(&mut data, leaf, half);
+            let mut chunk = Vec::new();
+            push_values(&mut chunk, &data, values, compression, half);
+            chunk
+        });
+        out.extend_from_slice(chunk);
+        return;
+    }
     scratch.clear();
     values.push_leaf_values(scratch, leaf, half);
     push_values(out, scratch, values, compression, half);
