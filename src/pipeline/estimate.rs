@@ -84,15 +84,15 @@ struct FillCost {
 }
 
 /// The block flood (the default): the surface, the solid's boundary leaves and the grids
-/// written (750 bytes per surface leaf), the block states (8 bytes per block of the box) and
-/// the inside's tiles (0.4 bits per inside voxel); no dense volume. Estimate/peak 0.81-1.27
+/// written (750 bytes per surface leaf), the block states (6 bytes per block of the box) and
+/// the inside's tiles (0.2 bits per inside voxel); no dense volume. Estimate/peak 0.75-1.27
 /// on the five meshes at 1024.
 const BLOCK_FLOOD_COST: FillCost = FillCost {
     bit_volumes: 0.0,
-    inside_volumes: 0.4,
+    inside_volumes: 0.2,
     face_bytes: 0.0,
     leaf_bytes: 750.0,
-    block_bytes: 8.0,
+    block_bytes: 6.0,
     triangle_bytes: TRIANGLE_BYTES,
 };
 /// The span flood and FloodingXYZ: two dense volumes (surface and reached) and what scales
