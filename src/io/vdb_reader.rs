@@ -156,9 +156,10 @@ impl VdbFile {
     /// Parses the header and descriptors of `data`, a whole `.vdb` file whose structure
     /// `vdb_structure::check_structure` accepted.
     pub fn parse(data: Vec<u8>) -> Parsed<VdbFile> {
+        // After the magic number: the file version (222 or later, checked), the library
+        // version, the offsets flag and the UUID.
         let mut c = Cursor::at(&data, 8);
-        let _version = c.u32()?;
-        c.take(8 + 1 + 36)?; // library version, offsets flag, UUID
+        c.take(4 + 8 + 1 + 36)?;
         skip_metadata(&mut c)?;
         let count = c.u32()?;
         let mut descriptors = Vec::new();

@@ -174,7 +174,7 @@ fn within(
         if ga > 0.0 {
             let bound = rhs / ga + ROW_SLACK;
             if bound < hi as f64 {
-                hi = *int_range(f64::NEG_INFINITY, bound.max(lo as f64 - 1.0)).end();
+                hi = floor_int(bound.max(lo as f64 - 1.0));
             }
         } else if ga < 0.0 {
             let bound = rhs / ga - ROW_SLACK;
@@ -548,9 +548,14 @@ fn is_planar(face: &[u32], pos: &[DVec3], n: DVec3) -> bool {
 /// Integer range `ceil(lo)..=floor(hi)`.
 #[inline]
 fn int_range(lo: f64, hi: f64) -> std::ops::RangeInclusive<i64> {
-    let h = hi as i64;
-    let h = if (h as f64) > hi { h - 1 } else { h };
-    ceil_int(lo)..=h
+    ceil_int(lo)..=floor_int(hi)
+}
+
+/// `floor(x)` by truncation plus a fix-up (see `ceil_int`).
+#[inline]
+fn floor_int(x: f64) -> i64 {
+    let h = x as i64;
+    if (h as f64) > x { h - 1 } else { h }
 }
 
 /// `ceil(x)` by truncation plus a fix-up: `f64::ceil`/`floor` are libm calls without SSE4.1.
