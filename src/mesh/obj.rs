@@ -18,27 +18,19 @@ pub(super) fn load_obj(path: &Path) -> Result<Mesh> {
         line,
         message,
     })?;
-    Ok(Mesh {
-        positions: parsed.positions,
-        indices: parsed.indices,
-        face_starts: parsed.face_starts,
-        colors: parsed.colors,
-        polylines: parsed.polylines,
-        source: path.to_path_buf(),
-        ..Default::default()
-    })
+    let mut mesh = Mesh::from_polygons(path, parsed.positions, &parsed.polygons);
+    mesh.colors = parsed.colors;
+    mesh.polylines = parsed.polylines;
+    Ok(mesh)
 }
 
-/// What an OBJ file holds (0-based indices): polygons as `Mesh` keeps them, their corners
-/// in one list (a few hundred thousand small lists cost more to allocate than to parse).
-#[derive(Debug)]
+/// What an OBJ file holds (0-based indices).
+#[derive(Debug, Default)]
 struct Parsed {
     positions: Vec<DVec3>,
     /// One colour per vertex, or none at all.
     colors: Vec<Vec3>,
-    indices: Vec<u32>,
-    /// Where each polygon starts in `indices`, and where the last ends.
-    face_starts: Vec<u32>,
+    polygons: Vec<Vec<u32>>,
     polylines: Vec<Vec<u32>>,
 }
 
@@ -64,14 +56,14 @@ fn numbers<'a, const N: usize>(
     Ok(out)
 }
 
-/// Appends the 0-based vertex indices of an `f` or `l` statement's corners to `out`.
+/// The 0-based vertex indices of an `f` or `l` statement's corners.
 fn corners<'a>(
     words: impl Iterator<Item = &'a str>,
     vertices: i64,
     what: &str,
     line: usize,
-    out: &mut Vec<u32>,
-) -> std::result::Result<(), LineError> {
+) -> std::result::Result<Vec<u32>, LineError> {
+    let mut out = Vec::new();
     for corner in words {
         let index = corner.split('/').next().unwrap_or("");
         let i = match index.parse::<i64>() {
@@ -91,18 +83,12 @@ fn corners<'a>(
         }
         out.push(i as u32);
     }
-    Ok(())
+    Ok(out)
 }
 
 /// Parses OBJ text, or names the first bad line: `(1-based line, message)`.
 fn parse_obj(text: &str) -> std::result::Result<Parsed, LineError> {
-    let mut out = Parsed {
-        positions: Vec::new(),
-        colors: Vec::new(),
-        indices: Vec::new(),
-        face_starts: vec![0],
-        polylines: Vec::new(),
-    };
+    let mut out = Parsed::default();
     // The first vertex line with a colour and the first without: a file must not mix them.
     let (mut colored, mut plain) = (None, None);
     for (n, raw) in text.lines().enumerate() {
@@ -112,9 +98,9 @@ fn parse_obj(text: &str) -> std::result::Result<Parsed, LineError> {
             Some("v") => {
                 out.positions
                     .push(DVec3::from_array(numbers::<3>(&mut words, "vertex", line)?));
-                let rest = [words.next(), words.next(), words.next()];
-                if let [Some(r), Some(g), Some(b)] = rest {
-                    let c = numbers::<3>(&mut [r, g, b].into_iter(), "vertex colour", line)?;
+                let rest: Vec<&str> = words.collect();
+                if rest.len() >= 3 {
+                    let c = numbers::<3>(&mut rest.into_iter(), "vertex colour", line)?;
                     out.colors.push(DVec3::from_array(c).as_vec3());
                     colored.get_or_insert(line);
                 } else {
@@ -130,14 +116,11 @@ fn parse_obj(text: &str) -> std::result::Result<Parsed, LineError> {
                 }
             }
             Some("f") => {
-                let vertices = out.positions.len() as i64;
-                corners(words, vertices, "face", line, &mut out.indices)?;
-                out.face_starts.push(out.indices.len() as u32);
+                let polygon = corners(words, out.positions.len() as i64, "face", line)?;
+                out.polygons.push(polygon);
             }
             Some("l") => {
-                let mut polyline = Vec::new();
-                let vertices = out.positions.len() as i64;
-                corners(words, vertices, "line", line, &mut polyline)?;
+                let polyline = corners(words, out.positions.len() as i64, "line", line)?;
                 if polyline.len() < 2 {
                     return Err((line, "a line needs 2 or more vertices".into()));
                 }
@@ -174,8 +157,7 @@ mod tests {
         let parsed =
             parse_obj("v 0 0 0\nv 9 9 9\nv 1 0 0\nvt 0 0\nv 0 1 0\nf 1/1 3/1 -1/1\n").unwrap();
         assert_eq!(parsed.positions.len(), 4);
-        assert_eq!(parsed.indices, vec![0, 2, 3]);
-        assert_eq!(parsed.face_starts, vec![0, 3]);
+        assert_eq!(parsed.polygons, vec![vec![0, 2, 3]]);
         assert!(parsed.colors.is_empty());
     }
 
