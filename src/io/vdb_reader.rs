@@ -6,7 +6,7 @@
 //! `tree/RootNode.h`, `InternalNode.h`, `LeafNode.h`), the one `vdb_writer` writes.
 
 use super::vdb_chunks::{COMPRESS_ACTIVE_MASK, read_chunk};
-use super::vdb_tree_structure::{LeafKind, TreeFormat};
+use super::vdb_tree_structure::{LeafKind, TreeFormat, value_type};
 use crate::grid::LEAF_VOXELS;
 use rayon::prelude::*;
 
@@ -160,7 +160,7 @@ impl VdbFile {
         // version, the offsets flag and the UUID.
         let mut c = Cursor::at(&data, 8);
         c.take(4 + 8 + 1 + 36)?;
-        skip_metadata(&mut c)?;
+        read_metadata(&mut c)?; // the file's own, unused
         let count = c.u32()?;
         let mut descriptors = Vec::new();
         for _ in 0..count {
@@ -279,7 +279,7 @@ impl VdbFile {
             .collect();
         Ok(GridInfo {
             name: d.name.clone(),
-            value_type: value_type_name(&d.type_name),
+            value_type: value_type(&d.type_name).to_string(),
             grid_class,
             voxel_size: header.voxel_size,
             origin: header.origin,
@@ -299,7 +299,7 @@ impl VdbFile {
         let owner = self.tree_owner(index)?;
         let header = self.header(owner)?;
         let format = TreeFormat::of(&owner.type_name)?;
-        let value_type = value_type_name(&owner.type_name);
+        let value_type = value_type(&owner.type_name).to_string();
         let components = match value_type.as_str() {
             "bool" | "mask" => 0,
             "float" => 1,
@@ -359,15 +359,6 @@ impl VdbFile {
     }
 }
 
-/// `Tree_float_5_4_3_HalfFloat` -> `float`.
-fn value_type_name(type_name: &str) -> String {
-    type_name
-        .strip_prefix("Tree_")
-        .and_then(|t| t.split("_5_4_3").next())
-        .unwrap_or(type_name)
-        .to_string()
-}
-
 /// The lowest and highest voxel offsets, per axis, of a non-empty leaf mask (bit
 /// `x << 6 | y << 3 | z`: word x, byte y, bit z).
 fn leaf_bounds(mask: &[u64; 8]) -> ([i32; 3], [i32; 3]) {
@@ -383,11 +374,6 @@ fn leaf_bounds(mask: &[u64; 8]) -> ([i32; 3], [i32; 3]) {
             7 - zbits.leading_zeros() as i32,
         ],
     )
-}
-
-/// A metadata map, skipped (the file's own).
-fn skip_metadata(c: &mut Cursor) -> Parsed<()> {
-    read_metadata(c).map(|_| ())
 }
 
 /// A metadata map, each value as text (OpenVDB's `str()`: numbers, `true`/`false`,

@@ -42,14 +42,8 @@ pub(super) enum LeafKind {
 impl TreeFormat {
     /// The format of a standard (5-4-3) tree of a registered type, or why it is not read.
     pub(super) fn of(type_name: &str) -> std::result::Result<Self, String> {
-        let (base, half) = match type_name.strip_suffix(HALF_SUFFIX) {
-            Some(base) => (base, true),
-            None => (type_name, false),
-        };
-        let value_type = base
-            .strip_prefix("Tree_")
-            .and_then(|t| t.strip_suffix("_5_4_3"))
-            .unwrap_or("");
+        let half = type_name.ends_with(HALF_SUFFIX);
+        let value_type = value_type(type_name);
         // (bytes, floating point, leaf layout)
         let (value, real, leaf) = match value_type {
             "bool" => (1, false, LeafKind::Bool),
@@ -78,6 +72,17 @@ impl TreeFormat {
             leaf,
         })
     }
+}
+
+/// The value type of a standard tree's type name (`Tree_float_5_4_3_HalfFloat` -> `float`),
+/// empty for any other tree.
+pub(super) fn value_type(type_name: &str) -> &str {
+    type_name
+        .strip_suffix(HALF_SUFFIX)
+        .unwrap_or(type_name)
+        .strip_prefix("Tree_")
+        .and_then(|t| t.strip_suffix("_5_4_3"))
+        .unwrap_or("")
 }
 
 /// Skips a grid's transform: a map type name and the map's fixed-size data (a frustum holds
