@@ -83,17 +83,20 @@ struct FillCost {
     triangle_bytes: f64,
 }
 
+/// A fill's peak comes after the surface's per-triangle tables are gone: each triangle then
+/// costs what the mesh keeps of it, 65 bytes.
+const FILLED_TRIANGLE_BYTES: f64 = 65.0;
 /// The block flood (the default): the surface, the solid's boundary leaves and the grids
-/// written (750 bytes per surface leaf), the block states (6 bytes per block of the box) and
-/// the inside's tiles (0.2 bits per inside voxel); no dense volume. Estimate/peak 0.75-1.27
-/// on the five meshes at 1024.
+/// written (1070 bytes per surface leaf), the block states (7 bytes per block of the box) and
+/// the inside's tiles (0.6 bits per inside voxel); no dense volume. Estimate/peak 0.86-1.06
+/// on the five meshes at 1024, 1 and 2 threads.
 const BLOCK_FLOOD_COST: FillCost = FillCost {
     bit_volumes: 0.0,
-    inside_volumes: 0.2,
+    inside_volumes: 0.6,
     face_bytes: 0.0,
-    leaf_bytes: 750.0,
-    block_bytes: 6.0,
-    triangle_bytes: TRIANGLE_BYTES,
+    leaf_bytes: 1070.0,
+    block_bytes: 7.0,
+    triangle_bytes: FILLED_TRIANGLE_BYTES,
 };
 /// The span flood and FloodingXYZ: two dense volumes (surface and reached) and what scales
 /// with them, the solid's tiles and the scanline queues, half a volume more; the surface's
@@ -121,15 +124,15 @@ const DEPTH_LAYERS_COST: FillCost = FillCost {
 };
 /// `measure` of a mesh: the block flood without writing, then components and genus counted
 /// over the solid, whose labels take about two bits per inside voxel and half a bit per
-/// voxel of the box. Estimate/peak 0.93-1.14 (bunny-closed, igea, armadillo, horse at
-/// 512-2048; was 0.79-1.44).
+/// voxel of the box. Estimate/peak 0.87-1.10 (bunny-closed, igea, armadillo, horse at
+/// 1024, 1 and 2 threads).
 const MEASURE_COST: FillCost = FillCost {
     bit_volumes: 0.6,
     inside_volumes: 2.1,
     face_bytes: 0.0,
     leaf_bytes: 920.0,
     block_bytes: 0.0,
-    triangle_bytes: TRIANGLE_BYTES,
+    triangle_bytes: FILLED_TRIANGLE_BYTES,
 };
 /// The beam fill: two dense volumes and the projective surface, whose per-triangle tables
 /// are smaller than the separating voxelizer's. Estimate/peak 0.82-1.21 (five meshes at

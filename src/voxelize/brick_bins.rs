@@ -138,6 +138,9 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
         .collect();
     let work: Vec<(Vec<Leaf>, [u64; CLASSES])> = bins
         .par_iter()
+        // One brick per task: bricks differ in cost by orders of magnitude, and rayon's
+        // default halving leaves a thread idle while the other works through a long run.
+        .with_max_len(1)
         .map(|bin| {
             // Each worker keeps its own scratch (rayon may split the work into many more
             // tasks than workers, and a brick's scratch is a megabyte with distances).
@@ -195,16 +198,51 @@ struct Bin {
     first_of: u64,
 }
 
-/// The bricks in use, each with its primitives.
+/// The bricks in use, each with its primitives in class and number order, bricks in the
+/// order of their first primitive. Binned in parallel runs of primitives, then joined.
 fn bin_primitives<const CLASSES: usize>(
     counts: [usize; CLASSES],
     candidates: &(impl Fn(usize, usize) -> CoordBox + Sync),
 ) -> Vec<Bin> {
+    let total: usize = counts.iter().sum();
+    let run = total
+        .div_ceil(4 * rayon::current_num_threads())
+        .max(1 << 14);
+    let runs: Vec<Vec<Bin>> = (0..total.div_ceil(run))
+        .into_par_iter()
+        .map(|r| bin_run(counts, candidates, r * run..((r + 1) * run).min(total)))
+        .collect();
+    let mut index: FxHashMap<Coord, usize> = FxHashMap::default();
+    let mut bins: Vec<Bin> = Vec::new();
+    for bin in runs.into_iter().flatten() {
+        match index.entry(bin.brick) {
+            std::collections::hash_map::Entry::Occupied(at) => {
+                let joined = &mut bins[*at.get()];
+                joined.entries.extend_from_slice(&bin.entries);
+                joined.first_of += bin.first_of;
+            }
+            std::collections::hash_map::Entry::Vacant(at) => {
+                at.insert(bins.len());
+                bins.push(bin);
+            }
+        }
+    }
+    bins
+}
+
+/// The bins of primitives `items`, numbered across the classes in order.
+fn bin_run<const CLASSES: usize>(
+    counts: [usize; CLASSES],
+    candidates: &(impl Fn(usize, usize) -> CoordBox + Sync),
+    items: std::ops::Range<usize>,
+) -> Vec<Bin> {
     let mut index: FxHashMap<Coord, u32> = FxHashMap::default();
     let mut bins: Vec<Bin> = Vec::new();
     let mut last = ([i64::MIN; 3], 0usize);
+    let mut class_start = 0;
     for (class, &count) in counts.iter().enumerate() {
-        for i in 0..count {
+        let numbers = items.start.max(class_start)..items.end.min(class_start + count);
+        for i in numbers.start - class_start..numbers.end.max(numbers.start) - class_start {
             let entry = ((class as u32) << CLASS_SHIFT) | i as u32;
             let [xs, ys, zs] = brick_range(&candidates(class, i));
             let mut first = true;
@@ -231,6 +269,7 @@ fn bin_primitives<const CLASSES: usize>(
                 }
             }
         }
+        class_start += count;
     }
     bins
 }
