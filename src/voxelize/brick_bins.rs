@@ -75,6 +75,38 @@ impl<const CLASSES: usize> BrickSink<'_, CLASSES> {
         }
     }
 
+    /// Whether the brick keeps only voxel bits: then `add_z_run` may mark them.
+    pub fn bits_only(&self) -> bool {
+        self.bits.distance.is_none() && self.bits.normal.is_none()
+    }
+
+    /// Marks voxels `(x, y, z + i)` for the set bits `i` of `run` (all inside the brick; a
+    /// brick is 64 voxels long, so one word holds a column). Only for a brick that keeps
+    /// voxel bits alone. Along z a leaf's voxels are consecutive bits of one word: a run
+    /// costs a word per leaf it crosses, not a mark per voxel.
+    #[inline]
+    pub fn add_z_run(&mut self, x: i64, y: i64, z: i64, run: u64) {
+        debug_assert!(self.bits_only());
+        let (lx, ly, lz) = (x - self.origin[0], y - self.origin[1], z - self.origin[2]);
+        debug_assert!(
+            [lx, ly, lz].iter().all(|&v| (0..BRICK).contains(&v))
+                && (run == 0 || lz + (64 - run.leading_zeros() as i64) <= BRICK),
+            "clipped to the brick"
+        );
+        let column = (u128::from(run) << lz) as u64;
+        let row = ((lx >> 3) as usize * EDGE_LEAVES + (ly >> 3) as usize) * EDGE_LEAVES;
+        let shift = (ly & 7) << 3;
+        let mut groups = column;
+        while groups != 0 {
+            let g = groups.trailing_zeros() as usize / 8;
+            let byte = (column >> (8 * g)) & 0xff;
+            groups &= !(0xff << (8 * g));
+            let leaf = row + g;
+            self.bits.classes[self.class][leaf * 8 + (lx & 7) as usize] |= byte << shift;
+            self.bits.touched[leaf / 64] |= 1 << (leaf % 64);
+        }
+    }
+
     /// Keeps `distance` for voxel `i` when the brick keeps distances and it is the nearest
     /// yet; whether it was.
     #[inline]

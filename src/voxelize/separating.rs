@@ -290,6 +290,8 @@ pub fn voxelize_mesh(
     };
 
     let r = sep.vertex_edge_radius();
+    // Whole spheres and cylinders: short edges may take the branch-free path.
+    let plain = opts.criterion == Criterion::Huang;
     // Classes in the paper's counting order: vertices, edges, bodies.
     let candidates = |class: usize, i: usize| match class {
         0 => reach_box(vertices[i].a, vertices[i].a, r + MARGIN),
@@ -315,15 +317,17 @@ pub fn voxelize_mesh(
         candidates,
         |class, i, clip, sink| match class {
             0 => vertex_sphere(&vertices[i], r, &keep, &[], clip, sink),
-            1 => edge_cylinder(&edges[i], r, &keep, &[], clip, sink),
+            1 => {
+                if !(plain && sink.bits_only() && short_edge_cylinder(&edges[i], r, clip, sink)) {
+                    edge_cylinder(&edges[i], r, &keep, &[], clip, sink)
+                }
+            }
             _ => {
                 let tri = &triangles[i];
-                face_body(
-                    tri,
-                    slab_bounds(sep.slab_half_thickness(tri.normal)),
-                    clip,
-                    sink,
-                )
+                let slab = slab_bounds(sep.slab_half_thickness(tri.normal));
+                if !(sink.bits_only() && small_face_body(tri, slab, clip, sink)) {
+                    face_body(tri, slab, clip, sink)
+                }
             }
         },
     )?;
@@ -726,6 +730,106 @@ pub(super) fn edge_cylinder<const C: usize>(
     }
 }
 
+/// Most voxels in the box of a primitive that `short_edge_cylinder` or `small_face_body`
+/// tests one by one.
+const SMALL_BOX_CELLS: i64 = 256;
+
+/// `lo..=hi` by axis, clipped to `clip`, when it holds at most `SMALL_BOX_CELLS` voxels.
+fn small_box(lo: DVec3, hi: DVec3, clip: &CoordBox) -> Option<[std::ops::RangeInclusive<i64>; 3]> {
+    let ranges = [0, 1, 2].map(|a| clipped(int_range(lo[a], hi[a]), clip, a));
+    let cells = ranges
+        .iter()
+        .map(|range| (range.end() - range.start() + 1).max(0))
+        .product::<i64>();
+    (cells <= SMALL_BOX_CELLS).then_some(ranges)
+}
+
+/// Marks, column by column along z, the voxels of the box (within one brick) that `inside`
+/// accepts, each column as one run.
+#[inline]
+fn mark_box<const C: usize>(
+    [xs, ys, zs]: [std::ops::RangeInclusive<i64>; 3],
+    inside: impl Fn(DVec3) -> bool,
+    sink: &mut BrickSink<C>,
+) {
+    let z0 = *zs.start();
+    for x in xs {
+        for y in ys.clone() {
+            let mut run = 0u64;
+            for z in zs.clone() {
+                let c = DVec3::new(x as f64, y as f64, z as f64);
+                run |= u64::from(inside(c)) << (z - z0);
+            }
+            if run != 0 {
+                sink.add_z_run(x, y, z0, run);
+            }
+        }
+    }
+}
+
+/// S_e as `edge_cylinder` marks it with whole cylinders and bits alone (no half-spaces, no
+/// channels), for an edge whose box holds at most `SMALL_BOX_CELLS` voxels: every voxel of
+/// the box gets `edge_cylinder`'s exact test, without a branch (its rows' set-up costs more
+/// than so few tests). Returns false, marking nothing, for a longer edge.
+fn short_edge_cylinder<const C: usize>(
+    e: &Primitive,
+    r: f64,
+    clip: &CoordBox,
+    sink: &mut BrickSink<C>,
+) -> bool {
+    let (p, d) = (e.a, e.b - e.a);
+    let r = r + MARGIN;
+    let reach = DVec3::splat(r + ROW_SLACK);
+    let Some(cells) = small_box(p.min(e.b) - reach, p.max(e.b) + reach, clip) else {
+        return false;
+    };
+    let len2 = d.length_squared();
+    if len2 == 0.0 {
+        return true; // both ends are one vertex: its sphere covers it
+    }
+    let tau_margin = MARGIN / len2.sqrt();
+    let r2 = r * r;
+    mark_box(
+        cells,
+        |c| {
+            let tau = (c - p).dot(d) / len2;
+            let d2 = (c - p - d * tau).length_squared();
+            (tau >= -tau_margin) & (tau <= 1.0 + tau_margin) & (d2 <= r2)
+        },
+        sink,
+    );
+    true
+}
+
+/// S_b as `face_body` marks it, with bits alone, for a triangle whose box (and slab) holds
+/// at most `SMALL_BOX_CELLS` voxels: every voxel of the box is tested against the slab
+/// `d_lo <= d < d_hi` and the edge planes without a branch. Returns false, marking
+/// nothing, for a larger triangle.
+fn small_face_body<const C: usize>(
+    tri: &Triangle,
+    (d_lo, d_hi): (f64, f64),
+    clip: &CoordBox,
+    sink: &mut BrickSink<C>,
+) -> bool {
+    let [a, b, c] = tri.corners;
+    let reach = DVec3::splat((-d_lo).max(d_hi) + ROW_SLACK);
+    let Some(cells) = small_box(a.min(b).min(c) - reach, a.max(b).max(c) + reach, clip) else {
+        return false;
+    };
+    let n = turned(tri.normal);
+    let sides = edge_planes(tri);
+    mark_box(
+        cells,
+        |x| {
+            let d = n.dot(x - a);
+            let [s0, s1, s2] = sides.map(|(m, p)| m.dot(x - p) >= -MARGIN);
+            (d_lo <= d) & (d < d_hi) & s0 & s1 & s2
+        },
+        sink,
+    );
+    true
+}
+
 /// S_b: voxel centres in the triangle's slab `d_lo <= d < d_hi` (`d` along the turned normal:
 /// see the module docs) whose projection lies inside it, in `clip`.
 pub(super) fn face_body<const C: usize>(
@@ -741,11 +845,7 @@ pub(super) fn face_body<const C: usize>(
     let t = (-d_lo).max(d_hi);
     let w = n.abs().max_position();
     let (u, v) = ((w + 1) % 3, (w + 2) % 3);
-    // In-plane inward normals of the edges: the planes E_i of the paper.
-    let sides = [(a, b), (b, c), (c, a)].map(|(p, q)| {
-        let m = tri.normal.cross(q - p);
-        (m / m.length(), p)
-    });
+    let sides = edge_planes(tri);
     // The same planes as half-spaces, to cut each column to the prism before the exact test:
     // worth it where columns are long (a thick slab, as the distance band's), not for the
     // one or two voxels of a separating surface's.
@@ -811,6 +911,16 @@ pub(super) fn face_body<const C: usize>(
             }
         }
     }
+}
+
+/// In-plane inward normals of the triangle's edges, each with a point on it: the planes E_i
+/// of the paper.
+fn edge_planes(tri: &Triangle) -> [(DVec3, DVec3); 3] {
+    let [a, b, c] = tri.corners;
+    [(a, b), (b, c), (c, a)].map(|(p, q)| {
+        let m = tri.normal.cross(q - p);
+        (m / m.length(), p)
+    })
 }
 
 #[inline]
