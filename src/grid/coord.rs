@@ -64,6 +64,15 @@ impl CoordBox {
         [0, 1, 2].map(|a| (self.max[a] - self.min[a] + 1) as u64)
     }
 
+    /// The voxels in both, or none.
+    pub fn intersection(&self, other: &CoordBox) -> Option<CoordBox> {
+        let b = CoordBox {
+            min: std::array::from_fn(|a| self.min[a].max(other.min[a])),
+            max: std::array::from_fn(|a| self.max[a].min(other.max[a])),
+        };
+        (0..3).all(|a| b.min[a] <= b.max[a]).then_some(b)
+    }
+
     pub fn contains(&self, c: Coord) -> bool {
         (0..3).all(|a| c[a] >= self.min[a] && c[a] <= self.max[a])
     }

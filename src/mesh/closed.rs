@@ -3,7 +3,6 @@
 
 use super::Mesh;
 use crate::error::{Error, Result};
-use rustc_hash::FxHashMap;
 
 /// Edges used by one face (holes) and by more than two (non-manifold), with one example of
 /// each as 1-based vertex numbers of the file.
@@ -23,25 +22,41 @@ impl EdgeCounts {
 
 impl Mesh {
     pub fn edge_counts(&self) -> EdgeCounts {
-        let mut uses: FxHashMap<(u32, u32), u32> = FxHashMap::default();
-        for f in 0..self.face_count() {
-            let face = self.face(f);
-            for k in 0..face.len() {
-                let (a, b) = (face[k], face[(k + 1) % face.len()]);
-                *uses.entry((a.min(b), a.max(b))).or_default() += 1;
-            }
+        // Each side's upper vertex, bucketed by its lower one (a counting sort): edges then
+        // come in (lower, upper) order without hashing.
+        let sides = || {
+            (0..self.face_count()).flat_map(|f| {
+                let face = self.face(f);
+                (0..face.len()).map(move |k| {
+                    let (a, b) = (face[k], face[(k + 1) % face.len()]);
+                    (a.min(b), a.max(b))
+                })
+            })
+        };
+        let mut start = vec![0usize; self.positions.len() + 1];
+        sides().for_each(|(lo, _)| start[lo as usize + 1] += 1);
+        for v in 0..self.positions.len() {
+            start[v + 1] += start[v];
         }
+        let mut fill = start.clone();
+        let mut uppers = vec![0u32; start[self.positions.len()]];
+        sides().for_each(|(lo, hi)| {
+            uppers[fill[lo as usize]] = hi;
+            fill[lo as usize] += 1;
+        });
         let mut counts = EdgeCounts::default();
-        let mut edges: Vec<_> = uses.into_iter().collect();
-        edges.sort_unstable();
-        for ((a, b), n) in edges {
-            let edge = Some([a, b].map(|v| self.vertex_number(v)));
-            if n == 1 {
-                counts.boundary += 1;
-                counts.first_boundary = counts.first_boundary.or(edge);
-            } else if n > 2 {
-                counts.non_manifold += 1;
-                counts.first_non_manifold = counts.first_non_manifold.or(edge);
+        for lo in 0..self.positions.len() {
+            let bucket = &mut uppers[start[lo]..start[lo + 1]];
+            bucket.sort_unstable();
+            for uses in bucket.chunk_by(|a, b| a == b) {
+                let edge = || Some([lo as u32, uses[0]].map(|v| self.vertex_number(v)));
+                if uses.len() == 1 {
+                    counts.boundary += 1;
+                    counts.first_boundary = counts.first_boundary.or_else(edge);
+                } else if uses.len() > 2 {
+                    counts.non_manifold += 1;
+                    counts.first_non_manifold = counts.first_non_manifold.or_else(edge);
+                }
             }
         }
         counts

@@ -25,7 +25,7 @@ use super::separating::{
     primitives, reach_box, vertex_sphere,
 };
 use crate::error::{Error, Result};
-use crate::grid::{Channels, SparseGrid, Transform};
+use crate::grid::{Channels, CoordBox, SparseGrid, Transform};
 use crate::mesh::Mesh;
 use glam::DVec3;
 
@@ -93,7 +93,10 @@ pub fn distance_band(
             }
             (1, e) => {
                 let halves = edge_halves(&edges[e], &adjacency, &triangles);
-                edge_cylinder(&edges[e], band, &every, halves.as_slice(), clip, sink)
+                let sector = sector_box(&edges[e], halves.as_slice(), band + MARGIN);
+                if let Some(clip) = clip.intersection(&sector) {
+                    edge_cylinder(&edges[e], band, &every, halves.as_slice(), &clip, sink)
+                }
             }
             (_, t) => face_body(&triangles[t], slab, clip, sink),
         },
@@ -173,6 +176,46 @@ fn edge_halves(e: &Primitive, adjacency: &Adjacency, triangles: &[Triangle]) -> 
         }
     }
     halves
+}
+
+/// Slack on `sector_box`: it bounds the exact sector, and the half-spaces' margins widen
+/// it by at most 2 MARGIN / SECTOR_ANGLE_SLACK = 0.002 voxels.
+const SECTOR_SLACK: f64 = 0.01;
+/// Angle (radians) by which a boundary ray of the sector may break a half-space and still
+/// bound it: a sector narrower than this keeps both its sides.
+const SECTOR_ANGLE_SLACK: f64 = 1e-6;
+
+/// A box holding every voxel centre that edge `e`'s cylinder of radius `r` marks within
+/// `halves`, planes through the edge (`edge_halves`). Across the edge they cut the disc of
+/// radius `r` to a sector: its box is the box of the apex and of the points of the circle
+/// that bound it, along each axis the farthest point of the circle and the ends of the
+/// arc (where a plane meets the circle), each kept where it lies in every half-space.
+fn sector_box(e: &Primitive, halves: &[HalfSpace], r: f64) -> CoordBox {
+    let dn = (e.b - e.a).normalize_or_zero();
+    let across = if dn == DVec3::ZERO {
+        [DVec3::X, DVec3::Y]
+    } else {
+        let e1 = dn.any_orthonormal_vector();
+        [e1, dn.cross(e1)]
+    };
+    // In-plane directions: each axis's farthest (both ways), and each plane's two rays.
+    let toward_axes = [DVec3::X, DVec3::Y, DVec3::Z].map(|axis| {
+        (across[0] * axis.dot(across[0]) + across[1] * axis.dot(across[1])).normalize_or_zero()
+    });
+    let rays = halves.iter().map(|h| dn.cross(h.g).normalize_or_zero());
+    let (mut lo, mut hi) = (DVec3::ZERO, DVec3::ZERO);
+    for u in toward_axes.into_iter().chain(rays).flat_map(|u| [u, -u]) {
+        if halves.iter().all(|h| h.g.dot(u) <= SECTOR_ANGLE_SLACK) {
+            lo = lo.min(u * r);
+            hi = hi.max(u * r);
+        }
+    }
+    let slack = DVec3::splat(SECTOR_SLACK);
+    let (lo, hi) = (e.a.min(e.b) + lo - slack, e.a.max(e.b) + hi + slack);
+    CoordBox {
+        min: [lo.x, lo.y, lo.z].map(|v| v.floor() as i64),
+        max: [hi.x, hi.y, hi.z].map(|v| v.ceil() as i64),
+    }
 }
 
 /// Where vertex `v` can be nearest: behind every edge and fan diagonal leaving it.
