@@ -93,13 +93,13 @@ impl GridValues<'_> {
 
     /// The active values of `leaf`, in offset order, as stored.
     fn push_leaf_values(self, out: &mut Vec<u8>, leaf: &Leaf, half: bool) {
-        let components = if matches!(self, GridValues::Normals | GridValues::Colors) {
-            3
-        } else {
-            1
+        // Gathered first, then stored in one pass at one precision.
+        let mut reals = [0f32; 3 * LEAF_VOXELS];
+        let mut len = 0;
+        let mut put = |v: f32| {
+            reals[len] = v;
+            len += 1;
         };
-        out.reserve(leaf.count() as usize * components * if half { 2 } else { 4 });
-        let mut put = |v: f32| push_real(out, v, half);
         match self {
             GridValues::Bool => unreachable!("bool leaves store a mask"),
             GridValues::Constant(v) => leaf.offsets().for_each(|_| put(v)),
@@ -132,6 +132,7 @@ impl GridValues<'_> {
                     .for_each(|n| vectors[n].iter().for_each(|&c| put(c)));
             }
         }
+        push_reals(out, &reals[..len], half);
     }
 
     /// The inside voxels of a level set's leaf at `origin` (the others are outside).
@@ -146,10 +147,22 @@ impl GridValues<'_> {
 }
 
 fn push_real(out: &mut Vec<u8>, v: f32, half: bool) {
+    push_reals(out, &[v], half);
+}
+
+/// `values` as stored: little-endian f32, or f16 when `half`.
+fn push_reals(out: &mut Vec<u8>, values: &[f32], half: bool) {
+    let start = out.len();
     if half {
-        out.extend_from_slice(&half::f16::from_f32(v).to_le_bytes());
+        out.resize(start + 2 * values.len(), 0);
+        for (bytes, &v) in out[start..].chunks_exact_mut(2).zip(values) {
+            bytes.copy_from_slice(&half::f16::from_f32(v).to_le_bytes());
+        }
     } else {
-        out.extend_from_slice(&v.to_le_bytes());
+        out.resize(start + 4 * values.len(), 0);
+        for (bytes, v) in out[start..].chunks_exact_mut(4).zip(values) {
+            bytes.copy_from_slice(&v.to_le_bytes());
+        }
     }
 }
 
