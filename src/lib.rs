@@ -5,6 +5,7 @@
 
 pub mod error;
 pub mod grid;
+pub mod huge_pages;
 pub mod implicit;
 pub mod io;
 pub mod mesh;

@@ -47,6 +47,7 @@ use super::brick_bins::{BrickSink, voxelize_in_bricks};
 use super::sink::nearest_channels;
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, SparseGrid, Transform};
+use crate::huge_pages::vec_to_fill;
 use crate::mesh::Mesh;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -363,7 +364,7 @@ fn fan_area_normal(face: &[u32], pos: &[DVec3]) -> DVec3 {
 /// Fan triangles with unit normals (degenerate ones dropped), where each face's triangles
 /// start, and the number of degenerate faces.
 fn triangles_of(mesh: &Mesh, pos: &[DVec3]) -> (Vec<Triangle>, Vec<usize>, usize) {
-    let mut triangles = Vec::with_capacity(mesh.indices.len());
+    let mut triangles = vec_to_fill(mesh.indices.len() - 2 * mesh.face_count());
     let mut starts = Vec::with_capacity(mesh.face_count() + 1);
     let mut degenerate = 0;
     for f in 0..mesh.face_count() {
@@ -434,7 +435,8 @@ fn edges_and_vertices(
         start[i + 1] += start[i];
     }
     let mut fill = start.clone();
-    let mut buckets = vec![(0u32, 0u32); start[pos.len()]];
+    let mut buckets = vec_to_fill(start[pos.len()]);
+    buckets.resize(start[pos.len()], (0u32, 0u32));
     for_each_edge(&mut |lo, hi, f| {
         buckets[fill[lo as usize]] = (hi, f);
         fill[lo as usize] += 1;
@@ -469,8 +471,8 @@ fn edges_from_buckets(
     mut buckets: Vec<(u32, u32)>,
     normal_of: &(dyn Fn(&[u32]) -> DVec3 + Sync),
 ) -> (Vec<Primitive>, Vec<u32>) {
-    let mut faces: Vec<u32> = Vec::with_capacity(buckets.len());
-    let mut edges = Vec::with_capacity(buckets.len() / 2);
+    let mut faces: Vec<u32> = vec_to_fill(buckets.len());
+    let mut edges = vec_to_fill(buckets.len() / 2);
     for lo in 0..pos.len() {
         let bucket = &mut buckets[start[lo]..start[lo + 1]];
         bucket.sort_unstable();
@@ -499,7 +501,7 @@ fn vertices_of(
     pos: &[DVec3],
     normal_of: &(dyn Fn(&[u32]) -> DVec3 + Sync),
 ) -> (Vec<Primitive>, Vec<u32>) {
-    let mut faces: Vec<u32> = Vec::with_capacity(mesh.indices.len());
+    let mut faces: Vec<u32> = vec_to_fill(mesh.indices.len());
     let mut vstart = vec![0usize; pos.len() + 1];
     for &v in &mesh.indices {
         vstart[v as usize + 1] += 1;
@@ -515,7 +517,7 @@ fn vertices_of(
             vfill[v as usize] += 1;
         }
     }
-    let mut vertices = Vec::with_capacity(pos.len());
+    let mut vertices = vec_to_fill(pos.len());
     for v in 0..pos.len() {
         let list = &mut around[vstart[v]..vstart[v + 1]];
         if list.is_empty() {
