@@ -9,7 +9,7 @@
 
 /// Vectors of at least this many bytes are advised (a few huge pages, little waste at the
 /// ends).
-const HUGE_BLOCK: usize = 8 << 20;
+const HUGE_BLOCK: usize = 4 << 20;
 /// The huge page size on x86-64 and aarch64 with 4 KiB base pages.
 const HUGE_PAGE: usize = 2 << 20;
 

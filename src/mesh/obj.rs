@@ -6,12 +6,13 @@
 
 use super::Mesh;
 use crate::error::{Error, Result};
+use crate::huge_pages::vec_to_fill;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::path::Path;
 
 pub(super) fn load_obj(path: &Path) -> Result<Mesh> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = read_text(path)?;
     // A byte-order mark is not part of the first line.
     let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let parsed = parse_obj(text).map_err(|(line, message)| Error::Parse {
@@ -27,6 +28,22 @@ pub(super) fn load_obj(path: &Path) -> Result<Mesh> {
         polylines: parsed.polylines,
         source: path.to_path_buf(),
         ..Default::default()
+    })
+}
+
+/// The whole file as text (UTF-8), read into one buffer of its size.
+fn read_text(path: &Path) -> Result<String> {
+    use std::io::Read;
+    let io_error = |e| Error::io(path, e);
+    let mut file = std::fs::File::open(path).map_err(io_error)?;
+    let size = file.metadata().map_err(io_error)?.len() as usize;
+    let mut bytes = vec_to_fill(size + 1);
+    file.read_to_end(&mut bytes).map_err(io_error)?;
+    String::from_utf8(bytes).map_err(|e| {
+        io_error(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("not UTF-8 text: {}", e.utf8_error()),
+        ))
     })
 }
 
@@ -258,10 +275,10 @@ fn join_pieces(pieces: Vec<Piece>) -> std::result::Result<Parsed, LineError> {
     }
     let total = |f: fn(&Parsed) -> usize| pieces.iter().map(|p| f(&p.parsed)).sum::<usize>();
     let mut out = Parsed {
-        positions: Vec::with_capacity(total(|p| p.positions.len())),
-        colors: Vec::with_capacity(total(|p| p.colors.len())),
-        indices: Vec::with_capacity(total(|p| p.indices.len())),
-        face_starts: Vec::with_capacity(total(|p| p.face_starts.len()) + 1),
+        positions: vec_to_fill(total(|p| p.positions.len())),
+        colors: vec_to_fill(total(|p| p.colors.len())),
+        indices: vec_to_fill(total(|p| p.indices.len())),
+        face_starts: vec_to_fill(total(|p| p.face_starts.len()) + 1),
         polylines: Vec::new(),
     };
     out.face_starts.push(0);

@@ -238,15 +238,18 @@ pub(super) fn primitives(mesh: &Mesh, transform: Transform, normals: bool) -> Re
             transform.voxel_size
         )));
     }
-    let pos: Vec<DVec3> = mesh
-        .positions
-        .par_iter()
-        .map(|&p| transform.world_to_index(p))
-        .collect();
-    let face_normals: Vec<DVec3> = (0..mesh.face_count())
-        .into_par_iter()
-        .map(|f| fan_area_normal(mesh.face(f), &pos))
-        .collect();
+    let mut pos: Vec<DVec3> = vec_to_fill(mesh.positions.len());
+    pos.par_extend(
+        mesh.positions
+            .par_iter()
+            .map(|&p| transform.world_to_index(p)),
+    );
+    let mut face_normals: Vec<DVec3> = vec_to_fill(mesh.face_count());
+    face_normals.par_extend(
+        (0..mesh.face_count())
+            .into_par_iter()
+            .map(|f| fan_area_normal(mesh.face(f), &pos)),
+    );
     let ((triangles, triangle_starts, degenerate_faces), (edges, vertices, faces)) = rayon::join(
         || triangles_of(mesh, &pos),
         || edges_and_vertices(mesh, &pos, &face_normals, normals),
