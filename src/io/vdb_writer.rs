@@ -85,8 +85,8 @@ impl GridValues<'_> {
     fn push_tile_value(self, out: &mut Vec<u8>, half: bool) {
         match self {
             GridValues::Bool => out.push(1),
-            GridValues::Constant(v) => push_real(out, v, half),
-            GridValues::Fog { .. } => push_real(out, 1.0, half),
+            GridValues::Constant(v) => push_reals(out, &[v], half),
+            GridValues::Fog { .. } => push_reals(out, &[1.0], half),
             _ => unreachable!("only voxel sets and fog volumes have active tiles"),
         }
     }
@@ -144,10 +144,6 @@ impl GridValues<'_> {
             _ => [0; 8],
         }
     }
-}
-
-fn push_real(out: &mut Vec<u8>, v: f32, half: bool) {
-    push_reals(out, &[v], half);
 }
 
 /// `values` as stored: little-endian f32, or f16 when `half`.
@@ -375,13 +371,12 @@ fn encode_grid(path: &Path, g: &GridOut, encoding: Encoding) -> Result<EncodedGr
             let mut out = Vec::with_capacity(batch.len() * 200);
             let mut scratch = Vec::new();
             for leaf in batch {
-                let chunks = &constant_chunks;
                 leaf_buffer(
                     &mut out,
                     &mut scratch,
                     leaf,
                     g.values,
-                    chunks,
+                    &constant_chunks,
                     compression,
                     half,
                 );

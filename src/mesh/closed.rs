@@ -2,6 +2,7 @@
 //! every inside test need it; an open mesh is refused with the first offending edge named.
 
 use super::Mesh;
+use super::key_groups::group_by_key;
 use crate::error::{Error, Result};
 
 /// Edges used by one face (holes) and by more than two (non-manifold), with one example of
@@ -22,27 +23,16 @@ impl EdgeCounts {
 
 impl Mesh {
     pub fn edge_counts(&self) -> EdgeCounts {
-        // Each side's upper vertex, bucketed by its lower one (a counting sort): edges then
-        // come in (lower, upper) order without hashing.
-        let sides = || {
-            (0..self.face_count()).flat_map(|f| {
+        // Each side's upper vertex, grouped by its lower one: edges then come in (lower,
+        // upper) order without hashing.
+        let (start, mut uppers) = group_by_key(self.positions.len(), |visit| {
+            for f in 0..self.face_count() {
                 let face = self.face(f);
-                (0..face.len()).map(move |k| {
+                for k in 0..face.len() {
                     let (a, b) = (face[k], face[(k + 1) % face.len()]);
-                    (a.min(b), a.max(b))
-                })
-            })
-        };
-        let mut start = vec![0usize; self.positions.len() + 1];
-        sides().for_each(|(lo, _)| start[lo as usize + 1] += 1);
-        for v in 0..self.positions.len() {
-            start[v + 1] += start[v];
-        }
-        let mut fill = start.clone();
-        let mut uppers = vec![0u32; start[self.positions.len()]];
-        sides().for_each(|(lo, hi)| {
-            uppers[fill[lo as usize]] = hi;
-            fill[lo as usize] += 1;
+                    visit(a.min(b), a.max(b));
+                }
+            }
         });
         let mut counts = EdgeCounts::default();
         for lo in 0..self.positions.len() {

@@ -9,6 +9,7 @@ mod fit;
 pub mod generate;
 mod gltf_scene;
 pub mod inside;
+pub mod key_groups;
 mod obj;
 mod off;
 mod ply;

@@ -10,9 +10,10 @@
 //! band), so one centre decides it.
 
 use crate::error::Result;
-use crate::grid::{Channels, Coord, CoordBox, Leaf, SparseGrid, Transform};
+use crate::grid::{Channels, Coord, Leaf, SparseGrid, Transform};
 use crate::mesh::inside::ColumnCrossings;
 use crate::mesh::{Mesh, index_box};
+use crate::ops::flood::padded;
 use crate::progress::Progress;
 use crate::voxelize::distance_band::distance_band;
 use rayon::prelude::*;
@@ -41,11 +42,7 @@ pub fn level_set(
     // The crossings cover the band's columns: the mesh's box widened by the band. They are
     // found beside the band, filling the threads in its serial steps.
     let reach = band.ceil() as i64;
-    let mesh_box = index_box(&mesh.bbox(), &transform);
-    let columns_box = CoordBox {
-        min: mesh_box.min.map(|v| v - reach),
-        max: mesh_box.max.map(|v| v + reach),
-    };
+    let columns_box = padded(index_box(&mesh.bbox(), &transform), reach);
     let (grid, columns) = rayon::join(
         || distance_band(mesh, transform, band, progress),
         || ColumnCrossings::new(mesh, &transform, columns_box),

@@ -210,12 +210,7 @@ fn sector_box(e: &Primitive, halves: &[HalfSpace], r: f64) -> CoordBox {
             hi = hi.max(u * r);
         }
     }
-    let slack = DVec3::splat(SECTOR_SLACK);
-    let (lo, hi) = (e.a.min(e.b) + lo - slack, e.a.max(e.b) + hi + slack);
-    CoordBox {
-        min: [lo.x, lo.y, lo.z].map(|v| v.floor() as i64),
-        max: [hi.x, hi.y, hi.z].map(|v| v.ceil() as i64),
-    }
+    reach_box(e.a.min(e.b) + lo, e.a.max(e.b) + hi, SECTOR_SLACK)
 }
 
 /// Where vertex `v` can be nearest: behind every edge and fan diagonal leaving it.

@@ -49,6 +49,7 @@ use crate::error::{Error, Result};
 use crate::grid::{CoordBox, SparseGrid, Transform};
 use crate::huge_pages::vec_to_fill;
 use crate::mesh::Mesh;
+use crate::mesh::key_groups::group_by_key;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -431,18 +432,9 @@ fn edges_and_vertices(
             }
         }
     };
-    // Bucket (upper vertex, face) by lower vertex.
-    let mut start = vec![0usize; pos.len() + 1];
-    for_each_edge(&mut |lo, _, _| start[lo as usize + 1] += 1);
-    for i in 0..pos.len() {
-        start[i + 1] += start[i];
-    }
-    let mut fill = start.clone();
-    let mut buckets = vec_to_fill(start[pos.len()]);
-    buckets.resize(start[pos.len()], (0u32, 0u32));
-    for_each_edge(&mut |lo, hi, f| {
-        buckets[fill[lo as usize]] = (hi, f);
-        fill[lo as usize] += 1;
+    // (upper vertex, face) grouped by lower vertex.
+    let (start, buckets) = group_by_key(pos.len(), |visit| {
+        for_each_edge(&mut |lo, hi, f| visit(lo, (hi, f)))
     });
     let normal_of = |fs: &[u32]| {
         if normals {
@@ -505,21 +497,11 @@ fn vertices_of(
     normal_of: &(dyn Fn(&[u32]) -> DVec3 + Sync),
 ) -> (Vec<Primitive>, Vec<u32>) {
     let mut faces: Vec<u32> = vec_to_fill(mesh.indices.len());
-    let mut vstart = vec![0usize; pos.len() + 1];
-    for &v in &mesh.indices {
-        vstart[v as usize + 1] += 1;
-    }
-    for i in 0..pos.len() {
-        vstart[i + 1] += vstart[i];
-    }
-    let mut vfill = vstart.clone();
-    let mut around = vec![0u32; mesh.indices.len()];
-    for f in 0..mesh.face_count() {
-        for &v in mesh.face(f) {
-            around[vfill[v as usize]] = f as u32;
-            vfill[v as usize] += 1;
+    let (vstart, mut around) = group_by_key(pos.len(), |visit| {
+        for f in 0..mesh.face_count() {
+            mesh.face(f).iter().for_each(|&v| visit(v, f as u32));
         }
-    }
+    });
     let mut vertices = vec_to_fill(pos.len());
     for v in 0..pos.len() {
         let list = &mut around[vstart[v]..vstart[v + 1]];
@@ -668,6 +650,7 @@ pub(super) fn edge_cylinder<const C: usize>(
     let reach = r * (1.0 - dn[v] * dn[v]).sqrt() / dn[w].abs() + ROW_SLACK;
     let cap = r * (1.0 - dn[w] * dn[w]).max(0.0).sqrt() + ROW_SLACK;
     let tau_margin = MARGIN / len2.sqrt();
+    let test = EdgeTest::new(e, r);
     // The quadratic's leading coefficient is the edge's: 1 - dn_v^2 >= 2/3, as v is not
     // its longest axis.
     let a = 1.0 - dn[v] * dn[v];
@@ -722,16 +705,46 @@ pub(super) fn edge_cylinder<const C: usize>(
             for iv in first..=last {
                 let mut x = row;
                 x[v] = iv as f64;
-                let tau = (x - p).dot(d) / len2;
-                if !(-tau_margin..=1.0 + tau_margin).contains(&tau) {
-                    continue;
-                }
-                let d2 = (x - p - d * tau).length_squared();
-                if d2 <= r * r && keep(e, x) {
+                let (inside, d2) = test.at(x);
+                if inside && keep(e, x) {
                     sink.add(to_coord(x), || d2.sqrt(), e.normal);
                 }
             }
         }
+    }
+}
+
+/// The exact test of S_e for an edge of non-zero length, with radius `r` (margin included):
+/// a centre within `r` of the edge whose projection falls on it (`tau` in `[0, 1]`, widened
+/// by `MARGIN` voxels along the edge).
+struct EdgeTest {
+    p: DVec3,
+    d: DVec3,
+    len2: f64,
+    tau_margin: f64,
+    r2: f64,
+}
+
+impl EdgeTest {
+    fn new(e: &Primitive, r: f64) -> Self {
+        let d = e.b - e.a;
+        let len2 = d.length_squared();
+        EdgeTest {
+            p: e.a,
+            d,
+            len2,
+            tau_margin: MARGIN / len2.sqrt(),
+            r2: r * r,
+        }
+    }
+
+    /// Whether `x` is in, and its squared distance to the edge's line; without a branch.
+    #[inline]
+    fn at(&self, x: DVec3) -> (bool, f64) {
+        let tau = (x - self.p).dot(self.d) / self.len2;
+        let d2 = (x - self.p - self.d * tau).length_squared();
+        let inside = (tau >= -self.tau_margin) & (tau <= 1.0 + self.tau_margin) & (d2 <= self.r2);
+        (inside, d2)
     }
 }
 
@@ -788,21 +801,11 @@ fn short_edge_cylinder<const C: usize>(
     let Some(cells) = small_box(p.min(e.b) - reach, p.max(e.b) + reach, clip) else {
         return false;
     };
-    let len2 = d.length_squared();
-    if len2 == 0.0 {
+    if d.length_squared() == 0.0 {
         return true; // both ends are one vertex: its sphere covers it
     }
-    let tau_margin = MARGIN / len2.sqrt();
-    let r2 = r * r;
-    mark_box(
-        cells,
-        |c| {
-            let tau = (c - p).dot(d) / len2;
-            let d2 = (c - p - d * tau).length_squared();
-            (tau >= -tau_margin) & (tau <= 1.0 + tau_margin) & (d2 <= r2)
-        },
-        sink,
-    );
+    let test = EdgeTest::new(e, r);
+    mark_box(cells, |c| test.at(c).0, sink);
     true
 }
 
@@ -827,8 +830,7 @@ fn small_face_body<const C: usize>(
         cells,
         |x| {
             let d = n.dot(x - a);
-            let [s0, s1, s2] = sides.map(|(m, p)| m.dot(x - p) >= -MARGIN);
-            (d_lo <= d) & (d < d_hi) & s0 & s1 & s2
+            (d_lo <= d) & (d < d_hi) & within_edge_planes(&sides, x)
         },
         sink,
     );
@@ -910,7 +912,7 @@ pub(super) fn face_body<const C: usize>(
                 x[w] = k as f64;
                 // A cut column is exact to 1e-6 voxels, which moves a plane distance by less
                 // than 1e-12: the distance band needs no test per voxel.
-                if !column_cut.is_empty() || sides.iter().all(|(m, p)| m.dot(x - *p) >= -MARGIN) {
+                if !column_cut.is_empty() || within_edge_planes(&sides, x) {
                     sink.add(to_coord(x), || n.dot(x - a).abs(), tri.normal);
                 }
             }
@@ -926,6 +928,15 @@ fn edge_planes(tri: &Triangle) -> [(DVec3, DVec3); 3] {
         let m = tri.normal.cross(q - p);
         (m / m.length(), p)
     })
+}
+
+/// Whether `x` lies inside every edge plane (`edge_planes`), up to `MARGIN`; without a
+/// branch.
+#[inline]
+fn within_edge_planes(sides: &[(DVec3, DVec3); 3], x: DVec3) -> bool {
+    sides
+        .iter()
+        .fold(true, |all, (m, p)| all & (m.dot(x - *p) >= -MARGIN))
 }
 
 #[inline]
