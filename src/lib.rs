@@ -3,6 +3,7 @@
 //! Meshes and analytic surfaces become sparse voxel grids whose separability is proven
 //! (Huang et al.), checked by flooding, and written as OpenVDB files.
 
+pub mod choice;
 pub mod error;
 pub mod grid;
 pub mod huge_pages;

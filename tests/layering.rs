@@ -7,7 +7,7 @@ use std::path::Path;
 /// The top-level modules from the bottom up; modules on one rank may not use each other.
 const LAYERS: [&[&str]; 13] = [
     &["error"],
-    &["system", "huge_pages", "progress", "random"],
+    &["system", "huge_pages", "progress", "random", "choice"],
     &["grid"],
     &["ffi"],
     &["io"],

@@ -7,6 +7,7 @@ use crate::openvdb_reference;
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
+use voxelkit::choice::Choice;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{Criterion, SeparatingOptions, voxelize_mesh};

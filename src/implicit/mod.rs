@@ -40,19 +40,15 @@ impl Coordinates {
     }
 }
 
-impl std::str::FromStr for Coordinates {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "cartesian" => Ok(Coordinates::Cartesian),
-            "spherical" => Ok(Coordinates::Spherical),
-            "cylindrical" => Ok(Coordinates::Cylindrical),
-            _ => Err(format!(
-                "coordinates must be cartesian, spherical or cylindrical, not `{s}`"
-            )),
-        }
-    }
+impl crate::choice::Choice for Coordinates {
+    const WHAT: &'static str = "the coordinates";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("cartesian", Coordinates::Cartesian),
+        ("spherical", Coordinates::Spherical),
+        ("cylindrical", Coordinates::Cylindrical),
+    ];
 }
+crate::named_choices!(Coordinates);
 
 /// The values θ takes: the paper's `[0, 2π)`, measured from +x toward +z with its cut along
 /// the positive x axis, or `(-π, π]`, cut along the negative x axis (`atan2`'s).
@@ -63,18 +59,14 @@ pub enum ThetaRange {
     Symmetric,
 }
 
-impl std::str::FromStr for ThetaRange {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "positive" => Ok(ThetaRange::Positive),
-            "symmetric" => Ok(ThetaRange::Symmetric),
-            _ => Err(format!(
-                "the theta range is positive ([0, 2pi), the paper's) or symmetric ((-pi, pi]), not `{s}`"
-            )),
-        }
-    }
+impl crate::choice::Choice for ThetaRange {
+    const WHAT: &'static str = "the theta range";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("positive", ThetaRange::Positive),
+        ("symmetric", ThetaRange::Symmetric),
+    ];
 }
+crate::named_choices!(ThetaRange);
 
 /// A compiled formula F; the surface is F = 0.
 #[derive(Clone, Debug, PartialEq)]

@@ -171,17 +171,15 @@ pub enum Compression {
     None,
 }
 
-impl std::str::FromStr for Compression {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "blosc" => Ok(Compression::Blosc),
-            "zip" => Ok(Compression::Zip),
-            "none" => Ok(Compression::None),
-            _ => Err(format!("compression must be blosc, zip or none, not `{s}`")),
-        }
-    }
+impl crate::choice::Choice for Compression {
+    const WHAT: &'static str = "the compression";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("blosc", Compression::Blosc),
+        ("zip", Compression::Zip),
+        ("none", Compression::None),
+    ];
 }
+crate::named_choices!(Compression);
 
 /// The metadata entries of every grid: the caller's plus `voxelkit_version`.
 fn meta_entries(metadata: &[(&str, String)]) -> Vec<(String, String)> {

@@ -10,6 +10,10 @@ use super::Aabb;
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, Transform};
 
+/// Voxels along the longest bounding-box axis when neither a resolution nor a voxel size is
+/// given.
+pub const DEFAULT_RESOLUTION: u32 = 256;
+
 /// How to choose the voxel size for a mesh.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum GridFit {
@@ -24,12 +28,12 @@ pub enum GridFit {
 
 impl GridFit {
     /// The fit the front ends' options ask for: the voxel size when given, else the
-    /// resolution, else 256 voxels along the longest axis.
+    /// resolution, else `DEFAULT_RESOLUTION` voxels along the longest axis.
     pub fn from_options(resolution: Option<u32>, voxel_size: Option<f64>) -> GridFit {
         match (resolution, voxel_size) {
             (_, Some(h)) => GridFit::VoxelSize(h),
             (Some(r), None) => GridFit::Resolution(r),
-            (None, None) => GridFit::Resolution(256),
+            (None, None) => GridFit::Resolution(DEFAULT_RESOLUTION),
         }
     }
 }

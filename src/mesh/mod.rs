@@ -19,7 +19,7 @@ pub use gltf_scene::GltfLayout;
 pub use up_axis::UpAxis;
 
 pub use closed::EdgeCounts;
-pub use fit::{GridFit, fit_transform, index_box};
+pub use fit::{DEFAULT_RESOLUTION, GridFit, fit_transform, index_box};
 
 use crate::error::{Error, Result};
 use glam::{DVec3, Vec3};

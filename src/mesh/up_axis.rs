@@ -15,16 +15,11 @@ pub enum UpAxis {
     Z,
 }
 
-impl std::str::FromStr for UpAxis {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "y" | "Y" => Ok(UpAxis::Y),
-            "z" | "Z" => Ok(UpAxis::Z),
-            _ => Err(format!("the up axis is y or z, not `{s}`")),
-        }
-    }
+impl crate::choice::Choice for UpAxis {
+    const WHAT: &'static str = "the up axis";
+    const NAMES: &'static [(&'static str, Self)] = &[("y", UpAxis::Y), ("z", UpAxis::Z)];
 }
+crate::named_choices!(UpAxis);
 
 impl Mesh {
     /// The mesh with its `up` axis turned to +z (a rotation: orientation and volume kept).

@@ -14,19 +14,15 @@ pub enum BooleanOp {
     Difference,
 }
 
-impl std::str::FromStr for BooleanOp {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "union" => Ok(BooleanOp::Union),
-            "intersection" => Ok(BooleanOp::Intersection),
-            "difference" => Ok(BooleanOp::Difference),
-            _ => Err(format!(
-                "the operation must be union, intersection or difference, not `{s}`"
-            )),
-        }
-    }
+impl crate::choice::Choice for BooleanOp {
+    const WHAT: &'static str = "the operation";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("union", BooleanOp::Union),
+        ("intersection", BooleanOp::Intersection),
+        ("difference", BooleanOp::Difference),
+    ];
 }
+crate::named_choices!(BooleanOp);
 
 /// Whether two transforms place voxels identically (to 1e-9 of a voxel).
 pub fn same_transform(a: &Transform, b: &Transform) -> bool {

@@ -10,6 +10,7 @@ pub mod bricks;
 mod estimate;
 mod outcome;
 mod report;
+pub mod request;
 mod solid;
 
 pub use outcome::{Outcome, check_output_path};

@@ -42,16 +42,12 @@ pub enum BeamFill {
     Paper,
 }
 
-impl std::str::FromStr for BeamFill {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "parity" => Ok(BeamFill::Parity),
-            "paper" => Ok(BeamFill::Paper),
-            _ => Err(format!("fill must be parity or paper, not `{s}`")),
-        }
-    }
+impl crate::choice::Choice for BeamFill {
+    const WHAT: &'static str = "the beam fill";
+    const NAMES: &'static [(&'static str, Self)] =
+        &[("parity", BeamFill::Parity), ("paper", BeamFill::Paper)];
 }
+crate::named_choices!(BeamFill);
 
 /// The beam solid and what its fill met.
 pub struct Beam {

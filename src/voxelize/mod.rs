@@ -59,13 +59,9 @@ impl Separability {
     }
 }
 
-impl std::str::FromStr for Separability {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "6" => Ok(Separability::Six),
-            "26" => Ok(Separability::TwentySix),
-            _ => Err(format!("separability must be 6 or 26, not `{s}`")),
-        }
-    }
+impl crate::choice::Choice for Separability {
+    const WHAT: &'static str = "separability";
+    const NAMES: &'static [(&'static str, Self)] =
+        &[("6", Separability::Six), ("26", Separability::TwentySix)];
 }
+crate::named_choices!(Separability);

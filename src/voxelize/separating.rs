@@ -85,25 +85,12 @@ pub enum Criterion {
     Clipped,
 }
 
-impl Criterion {
-    /// The name used on the command line and in metadata.
-    pub fn name(self) -> &'static str {
-        match self {
-            Criterion::Huang => "huang",
-            Criterion::Clipped => "clipped",
-        }
-    }
+impl crate::choice::Choice for Criterion {
+    const WHAT: &'static str = "the criterion";
+    const NAMES: &'static [(&'static str, Self)] =
+        &[("huang", Criterion::Huang), ("clipped", Criterion::Clipped)];
 }
-
-impl std::str::FromStr for Criterion {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        [Criterion::Huang, Criterion::Clipped]
-            .into_iter()
-            .find(|c| c.name() == s)
-            .ok_or_else(|| format!("criterion must be huang or clipped, not `{s}`"))
-    }
-}
+crate::named_choices!(Criterion);
 
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SeparatingOptions {

@@ -1,0 +1,774 @@
+//! The options of every job, declared once. Each request is a serde struct whose fields,
+//! defaults and documentation come from one `request!` declaration; the CLI, the C
+//! interface, the Python module, the Blender add-on and the Dask front end all fill these
+//! structs (Python and Dask by name, from the table `schema()` exports), and a request turns
+//! into a `Task` in one place (`task`). Choices are `crate::choice` tables.
+//!
+//! What "none" and 0 mean is decided here: `threads` none or 0 is every core;
+//! `max_memory_mib` none or 0 is the memory available.
+
+use super::{
+    ColorChoice, Fill, GridSource, Limits, MeasureSource, MeshSource, SubdivisionFill,
+    SurfaceMethod, Task,
+};
+use crate::choice::Choice;
+use crate::error::{Error, Result};
+use crate::grid::Adjacency;
+use crate::implicit::{Coordinates, ThetaRange};
+use crate::io::vdb::{Compression, WriteOptions};
+use crate::mesh::{DEFAULT_RESOLUTION, GridFit, UpAxis};
+use crate::ops::csg::BooleanOp;
+use crate::solids::beam::BeamFill;
+use crate::solids::depth_layers::{DepthLayerOptions, DirectionSet, Layers, Unclassified};
+use crate::solids::exterior_flood::FloodMethod;
+use crate::voxelize::Separability;
+use crate::voxelize::parametric::ParametricOptions;
+use crate::voxelize::separating::{Criterion, SeparatingOptions};
+use glam::{DVec3, Vec3};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// GRAYSTACK entries of FloodingXYZ unless asked otherwise.
+const GRAYSTACK: usize = 1 << 20;
+/// The distance band's half width in voxels unless asked otherwise.
+const BAND: f64 = 3.0;
+/// Mass per unit volume unless asked otherwise.
+const DENSITY: f64 = 1.0;
+
+/// What the table says of one field.
+#[derive(Clone, Debug, Serialize)]
+pub struct FieldSchema {
+    pub name: &'static str,
+    pub doc: String,
+    pub default: Value,
+    /// The names it takes, for a choice; empty otherwise.
+    pub choices: Vec<&'static str>,
+}
+
+/// A request's fields, defaults and docs, for the front ends that fill it by name.
+pub trait Schema: Default + Serialize + for<'de> Deserialize<'de> {
+    /// The request's name in the table: the Python function it backs.
+    const NAME: &'static str;
+    fn doc() -> String;
+    fn fields() -> Vec<FieldSchema>;
+
+    /// The request of these named values (a JSON object), every other field at its
+    /// default; an unknown name or a bad value is refused with the field's name.
+    fn from_json(values: Value) -> Result<Self> {
+        serde_path_to_error::deserialize(values).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner().to_string();
+            Error::InvalidArgument(if path == "." || inner.starts_with("unknown field") {
+                inner
+            } else {
+                format!("{path}: {inner}")
+            })
+        })
+    }
+}
+
+/// The choices a field's type offers (none but for `Choice` enums).
+pub trait FieldChoices {
+    fn choices() -> Vec<&'static str> {
+        Vec::new()
+    }
+}
+
+impl<T: Choice> FieldChoices for T {
+    fn choices() -> Vec<&'static str> {
+        T::names()
+    }
+}
+
+/// A plain (non-choice) field type.
+macro_rules! plain_fields {
+    ($($t:ty),*) => {$(impl FieldChoices for Option<$t> {})*};
+}
+plain_fields!(u32, u64, f64, String, [f32; 3]);
+
+macro_rules! request {
+    ($(#[doc = $sdoc:literal])* $name:ident as $py:literal {
+        $( $(#[doc = $doc:literal])* $field:ident : $ty:ty = $default:expr ),* $(,)?
+    }) => {
+        $(#[doc = $sdoc])*
+        #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+        #[serde(default, deny_unknown_fields)]
+        pub struct $name { $( $(#[doc = $doc])* pub $field: $ty, )* }
+
+        impl Default for $name {
+            fn default() -> Self {
+                $name { $( $field: $default, )* }
+            }
+        }
+
+        impl Schema for $name {
+            const NAME: &'static str = $py;
+            fn doc() -> String {
+                [$($sdoc),*].map(str::trim).join(" ")
+            }
+            fn fields() -> Vec<FieldSchema> {
+                let d = Self::default();
+                vec![$(FieldSchema {
+                    name: stringify!($field),
+                    doc: [$($doc),*].map(str::trim).join(" "),
+                    default: serde_json::to_value(&d.$field).unwrap_or(Value::Null),
+                    choices: <$ty as FieldChoices>::choices(),
+                }),*]
+            }
+        }
+    };
+}
+
+impl FieldChoices for bool {}
+impl FieldChoices for f64 {}
+impl FieldChoices for u32 {}
+impl FieldChoices for usize {}
+impl FieldChoices for Vec<String> {}
+impl FieldChoices for Directions {}
+impl FieldChoices for Bounds {}
+
+/// How a polygon mesh becomes a surface.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SurfaceKind {
+    /// Huang et al.'s 6/26-separating surface.
+    Separating,
+    /// Jegathese et al.'s scan-lines in each triangle's dominant plane.
+    Projective,
+}
+
+impl Choice for SurfaceKind {
+    const WHAT: &'static str = "the surface method";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("separating", SurfaceKind::Separating),
+        ("projective", SurfaceKind::Projective),
+    ];
+}
+
+/// How a mesh's solid is found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FillKind {
+    /// The 26-separating surface plus what the exterior flood cannot reach (Lai & Cheng).
+    Flood,
+    /// Passalis et al.'s depth layers with a stencil count.
+    DepthLayers,
+    /// The projective surface plus beams between front and back faces (Jegathese et al.).
+    Beam,
+}
+
+impl Choice for FillKind {
+    const WHAT: &'static str = "the fill method";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("flood", FillKind::Flood),
+        ("depth-layers", FillKind::DepthLayers),
+        ("beam", FillKind::Beam),
+    ];
+}
+
+/// Which exterior flood.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FloodKind {
+    /// Whole empty 8^3 blocks at once (fastest).
+    Blocks,
+    /// Scanline spans over a dense bit volume.
+    Spans,
+    /// Lai & Cheng's FloodingXYZ with a GRAYSTACK.
+    Xyz,
+}
+
+impl Choice for FloodKind {
+    const WHAT: &'static str = "the flood";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        ("blocks", FloodKind::Blocks),
+        ("spans", FloodKind::Spans),
+        ("xyz", FloodKind::Xyz),
+    ];
+}
+
+crate::named_choices!(SurfaceKind, FillKind, FloodKind);
+
+impl FloodKind {
+    /// The flood with a GRAYSTACK of `graystack` entries (xyz).
+    pub fn method(self, graystack: usize) -> FloodMethod {
+        match self {
+            FloodKind::Blocks => FloodMethod::Blocks,
+            FloodKind::Spans => FloodMethod::Spans,
+            FloodKind::Xyz => FloodMethod::Xyz {
+                capacity: graystack.max(1),
+            },
+        }
+    }
+}
+
+/// Depth-layer view directions: a count of the built-in ones, or integer (x, y, z) triples.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Directions {
+    Count(usize),
+    Given(Vec<[i64; 3]>),
+}
+
+impl Directions {
+    pub fn set(&self) -> Result<DirectionSet> {
+        match self {
+            Directions::Count(n) => DirectionSet::first(*n),
+            Directions::Given(list) => DirectionSet::given(list),
+        }
+    }
+}
+
+/// A formula's box: `[lo, hi]` for a cube, or `[[x0, y0, z0], [x1, y1, z1]]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Bounds {
+    Cube([f64; 2]),
+    Box([[f64; 3]; 2]),
+}
+
+impl Bounds {
+    pub fn corners(&self) -> (DVec3, DVec3) {
+        match self {
+            Bounds::Cube([lo, hi]) => (DVec3::splat(*lo), DVec3::splat(*hi)),
+            Bounds::Box([lo, hi]) => (DVec3::from_array(*lo), DVec3::from_array(*hi)),
+        }
+    }
+}
+
+request! {
+    /// The limits every job runs under.
+    LimitsRequest as "limits" {
+        /// Worker threads (none or 0: every core; at most 256).
+        threads: Option<u32> = None,
+        /// Refuse work estimated above this many MiB before it starts (none or 0: the memory
+        /// available).
+        max_memory_mib: Option<u64> = None,
+    }
+}
+
+request! {
+    /// How grids are written to a .vdb file.
+    WriteRequest as "write" {
+        /// Write only these grids, by name (empty: all but `voxels`, the boolean copy of
+        /// `density`'s voxels).
+        grids: Vec<String> = Vec::new(),
+        /// .vdb compression: blosc (OpenVDB's default), zip or none.
+        compression: Compression = Compression::Blosc,
+        /// Float and vector grids at half precision (16-bit: half the size).
+        half: bool = false,
+    }
+}
+
+request! {
+    /// A polygon mesh's surface: 6- or 26-separating (Huang et al.) or projective (Jegathese
+    /// et al.); with `sdf` or `udf`, exact distances within `band` voxels instead.
+    MeshRequest as "mesh" {
+        /// Voxels along the longest bounding-box axis (none: 256 unless voxel_size is given).
+        resolution: Option<u32> = None,
+        /// Voxel edge length in world units (instead of resolution).
+        voxel_size: Option<f64> = None,
+        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
+        up_axis: UpAxis = UpAxis::Z,
+        /// separating: Huang et al.'s surface; projective: Jegathese et al.'s scan-lines
+        /// (colours, no separability guarantee where triangles meet).
+        method: SurfaceKind = SurfaceKind::Separating,
+        /// 6: thin surface blocking face-connected paths; 26: blocks every path.
+        separability: Separability = Separability::TwentySix,
+        /// huang: the paper's full vertex spheres and edge cylinders; clipped: the same
+        /// clipped to the face slabs (still separating, far fewer redundant voxels).
+        criterion: Criterion = Criterion::Huang,
+        /// Also keep a `normal` grid (nearest face, edge or vertex normal per voxel).
+        normals: bool = false,
+        /// Projective: carry the mesh's vertex colours into a `Cd` grid.
+        colors: bool = true,
+        /// Projective: one (r, g, b) colour for every voxel instead.
+        color: Option<[f32; 3]> = None,
+        /// Exact signed distances (a level set, closed meshes) within `band`.
+        sdf: bool = false,
+        /// Exact unsigned distances within `band` (open meshes too).
+        udf: bool = false,
+        /// Half width of the distance band, in voxels.
+        band: f64 = BAND,
+    }
+}
+
+request! {
+    /// A closed mesh's solid: flood (the 26-separating surface and everything the exterior
+    /// flood cannot reach), depth-layers (Passalis et al.) or beam (Jegathese et al.); with
+    /// `sdf`, its level set.
+    SolidRequest as "solid" {
+        /// Voxels along the longest bounding-box axis (none: 256 unless voxel_size is given).
+        resolution: Option<u32> = None,
+        /// Voxel edge length in world units (instead of resolution).
+        voxel_size: Option<f64> = None,
+        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
+        up_axis: UpAxis = UpAxis::Z,
+        /// flood, depth-layers or beam.
+        method: FillKind = FillKind::Flood,
+        /// The exterior flood: blocks (fastest), spans, or xyz (Lai & Cheng's FloodingXYZ).
+        flood: FloodKind = FloodKind::Blocks,
+        /// GRAYSTACK capacity of the xyz flood (entries; when full, sweeps resume the flood).
+        graystack: usize = GRAYSTACK,
+        /// Depth layers: a count of the 16 built-in directions, or integer (x, y, z)
+        /// triples, each with a component of 1 or -1, none parallel.
+        directions: Directions = Directions::Count(16),
+        /// Depth layers: double (a stencil count, Passalis et al.) or single (Karabassi et al.).
+        layers: Layers = Layers::Double,
+        /// Depth layers: no-direction (a voxel no direction decides) or paper (a voxel on a
+        /// ray of any direction crossing more than four times).
+        unclassified: Unclassified = Unclassified::NoDirection,
+        /// Beam: parity (centres between exact crossings) or paper (from each back-face voxel
+        /// up to the next front-face voxel).
+        fill: BeamFill = BeamFill::Parity,
+        /// Mass per unit volume.
+        density: f64 = DENSITY,
+        /// Also count components (26-connected) and genus.
+        topology: bool = false,
+        /// Write the solid's level set instead: exact signed distances within `band`.
+        sdf: bool = false,
+        /// Half width of the distance band, in voxels.
+        band: f64 = BAND,
+    }
+}
+
+request! {
+    /// Volume, mass, area, components and genus of a closed mesh (its flooded 26-separating
+    /// surface) or of a closed voxel surface.
+    MeasureRequest as "measure" {
+        /// Voxels along the longest bounding-box axis (none: 256 unless voxel_size is given).
+        resolution: Option<u32> = None,
+        /// Voxel edge length in world units (instead of resolution).
+        voxel_size: Option<f64> = None,
+        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
+        up_axis: UpAxis = UpAxis::Z,
+        /// The exterior flood: blocks (fastest), spans, or xyz (Lai & Cheng's FloodingXYZ).
+        flood: FloodKind = FloodKind::Blocks,
+        /// GRAYSTACK capacity of the xyz flood (entries; when full, sweeps resume the flood).
+        graystack: usize = GRAYSTACK,
+        /// Mass per unit volume.
+        density: f64 = DENSITY,
+    }
+}
+
+request! {
+    /// A Catmull-Clark limit surface from its control mesh (Lai & Cheng); with `solid`, the
+    /// solid it bounds, flooded from seeds against the limit normals by FloodingXYZ.
+    SubdivRequest as "subdiv" {
+        /// Voxels along the longest bounding-box axis (none: 256 unless voxel_size is given).
+        resolution: Option<u32> = None,
+        /// Voxel edge length in world units (instead of resolution).
+        voxel_size: Option<f64> = None,
+        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
+        up_axis: UpAxis = UpAxis::Z,
+        /// The adjacency (6, 18 or 26) every voxel meets between its sub-patches' corners.
+        adjacency: Adjacency = Adjacency::TwentySix,
+        /// Every voxel the surface touches (an enveloping voxelization).
+        enclose: bool = false,
+        /// Each face's patch split K x K before the adaptive subdivision.
+        presplit: u32 = ParametricOptions::default().presplit,
+        /// The solid of the closed limit surface, with its volume and mass.
+        solid: bool = false,
+        /// GRAYSTACK capacity of FloodingXYZ (entries).
+        graystack: usize = GRAYSTACK,
+        /// Mass per unit volume.
+        density: f64 = DENSITY,
+        /// Also count components and genus.
+        topology: bool = false,
+    }
+}
+
+request! {
+    /// The surface F = 0 of a formula, by interval octree (Stolte & Kaufman).
+    ImplicitRequest as "implicit" {
+        /// cartesian (x, y, z), spherical (r, theta, phi) or cylindrical (r, theta, y: r and
+        /// theta in the XZ plane, y along the axis).
+        coords: Coordinates = Coordinates::Cartesian,
+        /// The box: [lo, hi] for a cube, or [[x0, y0, z0], [x1, y1, z1]].
+        bounds: Bounds = Bounds::Cube([-1.0, 1.0]),
+        /// Voxels along the box's longest side.
+        resolution: u32 = DEFAULT_RESOLUTION,
+        /// Also keep every level of the octree (each envelops the surface).
+        levels: bool = false,
+        /// Spherical and cylindrical: the surface where r < 0 too.
+        negative_r: bool = false,
+        /// positive (the paper's [0, 2pi)) or symmetric ((-pi, pi]).
+        theta_range: ThetaRange = ThetaRange::Positive,
+        /// The paper's [G]^2 - r^2 = 0 for F = G - r (the surface r = |G|).
+        squared: bool = false,
+    }
+}
+
+request! {
+    /// 3D lines (Jegathese et al.): the polylines (OBJ `l`) of a mesh, and with `edges` (or
+    /// when there are none) the faces' edges.
+    LinesRequest as "lines" {
+        /// Voxels along the longest bounding-box axis (none: 256 unless voxel_size is given).
+        resolution: Option<u32> = None,
+        /// Voxel edge length in world units (instead of resolution).
+        voxel_size: Option<f64> = None,
+        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
+        up_axis: UpAxis = UpAxis::Z,
+        /// Also the faces' edges.
+        edges: bool = false,
+        /// Carry the mesh's vertex colours into a `Cd` grid.
+        colors: bool = true,
+        /// One (r, g, b) colour for every voxel instead.
+        color: Option<[f32; 3]> = None,
+    }
+}
+
+request! {
+    /// A Boolean of two grids.
+    CombineRequest as "combine" {
+        /// union, intersection or difference.
+        op: BooleanOp = BooleanOp::Union,
+        /// The grid read from files (none: `voxels`, else `density`, else the first bool,
+        /// mask or float grid).
+        grid: Option<String> = None,
+        /// Resample the second grid onto the first's transform when they differ.
+        resample: bool = false,
+    }
+}
+
+request! {
+    /// The separating surface (or solid) of a mesh cut into bricks and voxelized by Dask
+    /// workers, merged into one .vdb.
+    BricksRequest as "distributed" {
+        /// Voxels along the longest bounding-box axis (none: 256 unless voxel_size is given).
+        resolution: Option<u32> = None,
+        /// Voxel edge length in world units (instead of resolution).
+        voxel_size: Option<f64> = None,
+        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
+        up_axis: UpAxis = UpAxis::Z,
+        /// Voxels along a brick's edge, a multiple of 8.
+        brick: u32 = 1024,
+        /// 6 or 26 (the surface; a solid is always 26).
+        separability: Separability = Separability::TwentySix,
+        /// Refuse a brick estimated above this many MiB (none or 0: the memory available).
+        max_memory_mib: Option<u64> = None,
+    }
+}
+
+/// The grid fit of `resolution` or `voxel_size` (not both), checked.
+pub fn grid_fit(resolution: Option<u32>, voxel_size: Option<f64>) -> Result<GridFit> {
+    if resolution.is_some() && voxel_size.is_some() {
+        return Err(Error::InvalidArgument(
+            "give resolution or voxel_size, not both".into(),
+        ));
+    }
+    if resolution == Some(0) {
+        return Err(Error::InvalidArgument(
+            "resolution must be at least 1".into(),
+        ));
+    }
+    if let Some(h) = voxel_size {
+        positive("voxel_size", h)?;
+    }
+    Ok(GridFit::from_options(resolution, voxel_size))
+}
+
+/// Refuses a value that is not a positive, finite number, naming the option.
+pub fn positive(name: &str, v: f64) -> Result<()> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidArgument(format!(
+            "{name} must be a positive number, not {v}"
+        )))
+    }
+}
+
+fn color_choice(colors: bool, color: Option<[f32; 3]>) -> ColorChoice {
+    match (color, colors) {
+        (Some(c), _) => ColorChoice::Constant(Vec3::from_array(c)),
+        (None, true) => ColorChoice::FromMesh,
+        (None, false) => ColorChoice::None,
+    }
+}
+
+fn distance_band(mesh: MeshSource, band: f64, signed: bool) -> Result<Task> {
+    positive("band", band)?;
+    Ok(Task::DistanceBand { mesh, band, signed })
+}
+
+impl LimitsRequest {
+    /// The limits, 0 read as none.
+    pub fn limits(&self) -> Limits {
+        Limits {
+            threads: self.threads.filter(|&n| n > 0).map(|n| n as usize),
+            max_memory: mib_limit(self.max_memory_mib),
+        }
+    }
+}
+
+/// A memory limit in MiB as bytes, 0 read as none.
+pub fn mib_limit(mib: Option<u64>) -> Option<u64> {
+    mib.filter(|&m| m > 0).map(|m| m.saturating_mul(1 << 20))
+}
+
+impl WriteRequest {
+    pub fn options(&self) -> WriteOptions {
+        WriteOptions {
+            grids: self.grids.clone(),
+            compression: self.compression,
+            half: self.half,
+        }
+    }
+}
+
+impl MeshRequest {
+    pub fn fit(&self) -> Result<GridFit> {
+        grid_fit(self.resolution, self.voxel_size)
+    }
+
+    pub fn separating(&self) -> SeparatingOptions {
+        SeparatingOptions {
+            separability: self.separability,
+            criterion: self.criterion,
+            normals: self.normals,
+        }
+    }
+
+    pub fn task(&self, mesh: MeshSource) -> Result<Task> {
+        if self.sdf && self.udf {
+            return Err(Error::InvalidArgument(
+                "sdf and udf exclude each other".into(),
+            ));
+        }
+        if self.sdf || self.udf {
+            return distance_band(mesh, self.band, self.sdf);
+        }
+        let method = match self.method {
+            SurfaceKind::Separating => SurfaceMethod::Separating(self.separating()),
+            SurfaceKind::Projective => {
+                SurfaceMethod::Projective(color_choice(self.colors, self.color))
+            }
+        };
+        Ok(Task::MeshSurface { mesh, method })
+    }
+}
+
+impl SolidRequest {
+    pub fn fit(&self) -> Result<GridFit> {
+        grid_fit(self.resolution, self.voxel_size)
+    }
+
+    pub fn depth_layers(&self) -> Result<DepthLayerOptions> {
+        Ok(DepthLayerOptions {
+            directions: self.directions.set()?,
+            layers: self.layers,
+            unclassified: self.unclassified,
+        })
+    }
+
+    pub fn task(&self, mesh: MeshSource) -> Result<Task> {
+        if self.sdf {
+            return distance_band(mesh, self.band, true);
+        }
+        positive("density", self.density)?;
+        let fill = match self.method {
+            FillKind::Flood => Fill::Flood(self.flood.method(self.graystack)),
+            FillKind::DepthLayers => Fill::DepthLayers(self.depth_layers()?),
+            FillKind::Beam => Fill::Beam(self.fill),
+        };
+        Ok(Task::Solid {
+            mesh,
+            fill,
+            density: self.density,
+            topology: self.topology,
+        })
+    }
+}
+
+impl MeasureRequest {
+    pub fn fit(&self) -> Result<GridFit> {
+        grid_fit(self.resolution, self.voxel_size)
+    }
+
+    pub fn task(&self, source: MeasureSource) -> Result<Task> {
+        positive("density", self.density)?;
+        Ok(Task::Measure {
+            source,
+            flood: self.flood.method(self.graystack),
+            density: self.density,
+        })
+    }
+}
+
+impl SubdivRequest {
+    pub fn fit(&self) -> Result<GridFit> {
+        grid_fit(self.resolution, self.voxel_size)
+    }
+
+    pub fn options(&self) -> Result<ParametricOptions> {
+        if self.presplit == 0 {
+            return Err(Error::InvalidArgument("presplit must be at least 1".into()));
+        }
+        Ok(ParametricOptions {
+            adjacency: self.adjacency,
+            presplit: self.presplit,
+            enclose: self.enclose,
+        })
+    }
+
+    pub fn task(&self, mesh: MeshSource) -> Result<Task> {
+        if self.solid {
+            positive("density", self.density)?;
+        }
+        Ok(Task::Subdivision {
+            mesh,
+            options: self.options()?,
+            solid: self.solid.then_some(SubdivisionFill {
+                graystack: self.graystack.max(1),
+                density: self.density,
+                topology: self.topology,
+            }),
+        })
+    }
+}
+
+impl ImplicitRequest {
+    pub fn fit(&self) -> Result<GridFit> {
+        grid_fit(Some(self.resolution), None)
+    }
+
+    pub fn task(&self, formula: String) -> Task {
+        let (min, max) = self.bounds.corners();
+        Task::Implicit {
+            formula,
+            coordinates: self.coords,
+            min,
+            max,
+            levels: self.levels,
+            negative_r: self.negative_r,
+            theta_range: self.theta_range,
+            squared: self.squared,
+        }
+    }
+}
+
+impl LinesRequest {
+    pub fn fit(&self) -> Result<GridFit> {
+        grid_fit(self.resolution, self.voxel_size)
+    }
+
+    pub fn task(&self, mesh: MeshSource) -> Task {
+        Task::Lines {
+            mesh,
+            edges: self.edges,
+            color: color_choice(self.colors, self.color),
+        }
+    }
+}
+
+impl CombineRequest {
+    pub fn task(&self, a: GridSource, b: GridSource) -> Task {
+        Task::Combine {
+            a,
+            b,
+            grid: self.grid.clone(),
+            op: self.op,
+            resample: self.resample,
+            curve: false,
+        }
+    }
+}
+
+impl BricksRequest {
+    pub fn fit(&self) -> Result<GridFit> {
+        grid_fit(self.resolution, self.voxel_size)
+    }
+}
+
+fn entry<R: Schema>() -> (String, Value) {
+    let fields: Vec<Value> = R::fields()
+        .into_iter()
+        .map(|f| serde_json::to_value(f).unwrap_or(Value::Null))
+        .collect();
+    (
+        R::NAME.to_string(),
+        serde_json::json!({ "doc": R::doc(), "fields": fields }),
+    )
+}
+
+/// Every request's fields: name, doc, default and choices, keyed by the request's name
+/// (`mesh`, `solid`, ..., `limits`, `write`). The front ends that fill requests by name
+/// (Python, Blender, Dask) take their parameters, defaults and choices from it.
+pub fn schema() -> Value {
+    Value::Object(
+        [
+            entry::<MeshRequest>(),
+            entry::<SolidRequest>(),
+            entry::<MeasureRequest>(),
+            entry::<SubdivRequest>(),
+            entry::<ImplicitRequest>(),
+            entry::<LinesRequest>(),
+            entry::<CombineRequest>(),
+            entry::<BricksRequest>(),
+            entry::<LimitsRequest>(),
+            entry::<WriteRequest>(),
+        ]
+        .into_iter()
+        .collect(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_field_is_documented_and_its_default_round_trips() {
+        for (name, request) in schema().as_object().unwrap() {
+            for f in request["fields"].as_array().unwrap() {
+                assert!(
+                    !f["doc"].as_str().unwrap().is_empty(),
+                    "{name}.{} has no doc",
+                    f["name"]
+                );
+            }
+        }
+        let defaults = serde_json::to_value(SolidRequest::default()).unwrap();
+        assert_eq!(
+            SolidRequest::from_json(defaults).unwrap(),
+            SolidRequest::default()
+        );
+    }
+
+    #[test]
+    fn bad_names_and_values_are_refused_with_the_field() {
+        let e = MeshRequest::from_json(serde_json::json!({"separability": 7})).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "invalid argument: separability: separability must be 6 or 26, not `7`"
+        );
+        let e = MeshRequest::from_json(serde_json::json!({"sepability": 6})).unwrap_err();
+        assert!(e.to_string().contains("unknown field `sepability`"), "{e}");
+        let r = MeshRequest::from_json(serde_json::json!({"separability": "6"})).unwrap();
+        assert_eq!(r.separability, Separability::Six);
+        let r = MeshRequest {
+            band: f64::INFINITY,
+            sdf: true,
+            ..MeshRequest::default()
+        };
+        let e = r.task(MeshSource::File("m.obj".into())).unwrap_err();
+        assert!(
+            e.to_string().contains("band must be a positive number"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn zero_threads_and_memory_mean_the_defaults() {
+        let zero = LimitsRequest {
+            threads: Some(0),
+            max_memory_mib: Some(0),
+        };
+        assert_eq!(zero.limits().threads, None);
+        assert_eq!(zero.limits().max_memory, None);
+        let some = LimitsRequest {
+            threads: Some(3),
+            max_memory_mib: Some(2),
+        };
+        assert_eq!(some.limits().threads, Some(3));
+        assert_eq!(some.limits().max_memory, Some(2 << 20));
+    }
+}
