@@ -169,7 +169,7 @@ vk_status vk_options_set_depth_layers(vk_options *options, uint32_t directions, 
 /* vk_voxelize_subdivision: each patch pre-split presplit x presplit (>= 1, default 8);
  * non-zero `enclose` refines until every voxel the surface touches is output. */
 vk_status vk_options_set_subdivision(vk_options *options, uint32_t presplit, int enclose);
-/* Worker threads for calls with these options; 0 means all cores. */
+/* Worker threads for calls with these options (0: all cores, the default; at most 256). */
 vk_status vk_options_set_threads(vk_options *options, uint32_t threads);
 /* Refuse work whose estimated memory exceeds `mib` MiB (0: the memory available, the
  * default) with VK_ERROR_TOO_LARGE before anything large is allocated. */
@@ -227,7 +227,8 @@ vk_status vk_grid_combine(const vk_grid *a, const vk_grid *b, vk_boolean op, int
 
 /* ---- grids ------------------------------------------------------------------------------ */
 
-/* Reads grid `name` (NULL: the first Bool, Mask or Float grid) of a .vdb file. */
+/* Reads grid `name` of a .vdb file (NULL: the voxel set voxelkit writes, `voxels`, else
+ * `density`, else the first Bool, Mask or Float grid). */
 vk_status vk_grid_read_vdb(const char *path, const char *name, vk_grid **out);
 
 /* Writes `density` (a fog volume, whole blocks as tiles) and, when the grid has them,

@@ -8,23 +8,22 @@
 //! returns non-zero) is the observer's answer, the workers skip what is left and the call
 //! returns `VK_ERROR_CANCELLED`. No algorithm and no orchestration lives here.
 
+use crate::choice::Choice;
 use crate::error::Error;
 use crate::grid::{LEAF_VOXELS, SparseGrid};
 use crate::implicit::Coordinates;
 use crate::io::vdb::{read_vdb_grid, write_vdb};
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::BooleanOp;
-use crate::pipeline::{
-    ColorChoice, Details, Fill, GridSource, Job, Limits, MeasureSource, MeshSource, Outcome,
-    SubdivisionFill, SurfaceMethod as PipelineSurface, Task,
+use crate::pipeline::request::{
+    CombineRequest, Directions, FillKind, FloodKind, ImplicitRequest, LimitsRequest, LinesRequest,
+    MeasureRequest, MeshRequest, SolidRequest, SubdivRequest, SurfaceKind, grid_fit,
 };
+use crate::pipeline::{Details, GridSource, Job, MeasureSource, MeshSource, Outcome, Task};
 use crate::progress::Observer;
-use crate::solids::csg_leaves::ALL_DIRECTIONS;
-use crate::solids::depth_layers::{DepthLayerOptions, DirectionSet, Layers};
-use crate::solids::exterior_flood::FloodMethod;
+use crate::solids::depth_layers::Layers;
 use crate::voxelize::Separability;
-use crate::voxelize::parametric::ParametricOptions;
-use crate::voxelize::separating::{Criterion, SeparatingOptions};
+use crate::voxelize::separating::Criterion;
 use glam::DVec3;
 use std::any::Any;
 use std::cell::RefCell;
@@ -89,32 +88,15 @@ pub struct VkOptions(Mutex<Options>);
 // which the header lets calls on any thread use (the flag is read atomically).
 unsafe impl Send for Options {}
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum SurfaceMethod {
-    Separating,
-    Projective,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum FillMethod {
-    Flood,
-    DepthLayers,
-    Beam,
-}
-
-#[derive(Clone, Copy)]
+/// What the setters set: the requests of `pipeline::request` (their defaults are the
+/// options' defaults) and the grid they share.
+#[derive(Clone)]
 struct Options {
     fit: GridFit,
-    separability: Separability,
-    criterion: Criterion,
-    normals: bool,
-    surface: SurfaceMethod,
-    fill: FillMethod,
-    flood: FloodMethod,
-    depth: DepthLayerOptions,
-    subdivision: ParametricOptions,
-    threads: u32,
-    max_memory: Option<u64>,
+    mesh: MeshRequest,
+    solid: SolidRequest,
+    subdivision: SubdivRequest,
+    limits: LimitsRequest,
     progress: Option<(VkProgressFn, *mut c_void)>,
     cancel: *const AtomicI32,
 }
@@ -122,17 +104,11 @@ struct Options {
 impl Default for Options {
     fn default() -> Self {
         Options {
-            fit: GridFit::Resolution(256),
-            separability: Separability::TwentySix,
-            criterion: Criterion::Huang,
-            normals: false,
-            surface: SurfaceMethod::Separating,
-            fill: FillMethod::Flood,
-            flood: FloodMethod::Blocks,
-            depth: ALL_DIRECTIONS,
-            subdivision: ParametricOptions::default(),
-            threads: 0,
-            max_memory: None,
+            fit: GridFit::from_options(None, None),
+            mesh: MeshRequest::default(),
+            solid: SolidRequest::default(),
+            subdivision: SubdivRequest::default(),
+            limits: LimitsRequest::default(),
             progress: None,
             cancel: std::ptr::null(),
         }
@@ -341,7 +317,7 @@ fn lock(options: &VkOptions) -> std::sync::MutexGuard<'_, Options> {
 /// A copy of the options behind a live handle, for one call.
 fn options_of(p: *const VkOptions) -> std::result::Result<Options, Failure> {
     let options: Arc<VkOptions> = borrow(p, Kind::Options)?;
-    Ok(*lock(&options))
+    Ok(lock(&options).clone())
 }
 
 fn non_null_out<T>(out: *mut T) -> std::result::Result<*mut T, Failure> {
@@ -494,10 +470,7 @@ fn run_job(options: &Options, task: Task) -> std::result::Result<Outcome, Failur
     let job = Job {
         task,
         fit: options.fit,
-        limits: Limits {
-            threads: (options.threads > 0).then_some(options.threads as usize),
-            max_memory: options.max_memory,
-        },
+        limits: options.limits.limits(),
         up_axis: Default::default(),
     };
     let outcome = job.run(&reporter)?;
@@ -651,32 +624,30 @@ pub extern "C" fn vk_options_free(options: *mut VkOptions) -> VkStatus {
     guard(|| release(options, Kind::Options))
 }
 
-#[unsafe(no_mangle)]
-pub extern "C" fn vk_options_set_resolution(options: *mut VkOptions, resolution: u32) -> VkStatus {
+/// Changes the options of a live handle.
+fn set(
+    options: *mut VkOptions,
+    change: impl FnOnce(&mut Options) -> std::result::Result<(), Failure>,
+) -> VkStatus {
     guard(|| {
         let options = options_mut(options)?;
         let mut o = lock(&options);
-        if !(1..=1 << 16).contains(&resolution) {
-            return Err(invalid(format!(
-                "resolution {resolution} must be between 1 and 65536"
-            )));
-        }
-        o.fit = GridFit::Resolution(resolution);
+        change(&mut o)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_resolution(options: *mut VkOptions, resolution: u32) -> VkStatus {
+    set(options, |o| {
+        o.fit = grid_fit(Some(resolution), None)?;
         Ok(())
     })
 }
 
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_voxel_size(options: *mut VkOptions, voxel_size: f64) -> VkStatus {
-    guard(|| {
-        let options = options_mut(options)?;
-        let mut o = lock(&options);
-        if !(voxel_size > 0.0 && voxel_size.is_finite()) {
-            return Err(invalid(format!(
-                "voxel size {voxel_size:?} must be positive and finite"
-            )));
-        }
-        o.fit = GridFit::VoxelSize(voxel_size);
+    set(options, |o| {
+        o.fit = grid_fit(None, Some(voxel_size))?;
         Ok(())
     })
 }
@@ -686,33 +657,26 @@ pub extern "C" fn vk_options_set_separability(
     options: *mut VkOptions,
     separability: c_int,
 ) -> VkStatus {
-    guard(|| {
-        let options = options_mut(options)?;
-        let mut o = lock(&options);
-        o.separability = separability.to_string().parse().map_err(invalid)?;
+    set(options, |o| {
+        let separability = Separability::from_number(i64::from(separability)).map_err(invalid)?;
+        o.mesh.separability = separability;
+        o.subdivision.adjacency = separability.flood_adjacency();
         Ok(())
     })
 }
 
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_criterion(options: *mut VkOptions, criterion: c_int) -> VkStatus {
-    guard(|| {
-        let options = options_mut(options)?;
-        let mut o = lock(&options);
-        o.criterion = match criterion {
-            0 => Criterion::Huang,
-            1 => Criterion::Clipped,
-            _ => return Err(invalid(format!("unknown vk_criterion {criterion}"))),
-        };
+    set(options, |o| {
+        o.mesh.criterion = Criterion::from_code(i64::from(criterion)).map_err(invalid)?;
         Ok(())
     })
 }
 
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_normals(options: *mut VkOptions, normals: c_int) -> VkStatus {
-    guard(|| {
-        let options: Arc<VkOptions> = options_mut(options)?;
-        lock(&options).normals = normals != 0;
+    set(options, |o| {
+        o.mesh.normals = normals != 0;
         Ok(())
     })
 }
@@ -722,29 +686,16 @@ pub extern "C" fn vk_options_set_surface_method(
     options: *mut VkOptions,
     method: c_int,
 ) -> VkStatus {
-    guard(|| {
-        let options = options_mut(options)?;
-        let mut o = lock(&options);
-        o.surface = match method {
-            0 => SurfaceMethod::Separating,
-            1 => SurfaceMethod::Projective,
-            _ => return Err(invalid(format!("unknown vk_surface_method {method}"))),
-        };
+    set(options, |o| {
+        o.mesh.method = SurfaceKind::from_code(i64::from(method)).map_err(invalid)?;
         Ok(())
     })
 }
 
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_fill_method(options: *mut VkOptions, method: c_int) -> VkStatus {
-    guard(|| {
-        let options = options_mut(options)?;
-        let mut o = lock(&options);
-        o.fill = match method {
-            0 => FillMethod::Flood,
-            1 => FillMethod::DepthLayers,
-            2 => FillMethod::Beam,
-            _ => return Err(invalid(format!("unknown vk_fill_method {method}"))),
-        };
+    set(options, |o| {
+        o.solid.method = FillKind::from_code(i64::from(method)).map_err(invalid)?;
         Ok(())
     })
 }
@@ -755,14 +706,19 @@ pub extern "C" fn vk_options_set_flood(
     flooding_xyz: c_int,
     graystack: usize,
 ) -> VkStatus {
-    guard(|| {
-        let options: Arc<VkOptions> = options_mut(options)?;
-        lock(&options).flood = if flooding_xyz != 0 {
-            FloodMethod::Xyz {
-                capacity: graystack.max(1),
-            }
+    set(options, |o| {
+        let xyz = flooding_xyz != 0;
+        o.solid.flood = if xyz {
+            FloodKind::Xyz
         } else {
-            FloodMethod::Blocks
+            FloodKind::Blocks
+        };
+        o.solid.graystack = graystack;
+        // The subdivision solid always floods by FloodingXYZ: it takes the stack when given.
+        o.subdivision.graystack = if xyz {
+            graystack
+        } else {
+            SubdivRequest::default().graystack
         };
         Ok(())
     })
@@ -774,17 +730,14 @@ pub extern "C" fn vk_options_set_depth_layers(
     directions: u32,
     double_layers: c_int,
 ) -> VkStatus {
-    guard(|| {
-        let options = options_mut(options)?;
-        let mut o = lock(&options);
-        o.depth = DepthLayerOptions {
-            directions: DirectionSet::first(directions as usize)?,
-            layers: if double_layers != 0 {
-                Layers::Double
-            } else {
-                Layers::Single
-            },
-            ..o.depth
+    set(options, |o| {
+        let directions = Directions::Count(directions as usize);
+        directions.set()?;
+        o.solid.directions = directions;
+        o.solid.layers = if double_layers != 0 {
+            Layers::Double
+        } else {
+            Layers::Single
         };
         Ok(())
     })
@@ -796,32 +749,30 @@ pub extern "C" fn vk_options_set_subdivision(
     presplit: u32,
     enclose: c_int,
 ) -> VkStatus {
-    guard(|| {
-        let options = options_mut(options)?;
-        let mut o = lock(&options);
-        if presplit == 0 {
-            return Err(invalid("the pre-split count must be at least 1"));
-        }
-        o.subdivision.presplit = presplit;
-        o.subdivision.enclose = enclose != 0;
+    set(options, |o| {
+        let changed = SubdivRequest {
+            presplit,
+            enclose: enclose != 0,
+            ..o.subdivision.clone()
+        };
+        changed.options()?;
+        o.subdivision = changed;
         Ok(())
     })
 }
 
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_threads(options: *mut VkOptions, threads: u32) -> VkStatus {
-    guard(|| {
-        let options: Arc<VkOptions> = options_mut(options)?;
-        lock(&options).threads = threads;
+    set(options, |o| {
+        o.limits.threads = Some(threads);
         Ok(())
     })
 }
 
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_max_memory(options: *mut VkOptions, mib: u64) -> VkStatus {
-    guard(|| {
-        let options: Arc<VkOptions> = options_mut(options)?;
-        lock(&options).max_memory = (mib > 0).then(|| mib.saturating_mul(1 << 20));
+    set(options, |o| {
+        o.limits.max_memory_mib = Some(mib);
         Ok(())
     })
 }
@@ -858,20 +809,7 @@ pub extern "C" fn vk_voxelize_mesh(
     options: *const VkOptions,
     out: *mut *mut VkGrid,
 ) -> VkStatus {
-    grid_from_job(options, out, |o| {
-        let method = match o.surface {
-            SurfaceMethod::Separating => PipelineSurface::Separating(SeparatingOptions {
-                separability: o.separability,
-                criterion: o.criterion,
-                normals: o.normals,
-            }),
-            SurfaceMethod::Projective => PipelineSurface::Projective(ColorChoice::FromMesh),
-        };
-        Ok(Task::MeshSurface {
-            mesh: mesh_source(mesh)?,
-            method,
-        })
-    })
+    grid_from_job(options, out, |o| Ok(o.mesh.task(mesh_source(mesh)?)?))
 }
 
 #[unsafe(no_mangle)]
@@ -881,11 +819,7 @@ pub extern "C" fn vk_voxelize_lines(
     out: *mut *mut VkGrid,
 ) -> VkStatus {
     grid_from_job(options, out, |_| {
-        Ok(Task::Lines {
-            mesh: mesh_source(mesh)?,
-            edges: false,
-            color: ColorChoice::FromMesh,
-        })
+        Ok(LinesRequest::default().task(mesh_source(mesh)?))
     })
 }
 
@@ -896,14 +830,7 @@ pub extern "C" fn vk_voxelize_subdivision(
     out: *mut *mut VkGrid,
 ) -> VkStatus {
     grid_from_job(options, out, |o| {
-        Ok(Task::Subdivision {
-            mesh: mesh_source(mesh)?,
-            options: ParametricOptions {
-                adjacency: o.separability.flood_adjacency(),
-                ..o.subdivision
-            },
-            solid: None,
-        })
+        Ok(o.subdivision.task(mesh_source(mesh)?)?)
     })
 }
 
@@ -917,12 +844,7 @@ pub extern "C" fn vk_voxelize_formula(
     out: *mut *mut VkGrid,
 ) -> VkStatus {
     grid_from_job(options, out, |_| {
-        let coordinates = match coordinates {
-            0 => Coordinates::Cartesian,
-            1 => Coordinates::Spherical,
-            2 => Coordinates::Cylindrical,
-            _ => return Err(invalid(format!("unknown vk_coordinates {coordinates}"))),
-        };
+        let coords = Coordinates::from_code(i64::from(coordinates)).map_err(invalid)?;
         let min = DVec3::from_slice(slice(bounds_min, 3, "bounds_min")?);
         let max = DVec3::from_slice(slice(bounds_max, 3, "bounds_max")?);
         if !(min.is_finite() && max.is_finite()) {
@@ -930,16 +852,12 @@ pub extern "C" fn vk_voxelize_formula(
                 "the bounds {min} .. {max} must be finite numbers"
             )));
         }
-        Ok(Task::Implicit {
-            formula: c_str(formula, "formula")?.to_string(),
-            coordinates,
-            min,
-            max,
-            levels: false,
-            negative_r: false,
-            theta_range: Default::default(),
-            squared: false,
-        })
+        let request = ImplicitRequest {
+            coords,
+            bounds: crate::pipeline::request::Bounds::Box([min.to_array(), max.to_array()]),
+            ..ImplicitRequest::default()
+        };
+        Ok(request.task(c_str(formula, "formula")?.to_string()))
     })
 }
 
@@ -950,19 +868,7 @@ pub extern "C" fn vk_fill_mesh(
     solid: *mut *mut VkGrid,
     measures: *mut VkMeasures,
 ) -> VkStatus {
-    let task = |o: &Options| {
-        let fill = match o.fill {
-            FillMethod::Flood => Fill::Flood(o.flood),
-            FillMethod::DepthLayers => Fill::DepthLayers(o.depth),
-            FillMethod::Beam => Fill::Beam(Default::default()),
-        };
-        Ok(Task::Solid {
-            mesh: mesh_source(mesh)?,
-            fill,
-            density: 1.0,
-            topology: false,
-        })
-    };
+    let task = |o: &Options| Ok(o.solid.task(mesh_source(mesh)?)?);
     let measures_of = |outcome: &Outcome| match &outcome.report.details {
         Details::DepthLayers(d) if d.unclassified_voxels > 0 => Err(invalid(format!(
             "{} voxels cannot be classified by depth layers (crossed more than four times \
@@ -988,22 +894,11 @@ pub extern "C" fn vk_fill_subdivision(
     measures: *mut VkMeasures,
 ) -> VkStatus {
     let task = |o: &Options| {
-        let graystack = match o.flood {
-            FloodMethod::Xyz { capacity } => capacity,
-            _ => 1 << 20,
+        let request = SubdivRequest {
+            solid: true,
+            ..o.subdivision.clone()
         };
-        Ok(Task::Subdivision {
-            mesh: mesh_source(mesh)?,
-            options: ParametricOptions {
-                adjacency: o.separability.flood_adjacency(),
-                ..o.subdivision
-            },
-            solid: Some(SubdivisionFill {
-                graystack,
-                density: 1.0,
-                topology: false,
-            }),
-        })
+        Ok(request.task(mesh_source(mesh)?)?)
     };
     solid_from_job(options, solid, measures, task, solid_measures)
 }
@@ -1016,11 +911,7 @@ pub extern "C" fn vk_measure_surface(
     guard(|| {
         let g = &borrow(surface, Kind::Grid)?.grid;
         non_null_out(measures)?;
-        let task = Task::Measure {
-            source: MeasureSource::Grid(g.clone()),
-            flood: FloodMethod::Blocks,
-            density: 1.0,
-        };
+        let task = MeasureRequest::default().task(MeasureSource::Grid(g.clone()))?;
         let outcome = run_job(&Options::default(), task)?;
         put(measures, solid_measures(&outcome)?)
     })
@@ -1037,20 +928,12 @@ pub extern "C" fn vk_grid_combine(
     guard(|| {
         let (a, b) = (&borrow(a, Kind::Grid)?.grid, &borrow(b, Kind::Grid)?.grid);
         non_null_out(out)?;
-        let op = match op {
-            0 => BooleanOp::Union,
-            1 => BooleanOp::Intersection,
-            2 => BooleanOp::Difference,
-            _ => return Err(invalid(format!("unknown vk_boolean {op}"))),
-        };
-        let task = Task::Combine {
-            a: GridSource::Grid(a.clone()),
-            b: GridSource::Grid(b.clone()),
-            grid: None,
-            op,
+        let request = CombineRequest {
+            op: BooleanOp::from_code(i64::from(op)).map_err(invalid)?,
             resample: resample != 0,
-            curve: false,
+            ..CombineRequest::default()
         };
+        let task = request.task(GridSource::Grid(a.clone()), GridSource::Grid(b.clone()));
         let outcome = run_job(&Options::default(), task)?;
         hand_out(VkGrid::from(outcome), Kind::Grid, out)
     })

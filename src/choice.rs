@@ -41,6 +41,11 @@ pub trait Choice: Copy + PartialEq + Sized + 'static {
             .ok_or_else(|| format!("{} must be {}, not `{s}`", Self::WHAT, Self::choices_text()))
     }
 
+    /// The value named by a number (separability 26).
+    fn from_number(n: i64) -> Result<Self, String> {
+        Self::parse_choice(&n.to_string())
+    }
+
     /// The value of a C interface code (its place in the table).
     fn from_code(code: i64) -> Result<Self, String> {
         usize::try_from(code)

@@ -20,22 +20,64 @@ call releases the GIL while it works; Ctrl-C cancels it, and ``progress=f`` call
 workers in bricks.
 """
 
-from ._voxelkit import (
-    Grid,
-    __version__,
-    combine,
-    csg,
-    implicit,
-    lines,
-    measure,
-    mesh,
-    read_vdb,
-    solid,
-    subdiv,
-)
+import inspect as _inspect
+import json as _json
+
+from . import _voxelkit
+from ._voxelkit import Grid, __version__, read_vdb
+
+#: Every function's options: ``OPTIONS[name]["fields"]`` lists each option's ``name``,
+#: ``doc``, ``default`` and ``choices``; ``OPTIONS["limits"]`` the keywords every job takes.
+#: The functions below, the Blender add-on and ``voxelkit.distributed`` are made from it.
+OPTIONS = _json.loads(_voxelkit.options())
+
+_PROGRESS_DOC = "progress: f(stage, done, total), called a few times a second (raising cancels)"
+
+
+def _default(value):
+    return tuple(value) if isinstance(value, list) else value
+
+
+def _from_schema(name, inputs, request, summary):
+    """``_voxelkit.<name>`` with the schema's signature and docs: positional inputs, then
+    the request's options, the limits and ``progress``."""
+    native = getattr(_voxelkit, name)
+    fields = (OPTIONS[request]["fields"] if request else []) + OPTIONS["limits"]["fields"]
+    kind = _inspect.Parameter.POSITIONAL_OR_KEYWORD
+    params = [_inspect.Parameter(i, kind) for i in inputs]
+    params += [_inspect.Parameter(f["name"], kind, default=_default(f["default"])) for f in fields]
+    params.append(_inspect.Parameter("progress", kind, default=None))
+    signature = _inspect.Signature(params)
+
+    def call(*args, **kwargs):
+        bound = signature.bind(*args, **kwargs)
+        given = dict(bound.arguments)
+        return native(*(given.pop(i) for i in inputs), **given)
+
+    lines = [OPTIONS[request]["doc"] if request else summary, "", summary if request else "", ""]
+    for f in fields:
+        choices = f" (one of {', '.join(map(str, f['choices']))})" if f["choices"] else ""
+        lines.append(f"{f['name']} = {f['default']!r}{choices}: {f['doc']}")
+    lines.append(_PROGRESS_DOC)
+    call.__name__ = call.__qualname__ = name
+    call.__module__ = __name__
+    call.__signature__ = signature
+    call.__doc__ = "\n".join(lines).replace("\n\n\n", "\n\n")
+    return call
+
+
+mesh = _from_schema("mesh", ["source"], "mesh", "source: a path (.obj, .stl, .ply, .off, .gltf, .glb) or a (vertices, faces) pair.")
+solid = _from_schema("solid", ["source"], "solid", "source: a closed mesh, as for mesh(); the report holds the volume, mass and area.")
+subdiv = _from_schema("subdiv", ["source"], "subdiv", "source: a Catmull-Clark control mesh (a path or a (vertices, faces) pair).")
+implicit = _from_schema("implicit", ["formula"], "implicit", "formula: F in the coordinates' variables; the surface is F = 0.")
+lines = _from_schema("lines", ["source"], "lines", "source: a mesh with polylines (OBJ `l`) or faces.")
+measure = _from_schema("measure", ["source"], "measure", "source: a closed mesh, a .vdb path or a Grid holding a surface; the measures are in the returned solid's report.")
+combine = _from_schema("combine", ["a", "b"], "combine", "a, b: Grids, or .vdb paths whose grid `grid` (or voxel set) is read; the result has a's transform.")
+csg = _from_schema("csg", ["tree"], None, "A CSG tree (the CLI's `csg --tree` JSON): a path to the JSON file, or the tree as a dict (its file names are then found from the current directory).")
 
 __all__ = [
     "Grid",
+    "OPTIONS",
     "__version__",
     "combine",
     "csg",

@@ -165,9 +165,10 @@ impl Choice for FillKind {
 }
 
 /// Which exterior flood.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum FloodKind {
     /// Whole empty 8^3 blocks at once (fastest).
+    #[default]
     Blocks,
     /// Scanline spans over a dense bit volume.
     Spans,
@@ -251,7 +252,7 @@ request! {
         /// `density`'s voxels).
         grids: Vec<String> = Vec::new(),
         /// .vdb compression: blosc (OpenVDB's default), zip or none.
-        compression: Compression = Compression::Blosc,
+        compression: Compression = Compression::default(),
         /// Float and vector grids at half precision (16-bit: half the size).
         half: bool = false,
     }
@@ -266,15 +267,15 @@ request! {
         /// Voxel edge length in world units (instead of resolution).
         voxel_size: Option<f64> = None,
         /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::Z,
+        up_axis: UpAxis = UpAxis::default(),
         /// separating: Huang et al.'s surface; projective: Jegathese et al.'s scan-lines
         /// (colours, no separability guarantee where triangles meet).
         method: SurfaceKind = SurfaceKind::Separating,
         /// 6: thin surface blocking face-connected paths; 26: blocks every path.
-        separability: Separability = Separability::TwentySix,
+        separability: Separability = Separability::default(),
         /// huang: the paper's full vertex spheres and edge cylinders; clipped: the same
         /// clipped to the face slabs (still separating, far fewer redundant voxels).
-        criterion: Criterion = Criterion::Huang,
+        criterion: Criterion = Criterion::default(),
         /// Also keep a `normal` grid (nearest face, edge or vertex normal per voxel).
         normals: bool = false,
         /// Projective: carry the mesh's vertex colours into a `Cd` grid.
@@ -300,11 +301,11 @@ request! {
         /// Voxel edge length in world units (instead of resolution).
         voxel_size: Option<f64> = None,
         /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::Z,
+        up_axis: UpAxis = UpAxis::default(),
         /// flood, depth-layers or beam.
         method: FillKind = FillKind::Flood,
         /// The exterior flood: blocks (fastest), spans, or xyz (Lai & Cheng's FloodingXYZ).
-        flood: FloodKind = FloodKind::Blocks,
+        flood: FloodKind = FloodKind::default(),
         /// GRAYSTACK capacity of the xyz flood (entries; when full, sweeps resume the flood).
         graystack: usize = GRAYSTACK,
         /// Depth layers: a count of the 16 built-in directions, or integer (x, y, z)
@@ -314,10 +315,10 @@ request! {
         layers: Layers = Layers::Double,
         /// Depth layers: no-direction (a voxel no direction decides) or paper (a voxel on a
         /// ray of any direction crossing more than four times).
-        unclassified: Unclassified = Unclassified::NoDirection,
+        unclassified: Unclassified = Unclassified::default(),
         /// Beam: parity (centres between exact crossings) or paper (from each back-face voxel
         /// up to the next front-face voxel).
-        fill: BeamFill = BeamFill::Parity,
+        fill: BeamFill = BeamFill::default(),
         /// Mass per unit volume.
         density: f64 = DENSITY,
         /// Also count components (26-connected) and genus.
@@ -338,9 +339,9 @@ request! {
         /// Voxel edge length in world units (instead of resolution).
         voxel_size: Option<f64> = None,
         /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::Z,
+        up_axis: UpAxis = UpAxis::default(),
         /// The exterior flood: blocks (fastest), spans, or xyz (Lai & Cheng's FloodingXYZ).
-        flood: FloodKind = FloodKind::Blocks,
+        flood: FloodKind = FloodKind::default(),
         /// GRAYSTACK capacity of the xyz flood (entries; when full, sweeps resume the flood).
         graystack: usize = GRAYSTACK,
         /// Mass per unit volume.
@@ -357,7 +358,7 @@ request! {
         /// Voxel edge length in world units (instead of resolution).
         voxel_size: Option<f64> = None,
         /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::Z,
+        up_axis: UpAxis = UpAxis::default(),
         /// The adjacency (6, 18 or 26) every voxel meets between its sub-patches' corners.
         adjacency: Adjacency = Adjacency::TwentySix,
         /// Every voxel the surface touches (an enveloping voxelization).
@@ -390,7 +391,7 @@ request! {
         /// Spherical and cylindrical: the surface where r < 0 too.
         negative_r: bool = false,
         /// positive (the paper's [0, 2pi)) or symmetric ((-pi, pi]).
-        theta_range: ThetaRange = ThetaRange::Positive,
+        theta_range: ThetaRange = ThetaRange::default(),
         /// The paper's [G]^2 - r^2 = 0 for F = G - r (the surface r = |G|).
         squared: bool = false,
     }
@@ -405,7 +406,7 @@ request! {
         /// Voxel edge length in world units (instead of resolution).
         voxel_size: Option<f64> = None,
         /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::Z,
+        up_axis: UpAxis = UpAxis::default(),
         /// Also the faces' edges.
         edges: bool = false,
         /// Carry the mesh's vertex colours into a `Cd` grid.
@@ -437,11 +438,11 @@ request! {
         /// Voxel edge length in world units (instead of resolution).
         voxel_size: Option<f64> = None,
         /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::Z,
+        up_axis: UpAxis = UpAxis::default(),
         /// Voxels along a brick's edge, a multiple of 8.
         brick: u32 = 1024,
         /// 6 or 26 (the surface; a solid is always 26).
-        separability: Separability = Separability::TwentySix,
+        separability: Separability = Separability::default(),
         /// Refuse a brick estimated above this many MiB (none or 0: the memory available).
         max_memory_mib: Option<u64> = None,
     }

@@ -38,6 +38,7 @@ fn _voxelkit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(jobs::measure, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::combine, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::read_vdb, m)?)?;
+    m.add_function(wrap_pyfunction!(jobs::options, m)?)?;
     bricks::register(m)?;
     Ok(())
 }

@@ -72,11 +72,11 @@ pub fn run(
     out: &OutputArgs,
     fit: GridFit,
     global: &Global,
-    task: impl Fn(MeshSource) -> Task + Sync,
+    task: impl Fn(MeshSource) -> Result<Task> + Sync,
 ) -> Result<()> {
     let pairs = pairs(inputs, out)?;
     if let ([(input, output)], None, false) = (&pairs[..], out.frames, out.shared_grid) {
-        let job = Job::new(task(MeshSource::File(input.clone())), fit);
+        let job = Job::new(task(MeshSource::File(input.clone()))?, fit);
         return run_and_report(job, output, global);
     }
     let fit = if out.frames.is_some() || out.shared_grid {
@@ -204,10 +204,10 @@ fn run_one(
     fit: GridFit,
     global: &Global,
     gate: &MemoryGate,
-    task: &(impl Fn(MeshSource) -> Task + Sync),
+    task: &(impl Fn(MeshSource) -> Result<Task> + Sync),
 ) -> Result<Outcome> {
     let start = Instant::now();
-    let job = Job::new(task(MeshSource::File(input.to_path_buf())), fit);
+    let job = Job::new(task(MeshSource::File(input.to_path_buf()))?, fit);
     let planned = plan_job(job, Some(output), global)?;
     let bytes = planned.plan().estimated_bytes;
     gate.acquire(bytes);
@@ -221,7 +221,7 @@ fn run_all(
     jobs: Option<usize>,
     fit: GridFit,
     global: &Global,
-    task: &(impl Fn(MeshSource) -> Task + Sync),
+    task: &(impl Fn(MeshSource) -> Result<Task> + Sync),
 ) -> Result<()> {
     let start = Instant::now();
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());

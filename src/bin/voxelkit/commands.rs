@@ -11,6 +11,7 @@ use voxelkit::io::brick_set::{BrickSet, is_brick_set};
 use voxelkit::io::vdb::{DENSITY_GRID, VOXELS_GRID, read_vdb_info};
 use voxelkit::mesh::{GridFit, generate};
 use voxelkit::ops::separability::check_mesh_separation;
+use voxelkit::pipeline::request::{MeshRequest, SurfaceKind};
 use voxelkit::pipeline::{Details, Job, MeshSource, Shape, SurfaceMethod, Task};
 use voxelkit::shapes::{Cylinder, Quadric, Sphere};
 use voxelkit::voxelize::Separability;
@@ -100,14 +101,8 @@ pub struct DistanceArgs {
     #[arg(long, conflicts_with = "sdf")]
     pub udf: bool,
     /// Half width of the distance band, in voxels (the background is band x voxel size).
-    #[arg(long, default_value_t = 3.0, value_name = "W")]
+    #[arg(long, default_value_t = voxelkit::pipeline::request::MeshRequest::default().band, value_name = "W")]
     pub band: f64,
-}
-
-impl DistanceArgs {
-    pub fn given(&self) -> bool {
-        self.sdf || self.udf
-    }
 }
 
 impl SurfaceArgs {
@@ -148,23 +143,26 @@ pub fn mesh(
             "--color and --no-color need --method projective (the separating surface carries no colour)".into(),
         ));
     }
-    let method = if projective {
-        SurfaceMethod::Projective(color.choice())
-    } else {
-        SurfaceMethod::Separating(surface.separating())
-    };
-    let task = |mesh| {
-        if distance.given() {
-            Task::DistanceBand {
-                mesh,
-                band: distance.band,
-                signed: distance.sdf,
-            }
+    let (colors, color) = color.request();
+    let request = MeshRequest {
+        method: if projective {
+            SurfaceKind::Projective
         } else {
-            Task::MeshSurface { mesh, method }
-        }
+            SurfaceKind::Separating
+        },
+        separability: surface.separability,
+        criterion: surface.criterion,
+        normals: surface.normals,
+        colors,
+        color,
+        sdf: distance.sdf,
+        udf: distance.udf,
+        band: distance.band,
+        ..MeshRequest::default()
     };
-    batch::run(inputs, out, fit.grid_fit(), global, task)
+    batch::run(inputs, out, fit.grid_fit(), global, |mesh| {
+        request.task(mesh)
+    })
 }
 
 fn positive(name: &str, v: f64) -> Result<()> {

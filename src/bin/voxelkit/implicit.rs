@@ -6,6 +6,7 @@ use glam::DVec3;
 use std::path::PathBuf;
 use voxelkit::implicit::{Coordinates, ThetaRange};
 use voxelkit::mesh::GridFit;
+use voxelkit::pipeline::request::ImplicitRequest;
 use voxelkit::pipeline::{Job, Task};
 use voxelkit::{Error, Result};
 
@@ -62,13 +63,13 @@ pub struct ImplicitArgs {
     /// A named example instead of a formula: sphere, torus, sinsin, gear, crankshaft.
     #[arg(long)]
     example: Option<String>,
-    #[arg(long, default_value = "cartesian", value_parser = parse_coords)]
+    #[arg(long, default_value_t = ImplicitRequest::default().coords, value_parser = parse_coords)]
     coords: Coordinates,
     /// The box searched: `lo,hi` (a cube) or `x0,y0,z0,x1,y1,z1`.
     #[arg(long, default_value = "-1,1", allow_hyphen_values = true)]
     bounds: String,
     /// Voxels along the longest side of the bounds.
-    #[arg(short, long, default_value_t = 256)]
+    #[arg(short, long, default_value_t = ImplicitRequest::default().resolution)]
     resolution: u32,
     /// Also write every level of the octree as `level_0` .. `level_n` (each envelops the
     /// surface).
@@ -80,7 +81,7 @@ pub struct ImplicitArgs {
     negative_r: bool,
     /// Spherical and cylindrical: the values theta takes, `positive` (the paper's
     /// [0, 2pi), cut along +x) or `symmetric` ((-pi, pi], cut along -x).
-    #[arg(long, default_value = "positive", value_parser = parse_theta_range)]
+    #[arg(long, default_value_t = ImplicitRequest::default().theta_range, value_parser = parse_theta_range)]
     theta_range: ThetaRange,
     /// For F = G - r: Stolte & Kaufman's substitution [G]^2 - r^2 = 0, the surface r = |G|
     /// (lobes where G < 0 included) instead of r = G as typed.

@@ -13,6 +13,7 @@ mod subdiv;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use voxelkit::pipeline::request::{MeshRequest, SurfaceKind, WriteRequest};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::Criterion;
 
@@ -59,7 +60,7 @@ struct Cli {
     #[arg(long, global = true, value_delimiter = ',', value_name = "NAMES")]
     grids: Vec<String>,
     /// .vdb compression: blosc (OpenVDB's default), zip or none.
-    #[arg(long, global = true, default_value = "blosc", value_parser = parse_compression)]
+    #[arg(long, global = true, default_value_t = WriteRequest::default().compression, value_parser = parse_compression)]
     compression: voxelkit::io::vdb::Compression,
     /// Write float and vector grids at half precision (16-bit: half the size).
     #[arg(long, global = true)]
@@ -67,7 +68,7 @@ struct Cli {
     /// The up axis of the input mesh files: `y` turns a Y-up file (most OBJ) to Z-up as
     /// Blender's OBJ importer does, (x, y, z) -> (x, -z, y), so the volume stands where the
     /// imported mesh stands; `z` keeps the coordinates.
-    #[arg(long, global = true, default_value = "z", value_name = "AXIS")]
+    #[arg(long, global = true, default_value_t = MeshRequest::default().up_axis, value_name = "AXIS")]
     up_axis: voxelkit::mesh::UpAxis,
     /// Also draw each result as a picture beside its output (`out.vdb` gives `out.png`;
     /// `voxelkit render` takes views and sizes).
@@ -90,11 +91,11 @@ pub struct FitArgs {
 #[derive(Args, Clone, Copy)]
 pub struct SurfaceArgs {
     /// 6: thin surface blocking face-connected paths; 26: thicker, blocks every path.
-    #[arg(short, long, default_value = "26", value_parser = parse_separability)]
+    #[arg(short, long, default_value_t = MeshRequest::default().separability, value_parser = parse_separability)]
     separability: Separability,
     /// huang: the paper's full vertex spheres and edge cylinders; clipped: the same clipped
     /// to the face slabs (still separating, far fewer redundant voxels). Meshes only.
-    #[arg(long, default_value = "huang", value_parser = parse_criterion)]
+    #[arg(long, default_value_t = MeshRequest::default().criterion, value_parser = parse_criterion)]
     criterion: Criterion,
     /// Also write a `normal` grid (nearest face/edge/vertex normal per voxel).
     #[arg(long)]
@@ -117,6 +118,10 @@ pub fn parse_criterion(s: &str) -> Result<Criterion, String> {
     s.parse()
 }
 
+fn parse_surface_kind(s: &str) -> Result<SurfaceKind, String> {
+    s.parse()
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Voxelize a polygon mesh (.obj, .stl, .ply, .off, .gltf or .glb) into a separating surface, or by projective
@@ -130,8 +135,8 @@ enum Command {
         /// separating: Huang et al.'s 6/26-separating surface; projective: Jegathese et al.'s
         /// scan-lines in each triangle's dominant plane (fast, colours, no separability
         /// guarantee where triangles meet; ignores -s, --criterion and --normals).
-        #[arg(long, value_enum, default_value = "separating")]
-        method: MeshMethod,
+        #[arg(long, default_value_t = MeshRequest::default().method, value_parser = parse_surface_kind)]
+        method: SurfaceKind,
         #[command(flatten)]
         color: projective::ColorArgs,
         #[command(flatten)]
@@ -171,7 +176,7 @@ enum Command {
         /// Folder for the example mesh and the .vdb files (created when missing).
         #[arg(short, long, default_value = "voxelkit-demo")]
         output: PathBuf,
-        #[arg(short, long, default_value_t = 256)]
+        #[arg(short, long, default_value_t = voxelkit::mesh::DEFAULT_RESOLUTION)]
         resolution: u32,
     },
     /// Fill a mesh: by exterior flooding of its 26-separating surface (closed meshes), or by
@@ -191,13 +196,6 @@ enum Command {
     /// Voxelize a Catmull-Clark control mesh from its exact limit surface (Lai & Cheng), or
     /// check the limit-surface evaluator against OpenSubdiv (`subdiv check`, `subdiv eval`).
     Subdiv(subdiv::SubdivArgs),
-}
-
-/// How `voxelkit mesh` voxelizes.
-#[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
-enum MeshMethod {
-    Separating,
-    Projective,
 }
 
 fn main() -> ExitCode {
@@ -233,7 +231,7 @@ fn main() -> ExitCode {
             out,
         } => commands::mesh(
             &inputs,
-            method == MeshMethod::Projective,
+            method == SurfaceKind::Projective,
             &color,
             &distance,
             fit,

@@ -8,7 +8,8 @@ use clap::Args;
 use glam::Vec3;
 use std::path::PathBuf;
 use voxelkit::Result;
-use voxelkit::pipeline::{ColorChoice, Job, MeshSource, Task};
+use voxelkit::pipeline::request::LinesRequest;
+use voxelkit::pipeline::{Job, MeshSource};
 
 fn parse_color(s: &str) -> std::result::Result<Vec3, String> {
     let v: Vec<f32> = s
@@ -40,12 +41,9 @@ impl ColorArgs {
         self.color.is_some() || self.no_color
     }
 
-    pub fn choice(&self) -> ColorChoice {
-        match (self.color, self.no_color) {
-            (Some(c), _) => ColorChoice::Constant(c),
-            (None, true) => ColorChoice::None,
-            (None, false) => ColorChoice::FromMesh,
-        }
+    /// The requests' `colors` and `color`.
+    pub fn request(&self) -> (bool, Option<[f32; 3]>) {
+        (!self.no_color, self.color.map(|c| c.to_array()))
     }
 }
 
@@ -67,10 +65,13 @@ pub struct LinesArgs {
 }
 
 pub fn lines(args: &LinesArgs, global: &Global) -> Result<()> {
-    let task = Task::Lines {
-        mesh: MeshSource::File(args.input.clone()),
+    let (colors, color) = args.color.request();
+    let request = LinesRequest {
         edges: args.edges,
-        color: args.color.choice(),
+        colors,
+        color,
+        ..LinesRequest::default()
     };
+    let task = request.task(MeshSource::File(args.input.clone()));
     run_and_report(Job::new(task, args.fit.grid_fit()), &args.output, global)
 }

@@ -6,41 +6,28 @@ use clap::Args;
 use std::path::PathBuf;
 use voxelkit::Result;
 use voxelkit::ops::csg::BooleanOp;
-use voxelkit::pipeline::{CsgSource, Fill, GridSource, Job, MeasureSource, MeshSource, Task};
+use voxelkit::pipeline::request::{FillKind, FloodKind, MeasureRequest, SolidRequest};
+use voxelkit::pipeline::{CsgSource, GridSource, Job, MeasureSource, MeshSource, Task};
 use voxelkit::solids::beam::BeamFill;
-use voxelkit::solids::exterior_flood::FloodMethod;
-
-/// The floods to choose from.
-#[derive(clap::ValueEnum, Clone, Copy)]
-enum FloodKind {
-    /// Whole empty 8^3 blocks at once, voxel by voxel only where the surface is (fastest).
-    Blocks,
-    /// The scanline flood over a dense bit volume.
-    Spans,
-    /// Lai & Cheng's FloodingXYZ with a GRAYSTACK.
-    Xyz,
-}
 
 /// How the exterior is flooded.
 #[derive(Args, Clone, Copy)]
 pub struct FloodArgs {
-    #[arg(long, value_enum, default_value = "blocks")]
+    /// The exterior flood: blocks (whole empty 8^3 blocks at once, fastest), spans (scanlines
+    /// over a dense bit volume) or xyz (Lai & Cheng's FloodingXYZ with a GRAYSTACK).
+    #[arg(long, default_value_t = SolidRequest::default().flood, value_parser = parse_flood)]
     flood: FloodKind,
     /// GRAYSTACK capacity for --flood xyz (entries; when full, sweeps resume the flood).
-    #[arg(long, default_value_t = 1 << 20)]
+    #[arg(long, default_value_t = SolidRequest::default().graystack)]
     graystack: usize,
 }
 
-impl FloodArgs {
-    fn method(&self) -> FloodMethod {
-        match self.flood {
-            FloodKind::Xyz => FloodMethod::Xyz {
-                capacity: self.graystack.max(1),
-            },
-            FloodKind::Blocks => FloodMethod::Blocks,
-            FloodKind::Spans => FloodMethod::Spans,
-        }
-    }
+fn parse_flood(s: &str) -> std::result::Result<FloodKind, String> {
+    s.parse()
+}
+
+fn parse_fill_kind(s: &str) -> std::result::Result<FillKind, String> {
+    s.parse()
 }
 
 /// Grid, flood and density: what filling and measuring take.
@@ -51,27 +38,12 @@ pub struct FillArgs {
     #[command(flatten)]
     flood: FloodArgs,
     /// Density (mass per unit volume) for the mass.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = SolidRequest::default().density)]
     pub density: f64,
 }
 
-/// How a solid is found.
-#[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
-pub enum SolidMethod {
-    /// The 26-separating surface plus everything the exterior flood cannot reach (Lai & Cheng).
-    Flood,
-    /// Depth buffers with a stencil count (Passalis et al.): exact at voxel centres, and
-    /// voxels no direction can decide are reported as unclassifiable.
-    DepthLayers,
-    /// The projective surface plus the beams of voxels between front and back faces along z
-    /// (Jegathese et al.); closed meshes only.
-    Beam,
-}
-
-/// The beam fills to choose from, parsed by the library.
-fn beam_fill_parser() -> impl clap::builder::TypedValueParser<Value = BeamFill> {
-    use clap::builder::TypedValueParser;
-    clap::builder::PossibleValuesParser::new(["parity", "paper"]).try_map(|s| s.parse::<BeamFill>())
+fn parse_beam_fill(s: &str) -> std::result::Result<BeamFill, String> {
+    s.parse()
 }
 
 #[derive(Args)]
@@ -81,15 +53,20 @@ pub struct SolidArgs {
     /// depth-layers open meshes are accepted and their undecidable voxels reported.
     #[arg(required = true, num_args = 1..)]
     pub inputs: Vec<PathBuf>,
-    #[arg(long, value_enum, default_value = "flood")]
-    pub method: SolidMethod,
+    /// flood: the 26-separating surface plus everything the exterior flood cannot reach (Lai
+    /// & Cheng); depth-layers: depth buffers with a stencil count (Passalis et al.), exact at
+    /// voxel centres, voxels no direction can decide reported as unclassifiable; beam: the
+    /// projective surface plus the beams of voxels between front and back faces along z
+    /// (Jegathese et al.), closed meshes only.
+    #[arg(long, default_value_t = SolidRequest::default().method, value_parser = parse_fill_kind)]
+    pub method: FillKind,
     /// --method beam: `parity` fills voxel centres between exact crossings 1-2, 3-4, ... of
     /// each column; `paper` fills Jegathese et al.'s way, from each back-face voxel up to the
     /// next front-face voxel.
     #[arg(
         long = "fill",
-        value_parser = beam_fill_parser(),
-        default_value = "parity",
+        value_parser = parse_beam_fill,
+        default_value_t = SolidRequest::default().fill,
         value_name = "RULE"
     )]
     pub beam_fill: BeamFill,
@@ -106,7 +83,7 @@ pub struct SolidArgs {
     #[arg(long)]
     pub sdf: bool,
     /// Half width of the --sdf band, in voxels.
-    #[arg(long, default_value_t = 3.0, value_name = "W")]
+    #[arg(long, default_value_t = SolidRequest::default().band, value_name = "W")]
     pub band: f64,
     /// Output: a .binvox or .vox (the whole solid), or a .vdb: `density` (1 on the whole
     /// solid, whole blocks as tiles), `shell` (its outer voxels) and `interior`; depth layers
@@ -170,33 +147,26 @@ fn parse_op(s: &str) -> std::result::Result<BooleanOp, String> {
 }
 
 pub fn solid(args: &SolidArgs, global: &Global) -> Result<()> {
-    let fill = match args.method {
-        SolidMethod::Flood => Fill::Flood(args.fill.flood.method()),
-        SolidMethod::DepthLayers => Fill::DepthLayers(args.depth.options()),
-        SolidMethod::Beam => Fill::Beam(args.beam_fill),
-    };
-    let task = |mesh| {
-        if args.sdf {
-            Task::DistanceBand {
-                mesh,
-                band: args.band,
-                signed: true,
-            }
-        } else {
-            Task::Solid {
-                mesh,
-                fill,
-                density: args.fill.density,
-                topology: args.topology,
-            }
-        }
+    let request = SolidRequest {
+        method: args.method,
+        flood: args.fill.flood.flood,
+        graystack: args.fill.flood.graystack,
+        directions: args.depth.directions.clone(),
+        layers: args.depth.layers,
+        unclassified: args.depth.unclassified,
+        fill: args.beam_fill,
+        density: args.fill.density,
+        topology: args.topology,
+        sdf: args.sdf,
+        band: args.band,
+        ..SolidRequest::default()
     };
     crate::batch::run(
         &args.inputs,
         &args.out,
         args.fill.fit.grid_fit(),
         global,
-        task,
+        |mesh| request.task(mesh),
     )
 }
 
@@ -210,11 +180,13 @@ pub fn measure(args: &MeasureArgs, global: &Global) -> Result<()> {
     } else {
         MeasureSource::Mesh(MeshSource::File(args.input.clone()))
     };
-    let task = Task::Measure {
-        source,
-        flood: args.fill.flood.method(),
+    let request = MeasureRequest {
+        flood: args.fill.flood.flood,
+        graystack: args.fill.flood.graystack,
         density: args.fill.density,
+        ..MeasureRequest::default()
     };
+    let task = request.task(source)?;
     let outcome = run_job(Job::new(task, args.fill.fit.grid_fit()), None, global)?;
     if global.json {
         println!("{}", outcome.report.to_json());

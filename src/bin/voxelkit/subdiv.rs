@@ -6,6 +6,7 @@ use crate::run::{Global, run_and_report};
 use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
 use voxelkit::grid::Adjacency;
+use voxelkit::pipeline::request::SubdivRequest;
 use voxelkit::pipeline::{Job, MeshSource, SubdivisionFill, Task};
 use voxelkit::subd::{ControlMesh, LimitSurface, compare_points, limit_area, read_points};
 use voxelkit::voxelize::parametric::ParametricOptions;
@@ -28,12 +29,12 @@ pub struct SubdivVoxelizeArgs {
     /// The adjacency the corner voxels of every final sub-patch must have: 6 gives the
     /// thickest surface, 26 the thinnest; all three block 6-paths (the paper's guarantee,
     /// checked by flooding). Use --enclose to block 26-paths as well.
-    #[arg(short, long, default_value = "26", value_parser = parse_adjacency)]
+    #[arg(short, long, default_value_t = SubdivRequest::default().adjacency, value_parser = parse_adjacency)]
     adjacency: Adjacency,
     #[command(flatten)]
     fit: FitArgs,
     /// Pre-split every patch k x k before the recursive subdivision.
-    #[arg(long, default_value_t = 8, value_name = "K")]
+    #[arg(long, default_value_t = SubdivRequest::default().presplit, value_name = "K")]
     presplit: u32,
     /// Output every voxel the limit surface touches: refine past the paper's adjacency test
     /// until each sub-patch provably lies in its corner voxels (thicker and slower; the
@@ -49,10 +50,10 @@ pub struct SubdivVoxelizeArgs {
     solid: bool,
     /// --solid: GRAYSTACK capacity of FloodingXYZ (entries; when full, sweeps resume the
     /// flood).
-    #[arg(long, default_value_t = 1 << 20, requires = "solid")]
+    #[arg(long, default_value_t = SubdivRequest::default().graystack, requires = "solid")]
     graystack: usize,
     /// --solid: density (mass per unit volume) for the mass.
-    #[arg(long, default_value_t = 1.0, requires = "solid")]
+    #[arg(long, default_value_t = SubdivRequest::default().density, requires = "solid")]
     density: f64,
     /// --solid: also count the solid's components (26-connected) and genus.
     #[arg(long, requires = "solid")]
@@ -91,12 +92,7 @@ enum SubdivAction {
 }
 
 fn parse_adjacency(s: &str) -> std::result::Result<Adjacency, String> {
-    match s {
-        "6" => Ok(Adjacency::Six),
-        "18" => Ok(Adjacency::Eighteen),
-        "26" => Ok(Adjacency::TwentySix),
-        _ => Err(format!("adjacency must be 6, 18 or 26, not `{s}`")),
-    }
+    s.parse()
 }
 
 pub fn run(args: &SubdivArgs, global: &Global) -> Result<()> {
