@@ -17,7 +17,7 @@ use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::BooleanOp;
 use crate::pipeline::request::{
     CombineRequest, Directions, FillKind, FloodKind, ImplicitRequest, LimitsRequest, LinesRequest,
-    MeasureRequest, MeshRequest, SolidRequest, SubdivRequest, SurfaceKind, grid_fit,
+    MeasureRequest, MeshRequest, Request, SolidRequest, SubdivRequest, SurfaceKind, grid_fit,
 };
 use crate::pipeline::{Details, GridSource, Job, MeasureSource, MeshSource, Outcome, Task};
 use crate::progress::Observer;
@@ -819,7 +819,7 @@ pub extern "C" fn vk_voxelize_lines(
     out: *mut *mut VkGrid,
 ) -> VkStatus {
     grid_from_job(options, out, |_| {
-        Ok(LinesRequest::default().task(mesh_source(mesh)?))
+        Ok(LinesRequest::default().task(mesh_source(mesh)?)?)
     })
 }
 
@@ -857,7 +857,7 @@ pub extern "C" fn vk_voxelize_formula(
             bounds: crate::pipeline::request::Bounds::Box([min.to_array(), max.to_array()]),
             ..ImplicitRequest::default()
         };
-        Ok(request.task(c_str(formula, "formula")?.to_string()))
+        Ok(request.task(c_str(formula, "formula")?.to_string())?)
     })
 }
 
@@ -933,7 +933,7 @@ pub extern "C" fn vk_grid_combine(
             resample: resample != 0,
             ..CombineRequest::default()
         };
-        let task = request.task(GridSource::Grid(a.clone()), GridSource::Grid(b.clone()));
+        let task = request.task((GridSource::Grid(a.clone()), GridSource::Grid(b.clone())))?;
         let outcome = run_job(&Options::default(), task)?;
         hand_out(VkGrid::from(outcome), Kind::Grid, out)
     })

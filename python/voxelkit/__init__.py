@@ -24,7 +24,7 @@ import inspect as _inspect
 import json as _json
 
 from . import _voxelkit
-from ._voxelkit import Grid, __version__, read_vdb
+from ._voxelkit import DEFAULT_RESOLUTION, Grid, __version__, read_vdb
 
 #: Every function's options: ``OPTIONS[name]["fields"]`` lists each option's ``name``,
 #: ``doc``, ``default`` and ``choices``; ``OPTIONS["limits"]`` the keywords every job takes.
@@ -52,7 +52,8 @@ def _from_schema(name, inputs, request, summary):
     def call(*args, **kwargs):
         bound = signature.bind(*args, **kwargs)
         given = dict(bound.arguments)
-        return native(*(given.pop(i) for i in inputs), **given)
+        positional = [given.pop(i) for i in inputs]
+        return native(*positional, **given)
 
     lines = [OPTIONS[request]["doc"] if request else summary, "", summary if request else "", ""]
     for f in fields:
@@ -76,6 +77,7 @@ combine = _from_schema("combine", ["a", "b"], "combine", "a, b: Grids, or .vdb p
 csg = _from_schema("csg", ["tree"], None, "A CSG tree (the CLI's `csg --tree` JSON): a path to the JSON file, or the tree as a dict (its file names are then found from the current directory).")
 
 __all__ = [
+    "DEFAULT_RESOLUTION",
     "Grid",
     "OPTIONS",
     "__version__",

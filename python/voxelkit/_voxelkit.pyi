@@ -7,6 +7,10 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+DEFAULT_RESOLUTION: int
+
+def options() -> str:
+    """The schema of every function's options, as JSON (see voxelkit.OPTIONS)."""
 
 Path = Union[str, PathLike]
 MeshSource = Union[Path, Tuple[npt.ArrayLike, Union[npt.ArrayLike, Sequence[Sequence[int]]]]]
@@ -75,9 +79,9 @@ def mesh(
     sdf: bool = False,
     udf: bool = False,
     band: float = 3.0,
+    up_axis: str = "z",
     threads: Optional[int] = None,
     max_memory_mib: Optional[int] = None,
-    up_axis: str = "z",
     progress: Optional[Progress] = None,
 ) -> Grid: ...
 def solid(
@@ -86,8 +90,8 @@ def solid(
     voxel_size: Optional[float] = None,
     method: str = "flood",
     flood: str = "blocks",
-    graystack: int = 1 << 20,
-    directions: Optional[Union[int, Sequence[Index]]] = None,
+    graystack: int = 1048576,
+    directions: Union[int, Sequence[Index]] = 16,
     layers: str = "double",
     unclassified: str = "no-direction",
     fill: str = "parity",
@@ -95,9 +99,9 @@ def solid(
     topology: bool = False,
     sdf: bool = False,
     band: float = 3.0,
+    up_axis: str = "z",
     threads: Optional[int] = None,
     max_memory_mib: Optional[int] = None,
-    up_axis: str = "z",
     progress: Optional[Progress] = None,
 ) -> Grid: ...
 def subdiv(
@@ -108,19 +112,19 @@ def subdiv(
     enclose: bool = False,
     presplit: int = 8,
     solid: bool = False,
-    graystack: int = 1 << 20,
+    graystack: int = 1048576,
     density: float = 1.0,
     topology: bool = False,
+    up_axis: str = "z",
     threads: Optional[int] = None,
     max_memory_mib: Optional[int] = None,
-    up_axis: str = "z",
     progress: Optional[Progress] = None,
 ) -> Grid: ...
 def implicit(
     formula: str,
     coords: str = "cartesian",
-    bounds: Optional[Union[Tuple[float, float], Tuple[Vec3, Vec3]]] = None,
-    resolution: int = 256,
+    bounds: Union[Tuple[float, float], Tuple[Vec3, Vec3]] = (-1.0, 1.0),
+    resolution: Optional[int] = 256,
     levels: bool = False,
     negative_r: bool = False,
     theta_range: str = "positive",
@@ -136,13 +140,7 @@ def lines(
     edges: bool = False,
     colors: bool = True,
     color: Optional[Vec3] = None,
-    threads: Optional[int] = None,
-    max_memory_mib: Optional[int] = None,
     up_axis: str = "z",
-    progress: Optional[Progress] = None,
-) -> Grid: ...
-def csg(
-    tree: Union[Path, Dict[str, Any]],
     threads: Optional[int] = None,
     max_memory_mib: Optional[int] = None,
     progress: Optional[Progress] = None,
@@ -152,11 +150,11 @@ def measure(
     resolution: Optional[int] = None,
     voxel_size: Optional[float] = None,
     flood: str = "blocks",
-    graystack: int = 1 << 20,
+    graystack: int = 1048576,
     density: float = 1.0,
+    up_axis: str = "z",
     threads: Optional[int] = None,
     max_memory_mib: Optional[int] = None,
-    up_axis: str = "z",
     progress: Optional[Progress] = None,
 ) -> Grid: ...
 def combine(
@@ -166,6 +164,13 @@ def combine(
     grid: Optional[str] = None,
     resample: bool = False,
     threads: Optional[int] = None,
+    max_memory_mib: Optional[int] = None,
+    progress: Optional[Progress] = None,
+) -> Grid: ...
+def csg(
+    tree: Union[Path, Dict[str, Any]],
+    threads: Optional[int] = None,
+    max_memory_mib: Optional[int] = None,
     progress: Optional[Progress] = None,
 ) -> Grid: ...
 def read_vdb(path: Path, grid: Optional[str] = None) -> Grid:

@@ -18,14 +18,19 @@ from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
 
 import voxelkit
 
-SEPARABILITY = [
-    ("26", "26-separating", "No 26-connected path of empty voxels crosses the surface"),
-    ("6", "6-separating", "Thinner: no face-connected path crosses the surface"),
-]
-METHOD = [
-    ("separating", "Separating", "Huang et al.'s separating surface"),
-    ("projective", "Projective", "Jegathese et al.'s scan-lines"),
-]
+# The mesh options the panel shows, with their choices and defaults, from the library's table.
+MESH_OPTIONS = {f["name"]: f for f in voxelkit.OPTIONS["mesh"]["fields"]}
+
+
+def _items(name, label):
+    """An EnumProperty's items and default for the mesh option ``name``."""
+    field = MESH_OPTIONS[name]
+    items = [(str(c), label(c), field["doc"]) for c in field["choices"]]
+    return items, str(field["default"])
+
+
+SEPARABILITY = _items("separability", lambda c: f"{c}-separating")
+METHOD = _items("method", lambda c: str(c).capitalize())
 FILL = [
     ("none", "Surface", "The surface voxels"),
     ("solid", "Solid", "The surface and everything inside it (closed meshes)"),
@@ -39,7 +44,7 @@ def _options(owner):
         "resolution": IntProperty(
             name="Resolution",
             description="Voxels along the longest side of the mesh's box",
-            default=128,
+            default=voxelkit.DEFAULT_RESOLUTION,
             min=1,
             max=65536,
         ),
@@ -50,8 +55,10 @@ def _options(owner):
             min=0.0,
             precision=5,
         ),
-        "separability": EnumProperty(name="Separability", items=SEPARABILITY, default="26"),
-        "method": EnumProperty(name="Method", items=METHOD, default="separating"),
+        "separability": EnumProperty(
+            name="Separability", items=SEPARABILITY[0], default=SEPARABILITY[1]
+        ),
+        "method": EnumProperty(name="Method", items=METHOD[0], default=METHOD[1]),
         "fill": EnumProperty(name="Fill", items=FILL, default="none"),
     }
     return owner

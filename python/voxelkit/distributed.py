@@ -28,7 +28,12 @@ import shutil
 import sys
 import time
 
+from . import OPTIONS
 from . import _voxelkit as vk
+
+#: The options of a distributed run, their defaults, choices and docs: the library's table.
+_FIELDS = OPTIONS["distributed"]["fields"]
+_DEFAULT = {f["name"]: f["default"] for f in _FIELDS}
 
 #: Bytes of memory per merged voxel, generously (leaves hold 512 voxels in about 3.5 KiB).
 _MERGED_BYTES_PER_VOXEL = 16
@@ -129,15 +134,15 @@ def run(
     source,
     output,
     solid=False,
-    resolution=None,
-    voxel_size=None,
-    brick=1024,
-    separability=26,
+    resolution=_DEFAULT["resolution"],
+    voxel_size=_DEFAULT["voxel_size"],
+    brick=_DEFAULT["brick"],
+    separability=_DEFAULT["separability"],
     scheduler=None,
     workers=2,
-    max_memory_mib=None,
+    max_memory_mib=_DEFAULT["max_memory_mib"],
     keep_bricks=False,
-    up_axis="z",
+    up_axis=_DEFAULT["up_axis"],
     progress=False,
     client=None,
 ):
@@ -238,6 +243,27 @@ def solid(source, output, **options):
     return run(source, output, solid=True, **options)
 
 
+#: Short forms of the table's options on the command line, and long ones that are not the
+#: field's name (as the voxelkit command names them).
+_SHORT = {"resolution": "-r", "separability": "-s"}
+_LONG = {"max_memory_mib": "--max-memory"}
+#: The types of the table's options that are not given by their default.
+_TYPES = {"resolution": int, "voxel_size": float, "max_memory_mib": int}
+
+
+def _add_option(parser, field):
+    """The command-line option of a table field: its name, type, default, choices and doc."""
+    name, default, choices = field["name"], field["default"], field["choices"]
+    kind = _TYPES.get(name) or type(default)
+    flags = [_SHORT[name]] if name in _SHORT else []
+    flags.append(_LONG.get(name, "--" + name.replace("_", "-")))
+    extra = {"metavar": "MIB"} if name == "max_memory_mib" else {}
+    if choices:
+        extra["choices"] = [kind(c) for c in choices]
+    shown = f" (default {default})" if default is not None else ""
+    parser.add_argument(*flags, dest=name, type=kind, default=default, help=field["doc"] + shown, **extra)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(
         prog="python -m voxelkit.distributed",
@@ -252,17 +278,14 @@ def main(argv=None):
         p.add_argument("input", help="mesh file (.obj, .stl, .ply, .off, .gltf, .glb)")
         p.add_argument("-o", "--output", required=True, help="output .vdb")
         fit = p.add_mutually_exclusive_group()
-        fit.add_argument("-r", "--resolution", type=int, help="voxels along the longest side (default 256)")
-        fit.add_argument("--voxel-size", type=float, help="voxel edge in world units")
-        p.add_argument("--brick", type=int, default=1024, help="voxels along a brick's edge, a multiple of 8 (default 1024)")
-        if name == "mesh":
-            p.add_argument("-s", "--separability", type=int, choices=(6, 26), default=26)
+        for field in _FIELDS:
+            if field["name"] == "separability" and name == "solid":
+                continue
+            _add_option(fit if field["name"] in ("resolution", "voxel_size") else p, field)
         where = p.add_mutually_exclusive_group()
         where.add_argument("--scheduler", help="address of a running Dask scheduler")
         where.add_argument("--workers", type=int, default=2, help="local worker processes (default 2)")
-        p.add_argument("--max-memory", type=int, metavar="MIB", help="refuse a brick estimated above this (MiB)")
         p.add_argument("--keep-bricks", action="store_true", help="keep the brick set instead of merging")
-        p.add_argument("--up-axis", choices=("y", "z"), default="z", help="the file's up axis (y: turn to z-up as Blender does)")
     args = parser.parse_args(argv)
     try:
         result = run(
@@ -272,10 +295,10 @@ def main(argv=None):
             resolution=args.resolution,
             voxel_size=args.voxel_size,
             brick=args.brick,
-            separability=getattr(args, "separability", 26),
+            separability=getattr(args, "separability", _DEFAULT["separability"]),
             scheduler=args.scheduler,
             workers=args.workers,
-            max_memory_mib=args.max_memory,
+            max_memory_mib=args.max_memory_mib,
             keep_bricks=args.keep_bricks,
             up_axis=args.up_axis,
             progress=True,

@@ -8,7 +8,7 @@
 //! `max_memory_mib` none or 0 is the memory available.
 
 use super::{
-    ColorChoice, Fill, GridSource, Limits, MeasureSource, MeshSource, SubdivisionFill,
+    ColorChoice, Fill, GridSource, Job, Limits, MeasureSource, MeshSource, SubdivisionFill,
     SurfaceMethod, Task,
 };
 use crate::choice::Choice;
@@ -266,13 +266,11 @@ request! {
         resolution: Option<u32> = None,
         /// Voxel edge length in world units (instead of resolution).
         voxel_size: Option<f64> = None,
-        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::default(),
+        /// 6: thin surface blocking face-connected paths; 26: blocks every path.
+        separability: Separability = Separability::default(),
         /// separating: Huang et al.'s surface; projective: Jegathese et al.'s scan-lines
         /// (colours, no separability guarantee where triangles meet).
         method: SurfaceKind = SurfaceKind::Separating,
-        /// 6: thin surface blocking face-connected paths; 26: blocks every path.
-        separability: Separability = Separability::default(),
         /// huang: the paper's full vertex spheres and edge cylinders; clipped: the same
         /// clipped to the face slabs (still separating, far fewer redundant voxels).
         criterion: Criterion = Criterion::default(),
@@ -288,6 +286,8 @@ request! {
         udf: bool = false,
         /// Half width of the distance band, in voxels.
         band: f64 = BAND,
+        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
+        up_axis: UpAxis = UpAxis::default(),
     }
 }
 
@@ -300,8 +300,6 @@ request! {
         resolution: Option<u32> = None,
         /// Voxel edge length in world units (instead of resolution).
         voxel_size: Option<f64> = None,
-        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::default(),
         /// flood, depth-layers or beam.
         method: FillKind = FillKind::Flood,
         /// The exterior flood: blocks (fastest), spans, or xyz (Lai & Cheng's FloodingXYZ).
@@ -327,6 +325,8 @@ request! {
         sdf: bool = false,
         /// Half width of the distance band, in voxels.
         band: f64 = BAND,
+        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
+        up_axis: UpAxis = UpAxis::default(),
     }
 }
 
@@ -338,14 +338,14 @@ request! {
         resolution: Option<u32> = None,
         /// Voxel edge length in world units (instead of resolution).
         voxel_size: Option<f64> = None,
-        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::default(),
         /// The exterior flood: blocks (fastest), spans, or xyz (Lai & Cheng's FloodingXYZ).
         flood: FloodKind = FloodKind::default(),
         /// GRAYSTACK capacity of the xyz flood (entries; when full, sweeps resume the flood).
         graystack: usize = GRAYSTACK,
         /// Mass per unit volume.
         density: f64 = DENSITY,
+        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
+        up_axis: UpAxis = UpAxis::default(),
     }
 }
 
@@ -357,8 +357,6 @@ request! {
         resolution: Option<u32> = None,
         /// Voxel edge length in world units (instead of resolution).
         voxel_size: Option<f64> = None,
-        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::default(),
         /// The adjacency (6, 18 or 26) every voxel meets between its sub-patches' corners.
         adjacency: Adjacency = Adjacency::TwentySix,
         /// Every voxel the surface touches (an enveloping voxelization).
@@ -373,6 +371,8 @@ request! {
         density: f64 = DENSITY,
         /// Also count components and genus.
         topology: bool = false,
+        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
+        up_axis: UpAxis = UpAxis::default(),
     }
 }
 
@@ -405,14 +405,14 @@ request! {
         resolution: Option<u32> = None,
         /// Voxel edge length in world units (instead of resolution).
         voxel_size: Option<f64> = None,
-        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::default(),
         /// Also the faces' edges.
         edges: bool = false,
         /// Carry the mesh's vertex colours into a `Cd` grid.
         colors: bool = true,
         /// One (r, g, b) colour for every voxel instead.
         color: Option<[f32; 3]> = None,
+        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
+        up_axis: UpAxis = UpAxis::default(),
     }
 }
 
@@ -437,14 +437,14 @@ request! {
         resolution: Option<u32> = None,
         /// Voxel edge length in world units (instead of resolution).
         voxel_size: Option<f64> = None,
-        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::default(),
         /// Voxels along a brick's edge, a multiple of 8.
         brick: u32 = 1024,
         /// 6 or 26 (the surface; a solid is always 26).
         separability: Separability = Separability::default(),
         /// Refuse a brick estimated above this many MiB (none or 0: the memory available).
         max_memory_mib: Option<u64> = None,
+        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
+        up_axis: UpAxis = UpAxis::default(),
     }
 }
 
@@ -515,11 +515,48 @@ impl WriteRequest {
     }
 }
 
-impl MeshRequest {
-    pub fn fit(&self) -> Result<GridFit> {
-        grid_fit(self.resolution, self.voxel_size)
+/// A request that makes a job: what it takes as input, the task and the grid it asks for.
+pub trait Request: Schema {
+    /// What the job reads besides the options: a mesh, a formula, two grids.
+    type Input;
+
+    /// The task, its options checked.
+    fn task(&self, input: Self::Input) -> Result<Task>;
+
+    /// The grid fit (the task's inputs decide the grid where the request has no fit).
+    fn fit(&self) -> Result<GridFit> {
+        Ok(GridFit::from_options(None, None))
     }
 
+    /// Which axis of a mesh file points up.
+    fn up_axis(&self) -> UpAxis {
+        UpAxis::default()
+    }
+
+    /// The job under `limits`.
+    fn job(&self, input: Self::Input, limits: &LimitsRequest) -> Result<Job> {
+        Ok(Job {
+            limits: limits.limits(),
+            up_axis: self.up_axis(),
+            ..Job::new(self.task(input)?, self.fit()?)
+        })
+    }
+}
+
+/// `fit` and `up_axis` of a request with `resolution`, `voxel_size` and `up_axis` fields.
+macro_rules! fitted {
+    () => {
+        fn fit(&self) -> Result<GridFit> {
+            grid_fit(self.resolution, self.voxel_size)
+        }
+
+        fn up_axis(&self) -> UpAxis {
+            self.up_axis
+        }
+    };
+}
+
+impl MeshRequest {
     pub fn separating(&self) -> SeparatingOptions {
         SeparatingOptions {
             separability: self.separability,
@@ -527,8 +564,13 @@ impl MeshRequest {
             normals: self.normals,
         }
     }
+}
 
-    pub fn task(&self, mesh: MeshSource) -> Result<Task> {
+impl Request for MeshRequest {
+    type Input = MeshSource;
+    fitted!();
+
+    fn task(&self, mesh: MeshSource) -> Result<Task> {
         if self.sdf && self.udf {
             return Err(Error::InvalidArgument(
                 "sdf and udf exclude each other".into(),
@@ -548,10 +590,6 @@ impl MeshRequest {
 }
 
 impl SolidRequest {
-    pub fn fit(&self) -> Result<GridFit> {
-        grid_fit(self.resolution, self.voxel_size)
-    }
-
     pub fn depth_layers(&self) -> Result<DepthLayerOptions> {
         Ok(DepthLayerOptions {
             directions: self.directions.set()?,
@@ -559,8 +597,13 @@ impl SolidRequest {
             unclassified: self.unclassified,
         })
     }
+}
 
-    pub fn task(&self, mesh: MeshSource) -> Result<Task> {
+impl Request for SolidRequest {
+    type Input = MeshSource;
+    fitted!();
+
+    fn task(&self, mesh: MeshSource) -> Result<Task> {
         if self.sdf {
             return distance_band(mesh, self.band, true);
         }
@@ -579,12 +622,11 @@ impl SolidRequest {
     }
 }
 
-impl MeasureRequest {
-    pub fn fit(&self) -> Result<GridFit> {
-        grid_fit(self.resolution, self.voxel_size)
-    }
+impl Request for MeasureRequest {
+    type Input = MeasureSource;
+    fitted!();
 
-    pub fn task(&self, source: MeasureSource) -> Result<Task> {
+    fn task(&self, source: MeasureSource) -> Result<Task> {
         positive("density", self.density)?;
         Ok(Task::Measure {
             source,
@@ -595,10 +637,6 @@ impl MeasureRequest {
 }
 
 impl SubdivRequest {
-    pub fn fit(&self) -> Result<GridFit> {
-        grid_fit(self.resolution, self.voxel_size)
-    }
-
     pub fn options(&self) -> Result<ParametricOptions> {
         if self.presplit == 0 {
             return Err(Error::InvalidArgument("presplit must be at least 1".into()));
@@ -609,8 +647,13 @@ impl SubdivRequest {
             enclose: self.enclose,
         })
     }
+}
 
-    pub fn task(&self, mesh: MeshSource) -> Result<Task> {
+impl Request for SubdivRequest {
+    type Input = MeshSource;
+    fitted!();
+
+    fn task(&self, mesh: MeshSource) -> Result<Task> {
         if self.solid {
             positive("density", self.density)?;
         }
@@ -626,14 +669,16 @@ impl SubdivRequest {
     }
 }
 
-impl ImplicitRequest {
-    pub fn fit(&self) -> Result<GridFit> {
+impl Request for ImplicitRequest {
+    type Input = String;
+
+    fn fit(&self) -> Result<GridFit> {
         grid_fit(Some(self.resolution), None)
     }
 
-    pub fn task(&self, formula: String) -> Task {
+    fn task(&self, formula: String) -> Result<Task> {
         let (min, max) = self.bounds.corners();
-        Task::Implicit {
+        Ok(Task::Implicit {
             formula,
             coordinates: self.coords,
             min,
@@ -642,34 +687,35 @@ impl ImplicitRequest {
             negative_r: self.negative_r,
             theta_range: self.theta_range,
             squared: self.squared,
-        }
+        })
     }
 }
 
-impl LinesRequest {
-    pub fn fit(&self) -> Result<GridFit> {
-        grid_fit(self.resolution, self.voxel_size)
-    }
+impl Request for LinesRequest {
+    type Input = MeshSource;
+    fitted!();
 
-    pub fn task(&self, mesh: MeshSource) -> Task {
-        Task::Lines {
+    fn task(&self, mesh: MeshSource) -> Result<Task> {
+        Ok(Task::Lines {
             mesh,
             edges: self.edges,
             color: color_choice(self.colors, self.color),
-        }
+        })
     }
 }
 
-impl CombineRequest {
-    pub fn task(&self, a: GridSource, b: GridSource) -> Task {
-        Task::Combine {
+impl Request for CombineRequest {
+    type Input = (GridSource, GridSource);
+
+    fn task(&self, (a, b): (GridSource, GridSource)) -> Result<Task> {
+        Ok(Task::Combine {
             a,
             b,
             grid: self.grid.clone(),
             op: self.op,
             resample: self.resample,
             curve: false,
-        }
+        })
     }
 }
 
@@ -750,7 +796,7 @@ mod tests {
             sdf: true,
             ..MeshRequest::default()
         };
-        let e = r.task(MeshSource::File("m.obj".into())).unwrap_err();
+        let e = Request::task(&r, MeshSource::File("m.obj".into())).unwrap_err();
         assert!(
             e.to_string().contains("band must be a positive number"),
             "{e}"

@@ -7,12 +7,12 @@ use super::arrays::mesh_source;
 use super::grid::Grid;
 use super::to_py_err;
 use super::watch::run_job;
-use crate::mesh::{GridFit, UpAxis};
+use crate::mesh::GridFit;
 use crate::pipeline::request::{
     CombineRequest, ImplicitRequest, LimitsRequest, LinesRequest, MeasureRequest, MeshRequest,
-    Schema, SolidRequest, SubdivRequest,
+    Request, Schema, SolidRequest, SubdivRequest,
 };
-use crate::pipeline::{CsgSource, GridSource, Job, MeasureSource, Outcome, Task};
+use crate::pipeline::{CsgSource, GridSource, Job, MeasureSource, MeshSource, Outcome, Task};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyString};
@@ -103,12 +103,11 @@ impl<R: Schema> Call<R> {
         })
     }
 
-    fn run(self, py: Python<'_>, task: Task, fit: GridFit, up_axis: UpAxis) -> PyResult<Grid> {
-        let job = Job {
-            limits: self.limits.limits(),
-            up_axis,
-            ..Job::new(task, fit)
-        };
+    fn run(self, py: Python<'_>, input: R::Input) -> PyResult<Grid>
+    where
+        R: Request,
+    {
+        let job = self.request.job(input, &self.limits).map_err(to_py_err)?;
         let inputs = job.task.input_files();
         let outcome = run_job(py, job, self.progress)?;
         Ok(Grid::new(outcome, inputs))
@@ -122,7 +121,15 @@ pub fn options() -> String {
     crate::pipeline::request::schema().to_string()
 }
 
-/// `source` is a path (.obj, .stl, .ply, .off, .gltf, .glb) or a `(vertices, faces)` pair.
+/// The job of request `R` on a mesh (a path or a `(vertices, faces)` pair).
+fn on_mesh<R: Request<Input = MeshSource>>(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Grid> {
+    Call::<R>::new(options)?.run(py, mesh_source(source)?)
+}
+
 #[pyfunction]
 #[pyo3(signature = (source, **options))]
 pub fn mesh(
@@ -130,11 +137,7 @@ pub fn mesh(
     source: &Bound<'_, PyAny>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Grid> {
-    let call = Call::<MeshRequest>::new(options)?;
-    let r = &call.request;
-    let task = r.task(mesh_source(source)?).map_err(to_py_err)?;
-    let (fit, up) = (r.fit().map_err(to_py_err)?, r.up_axis);
-    call.run(py, task, fit, up)
+    on_mesh::<MeshRequest>(py, source, options)
 }
 
 #[pyfunction]
@@ -144,11 +147,7 @@ pub fn solid(
     source: &Bound<'_, PyAny>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Grid> {
-    let call = Call::<SolidRequest>::new(options)?;
-    let r = &call.request;
-    let task = r.task(mesh_source(source)?).map_err(to_py_err)?;
-    let (fit, up) = (r.fit().map_err(to_py_err)?, r.up_axis);
-    call.run(py, task, fit, up)
+    on_mesh::<SolidRequest>(py, source, options)
 }
 
 #[pyfunction]
@@ -158,24 +157,7 @@ pub fn subdiv(
     source: &Bound<'_, PyAny>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Grid> {
-    let call = Call::<SubdivRequest>::new(options)?;
-    let r = &call.request;
-    let task = r.task(mesh_source(source)?).map_err(to_py_err)?;
-    let (fit, up) = (r.fit().map_err(to_py_err)?, r.up_axis);
-    call.run(py, task, fit, up)
-}
-
-#[pyfunction]
-#[pyo3(signature = (formula, **options))]
-pub fn implicit(
-    py: Python<'_>,
-    formula: String,
-    options: Option<&Bound<'_, PyDict>>,
-) -> PyResult<Grid> {
-    let call = Call::<ImplicitRequest>::new(options)?;
-    let task = call.request.task(formula);
-    let fit = call.request.fit().map_err(to_py_err)?;
-    call.run(py, task, fit, UpAxis::Z)
+    on_mesh::<SubdivRequest>(py, source, options)
 }
 
 #[pyfunction]
@@ -185,11 +167,17 @@ pub fn lines(
     source: &Bound<'_, PyAny>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Grid> {
-    let call = Call::<LinesRequest>::new(options)?;
-    let r = &call.request;
-    let task = r.task(mesh_source(source)?);
-    let (fit, up) = (r.fit().map_err(to_py_err)?, r.up_axis);
-    call.run(py, task, fit, up)
+    on_mesh::<LinesRequest>(py, source, options)
+}
+
+#[pyfunction]
+#[pyo3(signature = (formula, **options))]
+pub fn implicit(
+    py: Python<'_>,
+    formula: String,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Grid> {
+    Call::<ImplicitRequest>::new(options)?.run(py, formula)
 }
 
 /// A CSG tree (the CLI's `csg --tree` JSON): a path to the JSON file, or the tree as a dict
@@ -214,14 +202,13 @@ pub fn csg(
         CsgSource::File(tree.extract::<PathBuf>()?)
     };
     // A tree's options are in the tree: its only keywords are the limits.
-    let mut call = Call::<LimitsRequest>::new(options)?;
-    call.limits = call.request.clone();
-    call.run(
-        py,
-        Task::CsgTree(source),
-        GridFit::from_options(None, None),
-        UpAxis::Z,
-    )
+    let call = Call::<LimitsRequest>::new(options)?;
+    let job = Job {
+        limits: call.request.limits(),
+        ..Job::new(Task::CsgTree(source), GridFit::from_options(None, None))
+    };
+    let inputs = job.task.input_files();
+    Ok(Grid::new(run_job(py, job, call.progress)?, inputs))
 }
 
 #[pyfunction]
@@ -243,10 +230,7 @@ pub fn measure(
     } else {
         MeasureSource::Mesh(mesh_source(source)?)
     };
-    let r = &call.request;
-    let task = r.task(source).map_err(to_py_err)?;
-    let (fit, up) = (r.fit().map_err(to_py_err)?, r.up_axis);
-    call.run(py, task, fit, up)
+    call.run(py, source)
 }
 
 /// `a` and `b` are Grids, or `.vdb` paths whose grid `grid` or voxel set is read.
@@ -264,9 +248,7 @@ pub fn combine(
             Err(_) => Ok(GridSource::File(g.extract::<PathBuf>()?)),
         }
     };
-    let call = Call::<CombineRequest>::new(options)?;
-    let task = call.request.task(source(a)?, source(b)?);
-    call.run(py, task, GridFit::from_options(None, None), UpAxis::Z)
+    Call::<CombineRequest>::new(options)?.run(py, (source(a)?, source(b)?))
 }
 
 /// A grid of a `.vdb` file: the one named `grid`, else the voxel set voxelkit writes

@@ -28,6 +28,7 @@ pub(crate) fn to_py_err(e: Error) -> PyErr {
 #[pymodule]
 fn _voxelkit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("DEFAULT_RESOLUTION", crate::mesh::DEFAULT_RESOLUTION)?;
     m.add_class::<grid::Grid>()?;
     m.add_function(wrap_pyfunction!(jobs::mesh, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::solid, m)?)?;

@@ -11,7 +11,7 @@ use voxelkit::io::brick_set::{BrickSet, is_brick_set};
 use voxelkit::io::vdb::{DENSITY_GRID, VOXELS_GRID, read_vdb_info};
 use voxelkit::mesh::{GridFit, generate};
 use voxelkit::ops::separability::check_mesh_separation;
-use voxelkit::pipeline::request::{MeshRequest, SurfaceKind};
+use voxelkit::pipeline::request::{MeshRequest, Request, SurfaceKind};
 use voxelkit::pipeline::{Details, Job, MeshSource, Shape, SurfaceMethod, Task};
 use voxelkit::shapes::{Cylinder, Quadric, Sphere};
 use voxelkit::voxelize::Separability;

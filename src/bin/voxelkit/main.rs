@@ -13,7 +13,7 @@ mod subdiv;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use voxelkit::pipeline::request::{MeshRequest, SurfaceKind, WriteRequest};
+use voxelkit::pipeline::request::{LimitsRequest, MeshRequest, SurfaceKind, WriteRequest};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::Criterion;
 
@@ -44,15 +44,15 @@ use voxelkit::voxelize::separating::Criterion;
         peak, estimated MiB: the process's peak memory, and what planning estimated"
 )]
 struct Cli {
-    /// Worker threads (default: all cores; at most 256).
+    /// Worker threads (0 or none: all cores; at most 256).
     #[arg(long, global = true)]
-    threads: Option<usize>,
+    threads: Option<u32>,
     /// Print one JSON object instead of the human summary (no progress bars); errors too are
     /// one JSON object, on stderr.
     #[arg(long, global = true)]
     json: bool,
-    /// Refuse work whose estimated memory exceeds this many MiB, before it starts
-    /// [default: the memory available].
+    /// Refuse work whose estimated memory exceeds this many MiB, before it starts (0 or
+    /// none: the memory available).
     #[arg(long, global = true, value_name = "MIB")]
     max_memory: Option<u64>,
     /// Write only these grids of the .vdb, by name (e.g. `density,voxels`) [default: all but
@@ -209,8 +209,10 @@ fn main() -> ExitCode {
     voxelkit::io::atomic::remove_temporaries_on_signals();
     let cli = Cli::parse();
     let global = run::Global {
-        threads: cli.threads,
-        max_memory_mib: cli.max_memory,
+        limits: LimitsRequest {
+            threads: cli.threads,
+            max_memory_mib: cli.max_memory,
+        },
         up_axis: cli.up_axis,
         json: cli.json,
         preview: cli.preview,

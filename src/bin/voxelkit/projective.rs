@@ -8,7 +8,7 @@ use clap::Args;
 use glam::Vec3;
 use std::path::PathBuf;
 use voxelkit::Result;
-use voxelkit::pipeline::request::LinesRequest;
+use voxelkit::pipeline::request::{LinesRequest, Request};
 use voxelkit::pipeline::{Job, MeshSource};
 
 fn parse_color(s: &str) -> std::result::Result<Vec3, String> {
@@ -72,6 +72,6 @@ pub fn lines(args: &LinesArgs, global: &Global) -> Result<()> {
         color,
         ..LinesRequest::default()
     };
-    let task = request.task(MeshSource::File(args.input.clone()));
+    let task = request.task(MeshSource::File(args.input.clone()))?;
     run_and_report(Job::new(task, args.fit.grid_fit()), &args.output, global)
 }

@@ -104,7 +104,9 @@ pub fn run(args: &RenderArgs, global: &Global) -> Result<()> {
         normals: normals.as_ref(),
         colors: colors.as_ref(),
     };
-    let said = on_threads(global.threads, || draw(&scene, args.picture, &args.output))?;
+    let said = on_threads(global.limits().threads, || {
+        draw(&scene, args.picture, &args.output)
+    })?;
     if global.json {
         println!(
             "{}",

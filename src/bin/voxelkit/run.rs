@@ -9,14 +9,14 @@ use std::sync::Mutex;
 use std::time::Instant;
 use voxelkit::Result;
 use voxelkit::io::vdb::{WriteOptions, check_voxel_size};
+use voxelkit::pipeline::request::LimitsRequest;
 use voxelkit::pipeline::{Job, Limits, Outcome, PlannedJob, check_output_path};
 use voxelkit::progress::Observer;
 
 /// What every command shares: threads, memory limit, output style.
 #[derive(Clone)]
 pub struct Global {
-    pub threads: Option<usize>,
-    pub max_memory_mib: Option<u64>,
+    pub limits: LimitsRequest,
     pub up_axis: voxelkit::mesh::UpAxis,
     pub json: bool,
     pub write: WriteOptions,
@@ -26,10 +26,7 @@ pub struct Global {
 
 impl Global {
     pub fn limits(&self) -> Limits {
-        Limits {
-            threads: self.threads,
-            max_memory: self.max_memory_mib.map(|m| m.saturating_mul(1 << 20)),
-        }
+        self.limits.limits()
     }
 }
 

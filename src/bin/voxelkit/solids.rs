@@ -6,7 +6,7 @@ use clap::Args;
 use std::path::PathBuf;
 use voxelkit::Result;
 use voxelkit::ops::csg::BooleanOp;
-use voxelkit::pipeline::request::{FillKind, FloodKind, MeasureRequest, SolidRequest};
+use voxelkit::pipeline::request::{FillKind, FloodKind, MeasureRequest, Request, SolidRequest};
 use voxelkit::pipeline::{CsgSource, GridSource, Job, MeasureSource, MeshSource, Task};
 use voxelkit::solids::beam::BeamFill;
 

@@ -1,0 +1,94 @@
+"""Every option declared once: the module's functions, their stubs, their help and the Dask
+front end all come from the library's table (voxelkit.OPTIONS), with the CLI's defaults and
+errors."""
+
+import ast
+import inspect
+import pathlib
+
+import pytest
+
+import voxelkit
+
+STUBS = pathlib.Path(voxelkit.__file__).with_name("_voxelkit.pyi")
+#: Each function's positional inputs and the table entry of its options.
+FUNCTIONS = {
+    "mesh": (["source"], "mesh"),
+    "solid": (["source"], "solid"),
+    "subdiv": (["source"], "subdiv"),
+    "implicit": (["formula"], "implicit"),
+    "lines": (["source"], "lines"),
+    "measure": (["source"], "measure"),
+    "combine": (["a", "b"], "combine"),
+    "csg": (["tree"], None),
+}
+SPHERE = "x^2 + y^2 + z^2 - 0.5"
+
+
+def expected(request):
+    """(name, default) of a function's options: its request's, the limits, progress."""
+    fields = (voxelkit.OPTIONS[request]["fields"] if request else []) + voxelkit.OPTIONS["limits"]["fields"]
+    return [(f["name"], f["default"]) for f in fields] + [("progress", None)]
+
+
+def plain(value):
+    return list(value) if isinstance(value, tuple) else value
+
+
+def test_stubs_declare_the_tables_options_and_defaults():
+    tree = ast.parse(STUBS.read_text())
+    stubs = {n.name: n for n in tree.body if isinstance(n, ast.FunctionDef)}
+    for name, (inputs, request) in FUNCTIONS.items():
+        args = stubs[name].args
+        names = [a.arg for a in args.args]
+        assert names[: len(inputs)] == inputs, name
+        defaults = [plain(ast.literal_eval(d)) for d in args.defaults]
+        assert list(zip(names[len(inputs):], defaults)) == expected(request), name
+
+
+def test_signatures_and_help_document_every_option():
+    for name, (inputs, request) in FUNCTIONS.items():
+        fn = getattr(voxelkit, name)
+        params = list(inspect.signature(fn).parameters.values())
+        assert [p.name for p in params[: len(inputs)]] == inputs
+        got = [(p.name, plain(p.default)) for p in params[len(inputs):]]
+        assert got == expected(request), name
+        for option, _ in expected(request):
+            assert f"\n{option} = " in fn.__doc__ or f"\n{option}:" in fn.__doc__, (name, option)
+
+
+def test_a_bad_value_gets_the_clis_error(data):
+    path = data / "meshes" / "bunny-closed.obj"
+    with pytest.raises(ValueError, match="separability must be 6 or 26, not `7`"):
+        voxelkit.mesh(path, separability=7)
+    with pytest.raises(ValueError, match="the fill method must be flood, depth-layers or beam, not `x`"):
+        voxelkit.solid(path, method="x")
+    with pytest.raises(ValueError, match="band must be a positive number"):
+        voxelkit.mesh(path, sdf=True, band=-1.0)
+    with pytest.raises(ValueError, match="band: must be a finite number"):
+        voxelkit.mesh(path, sdf=True, band=float("nan"))
+    with pytest.raises(TypeError, match="unexpected keyword argument 'separabilty'"):
+        voxelkit.mesh(path, separabilty=6)
+
+
+def test_zero_threads_and_zero_memory_mean_the_defaults():
+    default = voxelkit.implicit(SPHERE, resolution=24)
+    zero = voxelkit.implicit(SPHERE, resolution=24, threads=0, max_memory_mib=0)
+    assert len(zero) > 0 and zero.same_voxels(default)
+
+
+def test_numpy_numbers_are_options():
+    np = pytest.importorskip("numpy")
+    grid = voxelkit.implicit(SPHERE, resolution=np.int64(24), bounds=np.array([-1.0, 1.0]))
+    assert grid.same_voxels(voxelkit.implicit(SPHERE, resolution=24))
+
+
+def test_the_dask_command_line_takes_the_tables_defaults(capsys):
+    distributed = pytest.importorskip("voxelkit.distributed")
+    with pytest.raises(SystemExit):
+        distributed.main(["mesh", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    fields = {f["name"]: f for f in voxelkit.OPTIONS["distributed"]["fields"]}
+    assert f"(default {fields['brick']['default']})" in text
+    assert "{6,26}" in text and "--max-memory" in text and "--up-axis" in text
+    assert inspect.signature(distributed.run).parameters["brick"].default == fields["brick"]["default"]
