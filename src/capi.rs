@@ -12,7 +12,7 @@ use crate::choice::Choice;
 use crate::error::Error;
 use crate::grid::{LEAF_VOXELS, SparseGrid};
 use crate::implicit::Coordinates;
-use crate::io::vdb::{read_vdb_grid, write_vdb};
+use crate::io::vdb::{MetaValue, read_vdb_grid, write_vdb};
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::BooleanOp;
 use crate::pipeline::request::{
@@ -70,7 +70,7 @@ pub struct VkMesh(Mesh);
 /// `vk_grid`: a grid and the `.vdb` metadata of the job that made it.
 pub struct VkGrid {
     grid: SparseGrid,
-    metadata: Vec<(String, String)>,
+    metadata: Vec<(String, MetaValue)>,
 }
 
 impl From<Outcome> for VkGrid {
@@ -954,7 +954,7 @@ pub extern "C" fn vk_grid_read_vdb(
         };
         let path = PathBuf::from(c_str(path, "path")?);
         let grid = read_vdb_grid(&path, name)?;
-        let metadata = vec![("source_file".to_string(), path.display().to_string())];
+        let metadata = vec![("source_file".to_string(), path.display().to_string().into())];
         hand_out(VkGrid { grid, metadata }, Kind::Grid, out)
     })
 }
@@ -964,7 +964,7 @@ pub extern "C" fn vk_grid_write_vdb(grid: *const VkGrid, path: *const c_char) ->
     guard(|| {
         let g = borrow(grid, Kind::Grid)?;
         let path = PathBuf::from(c_str(path, "path")?);
-        let meta: Vec<(&str, String)> = g
+        let meta: Vec<(&str, MetaValue)> = g
             .metadata
             .iter()
             .map(|(k, v)| (k.as_str(), v.clone()))

@@ -214,3 +214,69 @@ fn the_c_headers_enum_codes_are_the_name_tables() {
     check_codes::<Coordinates>(&header, "vk_coordinates", "VK_");
     check_codes::<BooleanOp>(&header, "vk_boolean", "VK_");
 }
+
+#[test]
+fn library_messages_name_options_and_the_cli_says_its_flags() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    for (r, name) in [("16", "a.vdb"), ("20", "b.vdb")] {
+        let o = voxelkit(&["shape", "sphere", "-r", r, "-o", &path(name)]);
+        assert!(o.status.success(), "{}", text(&o));
+    }
+    let o = voxelkit(&[
+        "csg",
+        "union",
+        &path("a.vdb"),
+        &path("b.vdb"),
+        "-o",
+        &path("c.vdb"),
+    ]);
+    assert!(!o.status.success());
+    let said = text(&o);
+    assert!(
+        said.contains("(--resample)") && !said.contains("option `"),
+        "{said}"
+    );
+    let a = voxelkit::io::vdb::read_vdb_grid(std::path::Path::new(&path("a.vdb")), None).unwrap();
+    let b = voxelkit::io::vdb::read_vdb_grid(std::path::Path::new(&path("b.vdb")), None).unwrap();
+    let e = voxelkit::ops::csg::combine(&a, &b, BooleanOp::Union, false).unwrap_err();
+    assert!(e.to_string().contains("(option `resample`)"), "{e}");
+}
+
+#[test]
+fn resolution_separability_and_voxel_sizes_are_typed_metadata() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    let info = |file: &str| -> Value {
+        let o = voxelkit(&["--json", "info", file]);
+        assert!(o.status.success(), "{}", text(&o));
+        let j: Value = serde_json::from_slice(&o.stdout).unwrap();
+        j["grids"][0]["metadata"].clone()
+    };
+    let o = voxelkit(&[
+        "shape",
+        "sphere",
+        "-r",
+        "24",
+        "-s",
+        "6",
+        "-o",
+        &path("r.vdb"),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let meta = info(&path("r.vdb"));
+    assert_eq!(meta["resolution"], Value::from(24), "{meta}");
+    assert_eq!(meta["separability"], Value::from(6), "{meta}");
+    let o = voxelkit(&[
+        "shape",
+        "sphere",
+        "--voxel-size",
+        "0.125",
+        "-o",
+        &path("h.vdb"),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let meta = info(&path("h.vdb"));
+    assert_eq!(meta["voxel_size"], Value::from(0.125), "{meta}");
+    assert!(meta.get("resolution").is_none(), "{meta}");
+}

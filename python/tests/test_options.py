@@ -92,3 +92,18 @@ def test_the_dask_command_line_takes_the_tables_defaults(capsys):
     assert f"(default {fields['brick']['default']})" in text
     assert "{6,26}" in text and "--max-memory" in text and "--up-axis" in text
     assert inspect.signature(distributed.run).parameters["brick"].default == fields["brick"]["default"]
+
+
+def test_pyopenvdb_reads_the_fit_and_separability_as_numbers(tmp_path):
+    pyopenvdb = pytest.importorskip("pyopenvdb")
+    voxelkit.implicit(SPHERE, resolution=24).write(tmp_path / "r.vdb")
+    grid = voxelkit.mesh((
+        [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
+        [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    ), voxel_size=0.125, separability=6)
+    grid.write(tmp_path / "h.vdb")
+    implicit = pyopenvdb.readAllGridMetadata(str(tmp_path / "r.vdb"))[0]
+    assert implicit["resolution"] == 24 and isinstance(implicit["resolution"], int)
+    mesh = pyopenvdb.readAllGridMetadata(str(tmp_path / "h.vdb"))[0]
+    assert mesh["voxel_size"] == 0.125 and isinstance(mesh["voxel_size"], float)
+    assert mesh["separability"] == 6 and isinstance(mesh["separability"], int)

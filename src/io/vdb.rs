@@ -59,7 +59,7 @@ fn vdb_error(path: &Path, e: impl std::fmt::Display) -> Error {
 
 /// Writes `grid` to `path` as `density` and (when present) `normal` and `Cd` grids, each with
 /// `grid.transform` and `metadata` plus `voxelkit_version`.
-pub fn write_vdb(path: &Path, grid: &SparseGrid, metadata: &[(&str, String)]) -> Result<()> {
+pub fn write_vdb(path: &Path, grid: &SparseGrid, metadata: &[(&str, MetaValue)]) -> Result<()> {
     write_vdb_as(path, grid, &[], metadata, &WriteOptions::default())
 }
 
@@ -69,7 +69,7 @@ pub fn write_vdb_as(
     path: &Path,
     grid: &SparseGrid,
     masks_to_add: &[(&str, &SparseGrid)],
-    metadata: &[(&str, String)],
+    metadata: &[(&str, MetaValue)],
     options: &WriteOptions,
 ) -> Result<()> {
     check_voxel_size(path, grid.transform.voxel_size)?;
@@ -181,9 +181,55 @@ impl crate::choice::Choice for Compression {
 }
 crate::named_choices!(Compression);
 
+/// A grid's metadata value, written with OpenVDB's type for it (so Houdini and pyopenvdb
+/// read numbers as numbers).
+#[derive(Clone, Debug, PartialEq)]
+pub enum MetaValue {
+    Text(String),
+    Int(i64),
+    Real(f64),
+}
+
+impl std::fmt::Display for MetaValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            MetaValue::Text(s) => f.write_str(s),
+            MetaValue::Int(n) => write!(f, "{n}"),
+            MetaValue::Real(x) => write!(f, "{x}"),
+        }
+    }
+}
+
+impl From<String> for MetaValue {
+    fn from(s: String) -> Self {
+        MetaValue::Text(s)
+    }
+}
+
+impl From<&str> for MetaValue {
+    fn from(s: &str) -> Self {
+        MetaValue::Text(s.to_string())
+    }
+}
+
+impl From<f64> for MetaValue {
+    fn from(x: f64) -> Self {
+        MetaValue::Real(x)
+    }
+}
+
+macro_rules! int_meta {
+    ($($t:ty),*) => {$(impl From<$t> for MetaValue {
+        fn from(n: $t) -> Self {
+            MetaValue::Int(i64::try_from(n).unwrap_or(i64::MAX))
+        }
+    })*};
+}
+int_meta!(u32, u64, usize, i64);
+
 /// The metadata entries of every grid: the caller's plus `voxelkit_version`.
-fn meta_entries(metadata: &[(&str, String)]) -> Vec<(String, String)> {
-    let mut meta: Vec<(String, String)> = metadata
+fn meta_entries(metadata: &[(&str, MetaValue)]) -> Vec<(String, MetaValue)> {
+    let mut meta: Vec<(String, MetaValue)> = metadata
         .iter()
         .map(|(k, v)| (k.to_string(), v.clone()))
         .collect();
@@ -201,7 +247,7 @@ pub fn write_distance_band(
     grid: &SparseGrid,
     background: f32,
     interior: Option<&SparseGrid>,
-    metadata: &[(&str, String)],
+    metadata: &[(&str, MetaValue)],
     options: &WriteOptions,
 ) -> Result<()> {
     check_voxel_size(path, grid.transform.voxel_size)?;

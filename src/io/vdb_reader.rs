@@ -21,10 +21,12 @@ const ROOT_TILE: i32 = 4096;
 /// OpenVDB appends this and a number to repeated grid names in a file.
 const NAME_SUFFIX_MARK: char = '\u{1e}';
 
-/// One metadata item of a grid, its value as text.
+/// One metadata item of a grid, its value as text, with OpenVDB's name of its type
+/// (`string`, `int64`, `double`, ...).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MetaEntry {
     pub key: String,
+    pub type_name: String,
     pub value: String,
 }
 
@@ -391,7 +393,11 @@ fn read_metadata(c: &mut Cursor) -> Parsed<Vec<MetaEntry>> {
             _ => metadata_text(&type_name, bytes),
         };
         if let Some(value) = value {
-            entries.push(MetaEntry { key, value });
+            entries.push(MetaEntry {
+                key,
+                type_name,
+                value,
+            });
         }
     }
     Ok(entries)

@@ -171,7 +171,7 @@ pub(super) struct GridOut<'g> {
     pub class: Option<&'static str>,
     /// OpenVDB's vector type of a Vec3 grid (`covariant normalize`, `invariant`).
     pub vector_type: Option<&'static str>,
-    pub metadata: &'g [(String, String)],
+    pub metadata: &'g [(String, super::vdb::MetaValue)],
 }
 
 /// How the file is written.
@@ -573,16 +573,25 @@ fn push_metadata(
     internal: [u64; 2],
     leaves: u64,
 ) {
+    use super::vdb::MetaValue;
     enum Meta {
         Str(String),
         Vec3i([i32; 3]),
         Int64(i64),
+        Double(f64),
         Bool(bool),
     }
     let mut map: BTreeMap<&str, Meta> = g
         .metadata
         .iter()
-        .map(|(k, v)| (k.as_str(), Meta::Str(v.clone())))
+        .map(|(k, v)| {
+            let value = match v {
+                MetaValue::Text(s) => Meta::Str(s.clone()),
+                MetaValue::Int(n) => Meta::Int64(*n),
+                MetaValue::Real(x) => Meta::Double(*x),
+            };
+            (k.as_str(), value)
+        })
         .collect();
     map.insert("name", Meta::Str(g.name.to_string()));
     if let Some(class) = g.class {
@@ -616,6 +625,7 @@ fn push_metadata(
             Meta::Str(s) => ("string", s.into_bytes()),
             Meta::Vec3i(v) => ("vec3i", v.iter().flat_map(|c| c.to_le_bytes()).collect()),
             Meta::Int64(v) => ("int64", v.to_le_bytes().to_vec()),
+            Meta::Double(v) => ("double", v.to_le_bytes().to_vec()),
             Meta::Bool(v) => ("bool", vec![v as u8]),
         };
         push_string(out, type_name);

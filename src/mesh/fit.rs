@@ -51,7 +51,8 @@ pub fn fit_transform(bbox: &Aabb, fit: GridFit) -> Result<Transform> {
         GridFit::Resolution(r) if longest > 0.0 => longest / r as f64,
         GridFit::Resolution(_) => {
             return Err(Error::InvalidArgument(
-                "the mesh has zero extent; give --voxel-size instead of --resolution".into(),
+                "the mesh has zero extent; give a voxel size (option `voxel_size`) instead of a resolution"
+                    .into(),
             ));
         }
         // Volumes and masses need h^3: refuse sizes whose cube overflows.

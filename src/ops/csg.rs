@@ -74,7 +74,7 @@ pub fn combine(
         &resampled
     } else {
         return Err(Error::InvalidArgument(format!(
-            "the grids' transforms differ (voxel size {} at {} against {} at {}): resample the second onto the first (--resample), or voxelize both on one grid",
+            "the grids' transforms differ (voxel size {} at {} against {} at {}): resample the second onto the first (option `resample`), or voxelize both on one grid",
             a.transform.voxel_size, a.transform.origin, b.transform.voxel_size, b.transform.origin
         )));
     };

@@ -537,18 +537,18 @@ impl PlannedJob {
 
     fn run_here(&self, progress: &Progress) -> Result<Outcome> {
         let t = self.plan.transform;
-        let fit = self.job.fit.describe();
+        let fit = self.job.fit;
         let source = self.job.describe_input();
         match (&self.job.task, &self.loaded) {
             (Task::MeshSurface { method, .. }, Loaded::Mesh(mesh)) => {
-                outcome::mesh_surface(mesh, t, *method, &fit, progress)
+                outcome::mesh_surface(mesh, t, *method, fit, progress)
             }
             (Task::SeparationCheck { options, .. }, Loaded::Mesh(mesh)) => {
-                outcome::separation_check(mesh, t, *options, &fit, progress)
+                outcome::separation_check(mesh, t, *options, fit, progress)
             }
             (Task::Lines { edges, color, .. }, Loaded::Mesh(mesh)) => {
                 let source = lines_source(mesh, *edges);
-                outcome::lines(mesh, t, source, color.coloring(mesh), &fit, progress)
+                outcome::lines(mesh, t, source, color.coloring(mesh), fit, progress)
             }
             (
                 Task::Shape {
@@ -560,7 +560,7 @@ impl PlannedJob {
                 Loaded::Shape,
             ) => {
                 let margin = *curvature_margin;
-                outcome::shape(shape, t, *separability, *normals, margin, &fit, progress)
+                outcome::shape(shape, t, *separability, *normals, margin, fit, progress)
             }
             (
                 Task::Subdivision {
@@ -569,7 +569,7 @@ impl PlannedJob {
                     ..
                 },
                 Loaded::Control(control),
-            ) => outcome::subdivision(control, t, options, &fit, progress),
+            ) => outcome::subdivision(control, t, options, fit, progress),
             (
                 Task::Subdivision {
                     options,
@@ -577,7 +577,7 @@ impl PlannedJob {
                     ..
                 },
                 Loaded::Control(control),
-            ) => solid::subdivision_solid(control, t, options, *fill, &fit, progress),
+            ) => solid::subdivision_solid(control, t, options, *fill, fit, progress),
             (
                 Task::Implicit {
                     min,
@@ -598,7 +598,7 @@ impl PlannedJob {
                 outcome::implicit(formula, text, *min, *max, &options, progress)
             }
             (Task::DistanceBand { band, signed, .. }, Loaded::Mesh(mesh)) => {
-                solid::distance_band(mesh, t, *band, *signed, &fit, progress)
+                solid::distance_band(mesh, t, *band, *signed, fit, progress)
             }
             (
                 Task::Solid {
@@ -608,7 +608,7 @@ impl PlannedJob {
                     ..
                 },
                 Loaded::Mesh(mesh),
-            ) => solid::mesh_solid(mesh, t, *fill, *density, *topology, &fit, progress),
+            ) => solid::mesh_solid(mesh, t, *fill, *density, *topology, fit, progress),
             (Task::Measure { flood, density, .. }, Loaded::Mesh(mesh)) => {
                 solid::measure_mesh(mesh, t, *flood, *density, progress)
             }

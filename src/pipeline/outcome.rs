@@ -12,9 +12,9 @@ use crate::implicit::Formula;
 use crate::io::atomic::check_output;
 use crate::io::binvox::write_binvox;
 use crate::io::brick_set::{BrickSet, is_brick_set};
-use crate::io::vdb::{WriteOptions, read_vdb_grid, write_distance_band, write_vdb_as};
+use crate::io::vdb::{MetaValue, WriteOptions, read_vdb_grid, write_distance_band, write_vdb_as};
 use crate::io::vox::write_vox;
-use crate::mesh::Mesh;
+use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::{BooleanOp, combine as combine_grids};
 use crate::ops::minimality::simple_voxel_count;
 use crate::ops::separability::check_mesh_separation;
@@ -38,7 +38,7 @@ pub struct Outcome {
     /// `opposite_normals`, `level_0` ..), by name.
     pub extra: Vec<(String, SparseGrid)>,
     /// The metadata every written grid carries (`method`, `source_file`, ...).
-    pub metadata: Vec<(String, String)>,
+    pub metadata: Vec<(String, MetaValue)>,
     pub report: Report,
     /// Set when `grid` holds distances (world units) to write as a narrow band, instead of a
     /// voxel set.
@@ -94,13 +94,13 @@ pub fn check_output_path(path: &Path, inputs: &[&Path]) -> Result<()> {
 impl Outcome {
     pub(super) fn new(
         grid: SparseGrid,
-        metadata: Vec<(&str, String)>,
+        metadata: Vec<(&str, MetaValue)>,
         details: Details,
     ) -> Outcome {
         let method = metadata
             .iter()
             .find(|(k, _)| *k == "method")
-            .map(|(_, v)| v.clone())
+            .map(|(_, v)| v.to_string())
             .unwrap_or_default();
         let report = Report {
             method,
@@ -136,8 +136,8 @@ impl Outcome {
             (read_vdb_grid(path, name)?, "read")
         };
         let metadata = vec![
-            ("method", method.to_string()),
-            ("source_file", source.clone()),
+            ("method", method.into()),
+            ("source_file", source.as_str().into()),
         ];
         let mut outcome = Outcome::new(grid, metadata, Details::None);
         outcome.report.input = source;
@@ -192,7 +192,7 @@ impl Outcome {
             self.report.output = Some(path.display().to_string());
             return Ok(());
         }
-        let meta: Vec<(&str, String)> = self
+        let meta: Vec<(&str, MetaValue)> = self
             .metadata
             .iter()
             .map(|(k, v)| (k.as_str(), v.clone()))
@@ -241,17 +241,28 @@ fn write_to_stdout(write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     result
 }
 
-/// `method`, `source_file` and `resolution`, the metadata every output carries.
+/// `method`, `source_file` and the grid's fit, the metadata every output carries.
 pub(super) fn provenance(
     method: &str,
     source: &str,
-    resolution: &str,
-) -> Vec<(&'static str, String)> {
-    vec![
-        ("method", method.to_string()),
-        ("source_file", source.to_string()),
-        ("resolution", resolution.to_string()),
-    ]
+    fit: GridFit,
+) -> Vec<(&'static str, MetaValue)> {
+    let mut meta = vec![("method", method.into()), ("source_file", source.into())];
+    meta.extend(fit_metadata(fit));
+    meta
+}
+
+/// How the grid was fitted, typed: `resolution` (an int) or `voxel_size` (a double), and
+/// `grid_placement` `shared` for a grid placed beforehand for several meshes.
+fn fit_metadata(fit: GridFit) -> Vec<(&'static str, MetaValue)> {
+    match fit {
+        GridFit::Resolution(r) => vec![("resolution", r.into())],
+        GridFit::VoxelSize(h) => vec![("voxel_size", h.into())],
+        GridFit::Placed(t) => vec![
+            ("voxel_size", t.voxel_size.into()),
+            ("grid_placement", "shared".into()),
+        ],
+    }
 }
 
 fn describe(coloring: Coloring) -> String {
@@ -265,11 +276,11 @@ fn describe(coloring: Coloring) -> String {
 /// A projective surface or line set, with its colouring in the metadata and the report.
 fn projective_outcome(
     grid: SparseGrid,
-    mut meta: Vec<(&str, String)>,
+    mut meta: Vec<(&str, MetaValue)>,
     s: &projective::ProjectiveStats,
     coloring: Coloring,
 ) -> Outcome {
-    meta.push(("color", describe(coloring)));
+    meta.push(("color", describe(coloring).into()));
     let details = ProjectiveDetails {
         triangles: s.triangles,
         degenerate_triangles: s.degenerate_triangles,
@@ -283,7 +294,7 @@ pub(super) fn mesh_surface(
     mesh: &Mesh,
     t: Transform,
     method: SurfaceMethod,
-    resolution: &str,
+    fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
@@ -296,8 +307,8 @@ pub(super) fn mesh_surface(
                 Criterion::Clipped => "huang-separating-clipped",
             };
             let sep = options.separability.adjacency();
-            let mut meta = provenance(method, &source, resolution);
-            meta.insert(1, ("separability", sep.to_string()));
+            let mut meta = provenance(method, &source, fit);
+            meta.insert(1, ("separability", sep.into()));
             let classes = SeparatingClasses {
                 vertex_voxels: s.vertex_voxels,
                 edge_voxels: s.edge_voxels,
@@ -326,7 +337,7 @@ pub(super) fn mesh_surface(
         SurfaceMethod::Projective(color) => {
             let coloring = color.coloring(mesh);
             let (grid, s) = projective::voxelize_triangles(mesh, t, coloring, progress)?;
-            let meta = provenance("projective-triangles", &source, resolution);
+            let meta = provenance("projective-triangles", &source, fit);
             Ok(projective_outcome(grid, meta, &s, coloring).timed(start))
         }
     }
@@ -336,16 +347,10 @@ pub(super) fn separation_check(
     mesh: &Mesh,
     t: Transform,
     options: SeparatingOptions,
-    resolution: &str,
+    fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
-    let mut outcome = mesh_surface(
-        mesh,
-        t,
-        SurfaceMethod::Separating(options),
-        resolution,
-        progress,
-    )?;
+    let mut outcome = mesh_surface(mesh, t, SurfaceMethod::Separating(options), fit, progress)?;
     let adjacency = options.separability.flood_adjacency();
     let found = check_mesh_separation(&outcome.grid, mesh, adjacency)?;
     let simple = simple_voxel_count(&outcome.grid, adjacency)?;
@@ -357,7 +362,7 @@ pub(super) fn separation_check(
         first_leak: found.first_leak,
         simple_voxels: simple,
         simple_share: simple as f64 / outcome.grid.voxel_count().max(1) as f64,
-        resolution: resolution.to_string(),
+        resolution: fit.describe(),
     });
     Ok(outcome)
 }
@@ -367,7 +372,7 @@ pub(super) fn lines(
     t: Transform,
     source: LineSource,
     coloring: Coloring,
-    resolution: &str,
+    fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
@@ -379,7 +384,7 @@ pub(super) fn lines(
     } else {
         "projective-lines"
     };
-    let meta = provenance(method, &mesh.source.display().to_string(), resolution);
+    let meta = provenance(method, &mesh.source.display().to_string(), fit);
     Ok(projective_outcome(grid, meta, &s, coloring).timed(start))
 }
 
@@ -389,7 +394,7 @@ pub(super) fn shape(
     separability: Separability,
     normals: bool,
     curvature_margin: bool,
-    resolution: &str,
+    fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
@@ -408,8 +413,8 @@ pub(super) fn shape(
     } else {
         "huang-separating-analytic-plain"
     };
-    let mut meta = provenance(method, &name, resolution);
-    meta.insert(1, ("separability", sep.to_string()));
+    let mut meta = provenance(method, &name, fit);
+    meta.insert(1, ("separability", sep.into()));
     let details = Details::Shape {
         shape: name,
         separability: sep,
@@ -421,7 +426,7 @@ pub(super) fn subdivision(
     control: &ControlMesh,
     t: Transform,
     options: &ParametricOptions,
-    resolution: &str,
+    fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
@@ -433,10 +438,10 @@ pub(super) fn subdivision(
         "lai-cheng-parametric"
     };
     let adjacency = options.adjacency.number();
-    let mut meta = provenance(method, &control.source.display().to_string(), resolution);
-    meta.insert(1, ("adjacency", adjacency.to_string()));
-    meta.push(("presplit", options.presplit.to_string()));
-    meta.push(("surface_area", s.area.to_string()));
+    let mut meta = provenance(method, &control.source.display().to_string(), fit);
+    meta.insert(1, ("adjacency", adjacency.into()));
+    meta.push(("presplit", options.presplit.into()));
+    meta.push(("surface_area", s.area.into()));
     let details = SubdivisionDetails {
         adjacency,
         opposite_normal_voxels: s.opposite_voxels,
@@ -469,10 +474,10 @@ pub(super) fn implicit(
     let s = out.stats;
     let coordinates = format!("{:?}", formula.coordinates).to_lowercase();
     let meta = vec![
-        ("method", "stolte-kaufman-interval-octree".to_string()),
-        ("formula", text.to_string()),
-        ("coordinates", coordinates.clone()),
-        ("resolution", options.resolution.to_string()),
+        ("method", "stolte-kaufman-interval-octree".into()),
+        ("formula", text.into()),
+        ("coordinates", coordinates.as_str().into()),
+        ("resolution", options.resolution.into()),
     ];
     let details = ImplicitDetails {
         formula: text.to_string(),
@@ -507,6 +512,6 @@ pub(super) fn combine(
     } else {
         format!("{op:?}").to_lowercase()
     };
-    let meta = vec![("method", method), ("source_file", source.to_string())];
+    let meta = vec![("method", method.into()), ("source_file", source.into())];
     Ok(Outcome::new(grid, meta, Details::None).timed(start))
 }

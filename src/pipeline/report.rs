@@ -432,7 +432,7 @@ fn depth_layer_summary(place: &str, method: &str, d: &DepthLayerDetails, timing:
         ));
     } else if d.unclassified_voxels > 0 {
         t.push_str(&format!(
-            "\n  {} voxels are crossed more than four times along every direction (with --unclassified paper: along some direction) and are written as `unclassified` (more --directions may decide some)",
+            "\n  {} voxels are crossed more than four times along every direction (with option `unclassified` paper: along some direction) and are written as `unclassified` (more directions, option `directions`, may decide some)",
             d.unclassified_voxels
         ));
     }

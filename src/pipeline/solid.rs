@@ -11,7 +11,8 @@ use super::report::{
 use super::{Fill, SubdivisionFill};
 use crate::error::Result;
 use crate::grid::{Adjacency, DenseMask, SparseGrid, Transform};
-use crate::mesh::{Mesh, index_box};
+use crate::io::vdb::MetaValue;
+use crate::mesh::{GridFit, Mesh, index_box};
 use crate::ops::flood::padded;
 use crate::ops::topology::{components, euler_characteristic};
 use crate::progress::Progress;
@@ -29,7 +30,8 @@ use std::time::Instant;
 
 /// Why the flood needs a closed mesh, for the error that refuses an open one.
 pub const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it and leave the solid hollow \
-     (--method depth-layers reports which voxels an open mesh leaves undecidable)";
+     (the depth-layers method, option `method`, reports which voxels an open mesh leaves \
+     undecidable)";
 
 /// What inside means for the exterior flood.
 const FLOOD_RULE: &str =
@@ -108,7 +110,7 @@ fn solid_details(
 fn surface_and_inside(
     surface: SparseGrid,
     solid: Solid,
-    meta: Vec<(&str, String)>,
+    meta: Vec<(&str, MetaValue)>,
     describe: impl FnOnce(&SparseGrid, &Solid) -> Result<SolidDetails>,
 ) -> Result<Outcome> {
     // The inside is mostly tiles: start from it and add the surface's leaves.
@@ -125,7 +127,7 @@ fn surface_and_inside(
 fn centre_solid(
     solid: &DenseMask,
     t: Transform,
-    meta: Vec<(&str, String)>,
+    meta: Vec<(&str, MetaValue)>,
     details: Details,
 ) -> Outcome {
     let outer = solid.boundary();
@@ -141,18 +143,12 @@ pub(super) fn mesh_solid(
     fill: Fill,
     density: f64,
     topology: bool,
-    resolution: &str,
+    fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
     let source = mesh.source.display().to_string();
-    let meta = |method: &str| {
-        vec![
-            ("method", method.to_string()),
-            ("source_file", source.clone()),
-            ("resolution", resolution.to_string()),
-        ]
-    };
+    let meta = |method: &str| provenance(method, &source, fit);
     let outcome = match fill {
         Fill::Flood(flood) => {
             let surface = flood_surface(mesh, t, progress)?;
@@ -240,7 +236,7 @@ pub(super) fn distance_band(
     t: Transform,
     band: f64,
     signed: bool,
-    resolution: &str,
+    fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
@@ -264,12 +260,8 @@ pub(super) fn distance_band(
     } else {
         "exact-unsigned-distance-band"
     };
-    let meta = vec![
-        ("method", method.to_string()),
-        ("source_file", mesh.source.display().to_string()),
-        ("resolution", resolution.to_string()),
-        ("band_voxels", band.to_string()),
-    ];
+    let mut meta = provenance(method, &mesh.source.display().to_string(), fit);
+    meta.push(("band_voxels", band.into()));
     let details = DistanceBandDetails {
         band,
         signed,
@@ -297,9 +289,9 @@ pub(super) fn measure_mesh(
     let meta = vec![
         (
             "method",
-            "huang-26-separating-surface+exterior-flood".to_string(),
+            "huang-26-separating-surface+exterior-flood".into(),
         ),
-        ("source_file", mesh.source.display().to_string()),
+        ("source_file", mesh.source.display().to_string().into()),
     ];
     let outcome = surface_and_inside(surface, solid, meta, |whole, solid| {
         let details = solid_details(whole, solid, density, FLOOD_RULE, Some(mesh), true)?;
@@ -322,8 +314,8 @@ pub(super) fn measure_surface(
     let solid = solid_from_surface(surface, flood, progress)?;
     progress.advance(1);
     let meta = vec![
-        ("method", "exterior-flood".to_string()),
-        ("source_file", source.to_string()),
+        ("method", "exterior-flood".into()),
+        ("source_file", source.into()),
     ];
     let outcome = surface_and_inside(surface.clone(), solid, meta, |whole, solid| {
         solid_details(whole, solid, density, FLOOD_RULE, None, true)
@@ -346,8 +338,8 @@ pub(super) fn csg_tree(tree: &CsgTree, progress: &Progress) -> Result<Outcome> {
             .collect(),
     };
     let meta = vec![
-        ("method", "csg-tree (voxel centres)".to_string()),
-        ("source_file", tree.source.display().to_string()),
+        ("method", "csg-tree (voxel centres)".into()),
+        ("source_file", tree.source.display().to_string().into()),
     ];
     Ok(centre_solid(&solid, t, meta, Details::Csg(details)).timed(start))
 }
@@ -359,7 +351,7 @@ pub(super) fn subdivision_solid(
     t: Transform,
     options: &ParametricOptions,
     fill: SubdivisionFill,
-    resolution: &str,
+    fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
@@ -371,14 +363,14 @@ pub(super) fn subdivision_solid(
         progress,
     )?;
     let method = "lai-cheng-parametric-enclosed+seeds+flooding-xyz";
-    let mut meta = provenance(method, &control.source.display().to_string(), resolution);
-    meta.push(("adjacency", options.adjacency.number().to_string()));
-    meta.push(("limit_volume", made.limit_volume.to_string()));
-    meta.push(("limit_area", made.limit_area.to_string()));
-    meta.push(("seeds", made.seeds.to_string()));
+    let mut meta = provenance(method, &control.source.display().to_string(), fit);
+    meta.push(("adjacency", options.adjacency.number().into()));
+    meta.push(("limit_volume", made.limit_volume.into()));
+    meta.push(("limit_area", made.limit_area.into()));
+    meta.push(("seeds", made.seeds.into()));
     // Steps along tilted normals can leave the solid; their floods reach the border and are
     // dropped (`solids::subdivision`).
-    meta.push(("outside_seeds", made.outside_seeds.to_string()));
+    meta.push(("outside_seeds", made.outside_seeds.into()));
     let (limit_volume, limit_area) = (made.limit_volume, made.limit_area);
     let opposite = made.surface.opposite;
     let outcome = surface_and_inside(made.surface.surface, made.solid, meta, |whole, solid| {

@@ -201,7 +201,7 @@ impl BrickJob {
 
 /// Writes `grid` to `path` (atomically) and returns its voxel count.
 fn write_brick(grid: &crate::grid::SparseGrid, path: &Path) -> Result<u64> {
-    let meta = [("method", "voxelkit brick".to_string())];
+    let meta = [("method", "voxelkit brick".into())];
     write_vdb_as(path, grid, &[], &meta, &WriteOptions::default())?;
     Ok(grid.voxel_count())
 }

@@ -20,7 +20,7 @@ use rayon::prelude::*;
 
 /// Why a signed distance needs a closed mesh, for the error that refuses an open one.
 const SIGN_NEEDS_CLOSED: &str = "a signed distance needs an inside, which an open surface does \
-     not have (--udf writes unsigned distances)";
+     not have (option `udf` writes unsigned distances)";
 
 /// A narrow-band level set and the inside it bounds.
 pub struct LevelSet {

@@ -3,7 +3,7 @@
 //! memory limit allows (each job's planned estimate is held until it ends); one failing
 //! file is reported and the others are still written, and the exit status says so at the end.
 
-use crate::run::{Global, finish_job, plan_job, run_and_report};
+use crate::run::{Global, finish_job, plan_job, run_and_report, with_flags};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -268,9 +268,13 @@ fn run_all(
                             ),
                             // Most errors name their file already.
                             Err(e) if e.to_string().contains(&*input.to_string_lossy()) => {
-                                eprintln!("error: {e}")
+                                eprintln!("error: {}", with_flags(&e.to_string()))
                             }
-                            Err(e) => eprintln!("error: {}: {e}", input.display()),
+                            Err(e) => eprintln!(
+                                "error: {}: {}",
+                                input.display(),
+                                with_flags(&e.to_string())
+                            ),
                         });
                     }
                     bar.inc(1);

@@ -250,7 +250,18 @@ struct GridSummary {
     uniform_linear: bool,
     bbox_min: [i32; 3],
     bbox_max: [i32; 3],
-    metadata: std::collections::BTreeMap<String, String>,
+    metadata: std::collections::BTreeMap<String, serde_json::Value>,
+}
+
+/// A metadata value as JSON of its OpenVDB type: numbers and booleans as such.
+fn typed(m: &voxelkit::io::vdb::MetaEntry) -> serde_json::Value {
+    let parsed = match m.type_name.as_str() {
+        "int32" | "int64" => m.value.parse::<i64>().ok().map(serde_json::Value::from),
+        "float" | "double" => m.value.parse::<f64>().ok().map(serde_json::Value::from),
+        "bool" => m.value.parse::<bool>().ok().map(serde_json::Value::from),
+        _ => None,
+    };
+    parsed.unwrap_or_else(|| serde_json::Value::from(m.value.clone()))
 }
 
 /// `info` on a brick set's index: the bricks, and the voxels of their main grids.
@@ -329,7 +340,7 @@ pub fn info(file: &Path, global: &Global) -> Result<()> {
                 metadata: g
                     .metadata
                     .iter()
-                    .map(|m| (m.key.clone(), m.value.clone()))
+                    .map(|m| (m.key.clone(), typed(m)))
                     .collect(),
             })
             .collect();

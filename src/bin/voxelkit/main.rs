@@ -263,7 +263,7 @@ fn main() -> ExitCode {
         Err(e) if cli.json => {
             let (file, line) = e.location();
             let j = serde_json::json!({
-                "error": e.to_string(),
+                "error": run::with_flags(&e.to_string()),
                 "file": file.map(|f| f.display().to_string()),
                 "line": line,
             });
@@ -271,7 +271,7 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", run::with_flags(&e.to_string()));
             ExitCode::FAILURE
         }
     }

@@ -127,13 +127,32 @@ pub fn run_job(job: Job, output: Option<&Path>, global: &Global) -> Result<Outco
     result
 }
 
+/// The library names options as the requests do (option `voxel_size`); the command line
+/// says its flags instead (`--voxel-size`).
+pub fn with_flags(text: &str) -> String {
+    const MARK: &str = "option `";
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find(MARK) {
+        out.push_str(&rest[..at]);
+        let after = &rest[at + MARK.len()..];
+        let Some(end) = after.find('`') else {
+            break;
+        };
+        out.push_str(&format!("--{}", after[..end].replace('_', "-")));
+        rest = &after[end + 1..];
+    }
+    out.push_str(rest);
+    out
+}
+
 /// Runs `job` and prints its report: on stdout, or on stderr when the `.vdb` goes to stdout.
 pub fn run_and_report(job: Job, output: &Path, global: &Global) -> Result<()> {
     let outcome = run_job(job, Some(output), global)?;
     let text = if global.json {
         outcome.report.to_json()
     } else {
-        outcome.report.summary()
+        with_flags(&outcome.report.summary())
     };
     if output == Path::new("-") {
         let _ = writeln!(std::io::stderr(), "{text}");

@@ -191,7 +191,7 @@ pub fn measure(args: &MeasureArgs, global: &Global) -> Result<()> {
     if global.json {
         println!("{}", outcome.report.to_json());
     } else {
-        println!("{}", outcome.report.summary());
+        println!("{}", crate::run::with_flags(&outcome.report.summary()));
     }
     Ok(())
 }
