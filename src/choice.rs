@@ -71,12 +71,17 @@ pub trait Choice: Copy + PartialEq + Sized + 'static {
     }
 }
 
-/// `FromStr`, `Display`, `Serialize` and `Deserialize` from a type's `Choice` table. A
-/// choice deserializes from its name, or from an integer where its names are numbers
+/// A type's name table (`Type, "what it is called": "name" => Variant, ...`) as its `Choice`
+/// impl, with `FromStr`, `Display`, `Serialize` and `Deserialize` from it. A choice
+/// deserializes from its name, or from an integer where its names are numbers
 /// (separability 26).
 #[macro_export]
 macro_rules! named_choices {
-    ($($t:ty),* $(,)?) => {$(
+    ($t:ident, $what:literal: $($name:literal => $v:ident),+ $(,)?) => {
+        impl $crate::choice::Choice for $t {
+            const WHAT: &'static str = $what;
+            const NAMES: &'static [(&'static str, Self)] = &[$(($name, $t::$v)),+];
+        }
         impl ::std::str::FromStr for $t {
             type Err = String;
             fn from_str(s: &str) -> ::std::result::Result<Self, String> {
@@ -98,7 +103,7 @@ macro_rules! named_choices {
                 $crate::choice::deserialize_choice(d)
             }
         }
-    )*};
+    };
 }
 
 /// A choice as its name, or as a number where its names are numbers.

@@ -8,15 +8,12 @@ pub enum Adjacency {
     TwentySix,
 }
 
-impl crate::choice::Choice for Adjacency {
-    const WHAT: &'static str = "the adjacency";
-    const NAMES: &'static [(&'static str, Self)] = &[
-        ("6", Adjacency::Six),
-        ("18", Adjacency::Eighteen),
-        ("26", Adjacency::TwentySix),
-    ];
+crate::named_choices! {
+    Adjacency, "the adjacency":
+    "6" => Six,
+    "18" => Eighteen,
+    "26" => TwentySix,
 }
-crate::named_choices!(Adjacency);
 
 impl Adjacency {
     pub fn number(self) -> u32 {

@@ -40,15 +40,12 @@ impl Coordinates {
     }
 }
 
-impl crate::choice::Choice for Coordinates {
-    const WHAT: &'static str = "the coordinates";
-    const NAMES: &'static [(&'static str, Self)] = &[
-        ("cartesian", Coordinates::Cartesian),
-        ("spherical", Coordinates::Spherical),
-        ("cylindrical", Coordinates::Cylindrical),
-    ];
+crate::named_choices! {
+    Coordinates, "the coordinates":
+    "cartesian" => Cartesian,
+    "spherical" => Spherical,
+    "cylindrical" => Cylindrical,
 }
-crate::named_choices!(Coordinates);
 
 /// The values θ takes: the paper's `[0, 2π)`, measured from +x toward +z with its cut along
 /// the positive x axis, or `(-π, π]`, cut along the negative x axis (`atan2`'s).
@@ -59,14 +56,11 @@ pub enum ThetaRange {
     Symmetric,
 }
 
-impl crate::choice::Choice for ThetaRange {
-    const WHAT: &'static str = "the theta range";
-    const NAMES: &'static [(&'static str, Self)] = &[
-        ("positive", ThetaRange::Positive),
-        ("symmetric", ThetaRange::Symmetric),
-    ];
+crate::named_choices! {
+    ThetaRange, "the theta range":
+    "positive" => Positive,
+    "symmetric" => Symmetric,
 }
-crate::named_choices!(ThetaRange);
 
 /// A compiled formula F; the surface is F = 0.
 #[derive(Clone, Debug, PartialEq)]

@@ -171,15 +171,12 @@ pub enum Compression {
     None,
 }
 
-impl crate::choice::Choice for Compression {
-    const WHAT: &'static str = "the compression";
-    const NAMES: &'static [(&'static str, Self)] = &[
-        ("blosc", Compression::Blosc),
-        ("zip", Compression::Zip),
-        ("none", Compression::None),
-    ];
+crate::named_choices! {
+    Compression, "the compression":
+    "blosc" => Blosc,
+    "zip" => Zip,
+    "none" => None,
 }
-crate::named_choices!(Compression);
 
 /// A grid's metadata value, written with OpenVDB's type for it (so Houdini and pyopenvdb
 /// read numbers as numbers).

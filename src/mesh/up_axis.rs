@@ -15,11 +15,11 @@ pub enum UpAxis {
     Z,
 }
 
-impl crate::choice::Choice for UpAxis {
-    const WHAT: &'static str = "the up axis";
-    const NAMES: &'static [(&'static str, Self)] = &[("y", UpAxis::Y), ("z", UpAxis::Z)];
+crate::named_choices! {
+    UpAxis, "the up axis":
+    "y" => Y,
+    "z" => Z,
 }
-crate::named_choices!(UpAxis);
 
 impl Mesh {
     /// The mesh with its `up` axis turned to +z (a rotation: orientation and volume kept).

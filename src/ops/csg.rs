@@ -14,15 +14,12 @@ pub enum BooleanOp {
     Difference,
 }
 
-impl crate::choice::Choice for BooleanOp {
-    const WHAT: &'static str = "the operation";
-    const NAMES: &'static [(&'static str, Self)] = &[
-        ("union", BooleanOp::Union),
-        ("intersection", BooleanOp::Intersection),
-        ("difference", BooleanOp::Difference),
-    ];
+crate::named_choices! {
+    BooleanOp, "the operation":
+    "union" => Union,
+    "intersection" => Intersection,
+    "difference" => Difference,
 }
-crate::named_choices!(BooleanOp);
 
 /// Whether two transforms place voxels identically (to 1e-9 of a voxel).
 pub fn same_transform(a: &Transform, b: &Transform) -> bool {

@@ -87,6 +87,23 @@ macro_rules! plain_fields {
 plain_fields!(u32, u64, f64, String, [f32; 3]);
 
 macro_rules! request {
+    // A request on a mesh: the grid fit first, its up axis last.
+    ($(#[doc = $sdoc:literal])* $name:ident as $py:literal fitted { $($fields:tt)* }) => {
+        request! {
+            $(#[doc = $sdoc])*
+            $name as $py {
+                /// Voxels along the longest bounding-box axis (none: the default resolution,
+                /// unless voxel_size is given).
+                resolution: Option<u32> = None,
+                /// Voxel edge length in world units (instead of resolution).
+                voxel_size: Option<f64> = None,
+                $($fields)*
+                /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's
+                /// importer does.
+                up_axis: UpAxis = UpAxis::default(),
+            }
+        }
+    };
     ($(#[doc = $sdoc:literal])* $name:ident as $py:literal {
         $( $(#[doc = $doc:literal])* $field:ident : $ty:ty = $default:expr ),* $(,)?
     }) => {
@@ -136,12 +153,10 @@ pub enum SurfaceKind {
     Projective,
 }
 
-impl Choice for SurfaceKind {
-    const WHAT: &'static str = "the surface method";
-    const NAMES: &'static [(&'static str, Self)] = &[
-        ("separating", SurfaceKind::Separating),
-        ("projective", SurfaceKind::Projective),
-    ];
+crate::named_choices! {
+    SurfaceKind, "the surface method":
+    "separating" => Separating,
+    "projective" => Projective,
 }
 
 /// How a mesh's solid is found.
@@ -155,13 +170,11 @@ pub enum FillKind {
     Beam,
 }
 
-impl Choice for FillKind {
-    const WHAT: &'static str = "the fill method";
-    const NAMES: &'static [(&'static str, Self)] = &[
-        ("flood", FillKind::Flood),
-        ("depth-layers", FillKind::DepthLayers),
-        ("beam", FillKind::Beam),
-    ];
+crate::named_choices! {
+    FillKind, "the fill method":
+    "flood" => Flood,
+    "depth-layers" => DepthLayers,
+    "beam" => Beam,
 }
 
 /// Which exterior flood.
@@ -176,16 +189,12 @@ pub enum FloodKind {
     Xyz,
 }
 
-impl Choice for FloodKind {
-    const WHAT: &'static str = "the flood";
-    const NAMES: &'static [(&'static str, Self)] = &[
-        ("blocks", FloodKind::Blocks),
-        ("spans", FloodKind::Spans),
-        ("xyz", FloodKind::Xyz),
-    ];
+crate::named_choices! {
+    FloodKind, "the flood":
+    "blocks" => Blocks,
+    "spans" => Spans,
+    "xyz" => Xyz,
 }
-
-crate::named_choices!(SurfaceKind, FillKind, FloodKind);
 
 impl FloodKind {
     /// The flood with a GRAYSTACK of `graystack` entries (xyz).
@@ -261,11 +270,7 @@ request! {
 request! {
     /// A polygon mesh's surface: 6- or 26-separating (Huang et al.) or projective (Jegathese
     /// et al.); with `sdf` or `udf`, exact distances within `band` voxels instead.
-    MeshRequest as "mesh" {
-        /// Voxels along the longest bounding-box axis (none: 256 unless voxel_size is given).
-        resolution: Option<u32> = None,
-        /// Voxel edge length in world units (instead of resolution).
-        voxel_size: Option<f64> = None,
+    MeshRequest as "mesh" fitted {
         /// 6: thin surface blocking face-connected paths; 26: blocks every path.
         separability: Separability = Separability::default(),
         /// separating: Huang et al.'s surface; projective: Jegathese et al.'s scan-lines
@@ -286,8 +291,6 @@ request! {
         udf: bool = false,
         /// Half width of the distance band, in voxels.
         band: f64 = BAND,
-        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::default(),
     }
 }
 
@@ -295,11 +298,7 @@ request! {
     /// A closed mesh's solid: flood (the 26-separating surface and everything the exterior
     /// flood cannot reach), depth-layers (Passalis et al.) or beam (Jegathese et al.); with
     /// `sdf`, its level set.
-    SolidRequest as "solid" {
-        /// Voxels along the longest bounding-box axis (none: 256 unless voxel_size is given).
-        resolution: Option<u32> = None,
-        /// Voxel edge length in world units (instead of resolution).
-        voxel_size: Option<f64> = None,
+    SolidRequest as "solid" fitted {
         /// flood, depth-layers or beam.
         method: FillKind = FillKind::Flood,
         /// The exterior flood: blocks (fastest), spans, or xyz (Lai & Cheng's FloodingXYZ).
@@ -325,38 +324,26 @@ request! {
         sdf: bool = false,
         /// Half width of the distance band, in voxels.
         band: f64 = BAND,
-        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::default(),
     }
 }
 
 request! {
     /// Volume, mass, area, components and genus of a closed mesh (its flooded 26-separating
     /// surface) or of a closed voxel surface.
-    MeasureRequest as "measure" {
-        /// Voxels along the longest bounding-box axis (none: 256 unless voxel_size is given).
-        resolution: Option<u32> = None,
-        /// Voxel edge length in world units (instead of resolution).
-        voxel_size: Option<f64> = None,
+    MeasureRequest as "measure" fitted {
         /// The exterior flood: blocks (fastest), spans, or xyz (Lai & Cheng's FloodingXYZ).
         flood: FloodKind = FloodKind::default(),
         /// GRAYSTACK capacity of the xyz flood (entries; when full, sweeps resume the flood).
         graystack: usize = GRAYSTACK,
         /// Mass per unit volume.
         density: f64 = DENSITY,
-        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::default(),
     }
 }
 
 request! {
     /// A Catmull-Clark limit surface from its control mesh (Lai & Cheng); with `solid`, the
     /// solid it bounds, flooded from seeds against the limit normals by FloodingXYZ.
-    SubdivRequest as "subdiv" {
-        /// Voxels along the longest bounding-box axis (none: 256 unless voxel_size is given).
-        resolution: Option<u32> = None,
-        /// Voxel edge length in world units (instead of resolution).
-        voxel_size: Option<f64> = None,
+    SubdivRequest as "subdiv" fitted {
         /// The adjacency (6, 18 or 26) every voxel meets between its sub-patches' corners.
         adjacency: Adjacency = Adjacency::TwentySix,
         /// Every voxel the surface touches (an enveloping voxelization).
@@ -371,8 +358,6 @@ request! {
         density: f64 = DENSITY,
         /// Also count components and genus.
         topology: bool = false,
-        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::default(),
     }
 }
 
@@ -400,19 +385,13 @@ request! {
 request! {
     /// 3D lines (Jegathese et al.): the polylines (OBJ `l`) of a mesh, and with `edges` (or
     /// when there are none) the faces' edges.
-    LinesRequest as "lines" {
-        /// Voxels along the longest bounding-box axis (none: 256 unless voxel_size is given).
-        resolution: Option<u32> = None,
-        /// Voxel edge length in world units (instead of resolution).
-        voxel_size: Option<f64> = None,
+    LinesRequest as "lines" fitted {
         /// Also the faces' edges.
         edges: bool = false,
         /// Carry the mesh's vertex colours into a `Cd` grid.
         colors: bool = true,
         /// One (r, g, b) colour for every voxel instead.
         color: Option<[f32; 3]> = None,
-        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::default(),
     }
 }
 
@@ -432,19 +411,13 @@ request! {
 request! {
     /// The separating surface (or solid) of a mesh cut into bricks and voxelized by Dask
     /// workers, merged into one .vdb.
-    BricksRequest as "distributed" {
-        /// Voxels along the longest bounding-box axis (none: 256 unless voxel_size is given).
-        resolution: Option<u32> = None,
-        /// Voxel edge length in world units (instead of resolution).
-        voxel_size: Option<f64> = None,
+    BricksRequest as "distributed" fitted {
         /// Voxels along a brick's edge, a multiple of 8.
         brick: u32 = 1024,
         /// 6 or 26 (the surface; a solid is always 26).
         separability: Separability = Separability::default(),
         /// Refuse a brick estimated above this many MiB (none or 0: the memory available).
         max_memory_mib: Option<u64> = None,
-        /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's importer does.
-        up_axis: UpAxis = UpAxis::default(),
     }
 }
 

@@ -42,12 +42,11 @@ pub enum BeamFill {
     Paper,
 }
 
-impl crate::choice::Choice for BeamFill {
-    const WHAT: &'static str = "the beam fill";
-    const NAMES: &'static [(&'static str, Self)] =
-        &[("parity", BeamFill::Parity), ("paper", BeamFill::Paper)];
+crate::named_choices! {
+    BeamFill, "the beam fill":
+    "parity" => Parity,
+    "paper" => Paper,
 }
-crate::named_choices!(BeamFill);
 
 /// The beam solid and what its fill met.
 pub struct Beam {

@@ -60,12 +60,11 @@ pub enum Layers {
     Double,
 }
 
-impl crate::choice::Choice for Layers {
-    const WHAT: &'static str = "the layers";
-    const NAMES: &'static [(&'static str, Self)] =
-        &[("double", Layers::Double), ("single", Layers::Single)];
+crate::named_choices! {
+    Layers, "the layers":
+    "double" => Double,
+    "single" => Single,
 }
-crate::named_choices!(Layers);
 
 /// Which voxels double layers leave unclassified.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -78,14 +77,11 @@ pub enum Unclassified {
     Paper,
 }
 
-impl crate::choice::Choice for Unclassified {
-    const WHAT: &'static str = "the unclassified rule";
-    const NAMES: &'static [(&'static str, Self)] = &[
-        ("no-direction", Unclassified::NoDirection),
-        ("paper", Unclassified::Paper),
-    ];
+crate::named_choices! {
+    Unclassified, "the unclassified rule":
+    "no-direction" => NoDirection,
+    "paper" => Paper,
 }
-crate::named_choices!(Unclassified);
 
 /// The view directions of a depth-layer solid: the first few of `DIRECTIONS`, or the user's
 /// own (§3.1's arbitrary directions, as integer vectors with a ±1 component so that their rays

@@ -59,9 +59,8 @@ impl Separability {
     }
 }
 
-impl crate::choice::Choice for Separability {
-    const WHAT: &'static str = "separability";
-    const NAMES: &'static [(&'static str, Self)] =
-        &[("6", Separability::Six), ("26", Separability::TwentySix)];
+crate::named_choices! {
+    Separability, "separability":
+    "6" => Six,
+    "26" => TwentySix,
 }
-crate::named_choices!(Separability);

@@ -85,12 +85,11 @@ pub enum Criterion {
     Clipped,
 }
 
-impl crate::choice::Choice for Criterion {
-    const WHAT: &'static str = "the criterion";
-    const NAMES: &'static [(&'static str, Self)] =
-        &[("huang", Criterion::Huang), ("clipped", Criterion::Clipped)];
+crate::named_choices! {
+    Criterion, "the criterion":
+    "huang" => Huang,
+    "clipped" => Clipped,
 }
-crate::named_choices!(Criterion);
 
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SeparatingOptions {
