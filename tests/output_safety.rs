@@ -211,3 +211,43 @@ fn a_signal_during_the_run_leaves_no_temporary_file() {
         }
     }
 }
+
+#[test]
+fn an_output_linked_to_another_input_of_the_batch_is_refused_and_that_input_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for name in ["a.obj", "b.obj", "f_0001.obj", "f_0002.obj"] {
+        std::fs::write(d.join(name), TETRA).unwrap();
+    }
+    let od = d.join("od");
+    std::fs::create_dir(&od).unwrap();
+    std::os::unix::fs::symlink("../b.obj", od.join("a.vdb")).unwrap();
+    std::fs::create_dir(d.join("o")).unwrap();
+    std::os::unix::fs::symlink("../f_0002.obj", d.join("o/o_0001.vdb")).unwrap();
+    let (a, b) = (d.join("a.obj"), d.join("b.obj"));
+    let (a, b, od) = (path_str(&a), path_str(&b), path_str(&od));
+    let frames = d.join("f_####.obj");
+    let pattern = d.join("o/o_####.vdb");
+    for args in [
+        vec!["mesh", a, b, "--out-dir", od],
+        vec!["mesh", a, b, "--out-dir", od, "--shared-grid"],
+        vec!["solid", a, b, "--out-dir", od],
+        vec![
+            "mesh",
+            path_str(&frames),
+            "--frames",
+            "1-2",
+            "-o",
+            path_str(&pattern),
+        ],
+    ] {
+        assert_refused(&args, "replace the input");
+        for input in ["b.obj", "f_0002.obj"] {
+            assert_eq!(
+                std::fs::read_to_string(d.join(input)).unwrap(),
+                TETRA,
+                "{args:?}: {input}"
+            );
+        }
+    }
+}

@@ -1,14 +1,87 @@
 //! Several mesh files in one call: frame patterns (`f_####.obj`, `#` standing for the
-//! zero-padded frame number as Houdini and Blender write it) over a frame range, and one
-//! grid placement shared by every file, fitted to the union of their bounding boxes, so that
-//! the frames of an animation share one voxel size and one origin and the volume does not
-//! jitter from frame to frame.
+//! zero-padded frame number as Houdini and Blender write it) over a frame range, one grid
+//! placement shared by every file, fitted to the union of their bounding boxes, so that the
+//! frames of an animation share one voxel size and one origin and the volume does not
+//! jitter from frame to frame; and the scheduler that runs the files' jobs at once as far as
+//! the memory limit allows (each job's planned estimate held until it ends).
 
 use crate::error::{Error, Result};
 use crate::mesh::{Aabb, GridFit, Mesh, UpAxis, fit_transform};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Condvar, Mutex};
+
+/// Memory held by the jobs of a batch that run now, against the limit.
+pub struct MemoryGate {
+    held: Mutex<u64>,
+    freed: Condvar,
+    limit: u64,
+}
+
+impl MemoryGate {
+    /// A gate at `limit` bytes (none: the memory available).
+    pub fn new(limit: Option<u64>) -> MemoryGate {
+        MemoryGate {
+            held: Mutex::new(0),
+            freed: Condvar::new(),
+            limit: limit
+                .or_else(crate::system::available_memory_bytes)
+                .unwrap_or(u64::MAX),
+        }
+    }
+
+    /// Runs `work` once `bytes` fit beside what runs (or nothing runs: planning has already
+    /// refused a job that cannot fit alone).
+    pub fn admit<T>(&self, bytes: u64, work: impl FnOnce() -> T) -> T {
+        {
+            let mut held = self.held.lock().unwrap_or_else(|e| e.into_inner());
+            while *held > 0 && held.saturating_add(bytes) > self.limit {
+                held = self.freed.wait(held).unwrap_or_else(|e| e.into_inner());
+            }
+            *held += bytes;
+        }
+        let result = work();
+        *self.held.lock().unwrap_or_else(|e| e.into_inner()) -= bytes;
+        self.freed.notify_all();
+        result
+    }
+}
+
+/// Runs `work(k)` for every `k` below `count` on up to `workers` threads, each taking the
+/// next item when it is free; `done(k, &result)` hears of each as it ends. The results come
+/// back in the order of `k`.
+pub fn run_pool<T: Send>(
+    count: usize,
+    workers: usize,
+    work: impl Fn(usize) -> T + Sync,
+    done: impl Fn(usize, &T) + Sync,
+) -> Vec<T> {
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<Option<T>>> = Mutex::new((0..count).map(|_| None).collect());
+    std::thread::scope(|scope| {
+        for _ in 0..workers.clamp(1, count.max(1)) {
+            scope.spawn(|| {
+                loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    if k >= count {
+                        break;
+                    }
+                    let result = work(k);
+                    done(k, &result);
+                    results.lock().unwrap_or_else(|e| e.into_inner())[k] = Some(result);
+                }
+            });
+        }
+    });
+    results
+        .into_inner()
+        .unwrap_or_else(|e| e.into_inner())
+        .into_iter()
+        .flatten()
+        .collect()
+}
 
 /// A file name with one run of `#`: the frame number, zero-padded to the run's length.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -121,6 +194,46 @@ pub fn shared_placement(files: &[PathBuf], fit: GridFit, up: UpAxis) -> Result<G
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_pool_runs_every_item_once_and_keeps_their_order() {
+        let heard = AtomicUsize::new(0);
+        let out = run_pool(
+            50,
+            4,
+            |k| k * k,
+            |_, _| {
+                heard.fetch_add(1, Ordering::Relaxed);
+            },
+        );
+        assert_eq!(out, (0..50).map(|k| k * k).collect::<Vec<_>>());
+        assert_eq!(heard.into_inner(), 50);
+    }
+
+    #[test]
+    fn the_gate_holds_jobs_that_do_not_fit_beside_those_running() {
+        let gate = MemoryGate::new(Some(10));
+        let running = AtomicUsize::new(0);
+        let most = AtomicUsize::new(0);
+        run_pool(
+            8,
+            4,
+            |_| {
+                gate.admit(6, || {
+                    let now = running.fetch_add(1, Ordering::SeqCst) + 1;
+                    most.fetch_max(now, Ordering::SeqCst);
+                    std::thread::sleep(std::time::Duration::from_millis(5));
+                    running.fetch_sub(1, Ordering::SeqCst);
+                })
+            },
+            |_, _| {},
+        );
+        assert_eq!(
+            most.into_inner(),
+            1,
+            "two jobs of 6 ran under a limit of 10"
+        );
+    }
 
     #[test]
     fn patterns_pad_the_frame_number() {

@@ -7,11 +7,9 @@ use crate::run::{Global, finish_job, plan_job, run_and_report, with_flags};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Condvar, Mutex};
 use std::time::Instant;
 use voxelkit::mesh::GridFit;
-use voxelkit::pipeline::batch::{FramePattern, FrameRange, shared_placement};
+use voxelkit::pipeline::batch::{FramePattern, FrameRange, MemoryGate, run_pool, shared_placement};
 use voxelkit::pipeline::{Job, MeshSource, Outcome, Task};
 use voxelkit::progress::Unobserved;
 use voxelkit::{Error, Result};
@@ -173,47 +171,23 @@ fn pairs(inputs: &[PathBuf], out: &OutputArgs) -> Result<Vec<(PathBuf, PathBuf)>
     Ok(pairs)
 }
 
-/// Memory held by the jobs running now, against the limit.
-struct MemoryGate {
-    held: Mutex<u64>,
-    freed: Condvar,
-    limit: u64,
-}
-
-impl MemoryGate {
-    /// Waits until `bytes` fit beside what runs (or nothing runs: planning has already
-    /// refused a job that cannot fit alone).
-    fn acquire(&self, bytes: u64) {
-        let mut held = self.held.lock().unwrap_or_else(|e| e.into_inner());
-        while *held > 0 && held.saturating_add(bytes) > self.limit {
-            held = self.freed.wait(held).unwrap_or_else(|e| e.into_inner());
-        }
-        *held += bytes;
-    }
-
-    fn release(&self, bytes: u64) {
-        *self.held.lock().unwrap_or_else(|e| e.into_inner()) -= bytes;
-        self.freed.notify_all();
-    }
-}
-
-/// One input's job: planned, run once its memory fits, written.
+/// One input's job: planned (its output checked against every input of the batch), run
+/// once its memory fits, written.
 fn run_one(
-    input: &Path,
-    output: &Path,
+    (input, output): &(PathBuf, PathBuf),
+    batch_inputs: &[&Path],
     fit: GridFit,
     global: &Global,
     gate: &MemoryGate,
     task: &(impl Fn(MeshSource) -> Result<Task> + Sync),
 ) -> Result<Outcome> {
     let start = Instant::now();
-    let job = Job::new(task(MeshSource::File(input.to_path_buf()))?, fit);
-    let planned = plan_job(job, Some(output), global)?;
+    let job = Job::new(task(MeshSource::File(input.clone()))?, fit);
+    let planned = plan_job(job, Some(output), batch_inputs, global)?;
     let bytes = planned.plan().estimated_bytes;
-    gate.acquire(bytes);
-    let outcome = finish_job(planned, Some(output), &Unobserved, global, start);
-    gate.release(bytes);
-    outcome
+    gate.admit(bytes, || {
+        finish_job(planned, Some(output), &Unobserved, global, start)
+    })
 }
 
 fn run_all(
@@ -226,16 +200,8 @@ fn run_all(
     let start = Instant::now();
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let workers = jobs.unwrap_or(cores).clamp(1, pairs.len());
-    let limit = global
-        .limits()
-        .max_memory
-        .or_else(voxelkit::system::available_memory_bytes)
-        .unwrap_or(u64::MAX);
-    let gate = MemoryGate {
-        held: Mutex::new(0),
-        freed: Condvar::new(),
-        limit,
-    };
+    let gate = MemoryGate::new(global.limits().max_memory);
+    let batch_inputs: Vec<&Path> = pairs.iter().map(|(i, _)| i.as_path()).collect();
     let bar = if global.json {
         ProgressBar::hidden()
     } else {
@@ -246,59 +212,46 @@ fn run_all(
         )
     };
     bar.set_message("files");
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<Result<Outcome>>>> =
-        Mutex::new((0..pairs.len()).map(|_| None).collect());
-    std::thread::scope(|scope| {
-        for _ in 0..workers {
-            scope.spawn(|| {
-                loop {
-                    let k = next.fetch_add(1, Ordering::Relaxed);
-                    let Some((input, output)) = pairs.get(k) else {
-                        break;
-                    };
-                    let result = run_one(input, output, fit, global, &gate, task);
-                    if !global.json {
-                        bar.suspend(|| match &result {
-                            Ok(o) => println!(
-                                "wrote {}: {} voxels, {:.2} s",
-                                output.display(),
-                                o.report.voxels,
-                                o.report.seconds
-                            ),
-                            // Most errors name their file already.
-                            Err(e) if e.to_string().contains(&*input.to_string_lossy()) => {
-                                eprintln!("error: {}", with_flags(&e.to_string()))
-                            }
-                            Err(e) => eprintln!(
-                                "error: {}: {}",
-                                input.display(),
-                                with_flags(&e.to_string())
-                            ),
-                        });
+    let results = run_pool(
+        pairs.len(),
+        workers,
+        |k| run_one(&pairs[k], &batch_inputs, fit, global, &gate, task),
+        |k, result| {
+            let (input, output) = &pairs[k];
+            if !global.json {
+                bar.suspend(|| match result {
+                    Ok(o) => println!(
+                        "wrote {}: {} voxels, {:.2} s",
+                        output.display(),
+                        o.report.voxels,
+                        o.report.seconds
+                    ),
+                    // Most errors name their file already.
+                    Err(e) if e.to_string().contains(&*input.to_string_lossy()) => {
+                        eprintln!("error: {}", with_flags(&e.to_string()))
                     }
-                    bar.inc(1);
-                    results.lock().unwrap_or_else(|e| e.into_inner())[k] = Some(result);
-                }
-            });
-        }
-    });
+                    Err(e) => {
+                        eprintln!("error: {}: {}", input.display(), with_flags(&e.to_string()))
+                    }
+                });
+            }
+            bar.inc(1);
+        },
+    );
     bar.finish_and_clear();
-    let results = results.into_inner().unwrap_or_else(|e| e.into_inner());
-    let failed = results.iter().filter(|r| matches!(r, Some(Err(_)))).count();
+    let failed = results.iter().filter(|r| r.is_err()).count();
     let seconds = start.elapsed().as_secs_f64();
     if global.json {
         let items: Vec<serde_json::Value> = pairs
             .iter()
             .zip(&results)
             .map(|((input, output), r)| match r {
-                Some(Ok(o)) => serde_json::to_value(&o.report).expect("a report serializes"),
-                Some(Err(e)) => serde_json::json!({
+                Ok(o) => serde_json::to_value(&o.report).expect("a report serializes"),
+                Err(e) => serde_json::json!({
                     "input": input.display().to_string(),
                     "output": output.display().to_string(),
                     "error": e.to_string(),
                 }),
-                None => unreachable!("every input runs"),
             })
             .collect();
         let summary = serde_json::json!({

@@ -74,9 +74,14 @@ impl Observer for Bars {
     }
 }
 
-/// Plans `job` and refuses an `output` that cannot be written (or is an input), before any
-/// work.
-pub fn plan_job(job: Job, output: Option<&Path>, global: &Global) -> Result<PlannedJob> {
+/// Plans `job` and refuses, before any work, an `output` that cannot be written or that is
+/// one of its inputs or of `also_read` (the other inputs of a batch), links followed.
+pub fn plan_job(
+    job: Job,
+    output: Option<&Path>,
+    also_read: &[&Path],
+    global: &Global,
+) -> Result<PlannedJob> {
     let planned = Job {
         limits: global.limits(),
         up_axis: global.up_axis,
@@ -85,7 +90,8 @@ pub fn plan_job(job: Job, output: Option<&Path>, global: &Global) -> Result<Plan
     .plan()?;
     if let Some(out) = output {
         let inputs = planned.input_files();
-        let inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
+        let mut inputs: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
+        inputs.extend_from_slice(also_read);
         check_output_path(out, &inputs)?;
         check_voxel_size(out, planned.plan().transform.voxel_size)?;
     }
@@ -120,7 +126,7 @@ pub fn finish_job(
 /// whole run timed.
 pub fn run_job(job: Job, output: Option<&Path>, global: &Global) -> Result<Outcome> {
     let start = Instant::now();
-    let planned = plan_job(job, output, global)?;
+    let planned = plan_job(job, output, &[], global)?;
     let bars = Bars::new(global.json);
     let result = finish_job(planned, output, &bars, global, start);
     bars.finish();
