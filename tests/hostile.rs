@@ -5,6 +5,7 @@
 #![cfg(feature = "vdb")]
 
 use std::path::Path;
+use std::process::Command;
 mod cli_support;
 
 use cli_support::{json_field, text, voxelkit};
@@ -497,4 +498,221 @@ fn a_mirrored_grid_is_refused_saying_what_is_read() {
     let o = voxelkit(&["measure", mirror.to_str().unwrap()]);
     let msg = text(&o);
     assert!(!o.status.success() && msg.contains("mirroring"), "{msg}");
+}
+
+/// A tetrahedron as `model/m.gltf` with its buffer in `model/m.bin`, and the buffer's URI
+/// replaced by `uri` (none: kept).
+fn gltf_naming(dir: &Path, uri: Option<&str>) -> std::path::PathBuf {
+    let folder = dir.join("model");
+    std::fs::create_dir_all(&folder).unwrap();
+    let obj = dir.join("t.obj");
+    std::fs::write(&obj, TETRA).unwrap();
+    let gltf = folder.join("m.gltf");
+    Mesh::load(&obj)
+        .unwrap()
+        .write_gltf(&gltf, voxelkit::mesh::GltfLayout::SeparateBuffer, &[])
+        .unwrap();
+    if let Some(uri) = uri {
+        let mut json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&gltf).unwrap()).unwrap();
+        json["buffers"][0]["uri"] = uri.into();
+        std::fs::write(&gltf, json.to_string()).unwrap();
+    }
+    gltf
+}
+
+#[test]
+fn a_gltf_buffer_is_read_from_the_models_folder_only_and_no_further_than_declared() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let fine = gltf_naming(d, None);
+    assert_eq!(Mesh::load(&fine).unwrap().face_count(), 4);
+    // The same buffer outside the folder, behind a link, a FIFO, a device, a folder.
+    std::fs::copy(d.join("model/m.bin"), d.join("outside.bin")).unwrap();
+    std::os::unix::fs::symlink("../outside.bin", d.join("model/link.bin")).unwrap();
+    let fifo = d.join("model/fifo.bin");
+    assert!(
+        Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success()
+    );
+    std::fs::create_dir_all(d.join("model/sub")).unwrap();
+    std::fs::write(d.join("model/short.bin"), [0u8; 8]).unwrap();
+    let passwd = "root:x:0:0:secret-of-the-machine";
+    std::fs::write(d.join("passwd"), passwd).unwrap();
+    let absolute = d.join("passwd").display().to_string();
+    for (uri, why) in [
+        (absolute.as_str(), "an absolute path"),
+        ("/dev/zero", "an absolute path"),
+        ("/dev/urandom", "an absolute path"),
+        ("../outside.bin", "outside the model's folder"),
+        ("..%2Foutside.bin", "outside the model's folder"),
+        ("link.bin", "outside the model's folder"),
+        ("fifo.bin", "not a regular file"),
+        ("sub", "not a regular file"),
+        ("short.bin", "holds 8 bytes, but the model declares"),
+    ] {
+        let gltf = gltf_naming(d, Some(uri));
+        let started = std::time::Instant::now();
+        let e = Mesh::load(&gltf).expect_err(uri).to_string();
+        assert!(e.contains(why) && e.contains("m.gltf"), "{uri}: {e}");
+        assert!(
+            !e.contains("secret"),
+            "{uri}: the error shows the file's bytes: {e}"
+        );
+        assert!(
+            started.elapsed() < std::time::Duration::from_secs(5),
+            "{uri}"
+        );
+        // The command line says the same, and writes nothing.
+        let out = d.join("out.vdb");
+        let o = voxelkit(&[
+            "mesh",
+            gltf.to_str().unwrap(),
+            "-r",
+            "8",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(
+            !o.status.success() && text(&o).contains(why),
+            "{uri}: {}",
+            text(&o)
+        );
+        assert!(!out.exists(), "{uri}");
+    }
+}
+
+/// A brick set of one real brick (`b.vdb`) in `set/`, its index edited by `edit`.
+fn brick_index(dir: &Path, edit: impl Fn(&mut serde_json::Value)) -> std::path::PathBuf {
+    let set = dir.join("set");
+    std::fs::create_dir_all(&set).unwrap();
+    let grid = voxelkit::pipeline::Outcome::read_vdb(&sphere_vdb(dir), None)
+        .unwrap()
+        .grid;
+    voxelkit::io::vdb::write_vdb(&set.join("b.vdb"), &grid, &[]).unwrap();
+    let mut index = serde_json::json!({
+        "format": "voxelkit-bricks", "voxel_size": grid.transform.voxel_size,
+        "origin": grid.transform.origin.to_array(), "brick_size": 64,
+        "bricks": [{"brick": [0, 0, 0], "file": "b.vdb"}], "full_bricks": [],
+    });
+    edit(&mut index);
+    let path = set.join("index.json");
+    std::fs::write(&path, index.to_string()).unwrap();
+    path
+}
+
+fn sphere_vdb(dir: &Path) -> std::path::PathBuf {
+    let path = dir.join("sphere.vdb");
+    if !path.exists() {
+        let o = voxelkit(&[
+            "shape",
+            "sphere",
+            "--radius",
+            "0.5",
+            "--center",
+            "0.5,0.5,0.5",
+            "--voxel-size",
+            "0.05",
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+    }
+    path
+}
+
+#[test]
+fn a_tampered_brick_index_is_refused_alike_by_info_and_read_vdb() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let fine = brick_index(d, |_| {});
+    let o = voxelkit(&["info", fine.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    std::fs::copy(sphere_vdb(d), d.join("outside.vdb")).unwrap();
+    assert!(
+        Command::new("mkfifo")
+            .arg(d.join("set/fifo.vdb"))
+            .status()
+            .unwrap()
+            .success()
+    );
+    let cases: Vec<(&str, Box<dyn Fn(&mut serde_json::Value)>, &str)> = vec![
+        (
+            "outside",
+            Box::new(|j| j["bricks"][0]["file"] = "../outside.vdb".into()),
+            "outside the model's folder",
+        ),
+        (
+            "absolute",
+            Box::new(|j| j["bricks"][0]["file"] = "/etc/passwd".into()),
+            "an absolute path",
+        ),
+        (
+            "fifo",
+            Box::new(|j| j["bricks"][0]["file"] = "fifo.vdb".into()),
+            "not a regular file",
+        ),
+        (
+            "brick twice",
+            Box::new(|j| {
+                j["bricks"]
+                    .as_array_mut()
+                    .unwrap()
+                    .push(serde_json::json!({"brick": [0, 0, 0], "file": "c.vdb"}))
+            }),
+            "listed twice",
+        ),
+        (
+            "file twice",
+            Box::new(|j| {
+                j["bricks"]
+                    .as_array_mut()
+                    .unwrap()
+                    .push(serde_json::json!({"brick": [1, 0, 0], "file": "b.vdb"}))
+            }),
+            "named for two bricks",
+        ),
+        (
+            "far brick",
+            Box::new(|j| j["bricks"][0]["brick"] = serde_json::json!([1i64 << 62, 0, 0])),
+            "32-bit",
+        ),
+        (
+            "brick size",
+            Box::new(|j| j["brick_size"] = 12.into()),
+            "multiple of 8",
+        ),
+        (
+            "huge brick",
+            Box::new(|j| j["brick_size"] = (1i64 << 40).into()),
+            "multiple of 8",
+        ),
+        (
+            "voxel size",
+            Box::new(|j| j["voxel_size"] = (-1.0).into()),
+            "voxel_size -1",
+        ),
+    ];
+    for (name, edit, why) in cases {
+        let index = brick_index(d, edit);
+        let started = std::time::Instant::now();
+        let o = voxelkit(&["info", index.to_str().unwrap()]);
+        assert!(
+            !o.status.success() && text(&o).contains(why),
+            "{name}: info: {}",
+            text(&o)
+        );
+        let Err(e) = voxelkit::pipeline::Outcome::read_vdb(&index, None) else {
+            panic!("{name}: read_vdb accepted it");
+        };
+        let e = e.to_string();
+        assert!(e.contains(why), "{name}: read_vdb: {e}");
+        assert!(
+            started.elapsed() < std::time::Duration::from_secs(5),
+            "{name}"
+        );
+    }
 }

@@ -3,6 +3,7 @@
 //! Python) take the index file and see one grid.
 
 use super::atomic::write_atomic;
+use super::references::referenced_file;
 use super::vdb::read_vdb_grid;
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, NODE_DIM, SparseGrid, Transform};
@@ -12,6 +13,8 @@ use std::path::{Path, PathBuf};
 
 /// The `format` value of an index.
 pub const BRICK_SET_FORMAT: &str = "voxelkit-bricks";
+/// The largest brick edge an index may give (Dask runs use 1024 by default).
+pub const MAX_BRICK_SIZE: i64 = 1 << 16;
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct BrickSet {
@@ -63,14 +66,67 @@ impl BrickSet {
                 message: format!("not a brick set (format `{}`)", set.format),
             });
         }
-        if set.brick_size < 8 || set.brick_size % 8 != 0 {
-            return Err(Error::Parse {
-                path: path.to_path_buf(),
-                line: 0,
-                message: format!("brick_size {} is not a multiple of 8", set.brick_size),
-            });
-        }
+        set.check().map_err(|message| Error::Parse {
+            path: path.to_path_buf(),
+            line: 0,
+            message,
+        })?;
         Ok(set)
+    }
+
+    /// Refuses an index no run writes: a voxel size or origin that is not a finite number
+    /// (a positive one for the size), a brick size that is not a multiple of 8 up to
+    /// `MAX_BRICK_SIZE`, a brick whose voxels OpenVDB's 32-bit coordinates cannot hold, a
+    /// brick listed twice or a file named for two bricks.
+    fn check(&self) -> std::result::Result<(), String> {
+        if !(self.voxel_size.is_finite() && self.voxel_size > 0.0) {
+            return Err(format!(
+                "voxel_size {} is not a positive number",
+                self.voxel_size
+            ));
+        }
+        if !self.origin.iter().all(|c| c.is_finite()) {
+            return Err(format!(
+                "origin {:?} is not three finite numbers",
+                self.origin
+            ));
+        }
+        let size = self.brick_size;
+        if !(8..=MAX_BRICK_SIZE).contains(&size) || size % 8 != 0 {
+            return Err(format!(
+                "brick_size {size} is not a multiple of 8 between 8 and {MAX_BRICK_SIZE}"
+            ));
+        }
+        let in_range = |b: &[i64; 3]| {
+            b.iter().all(|&v| {
+                v.checked_mul(size).is_some_and(|lo| {
+                    lo >= i64::from(i32::MIN) && lo + (size - 1) <= i64::from(i32::MAX)
+                })
+            })
+        };
+        let mut bricks = std::collections::HashSet::new();
+        let listed = self
+            .bricks
+            .iter()
+            .map(|b| &b.brick)
+            .chain(&self.full_bricks);
+        for b in listed {
+            if !in_range(b) {
+                return Err(format!(
+                    "brick {b:?} lies beyond the coordinates a .vdb holds (32-bit voxel indices)"
+                ));
+            }
+            if !bricks.insert(*b) {
+                return Err(format!("brick {b:?} is listed twice"));
+            }
+        }
+        let mut files = std::collections::HashSet::new();
+        for b in &self.bricks {
+            if !files.insert(b.file.as_str()) {
+                return Err(format!("`{}` is named for two bricks", b.file));
+            }
+        }
+        Ok(())
     }
 
     /// Writes the index atomically.
@@ -81,10 +137,19 @@ impl BrickSet {
         })
     }
 
-    /// The brick files, as paths beside the index at `index`.
-    pub fn files(&self, index: &Path) -> Vec<PathBuf> {
-        let folder = index.parent().unwrap_or(Path::new("."));
-        self.bricks.iter().map(|b| folder.join(&b.file)).collect()
+    /// The brick files, in the folder of the index at `index` (regular files inside it: see
+    /// `io::references`).
+    pub fn files(&self, index: &Path) -> Result<Vec<PathBuf>> {
+        self.bricks
+            .iter()
+            .map(|b| {
+                referenced_file(index, &b.file).map_err(|m| Error::Parse {
+                    path: index.to_path_buf(),
+                    line: 0,
+                    message: format!("brick {:?}: {m}", b.brick),
+                })
+            })
+            .collect()
     }
 
     pub fn transform(&self) -> Transform {
@@ -95,7 +160,7 @@ impl BrickSet {
     /// full bricks as tiles.
     pub fn merge(&self, index: &Path) -> Result<SparseGrid> {
         let mut grid = SparseGrid::new(self.transform(), crate::grid::Channels::NONE);
-        for (brick, file) in self.bricks.iter().zip(self.files(index)) {
+        for (brick, file) in self.bricks.iter().zip(self.files(index)?) {
             let part = read_vdb_grid(&file, None)?;
             let voxels = brick_voxels(brick.brick, self.brick_size);
             if let Some(b) = part.bbox()

@@ -4,6 +4,7 @@ pub mod binvox;
 #[cfg(feature = "vdb")]
 pub mod brick_set;
 pub mod preview;
+pub mod references;
 #[cfg(feature = "vdb")]
 pub mod vdb;
 #[cfg(feature = "vdb")]

@@ -9,6 +9,7 @@
 
 use super::Mesh;
 use crate::error::{Error, Result};
+use crate::io::references::read_referenced;
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::buffer::Source;
 use ::gltf::mesh::Mode;
@@ -26,11 +27,11 @@ fn parse_error(path: &Path, message: String) -> Error {
     }
 }
 
-/// The bytes of every buffer: the `.glb`'s binary chunk, a `data:` URI or a file beside the
-/// `.gltf`; each at least as long as the file declares.
+/// The bytes of every buffer: the `.glb`'s binary chunk, a `data:` URI or a file in the
+/// model's folder (no further than the buffer's declared length); each at least as long as
+/// the file declares.
 fn load_buffers(path: &Path, document: &Document, blob: Option<Vec<u8>>) -> Result<Vec<Vec<u8>>> {
     let mut blob = blob;
-    let folder = path.parent().unwrap_or(Path::new(""));
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
         let at = |m: String| parse_error(path, format!("buffer {}: {m}", buffer.index()));
@@ -47,9 +48,8 @@ fn load_buffers(path: &Path, document: &Document, blob: Option<Vec<u8>>) -> Resu
                     .map_err(|e| at(format!("bad base64 data: {e}")))?
             }
             Source::Uri(uri) => {
-                let file = folder.join(percent_decoded(uri).map_err(at)?);
-                std::fs::read(&file)
-                    .map_err(|e| at(format!("cannot read {}: {e}", file.display())))?
+                let reference = percent_decoded(uri).map_err(at)?;
+                read_referenced(path, &reference, buffer.length() as u64).map_err(at)?
             }
         };
         if data.len() < buffer.length() {

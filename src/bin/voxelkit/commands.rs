@@ -269,7 +269,7 @@ fn brick_set_info(index: &Path, global: &Global) -> Result<()> {
     let set = BrickSet::read(index)?;
     let mut voxels = (set.full_bricks.len() as u64) * (set.brick_size as u64).pow(3);
     let mut rows = Vec::new();
-    for (brick, file) in set.bricks.iter().zip(set.files(index)) {
+    for (brick, file) in set.bricks.iter().zip(set.files(index)?) {
         let grids = read_vdb_info(&file)?;
         let main = grids
             .iter()
