@@ -2,8 +2,11 @@
 solids, on every closed mesh of the shared data; it succeeds where the single run does not fit
 the memory limit; kept brick sets read back as one grid."""
 
+import os
+import signal
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -105,3 +108,73 @@ def test_a_voxel_size_openvdb_cannot_store_is_refused_before_any_work(data, tmp_
     with pytest.raises(OSError, match="cannot store voxel size"):
         vd.mesh(data / "meshes" / "igea.obj", out, resolution=8192, brick=1024)
     assert not list(tmp_path.iterdir()), "nothing is left behind"
+
+
+def _descendants(pid):
+    """The process ids below `pid`, from /proc."""
+    children = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as f:
+                    parent = int(f.read().rsplit(")", 1)[1].split()[1])
+            except (OSError, IndexError, ValueError):
+                continue
+            children.setdefault(parent, []).append(int(entry))
+    found, todo = [], [pid]
+    while todo:
+        for c in children.get(todo.pop(), []):
+            found.append(c)
+            todo.append(c)
+    return found
+
+
+def _start(path, out, *extra):
+    return subprocess.Popen(
+        [sys.executable, "-m", "voxelkit.distributed", "mesh", str(path), "-r", "1024",
+         "--brick", "64", "--workers", "2", "-o", str(out), *extra],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+
+
+def _wait_for_bricks(run, folder, timeout=120):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and run.poll() is None:
+        if folder.is_dir() and any(folder.glob("brick_*.vdb")):
+            return True
+        time.sleep(0.05)
+    return False
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+def test_a_signal_during_a_run_leaves_no_partial_folder_and_a_rerun_works(data, dask, tmp_path, signum):
+    path = data / "meshes" / "igea.obj"
+    out = tmp_path / "igea.vdb"
+    folder = tmp_path / "igea.bricks"
+    run = _start(path, out)
+    assert _wait_for_bricks(run, folder), "no brick was written"
+    run.send_signal(signum)
+    _, err = run.communicate(timeout=120)
+    assert run.returncode != 0, "the run completed despite the signal"
+    assert "stopped by signal" in err and "Traceback" not in err, err
+    assert not folder.exists() and not out.exists()
+    again = subprocess.run(
+        [sys.executable, "-m", "voxelkit.distributed", "mesh", str(path), "-r", "128",
+         "--brick", "64", "--workers", "1", "-o", str(out)],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert again.returncode == 0, again.stderr
+
+
+def test_a_killed_worker_is_retried_and_the_result_is_whole(data, dask, tmp_path):
+    path = data / "meshes" / "igea.obj"
+    out = tmp_path / "igea.vdb"
+    run = _start(path, out)
+    assert _wait_for_bricks(run, tmp_path / "igea.bricks"), "no brick was written"
+    workers = [p for p in _descendants(run.pid) if b"spawn_main" in open(f"/proc/{p}/cmdline", "rb").read()]
+    assert workers, "no worker process found"
+    os.kill(workers[-1], signal.SIGKILL)
+    _, err = run.communicate(timeout=600)
+    assert run.returncode == 0, err
+    assert "Traceback" not in err, err
+    assert voxel_set(voxelkit.read_vdb(out).ijk) == voxel_set(voxelkit.mesh(path, resolution=1024).ijk)

@@ -23,9 +23,13 @@ calls ``run`` must do so under ``if __name__ == "__main__":``. ``--max-memory`` 
 """
 
 import argparse
+import contextlib
+import logging
 import os
 import shutil
+import signal
 import sys
+import threading
 import time
 
 from . import OPTIONS
@@ -113,16 +117,72 @@ def _client(scheduler, workers, threads):
     return Client(cluster), cluster
 
 
-def _run(client, calls, stage, progress):
-    """Submits `calls` ({brick: (function, args)}) and gathers {brick: result}."""
+#: How often a brick whose worker died is run again on another worker.
+_RETRIES = 2
+
+
+class _Stopped(KeyboardInterrupt):
+    """SIGTERM or SIGINT during a run: raised in the main thread, and again at the next
+    stage should Dask's own waiting have swallowed it."""
+
+
+@contextlib.contextmanager
+def _stopped_by_signals():
+    """SIGTERM and SIGINT end the run (its bricks removed) instead of killing the process
+    with its partial bricks left, or being lost inside Dask's waiting."""
+    if threading.current_thread() is not threading.main_thread():
+        yield lambda: None
+        return
+    caught = []
+
+    def stop(signum, _frame):
+        caught.append(signum)
+        # The cluster is torn down mid-work: Dask's own logs of the closing would bury the
+        # one line that says why the run ended.
+        for name in ["distributed", *logging.root.manager.loggerDict]:
+            if name.split(".")[0] == "distributed":
+                logging.getLogger(name).disabled = True
+        raise _Stopped(f"stopped by signal {signal.Signals(signum).name}")
+
+    previous = {s: signal.signal(s, stop) for s in (signal.SIGTERM, signal.SIGINT)}
+
+    def check():
+        if caught:
+            raise _Stopped(f"stopped by signal {signal.Signals(caught[0]).name}")
+
+    try:
+        yield check
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+
+
+def _run(client, calls, stage, progress, check):
+    """Submits `calls` ({brick: (function, args)}) and gathers {brick: result}. A brick's
+    arguments travel with its task (not scattered to one worker), so that a brick whose
+    worker dies runs again elsewhere; a brick that still fails ends the run with an error
+    that names it."""
     from dask.distributed import as_completed
 
-    futures = {client.submit(f, *args, pure=False): b for b, (f, args) in calls.items()}
+    futures = {
+        client.submit(f, *args, pure=False, retries=_RETRIES): b for b, (f, args) in calls.items()
+    }
     results = {}
     progress.show(stage, 0, len(futures))
     for future in as_completed(futures):
-        results[futures[future]] = future.result()
+        check()
+        b = futures[future]
+        try:
+            results[b] = future.result()
+        except (ValueError, MemoryError, OSError):
+            raise
+        except Exception as e:
+            raise RuntimeError(
+                f"brick {b} ({stage}) failed on its worker after {_RETRIES} retries: "
+                f"{type(e).__name__}: {e}"
+            ) from None
         progress.show(stage, len(results), len(futures))
+    check()
     return results
 
 
@@ -163,18 +223,19 @@ def run(
     folder = os.path.splitext(output)[0] + ".bricks"
     if os.path.exists(folder):
         raise OSError(f"{folder}: already exists; remove it or choose another output")
-    os.makedirs(folder)
-    try:
-        return _run_in(plan, folder, output, solid, separability, scheduler, workers,
-                       max_memory_mib, keep_bricks, progress, client, start)
-    except BaseException:
-        # No half-written output: the bricks of a failed or interrupted run go.
-        shutil.rmtree(folder, ignore_errors=True)
-        raise
+    with _stopped_by_signals() as check:
+        os.makedirs(folder)
+        try:
+            return _run_in(plan, folder, output, solid, separability, scheduler, workers,
+                           max_memory_mib, keep_bricks, progress, client, start, check)
+        except BaseException:
+            # No half-written output: the bricks of a failed or interrupted run go.
+            shutil.rmtree(folder, ignore_errors=True)
+            raise
 
 
 def _run_in(plan, folder, output, solid, separability, scheduler, workers, max_memory_mib,
-            keep_bricks, progress, client, start):
+            keep_bricks, progress, client, start, check):
     show = _Progress(progress)
     threads = max(1, (os.cpu_count() or 1) // max(1, workers))
     own = client is None
@@ -182,7 +243,7 @@ def _run_in(plan, folder, output, solid, separability, scheduler, workers, max_m
         client, cluster = _client(scheduler, workers, threads)
     try:
         origin, h, size = plan.origin, plan.voxel_size, plan.size
-        arrays = {b: client.scatter(plan.faces_of(b)) for b in plan.bricks}
+        arrays = {b: plan.faces_of(b) for b in plan.bricks}
         files = {b: _brick_file(b) for b in plan.bricks}
         path = {b: os.path.abspath(os.path.join(folder, files[b])) for b in plan.bricks}
         full_bricks = []
@@ -192,6 +253,7 @@ def _run_in(plan, folder, output, solid, separability, scheduler, workers, max_m
                 {b: (_brick_faces, (arrays[b], origin, h, b, size, max_memory_mib)) for b in plan.bricks},
                 "outside labels",
                 show,
+                check,
             )
             exterior = vk.brick_exterior(plan, faces)
             del faces
@@ -200,13 +262,13 @@ def _run_in(plan, folder, output, solid, separability, scheduler, workers, max_m
                 b: (_solid_brick, (arrays[b], origin, h, b, size, exterior[b], path[b], max_memory_mib))
                 for b in plan.bricks
             }
-            counts = _run(client, calls, "solid", show)
+            counts = _run(client, calls, "solid", show, check)
         else:
             calls = {
                 b: (_surface_brick, (arrays[b], origin, h, b, size, path[b], separability, max_memory_mib))
                 for b in plan.bricks
             }
-            counts = _run(client, calls, "surface", show)
+            counts = _run(client, calls, "surface", show, check)
         peaks = list(client.run(_peak_rss_mib).values())
     finally:
         if own:
@@ -218,6 +280,7 @@ def _run_in(plan, folder, output, solid, separability, scheduler, workers, max_m
     merge = not keep_bricks and (
         available is None or voxels * _MERGED_BYTES_PER_VOXEL < available
     )
+    check()
     index = os.path.join(folder, "index.json")
     grid = vk.brick_finish(plan, files, full_bricks, index, merged=output if merge else None)
     if merge:
@@ -303,9 +366,12 @@ def main(argv=None):
             up_axis=args.up_axis,
             progress=True,
         )
-    except (ValueError, MemoryError, OSError) as e:
+    except (ValueError, MemoryError, OSError, RuntimeError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt as e:
+        print(f"error: {e or 'interrupted'}; the partial bricks were removed", file=sys.stderr)
+        return 130
     peaks = ", ".join(f"{p:.0f}" for p in result["worker_peak_mib"])
     print(
         f"{result['output']}: {result['voxels']} voxels from {result['bricks']} bricks "
