@@ -20,9 +20,9 @@
 
 use super::Progress;
 use super::brick_bins::voxelize_in_bricks;
-use super::separating::{
-    Adjacency, HalfSpace, MARGIN, Primitive, Primitives, Triangle, edge_cylinder, face_body,
-    primitives, reach_box, vertex_sphere,
+use super::separating_kernel::{
+    Adjacency, HalfSpace, MARGIN, Primitive, PrimitiveClass, Primitives, Triangle, edge_cylinder,
+    face_body, primitives, reach_box, vertex_sphere,
 };
 use crate::error::{Error, Result};
 use crate::grid::{Channels, CoordBox, SparseGrid, Transform};
@@ -43,13 +43,14 @@ pub fn distance_band(
             "the band must be at least one voxel wide, got {band}"
         )));
     }
+    let found = primitives(mesh, transform, false)?;
     let Primitives {
         triangles,
         edges,
         vertices,
         adjacency,
         ..
-    } = primitives(mesh, transform, false)?;
+    } = &found;
     let channels = Channels {
         value: true,
         ..Channels::NONE
@@ -57,48 +58,30 @@ pub fn distance_band(
     // A closed slab: plane distances up to the band on both sides.
     let slab = (-band - MARGIN, band + MARGIN);
     let every = |_: &Primitive, _: DVec3| true;
-    // One class: the brick keeps the least distance, whichever feature gave it.
-    let (nv, ne) = (vertices.len(), edges.len());
-    let feature = |i: usize| {
-        if i < nv {
-            (0, i)
-        } else if i < nv + ne {
-            (1, i - nv)
-        } else {
-            (2, i - nv - ne)
-        }
-    };
-    let candidates = |_, i: usize| match feature(i) {
-        (0, v) => reach_box(vertices[v].a, vertices[v].a, band + MARGIN),
-        (1, e) => reach_box(
-            edges[e].a.min(edges[e].b),
-            edges[e].a.max(edges[e].b),
-            band + MARGIN,
-        ),
-        (_, t) => {
-            let [a, b, c] = triangles[t].corners;
-            reach_box(a.min(b).min(c), a.max(b).max(c), band + MARGIN)
-        }
+    // One brick class for all: the brick keeps the least distance, whichever feature gave it.
+    let candidates = |_, i: usize| {
+        let (class, n) = found.numbered(i);
+        found.reach_box_of(class, n, band + MARGIN)
     };
     let (grid, _) = voxelize_in_bricks(
-        [nv + ne + triangles.len()],
+        [found.counts().iter().sum()],
         transform,
         channels,
         progress,
         candidates,
-        |_, i, clip, sink| match feature(i) {
-            (0, v) => {
-                let halves = vertex_halves(&vertices[v], &adjacency, &triangles);
+        |_, i, clip, sink| match found.numbered(i) {
+            (PrimitiveClass::Vertex, v) => {
+                let halves = vertex_halves(&vertices[v], adjacency, triangles);
                 vertex_sphere(&vertices[v], band, &every, halves.as_slice(), clip, sink)
             }
-            (1, e) => {
-                let halves = edge_halves(&edges[e], &adjacency, &triangles);
+            (PrimitiveClass::Edge, e) => {
+                let halves = edge_halves(&edges[e], adjacency, triangles);
                 let sector = sector_box(&edges[e], halves.as_slice(), band + MARGIN);
                 if let Some(clip) = clip.intersection(&sector) {
                     edge_cylinder(&edges[e], band, &every, halves.as_slice(), &clip, sink)
                 }
             }
-            (_, t) => face_body(&triangles[t], slab, clip, sink),
+            (PrimitiveClass::Body, t) => face_body(&triangles[t], slab, clip, sink),
         },
     )?;
     Ok(grid)

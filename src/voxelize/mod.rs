@@ -7,6 +7,7 @@ pub mod parametric;
 pub mod projective;
 pub mod separating;
 pub mod separating_analytic;
+mod separating_kernel;
 pub mod sign_change;
 mod sink;
 

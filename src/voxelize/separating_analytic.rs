@@ -24,7 +24,7 @@
 
 use super::Progress;
 use super::Separability;
-use super::separating::{slab_bounds, turned};
+use super::separating_kernel::{slab_bounds, turned};
 use super::sink::{nearest_channels, voxelize_parallel};
 use crate::grid::{SparseGrid, Transform};
 use crate::mesh::Aabb;

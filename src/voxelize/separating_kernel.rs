@@ -1,0 +1,729 @@
+//! The separating criterion's primitives and exact tests (Huang et al. §4–5, see
+//! `separating` for the criterion and why it separates): a mesh's triangles, edges and
+//! vertices in index space with the faces around each, and the row scans that mark the
+//! voxels of a vertex sphere, an edge cylinder or a face's body, each optionally cut by
+//! half-spaces. The surface voxelizer (`separating`) and the distance band
+//! (`distance_band`) both scan with these, so that both find exactly the same voxels.
+
+use super::Separability;
+use super::brick_bins::BrickSink;
+use crate::error::{Error, Result};
+use crate::grid::{CoordBox, Transform};
+use crate::huge_pages::vec_to_fill;
+use crate::mesh::Mesh;
+use crate::mesh::key_groups::group_by_key;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Tolerance, in voxels, added to every inclusion test.
+pub(super) const MARGIN: f64 = 1e-9;
+
+/// The slab's bounds on `d = n·(x - p)` for the turned normal (see the module docs): the
+/// voxel is in when `lo <= d < hi`.
+pub(super) fn slab_bounds(t: f64) -> (f64, f64) {
+    (-t - MARGIN, t - MARGIN / 2.0)
+}
+
+/// `n` turned so that its largest component is positive: the orientation the half-open slabs
+/// are measured in, the same for a face whatever its winding.
+pub(super) fn turned(n: DVec3) -> DVec3 {
+    if n[n.abs().max_position()] < 0.0 {
+        -n
+    } else {
+        n
+    }
+}
+
+/// Extra room when clipping candidate rows (the exact tests run on every candidate).
+pub(super) const ROW_SLACK: f64 = 1e-6;
+
+pub(super) struct Triangle {
+    pub(super) corners: [DVec3; 3],
+    pub(super) normal: DVec3,
+}
+
+/// A vertex (`a == b`) or an edge, with the faces around it.
+pub(super) struct Primitive {
+    pub(super) a: DVec3,
+    pub(super) b: DVec3,
+    normal: DVec3,
+    /// Range of `Adjacency::faces` holding the faces around it.
+    pub(super) faces: std::ops::Range<usize>,
+}
+
+/// A half-space `g·x + h <= 0` that limits a sphere or a cylinder to where its primitive can
+/// be the nearest part of the mesh (the distance band's clipping; the separating surface
+/// uses whole spheres and cylinders and passes none).
+#[derive(Clone, Copy)]
+pub(super) struct HalfSpace {
+    pub(super) g: DVec3,
+    pub(super) h: f64,
+}
+
+/// `range`, the values of coordinate `axis` with the others as in `x`, narrowed to where
+/// every half-space holds (widened by `ROW_SLACK`: a candidate range).
+#[inline]
+pub(super) fn within(
+    range: std::ops::RangeInclusive<i64>,
+    mut x: DVec3,
+    axis: usize,
+    halves: &[HalfSpace],
+) -> std::ops::RangeInclusive<i64> {
+    let (mut lo, mut hi) = (*range.start(), *range.end());
+    x[axis] = 0.0;
+    for half in halves {
+        // g_axis t <= rhs
+        let rhs = -(half.g.dot(x) + half.h);
+        let ga = half.g[axis];
+        if ga > 0.0 {
+            let bound = rhs / ga + ROW_SLACK;
+            if bound < hi as f64 {
+                hi = floor_int(bound.max(lo as f64 - 1.0));
+            }
+        } else if ga < 0.0 {
+            let bound = rhs / ga - ROW_SLACK;
+            if bound > lo as f64 {
+                lo = ceil_int(bound.min(hi as f64 + 1.0));
+            }
+        } else if rhs < 0.0 {
+            return int_range(0.0, -1.0);
+        }
+        if lo > hi {
+            break;
+        }
+    }
+    lo..=hi
+}
+
+/// Faces around edges and vertices, and each face's fan triangles.
+pub(super) struct Adjacency {
+    pub(super) faces: Vec<u32>,
+    /// `triangle_starts[f]..triangle_starts[f+1]`: the kept triangles of face `f`.
+    pub(super) triangle_starts: Vec<usize>,
+}
+
+impl Adjacency {
+    /// Whether `x` lies in the slab (half thickness `t`) of a triangle of a face of `p`.
+    pub(super) fn in_face_slab(
+        &self,
+        p: &Primitive,
+        triangles: &[Triangle],
+        sep: Separability,
+        x: DVec3,
+    ) -> bool {
+        self.faces[p.faces.clone()].iter().any(|&f| {
+            let range = self.triangle_starts[f as usize]..self.triangle_starts[f as usize + 1];
+            triangles[range].iter().any(|tri| {
+                let (lo, hi) = slab_bounds(sep.slab_half_thickness(tri.normal));
+                let d = turned(tri.normal).dot(x - tri.corners[0]);
+                lo <= d && d < hi
+            })
+        })
+    }
+}
+
+/// The criterion's primitives in the paper's counting order: a voxel counts for the first
+/// class that marks it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum PrimitiveClass {
+    Vertex,
+    Edge,
+    Body,
+}
+
+impl PrimitiveClass {
+    /// The classes in counting order.
+    pub(super) const ALL: [PrimitiveClass; 3] = [
+        PrimitiveClass::Vertex,
+        PrimitiveClass::Edge,
+        PrimitiveClass::Body,
+    ];
+}
+
+impl Primitives {
+    /// How many primitives of each class, in counting order.
+    pub(super) fn counts(&self) -> [usize; 3] {
+        [self.vertices.len(), self.edges.len(), self.triangles.len()]
+    }
+
+    /// Primitive `i` of all, numbered in counting order: its class and its number in it.
+    pub(super) fn numbered(&self, i: usize) -> (PrimitiveClass, usize) {
+        let [nv, ne, _] = self.counts();
+        if i < nv {
+            (PrimitiveClass::Vertex, i)
+        } else if i < nv + ne {
+            (PrimitiveClass::Edge, i - nv)
+        } else {
+            (PrimitiveClass::Body, i - nv - ne)
+        }
+    }
+
+    /// The voxels within `reach` of primitive `n` of `class`.
+    pub(super) fn reach_box_of(&self, class: PrimitiveClass, n: usize, reach: f64) -> CoordBox {
+        match class {
+            PrimitiveClass::Vertex => reach_box(self.vertices[n].a, self.vertices[n].a, reach),
+            PrimitiveClass::Edge => {
+                let e = &self.edges[n];
+                reach_box(e.a.min(e.b), e.a.max(e.b), reach)
+            }
+            PrimitiveClass::Body => {
+                let [a, b, c] = self.triangles[n].corners;
+                reach_box(a.min(b).min(c), a.max(b).max(c), reach)
+            }
+        }
+    }
+}
+
+/// A mesh's primitives in index space: its fan triangles, its edges and its vertices.
+pub(super) struct Primitives {
+    pub(super) triangles: Vec<Triangle>,
+    pub(super) edges: Vec<Primitive>,
+    pub(super) vertices: Vec<Primitive>,
+    pub(super) adjacency: Adjacency,
+    pub(super) degenerate_faces: usize,
+}
+
+/// The primitives of `mesh` (world units) on `transform`'s voxels, edges and vertices with
+/// their faces' mean normal when `normals` is set.
+pub(super) fn primitives(mesh: &Mesh, transform: Transform, normals: bool) -> Result<Primitives> {
+    mesh.validate()?;
+    if !(transform.voxel_size > 0.0 && transform.voxel_size.is_finite()) {
+        return Err(Error::InvalidArgument(format!(
+            "voxel size must be positive, got {}",
+            transform.voxel_size
+        )));
+    }
+    let mut pos: Vec<DVec3> = vec_to_fill(mesh.positions.len());
+    pos.par_extend(
+        mesh.positions
+            .par_iter()
+            .map(|&p| transform.world_to_index(p)),
+    );
+    let mut face_normals: Vec<DVec3> = vec_to_fill(mesh.face_count());
+    face_normals.par_extend(
+        (0..mesh.face_count())
+            .into_par_iter()
+            .map(|f| fan_area_normal(mesh.face(f), &pos)),
+    );
+    let ((triangles, triangle_starts, degenerate_faces), (edges, vertices, faces)) = rayon::join(
+        || triangles_of(mesh, &pos),
+        || edges_and_vertices(mesh, &pos, &face_normals, normals),
+    );
+    Ok(Primitives {
+        triangles,
+        edges,
+        vertices,
+        adjacency: Adjacency {
+            faces,
+            triangle_starts,
+        },
+        degenerate_faces,
+    })
+}
+
+/// The voxels within `reach` of the box from `lo` to `hi`.
+pub(super) fn reach_box(lo: DVec3, hi: DVec3, reach: f64) -> CoordBox {
+    let (lo, hi) = (lo - DVec3::splat(reach), hi + DVec3::splat(reach));
+    CoordBox {
+        min: [lo.x, lo.y, lo.z].map(|v| v.floor() as i64),
+        max: [hi.x, hi.y, hi.z].map(|v| v.ceil() as i64),
+    }
+}
+
+/// Twice the vector area of a polygon's fan (its normal, weighted by area).
+pub(super) fn fan_area_normal(face: &[u32], pos: &[DVec3]) -> DVec3 {
+    let p0 = pos[face[0] as usize];
+    (1..face.len() - 1)
+        .map(|k| (pos[face[k] as usize] - p0).cross(pos[face[k + 1] as usize] - p0))
+        .sum()
+}
+
+/// Fan triangles with unit normals (degenerate ones dropped), where each face's triangles
+/// start, and the number of degenerate faces.
+pub(super) fn triangles_of(mesh: &Mesh, pos: &[DVec3]) -> (Vec<Triangle>, Vec<usize>, usize) {
+    let mut triangles = vec_to_fill(mesh.indices.len() - 2 * mesh.face_count());
+    let mut starts = Vec::with_capacity(mesh.face_count() + 1);
+    let mut degenerate = 0;
+    for f in 0..mesh.face_count() {
+        starts.push(triangles.len());
+        let face = mesh.face(f);
+        let mut kept = 0;
+        for k in 1..face.len() - 1 {
+            let corners = [
+                pos[face[0] as usize],
+                pos[face[k] as usize],
+                pos[face[k + 1] as usize],
+            ];
+            let cross = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+            let len = cross.length();
+            // Relative to the longest edge squared: slivers thinner than 1e-12 have no stable plane.
+            let scale = (corners[1] - corners[0])
+                .length_squared()
+                .max((corners[2] - corners[0]).length_squared());
+            if len > 1e-12 * scale && len > 0.0 {
+                triangles.push(Triangle {
+                    corners,
+                    normal: cross / len,
+                });
+                kept += 1;
+            }
+        }
+        if kept == 0 {
+            degenerate += 1;
+        }
+    }
+    starts.push(triangles.len());
+    (triangles, starts, degenerate)
+}
+
+/// Deduplicated edges (polygon sides, plus fan diagonals of non-planar polygons) and the
+/// used vertices, each with the faces around it (a range of the returned list) and, when
+/// `normals` is set, the normalized sum of their area-weighted normals. Linear time:
+/// edges are bucketed by their lower vertex, corners by their vertex (counting sorts).
+pub(super) fn edges_and_vertices(
+    mesh: &Mesh,
+    pos: &[DVec3],
+    face_normals: &[DVec3],
+    normals: bool,
+) -> (Vec<Primitive>, Vec<Primitive>, Vec<u32>) {
+    let planar: Vec<bool> = (0..mesh.face_count())
+        .map(|f| mesh.face(f).len() == 3 || is_planar(mesh.face(f), pos, face_normals[f]))
+        .collect();
+    let for_each_edge = |visit: &mut dyn FnMut(u32, u32, u32)| {
+        for (f, &flat) in planar.iter().enumerate() {
+            let face = mesh.face(f);
+            for k in 0..face.len() {
+                let (a, b) = (face[k], face[(k + 1) % face.len()]);
+                if a != b {
+                    visit(a.min(b), a.max(b), f as u32);
+                }
+            }
+            if !flat {
+                for k in 2..face.len() - 1 {
+                    visit(face[0].min(face[k]), face[0].max(face[k]), f as u32);
+                }
+            }
+        }
+    };
+    // (upper vertex, face) grouped by lower vertex.
+    let (start, buckets) = group_by_key(pos.len(), |visit| {
+        for_each_edge(&mut |lo, hi, f| visit(lo, (hi, f)))
+    });
+    let normal_of = |fs: &[u32]| {
+        if normals {
+            fs.iter()
+                .map(|&f| face_normals[f as usize])
+                .sum::<DVec3>()
+                .normalize_or_zero()
+        } else {
+            DVec3::ZERO
+        }
+    };
+    let (edges_part, vertices_part) = rayon::join(
+        || edges_from_buckets(pos, &start, buckets, &normal_of),
+        || vertices_of(mesh, pos, &normal_of),
+    );
+    let ((edges, mut faces), (mut vertices, vertex_faces)) = (edges_part, vertices_part);
+    let shift = faces.len();
+    for v in &mut vertices {
+        v.faces = v.faces.start + shift..v.faces.end + shift;
+    }
+    faces.extend(vertex_faces);
+    (edges, vertices, faces)
+}
+
+/// One edge per distinct (lower, upper) vertex pair of the buckets, with its faces.
+pub(super) fn edges_from_buckets(
+    pos: &[DVec3],
+    start: &[usize],
+    mut buckets: Vec<(u32, u32)>,
+    normal_of: &(dyn Fn(&[u32]) -> DVec3 + Sync),
+) -> (Vec<Primitive>, Vec<u32>) {
+    let mut faces: Vec<u32> = vec_to_fill(buckets.len());
+    let mut edges = vec_to_fill(buckets.len() / 2);
+    for lo in 0..pos.len() {
+        let bucket = &mut buckets[start[lo]..start[lo + 1]];
+        bucket.sort_unstable();
+        for group in bucket.chunk_by(|x, y| x.0 == y.0) {
+            let first = faces.len();
+            for g in group {
+                // Sorted within the group: a face listing the edge twice appears once.
+                if faces.len() == first || faces[faces.len() - 1] != g.1 {
+                    faces.push(g.1);
+                }
+            }
+            edges.push(Primitive {
+                a: pos[lo],
+                b: pos[group[0].0 as usize],
+                normal: normal_of(&faces[first..]),
+                faces: first..faces.len(),
+            });
+        }
+    }
+    (edges, faces)
+}
+
+/// The used vertices with the faces around each, by a counting sort of the corners.
+pub(super) fn vertices_of(
+    mesh: &Mesh,
+    pos: &[DVec3],
+    normal_of: &(dyn Fn(&[u32]) -> DVec3 + Sync),
+) -> (Vec<Primitive>, Vec<u32>) {
+    let mut faces: Vec<u32> = vec_to_fill(mesh.indices.len());
+    let (vstart, mut around) = group_by_key(pos.len(), |visit| {
+        for f in 0..mesh.face_count() {
+            mesh.face(f).iter().for_each(|&v| visit(v, f as u32));
+        }
+    });
+    let mut vertices = vec_to_fill(pos.len());
+    for v in 0..pos.len() {
+        let list = &mut around[vstart[v]..vstart[v + 1]];
+        if list.is_empty() {
+            continue; // not used by any face
+        }
+        list.sort_unstable();
+        let first = faces.len();
+        for &f in list.iter() {
+            if faces.len() == first || faces[faces.len() - 1] != f {
+                faces.push(f);
+            }
+        }
+        vertices.push(Primitive {
+            a: pos[v],
+            b: pos[v],
+            normal: normal_of(&faces[first..]),
+            faces: first..faces.len(),
+        });
+    }
+    (vertices, faces)
+}
+
+/// All corners within 1e-6 voxels of the plane through the first corner with normal `n`.
+pub(super) fn is_planar(face: &[u32], pos: &[DVec3], n: DVec3) -> bool {
+    let n = n.normalize_or_zero();
+    if n == DVec3::ZERO {
+        return false;
+    }
+    let p0 = pos[face[0] as usize];
+    face.iter()
+        .all(|&i| n.dot(pos[i as usize] - p0).abs() <= 1e-6)
+}
+
+/// Integer range `ceil(lo)..=floor(hi)`.
+#[inline]
+pub(super) fn int_range(lo: f64, hi: f64) -> std::ops::RangeInclusive<i64> {
+    ceil_int(lo)..=floor_int(hi)
+}
+
+/// `floor(x)` by truncation plus a fix-up (see `ceil_int`).
+#[inline]
+pub(super) fn floor_int(x: f64) -> i64 {
+    let h = x as i64;
+    if (h as f64) > x { h - 1 } else { h }
+}
+
+/// `ceil(x)` by truncation plus a fix-up: `f64::ceil`/`floor` are libm calls without SSE4.1.
+#[inline]
+pub(super) fn ceil_int(x: f64) -> i64 {
+    let l = x as i64;
+    if (l as f64) < x { l + 1 } else { l }
+}
+
+/// Integer range `ceil(lo)..ceil(hi)`: the integers `v` with `lo <= v < hi`.
+#[inline]
+pub(super) fn half_open_range(lo: f64, hi: f64) -> std::ops::RangeInclusive<i64> {
+    ceil_int(lo)..=ceil_int(hi) - 1
+}
+
+/// Values of `v` with `a v^2 + 2 b v + c <= 0` (`a > 0`, `inv_a = 1 / a`), widened by
+/// `MARGIN`; empty when none. A candidate range: the caller tests each value exactly, and
+/// the reciprocal's rounding is far below the margin.
+#[inline]
+pub(super) fn quadratic_range(a: f64, inv_a: f64, b: f64, c: f64) -> std::ops::RangeInclusive<i64> {
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return int_range(0.0, -1.0);
+    }
+    let root = disc.sqrt();
+    int_range((-b - root) * inv_a - MARGIN, (-b + root) * inv_a + MARGIN)
+}
+
+/// `range` clipped to `clip`'s extent along `axis`.
+#[inline]
+pub(super) fn clipped(
+    range: std::ops::RangeInclusive<i64>,
+    clip: &CoordBox,
+    axis: usize,
+) -> std::ops::RangeInclusive<i64> {
+    (*range.start()).max(clip.min[axis])..=(*range.end()).min(clip.max[axis])
+}
+
+/// S_v: voxel centres within `r` of the vertex (that `keep` accepts), in `clip`.
+pub(super) fn vertex_sphere<const C: usize>(
+    v: &Primitive,
+    r: f64,
+    keep: &impl Fn(&Primitive, DVec3) -> bool,
+    halves: &[HalfSpace],
+    clip: &CoordBox,
+    sink: &mut BrickSink<C>,
+) {
+    let p = v.a;
+    let r2 = (r + MARGIN) * (r + MARGIN);
+    for x in clipped(int_range(p.x - r - MARGIN, p.x + r + MARGIN), clip, 0) {
+        for y in clipped(int_range(p.y - r - MARGIN, p.y + r + MARGIN), clip, 1) {
+            let column = within(
+                clip.min[2]..=clip.max[2],
+                DVec3::new(x as f64, y as f64, 0.0),
+                2,
+                halves,
+            );
+            if column.is_empty() {
+                continue;
+            }
+            let (dx, dy) = (x as f64 - p.x, y as f64 - p.y);
+            // (z - p.z)^2 <= r2 - dx^2 - dy^2
+            let near = quadratic_range(1.0, 1.0, -p.z, p.z * p.z + dx * dx + dy * dy - r2);
+            let (first, last) = (
+                (*near.start()).max(*column.start()),
+                (*near.end()).min(*column.end()),
+            );
+            for z in first..=last {
+                let c = DVec3::new(x as f64, y as f64, z as f64);
+                let d2 = (c - p).length_squared();
+                if d2 <= r2 && keep(v, c) {
+                    sink.add([x, y, z], || d2.sqrt(), v.normal);
+                }
+            }
+        }
+    }
+}
+
+/// S_e: voxel centres within `r` of the edge whose projection falls on the edge (and that
+/// `keep` accepts), in `clip`.
+pub(super) fn edge_cylinder<const C: usize>(
+    e: &Primitive,
+    r: f64,
+    keep: &impl Fn(&Primitive, DVec3) -> bool,
+    halves: &[HalfSpace],
+    clip: &CoordBox,
+    sink: &mut BrickSink<C>,
+) {
+    let (p, d) = (e.a, e.b - e.a);
+    let len2 = d.length_squared();
+    if len2 == 0.0 {
+        return; // both ends are one vertex: its sphere covers it
+    }
+    let w = d.abs().max_position();
+    let (u, v) = ((w + 1) % 3, (w + 2) % 3);
+    let r = r + MARGIN;
+    let dn = d / len2.sqrt();
+    // In a plane across axis w the cylinder's section is an ellipse reaching
+    // r sqrt(1 - dn_v^2) / |dn_w| from the axis along u; the caps, discs of radius r across
+    // the edge, reach r sqrt(1 - dn_w^2) beyond its ends along w.
+    let reach = r * (1.0 - dn[v] * dn[v]).sqrt() / dn[w].abs() + ROW_SLACK;
+    let cap = r * (1.0 - dn[w] * dn[w]).max(0.0).sqrt() + ROW_SLACK;
+    let tau_margin = MARGIN / len2.sqrt();
+    let test = EdgeTest::new(e, r);
+    // The quadratic's leading coefficient is the edge's: 1 - dn_v^2 >= 2/3, as v is not
+    // its longest axis.
+    let a = 1.0 - dn[v] * dn[v];
+    let inv_a = 1.0 / a;
+    // Reciprocals for the candidate ranges (the exact tests below divide).
+    let inv_len2 = 1.0 / len2;
+    let dt = d[v] * inv_len2;
+    let inv_dt = 1.0 / dt;
+    let columns = clip.min[v]..=clip.max[v];
+    for k in clipped(
+        int_range(p[w].min(e.b[w]) - cap, p[w].max(e.b[w]) + cap),
+        clip,
+        w,
+    ) {
+        let c = p + d * ((k as f64 - p[w]) / d[w]);
+        for iu in clipped(int_range(c[u] - reach, c[u] + reach), clip, u) {
+            let mut row = DVec3::ZERO;
+            row[w] = k as f64;
+            row[u] = iu as f64;
+            let span = within(columns.clone(), row, v, halves);
+            if span.is_empty() {
+                continue;
+            }
+            // y = x - p with x_v = 0; dist^2(v) = |y + v e_v|^2 - ((y + v e_v)·dn)^2 <= r^2.
+            let y0 = row - p;
+            // tau is linear along the row: keep the values of iv whose projection can fall on
+            // the edge (most of a short edge's rows lie beyond its ends).
+            let t0 = y0.dot(d) * inv_len2;
+            let on_edge = if dt == 0.0 {
+                if (-tau_margin..=1.0 + tau_margin).contains(&t0) {
+                    span
+                } else {
+                    continue;
+                }
+            } else {
+                let (e0, e1) = (
+                    (-tau_margin - t0) * inv_dt,
+                    (1.0 + tau_margin - t0) * inv_dt,
+                );
+                let along = int_range(e0.min(e1) - ROW_SLACK, e0.max(e1) + ROW_SLACK);
+                (*span.start()).max(*along.start())..=(*span.end()).min(*along.end())
+            };
+            if on_edge.is_empty() {
+                continue;
+            }
+            let along = y0.dot(dn);
+            let b = y0[v] - along * dn[v];
+            let cc = y0.length_squared() - along * along - r * r;
+            let near = quadratic_range(a, inv_a, b, cc);
+            let first = (*near.start()).max(*on_edge.start());
+            let last = (*near.end()).min(*on_edge.end());
+            for iv in first..=last {
+                let mut x = row;
+                x[v] = iv as f64;
+                let (inside, d2) = test.at(x);
+                if inside && keep(e, x) {
+                    sink.add(to_coord(x), || d2.sqrt(), e.normal);
+                }
+            }
+        }
+    }
+}
+
+/// The exact test of S_e for an edge of non-zero length, with radius `r` (margin included):
+/// a centre within `r` of the edge whose projection falls on it (`tau` in `[0, 1]`, widened
+/// by `MARGIN` voxels along the edge).
+pub(super) struct EdgeTest {
+    p: DVec3,
+    d: DVec3,
+    len2: f64,
+    tau_margin: f64,
+    r2: f64,
+}
+
+impl EdgeTest {
+    pub(super) fn new(e: &Primitive, r: f64) -> Self {
+        let d = e.b - e.a;
+        let len2 = d.length_squared();
+        EdgeTest {
+            p: e.a,
+            d,
+            len2,
+            tau_margin: MARGIN / len2.sqrt(),
+            r2: r * r,
+        }
+    }
+
+    /// Whether `x` is in, and its squared distance to the edge's line; without a branch.
+    #[inline]
+    pub(super) fn at(&self, x: DVec3) -> (bool, f64) {
+        let tau = (x - self.p).dot(self.d) / self.len2;
+        let d2 = (x - self.p - self.d * tau).length_squared();
+        let inside = (tau >= -self.tau_margin) & (tau <= 1.0 + self.tau_margin) & (d2 <= self.r2);
+        (inside, d2)
+    }
+}
+
+/// S_b: voxel centres in the triangle's slab `d_lo <= d < d_hi` (`d` along the turned normal:
+/// see the module docs) whose projection lies inside it, in `clip`.
+pub(super) fn face_body<const C: usize>(
+    tri: &Triangle,
+    (d_lo, d_hi): (f64, f64),
+    clip: &CoordBox,
+    sink: &mut BrickSink<C>,
+) {
+    // The slab is measured along the turned normal; the row bounds below do not depend on
+    // the normal's sign, the edge planes do (they point inwards for the face's own normal).
+    let n = turned(tri.normal);
+    let [a, b, c] = tri.corners;
+    let t = (-d_lo).max(d_hi);
+    let w = n.abs().max_position();
+    let (u, v) = ((w + 1) % 3, (w + 2) % 3);
+    let sides = edge_planes(tri);
+    // The same planes as half-spaces, to cut each column to the prism before the exact test:
+    // worth it where columns are long (a thick slab, as the distance band's), not for the
+    // one or two voxels of a separating surface's.
+    let inside_sides = sides.map(|(m, p)| HalfSpace {
+        g: -m,
+        h: m.dot(p) - MARGIN,
+    });
+    let column_cut: &[HalfSpace] = if (d_hi - d_lo) / n[w] > 4.0 {
+        &inside_sides
+    } else {
+        &[]
+    };
+    let lo = a.min(b).min(c) - DVec3::splat(t);
+    let hi = a.max(b).max(c) + DVec3::splat(t);
+    let half = t / n[w].abs();
+    let inv_nw = 1.0 / n[w];
+    // Clip each row to the columns whose slab segment can reach inside every edge plane: the
+    // best k of the slab turns each plane test into a linear bound on iv, `at(iu) + slope iv
+    // >= 0` with `at(iu) = at0 + at1 iu`, set up once per triangle.
+    let bounds = sides.map(|(m, p)| {
+        let slope = m[v] - m[w] * n[v] / n[w];
+        let at1 = m[u] - m[w] * n[u] / n[w];
+        let at0 = -m[u] * p[u] - m[v] * p[v]
+            + m[w] * (a[w] - p[w])
+            + m[w] * (n[u] * a[u] + n[v] * a[v]) / n[w]
+            + m[w].abs() * half
+            + ROW_SLACK;
+        (slope, at0, at1)
+    });
+    for iu in clipped(int_range(lo[u], hi[u]), clip, u) {
+        let (mut v_lo, mut v_hi) = (lo[v], hi[v]);
+        for &(slope, at0, at1) in &bounds {
+            let at_zero = at0 + at1 * iu as f64;
+            if slope > 0.0 {
+                v_lo = v_lo.max(-at_zero / slope);
+            } else if slope < 0.0 {
+                v_hi = v_hi.min(-at_zero / slope);
+            } else if at_zero < 0.0 {
+                v_hi = f64::NEG_INFINITY;
+            }
+        }
+        if v_lo > v_hi {
+            continue;
+        }
+        for iv in clipped(int_range(v_lo, v_hi), clip, v) {
+            let s = n[u] * (iu as f64 - a[u]) + n[v] * (iv as f64 - a[v]);
+            // d_lo <= s + n_w (k - a_w) < d_hi with n_w > 0, solved for k (the slab's
+            // margins dwarf the reciprocal's rounding).
+            let k0 = a[w] + (d_lo - s) * inv_nw;
+            let k1 = a[w] + (d_hi - s) * inv_nw;
+            let mut column = DVec3::ZERO;
+            column[u] = iu as f64;
+            column[v] = iv as f64;
+            let slab = clipped(half_open_range(k0, k1), clip, w);
+            for k in within(slab, column, w, column_cut) {
+                let mut x = column;
+                x[w] = k as f64;
+                // A cut column is exact to 1e-6 voxels, which moves a plane distance by less
+                // than 1e-12: the distance band needs no test per voxel.
+                if !column_cut.is_empty() || within_edge_planes(&sides, x) {
+                    sink.add(to_coord(x), || n.dot(x - a).abs(), tri.normal);
+                }
+            }
+        }
+    }
+}
+
+/// In-plane inward normals of the triangle's edges, each with a point on it: the planes E_i
+/// of the paper.
+pub(super) fn edge_planes(tri: &Triangle) -> [(DVec3, DVec3); 3] {
+    let [a, b, c] = tri.corners;
+    [(a, b), (b, c), (c, a)].map(|(p, q)| {
+        let m = tri.normal.cross(q - p);
+        (m / m.length(), p)
+    })
+}
+
+/// Whether `x` lies inside every edge plane (`edge_planes`), up to `MARGIN`; without a
+/// branch.
+#[inline]
+pub(super) fn within_edge_planes(sides: &[(DVec3, DVec3); 3], x: DVec3) -> bool {
+    sides
+        .iter()
+        .fold(true, |all, (m, p)| all & (m.dot(x - *p) >= -MARGIN))
+}
+
+#[inline]
+pub(super) fn to_coord(x: DVec3) -> [i64; 3] {
+    [x.x as i64, x.y as i64, x.z as i64]
+}
