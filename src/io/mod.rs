@@ -10,6 +10,8 @@ pub mod vdb;
 #[cfg(feature = "vdb")]
 mod vdb_chunks;
 #[cfg(feature = "vdb")]
+mod vdb_format;
+#[cfg(feature = "vdb")]
 mod vdb_reader;
 #[cfg(feature = "vdb")]
 mod vdb_structure;

@@ -8,6 +8,7 @@
 //! then rename).
 
 use super::atomic::write_atomic;
+use super::vdb_format::{COVARIANT_NORMALIZE, FOG_VOLUME, LEVEL_SET};
 use super::vdb_writer::{Encoding, GridOut, GridValues, compression_flags, write_grids};
 use crate::error::{Error, Result};
 use crate::grid::{Channels, LEAF_VOXELS, Leaf, SparseGrid, Transform};
@@ -87,7 +88,7 @@ pub fn write_vdb_as(
             DENSITY_GRID,
             grid,
             GridValues::Constant(1.0),
-            Some("fog volume"),
+            Some(FOG_VOLUME),
             None,
         ),
         grid_out(VOXELS_GRID, grid, GridValues::Bool, None, None),
@@ -96,7 +97,7 @@ pub fn write_vdb_as(
         // Normals transform covariantly; colours are plain triples.
         let normals = grid_out(NORMAL_GRID, grid, GridValues::Normals, None, None);
         candidates.push(GridOut {
-            vector_type: Some("covariant normalize"),
+            vector_type: Some(COVARIANT_NORMALIZE),
             ..normals
         });
     }
@@ -270,7 +271,7 @@ pub fn write_distance_band(
                     band: grid,
                     background,
                 },
-                Some("fog volume"),
+                Some(FOG_VOLUME),
             ),
             grid_out(
                 LEVEL_SET_GRID,
@@ -279,7 +280,7 @@ pub fn write_distance_band(
                     background,
                     interior,
                 },
-                Some("level set"),
+                Some(LEVEL_SET),
             ),
         ],
         None => vec![grid_out(

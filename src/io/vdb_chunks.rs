@@ -5,13 +5,7 @@
 
 use std::os::raw::{c_char, c_int, c_ulong, c_void};
 
-/// Per-grid compression flags (OpenVDB's `COMPRESS_*`).
-pub(super) const COMPRESS_ZIP: u32 = 0x1;
-pub(super) const COMPRESS_ACTIVE_MASK: u32 = 0x2;
-pub(super) const COMPRESS_BLOSC: u32 = 0x4;
-
-/// OpenVDB pads buffers shorter than this before blosc compresses them.
-pub(super) const BLOSC_PAD_BYTES: usize = 128;
+use super::vdb_format::{BLOSC_PAD_BYTES, COMPRESS_BLOSC, COMPRESS_ZIP};
 
 /// Blosc's chunk header, in bytes: the most compressing can add.
 const BLOSC_OVERHEAD: usize = 16;

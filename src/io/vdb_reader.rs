@@ -5,21 +5,15 @@
 //! value flags). The layout is OpenVDB's file format 222 and later (`io/Compression.h`,
 //! `tree/RootNode.h`, `InternalNode.h`, `LeafNode.h`), the one `vdb_writer` writes.
 
-use super::vdb_chunks::{COMPRESS_ACTIVE_MASK, read_chunk};
-use super::vdb_tree_structure::{LeafKind, TreeFormat, value_type};
+use super::vdb_chunks::read_chunk;
+use super::vdb_format::{
+    CHILD_LOG2, COMPRESS_ACTIVE_MASK, NAME_SUFFIX_MARK, NODE_LOG2, ROOT_TILE, VdbFault, value_type,
+};
+use super::vdb_tree_structure::{LeafKind, TreeFormat};
 use crate::grid::LEAF_VOXELS;
 use rayon::prelude::*;
 
-type Parsed<T> = std::result::Result<T, String>;
-
-/// Log2 of the child extent, in voxels, of the root's children (128) and of their children (8).
-const CHILD_LOG2: [u32; 2] = [7, 3];
-/// Log2 of the slots per axis of the two internal node levels (32, 16).
-const NODE_LOG2: [u32; 2] = [5, 4];
-/// The edge of a root tile, in voxels.
-const ROOT_TILE: i32 = 4096;
-/// OpenVDB appends this and a number to repeated grid names in a file.
-const NAME_SUFFIX_MARK: char = '\u{1e}';
+type Parsed<T> = std::result::Result<T, VdbFault>;
 
 /// One metadata item of a grid, its value as text, with OpenVDB's name of its type
 /// (`string`, `int64`, `double`, ...).
@@ -83,7 +77,7 @@ impl<'a> Cursor<'a> {
         let bytes = self
             .data
             .get(self.pos..self.pos.saturating_add(n))
-            .ok_or_else(|| format!("it ends inside a record at byte {}", self.pos))?;
+            .ok_or(VdbFault::Truncated { at: self.pos })?;
         self.pos += n;
         Ok(bytes)
     }
@@ -173,9 +167,11 @@ impl VdbFile {
             };
             let type_name = c.string()?;
             let parent = c.string()?;
-            let start = usize::try_from(c.i64()?).map_err(|e| e.to_string())?;
-            let buffers = usize::try_from(c.i64()?).map_err(|e| e.to_string())?;
-            let end = usize::try_from(c.i64()?).map_err(|e| e.to_string())?;
+            let start =
+                usize::try_from(c.i64()?).map_err(|e| VdbFault::BadOffset(e.to_string()))?;
+            let buffers =
+                usize::try_from(c.i64()?).map_err(|e| VdbFault::BadOffset(e.to_string()))?;
+            let end = usize::try_from(c.i64()?).map_err(|e| VdbFault::BadOffset(e.to_string()))?;
             descriptors.push(Descriptor {
                 name,
                 type_name,
@@ -201,11 +197,9 @@ impl VdbFile {
                 .descriptors
                 .iter()
                 .find(|p| p.instance_of.is_none() && &p.name == parent)
-                .ok_or_else(|| {
-                    format!(
-                        "grid `{}` shares the tree of a missing grid `{parent}`",
-                        d.name
-                    )
+                .ok_or_else(|| VdbFault::MissingInstance {
+                    grid: d.name.clone(),
+                    parent: parent.clone(),
                 }),
         }
     }
@@ -231,7 +225,7 @@ impl VdbFile {
         let header = self.header(d)?;
         let owner = self.tree_owner(index)?;
         let owner_header = self.header(owner)?;
-        let format = TreeFormat::of(&owner.type_name)?;
+        let format = TreeFormat::of(&owner.type_name).map_err(VdbFault::TreeType)?;
         let topology = read_topology(
             &self.data,
             owner_header.tree,
@@ -300,17 +294,17 @@ impl VdbFile {
     pub fn read_tree(&self, index: usize) -> Parsed<TreeRead> {
         let owner = self.tree_owner(index)?;
         let header = self.header(owner)?;
-        let format = TreeFormat::of(&owner.type_name)?;
+        let format = TreeFormat::of(&owner.type_name).map_err(VdbFault::TreeType)?;
         let value_type = value_type(&owner.type_name).to_string();
         let components = match value_type.as_str() {
             "bool" | "mask" => 0,
             "float" => 1,
             "vec3s" => 3,
             other => {
-                return Err(format!(
-                    "grid `{}` has value type {other}; only bool, mask, float and vec3s grids can be read",
-                    self.descriptors[index].name
-                ));
+                return Err(VdbFault::ValueType {
+                    grid: self.descriptors[index].name.clone(),
+                    value_type: other.to_string(),
+                });
             }
         };
         let topology = read_topology(&self.data, header.tree, format, header.compression)?;
@@ -468,7 +462,7 @@ fn linear_map(c: &mut Cursor, name: &str) -> Parsed<([f64; 3], [f64; 3], bool)> 
             }
             m.map(|r| [r[0], r[1], r[2]])
         }
-        _ => return Err(format!("a transform of unknown kind `{name}`")),
+        _ => return Err(VdbFault::Transform(name.to_string())),
     };
     let size = std::array::from_fn(|a| rows[a].iter().map(|v| v * v).sum::<f64>().sqrt());
     let h = rows[0][0];
@@ -496,7 +490,7 @@ struct Topology {
 fn read_topology(data: &[u8], at: usize, format: TreeFormat, compression: u32) -> Parsed<Topology> {
     let mut c = Cursor::at(data, at);
     if c.u32()? != 1 {
-        return Err("a tree of more than one buffer".into());
+        return Err(VdbFault::Buffers);
     }
     let background = c.take(format.value as usize)?.to_vec();
     let (tile_count, child_count) = (c.u32()?, c.u32()?);
@@ -603,7 +597,7 @@ fn value_flag(c: &mut Cursor) -> Parsed<(u8, usize, bool)> {
         3 => (0, true),
         4 => (1, true),
         5 => (2, true),
-        _ => return Err(format!("a node with compression flag {flag}")),
+        _ => return Err(VdbFault::NodeFlag(flag)),
     };
     Ok((flag, inactive, selection))
 }
@@ -637,7 +631,8 @@ fn skip_compressed_values(
         &c.data[c.pos..],
         count * format.stored as usize,
         compression,
-    )?;
+    )
+    .map_err(VdbFault::Chunk)?;
     c.pos += used;
     Ok(())
 }
@@ -690,7 +685,8 @@ fn leaf_values(
             &c.data[c.pos..],
             count * format.stored as usize,
             compression,
-        )?;
+        )
+        .map_err(VdbFault::Chunk)?;
         if format.half {
             bytes
                 .chunks_exact(2)
@@ -708,8 +704,7 @@ fn leaf_values(
     let mut next = stored.chunks_exact(components);
     for n in 0..LEAF_VOXELS {
         let value = if bit(&mask, n) {
-            next.next()
-                .ok_or("a leaf with fewer values than active voxels")?
+            next.next().ok_or(VdbFault::ShortLeaf)?
         } else if bit(&selected, n) {
             &second[..]
         } else {

@@ -4,19 +4,11 @@
 //! make it allocate gigabytes for one string, a damaged chunk size overruns a node's buffer,
 //! and a header alone reads as a file without grids.
 
+use super::vdb_format::{DELAYED_LOAD, MAGIC, NODE_MASK_VERSION};
 use super::vdb_tree_structure::{self, TreeFormat};
 use crate::error::{Error, Result};
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
-
-/// OpenVDB's magic number, the file's first eight bytes.
-const MAGIC: i64 = 0x5644_4220;
-/// The type name of OpenVDB's per-leaf delayed-load table.
-const DELAYED_LOAD: &[u8] = b"__delayedload";
-/// The first file version with compression flags at the start of each grid and a flag before
-/// each node's values (OpenVDB 2.0, 2013), the oldest read: older layouts are refused rather
-/// than read on trust.
-const NODE_MASK_VERSION: u32 = 222;
 
 pub(super) struct Reader {
     input: BufReader<std::fs::File>,

@@ -4,18 +4,14 @@
 //! the buffer's size, and blosc trusts the sizes in its own chunk header. Every chunk is
 //! checked here against what the node holds, and every node against the bytes of the grid.
 
-use super::vdb_chunks::{BLOSC_PAD_BYTES, COMPRESS_ACTIVE_MASK, COMPRESS_BLOSC, COMPRESS_ZIP};
+use super::vdb_format::{
+    BLOSC_PAD_BYTES, COMPRESS_ACTIVE_MASK, COMPRESS_BLOSC, COMPRESS_ZIP, HALF_SUFFIX,
+    LEAF_MASK_BYTES, NODE_LOG2, value_type,
+};
 use super::vdb_structure::Reader;
 use std::collections::HashSet;
 
 type Check = std::result::Result<(), String>;
-
-/// The suffix OpenVDB adds to a grid type saved at half precision.
-const HALF_SUFFIX: &str = "_HalfFloat";
-/// Log2 of the node edges of OpenVDB's standard trees (5, 4, 3), from the root's children down.
-const NODE_LOG2: [u32; 2] = [5, 4];
-/// A leaf's 8^3 voxel mask, in bytes.
-const LEAF_MASK_BYTES: u64 = 64;
 
 /// What a grid type name tells about its tree's stored values.
 #[derive(Clone, Copy)]
@@ -72,17 +68,6 @@ impl TreeFormat {
             leaf,
         })
     }
-}
-
-/// The value type of a standard tree's type name (`Tree_float_5_4_3_HalfFloat` -> `float`),
-/// empty for any other tree.
-pub(super) fn value_type(type_name: &str) -> &str {
-    type_name
-        .strip_suffix(HALF_SUFFIX)
-        .unwrap_or(type_name)
-        .strip_prefix("Tree_")
-        .and_then(|t| t.strip_suffix("_5_4_3"))
-        .unwrap_or("")
 }
 
 /// Skips a grid's transform: a map type name and the map's fixed-size data (a frustum holds

@@ -7,8 +7,10 @@
 //! blocks) in coordinate order, each with its 128^3 children and 128^3 tiles, those with
 //! their leaves and 8^3 tiles; then every leaf's buffer in the same order.
 
-use super::vdb_chunks::{
-    COMPRESS_ACTIVE_MASK, COMPRESS_BLOSC, COMPRESS_ZIP, compression_name, push_chunk,
+use super::vdb_chunks::{compression_name, push_chunk};
+use super::vdb_format::{
+    CHILD_LOG2, COMPRESS_ACTIVE_MASK, COMPRESS_BLOSC, COMPRESS_ZIP, FILE_VERSION, LIBRARY_VERSION,
+    MAGIC, NODE_LOG2, ROOT_TILE, tree_type,
 };
 use super::vdb_tree_structure::{TreeFormat, tree_memory};
 use crate::error::{Error, Result};
@@ -19,10 +21,6 @@ use std::io::Write;
 use std::path::Path;
 use std::sync::OnceLock;
 
-/// OpenVDB's magic number and the file format version written (OpenVDB 10's).
-const MAGIC: i64 = 0x5644_4220;
-const FILE_VERSION: u32 = 224;
-const LIBRARY_VERSION: [u32; 2] = [10, 0];
 /// Leaves per parallel batch of leaf buffers.
 const BATCH: usize = 2048;
 
@@ -54,12 +52,12 @@ pub(super) enum GridValues<'g> {
 }
 
 impl GridValues<'_> {
-    fn tree_type(self) -> &'static str {
-        match self {
-            GridValues::Bool => "Tree_bool_5_4_3",
-            GridValues::Normals | GridValues::Colors => "Tree_vec3s_5_4_3",
-            _ => "Tree_float_5_4_3",
-        }
+    fn tree_type(self) -> String {
+        tree_type(match self {
+            GridValues::Bool => "bool",
+            GridValues::Normals | GridValues::Colors => "vec3s",
+            _ => "float",
+        })
     }
 
     fn is_real(self) -> bool {
@@ -201,7 +199,7 @@ pub(super) fn write_grids(
         let encoded = encode_grid(path, g, encoding)?;
         let mut descriptor = Vec::new();
         push_string(&mut descriptor, g.name);
-        let mut tree_type = g.values.tree_type().to_string();
+        let mut tree_type = g.values.tree_type();
         if encoding.half && g.values.is_real() {
             tree_type.push_str("_HalfFloat");
         }
@@ -307,7 +305,11 @@ fn key(path: &Path, origin: [i64; 3]) -> Result<Key> {
         c.iter()
             .fold(0u16, |s, &v| (s << bits) | ((v >> shift) & mask) as u16)
     };
-    Ok((c.map(|v| v & !4095), slot(7, 5), slot(3, 4)))
+    Ok((
+        c.map(|v| v & !(ROOT_TILE - 1)),
+        slot(CHILD_LOG2[0], NODE_LOG2[0]),
+        slot(CHILD_LOG2[1], NODE_LOG2[1]),
+    ))
 }
 
 fn encode_grid(path: &Path, g: &GridOut, encoding: Encoding) -> Result<EncodedGrid> {
@@ -608,7 +610,7 @@ fn push_metadata(
         "file_compression",
         Meta::Str(compression_name(encoding.compression).to_string()),
     );
-    let format = TreeFormat::of(g.values.tree_type()).expect("a standard tree");
+    let format = TreeFormat::of(&g.values.tree_type()).expect("a standard tree");
     map.insert(
         "file_mem_bytes",
         Meta::Int64(tree_memory(format, internal, leaves) as i64),
