@@ -12,6 +12,9 @@ use crate::error::Result;
 use crate::grid::{Coord, DenseMask};
 use crate::progress::Progress;
 
+/// GRAYSTACK entries unless the user asks otherwise.
+pub const DEFAULT_GRAYSTACK: usize = 1 << 20;
+
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FloodXyzStats {
     /// FloodingXYZ calls.

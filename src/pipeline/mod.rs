@@ -13,9 +13,9 @@ mod report;
 pub mod request;
 mod solid;
 
+pub use crate::solids::flooded_mesh::FLOOD_NEEDS_CLOSED;
 pub use outcome::{Outcome, check_output_path};
 pub use report::*;
-pub use solid::FLOOD_NEEDS_CLOSED;
 
 use crate::error::{Error, Result};
 use crate::grid::{SparseGrid, Transform};

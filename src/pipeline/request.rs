@@ -18,6 +18,7 @@ use crate::implicit::{Coordinates, ThetaRange};
 use crate::io::vdb::{Compression, WriteOptions};
 use crate::mesh::{DEFAULT_RESOLUTION, GridFit, UpAxis};
 use crate::ops::csg::BooleanOp;
+use crate::ops::flood_xyz::DEFAULT_GRAYSTACK;
 use crate::solids::beam::BeamFill;
 use crate::solids::depth_layers::{DepthLayerOptions, DirectionSet, Layers, Unclassified};
 use crate::solids::exterior_flood::FloodMethod;
@@ -28,8 +29,6 @@ use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-/// GRAYSTACK entries of FloodingXYZ unless asked otherwise.
-const GRAYSTACK: usize = 1 << 20;
 /// The distance band's half width in voxels unless asked otherwise.
 const BAND: f64 = 3.0;
 /// Mass per unit volume unless asked otherwise.
@@ -304,7 +303,7 @@ request! {
         /// The exterior flood: blocks (fastest), spans, or xyz (Lai & Cheng's FloodingXYZ).
         flood: FloodKind = FloodKind::default(),
         /// GRAYSTACK capacity of the xyz flood (entries; when full, sweeps resume the flood).
-        graystack: usize = GRAYSTACK,
+        graystack: usize = DEFAULT_GRAYSTACK,
         /// Depth layers: a count of the 16 built-in directions, or integer (x, y, z)
         /// triples, each with a component of 1 or -1, none parallel.
         directions: Directions = Directions::Count(16),
@@ -334,7 +333,7 @@ request! {
         /// The exterior flood: blocks (fastest), spans, or xyz (Lai & Cheng's FloodingXYZ).
         flood: FloodKind = FloodKind::default(),
         /// GRAYSTACK capacity of the xyz flood (entries; when full, sweeps resume the flood).
-        graystack: usize = GRAYSTACK,
+        graystack: usize = DEFAULT_GRAYSTACK,
         /// Mass per unit volume.
         density: f64 = DENSITY,
     }
@@ -353,7 +352,7 @@ request! {
         /// The solid of the closed limit surface, with its volume and mass.
         solid: bool = false,
         /// GRAYSTACK capacity of FloodingXYZ (entries).
-        graystack: usize = GRAYSTACK,
+        graystack: usize = DEFAULT_GRAYSTACK,
         /// Mass per unit volume.
         density: f64 = DENSITY,
         /// Also count components and genus.

@@ -10,28 +10,20 @@ use super::report::{
 };
 use super::{Fill, SubdivisionFill};
 use crate::error::Result;
-use crate::grid::{Adjacency, DenseMask, SparseGrid, Transform};
+use crate::grid::{DenseMask, SparseGrid, Transform};
 use crate::io::vdb::MetaValue;
 use crate::mesh::{GridFit, Mesh, index_box};
-use crate::ops::flood::padded;
-use crate::ops::topology::{components, euler_characteristic};
 use crate::progress::Progress;
 use crate::solids::beam::{BeamFill, beam_solid};
 use crate::solids::csg_tree::CsgTree;
 use crate::solids::depth_layers::{Layers, depth_layer_solid};
-use crate::solids::exterior_flood::{FloodMethod, Solid, solid_from_surface};
+use crate::solids::exterior_flood::{FloodMethod, Solid};
+use crate::solids::flooded_mesh::{self, SurfaceAndInside};
 use crate::solids::level_set::{level_set, unsigned_distance};
 use crate::subd::ControlMesh;
-use crate::voxelize::Separability;
 use crate::voxelize::parametric::ParametricOptions;
-use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 use rayon::prelude::*;
 use std::time::Instant;
-
-/// Why the flood needs a closed mesh, for the error that refuses an open one.
-pub const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it and leave the solid hollow \
-     (the depth-layers method, option `method`, reports which voxels an open mesh leaves \
-     undecidable)";
 
 /// What inside means for the exterior flood.
 const FLOOD_RULE: &str =
@@ -43,27 +35,6 @@ const SUBDIVISION_RULE: &str = "inside = what FloodingXYZ reaches from the seeds
 /// What inside means for the beams, by fill.
 const BEAM_RULE: &str = "inside = the beams between front and back faces along z (centres between crossings 1-2, 3-4, ...)";
 const BEAM_PAPER_RULE: &str = "inside = the beams along z from each back-face voxel up to the next front-face voxel (Jegathese et al.)";
-
-/// The 26-separating surface a flood fills.
-fn flood_surface(mesh: &Mesh, t: Transform, progress: &Progress) -> Result<SparseGrid> {
-    mesh.require_closed(FLOOD_NEEDS_CLOSED)?;
-    let options = SeparatingOptions {
-        separability: Separability::TwentySix,
-        ..Default::default()
-    };
-    Ok(voxelize_mesh(mesh, t, &options, progress)?.0)
-}
-
-/// Components (26-connected) and genus (components - Euler characteristic) of the whole
-/// solid, surface and inside.
-fn topology(whole: &SparseGrid) -> Result<(u64, i64)> {
-    let Some(bbox) = whole.bbox() else {
-        return Ok((0, 0));
-    };
-    let all = DenseMask::from_grid(whole, padded(bbox, 1))?;
-    let parts = components(&all, Adjacency::TwentySix);
-    Ok((parts, parts as i64 - euler_characteristic(&all)))
-}
 
 /// The report of a surface and the solid inside it (with components and genus when
 /// `with_topology`).
@@ -77,7 +48,7 @@ fn solid_details(
 ) -> Result<SolidDetails> {
     let m = solid.measures;
     let (components, genus) = if with_topology {
-        let (c, g) = topology(whole)?;
+        let (c, g) = flooded_mesh::topology(whole)?;
         (Some(c), Some(g))
     } else {
         (None, None)
@@ -108,14 +79,15 @@ fn solid_details(
 /// A surface plus the voxels inside it: `density` on both, `shell` and `interior` apart.
 /// `describe` reports on the whole solid.
 fn surface_and_inside(
-    surface: SparseGrid,
-    solid: Solid,
+    parts: SurfaceAndInside,
     meta: Vec<(&str, MetaValue)>,
     describe: impl FnOnce(&SparseGrid, &Solid) -> Result<SolidDetails>,
 ) -> Result<Outcome> {
-    // The inside is mostly tiles: start from it and add the surface's leaves.
-    let mut whole = solid.inside.clone();
-    whole.union(&surface);
+    let SurfaceAndInside {
+        surface,
+        solid,
+        whole,
+    } = parts;
     let details = describe(&whole, &solid)?;
     Ok(Outcome::new(whole, meta, Details::Solid(details))
         .with("shell", surface)
@@ -151,10 +123,9 @@ pub(super) fn mesh_solid(
     let meta = |method: &str| provenance(method, &source, fit);
     let outcome = match fill {
         Fill::Flood(flood) => {
-            let surface = flood_surface(mesh, t, progress)?;
-            let solid = solid_from_surface(&surface, flood, progress)?;
+            let parts = flooded_mesh::flooded_mesh(mesh, t, flood, progress)?;
             let method = meta("huang-26-separating-surface+exterior-flood");
-            surface_and_inside(surface, solid, method, |whole, solid| {
+            surface_and_inside(parts, method, |whole, solid| {
                 solid_details(whole, solid, density, FLOOD_RULE, Some(mesh), topology)
             })?
         }
@@ -166,10 +137,10 @@ pub(super) fn mesh_solid(
             };
             let mut method = meta(name);
             method.push(("color", "none".into()));
-            let mut outcome =
-                surface_and_inside(beam.surface, beam.solid, method, |whole, solid| {
-                    solid_details(whole, solid, density, rule, Some(mesh), topology)
-                })?;
+            let parts = SurfaceAndInside::of(beam.surface, beam.solid);
+            let mut outcome = surface_and_inside(parts, method, |whole, solid| {
+                solid_details(whole, solid, density, rule, Some(mesh), topology)
+            })?;
             if beam.unclosed_beams > 0 {
                 outcome.report.warnings.push(format!(
                     "{} beams opened by a back face were not closed by a front face in their column and were left empty",
@@ -284,8 +255,7 @@ pub(super) fn measure_mesh(
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
-    let surface = flood_surface(mesh, t, progress)?;
-    let solid = solid_from_surface(&surface, flood, progress)?;
+    let parts = flooded_mesh::flooded_mesh(mesh, t, flood, progress)?;
     let meta = vec![
         (
             "method",
@@ -293,7 +263,7 @@ pub(super) fn measure_mesh(
         ),
         ("source_file", mesh.source.display().to_string().into()),
     ];
-    let outcome = surface_and_inside(surface, solid, meta, |whole, solid| {
+    let outcome = surface_and_inside(parts, meta, |whole, solid| {
         let details = solid_details(whole, solid, density, FLOOD_RULE, Some(mesh), true)?;
         Ok(SolidDetails {
             mesh_area: Some(mesh.area()),
@@ -311,13 +281,13 @@ pub(super) fn measure_surface(
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
-    let solid = solid_from_surface(surface, flood, progress)?;
+    let parts = SurfaceAndInside::flooded(surface.clone(), flood, progress)?;
     progress.advance(1);
     let meta = vec![
         ("method", "exterior-flood".into()),
         ("source_file", source.into()),
     ];
-    let outcome = surface_and_inside(surface.clone(), solid, meta, |whole, solid| {
+    let outcome = surface_and_inside(parts, meta, |whole, solid| {
         solid_details(whole, solid, density, FLOOD_RULE, None, true)
     })?;
     Ok(outcome.timed(start))
@@ -373,7 +343,8 @@ pub(super) fn subdivision_solid(
     meta.push(("outside_seeds", made.outside_seeds.into()));
     let (limit_volume, limit_area) = (made.limit_volume, made.limit_area);
     let opposite = made.surface.opposite;
-    let outcome = surface_and_inside(made.surface.surface, made.solid, meta, |whole, solid| {
+    let parts = SurfaceAndInside::of(made.surface.surface, made.solid);
+    let outcome = surface_and_inside(parts, meta, |whole, solid| {
         let mut details = solid_details(
             whole,
             solid,

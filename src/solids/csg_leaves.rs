@@ -8,6 +8,7 @@ use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::mesh::{Aabb, Mesh, index_box};
 use crate::ops::csg::{resample, same_transform};
+use crate::ops::flood_xyz::DEFAULT_GRAYSTACK;
 use crate::progress::Progress;
 use crate::shapes::{Cuboid, Cylinder, Sphere};
 use crate::solids::depth_layers::{DepthLayerOptions, Layers, depth_layer_solid};
@@ -158,10 +159,11 @@ pub fn subdivision_leaf(
         control,
         *transform,
         &Default::default(),
-        1 << 20,
+        DEFAULT_GRAYSTACK,
         &Progress::none(),
     )?;
-    DenseMask::from_grid(&crate::solids::subdivision::whole(&made), bbox)
+    let whole = super::flooded_mesh::SurfaceAndInside::of(made.surface.surface, made.solid).whole;
+    DenseMask::from_grid(&whole, bbox)
 }
 
 /// The active voxels of `grid` on `transform` (resampled when the transforms differ) that

@@ -8,5 +8,6 @@ pub mod csg_leaves;
 pub mod csg_tree;
 pub mod depth_layers;
 pub mod exterior_flood;
+pub mod flooded_mesh;
 pub mod level_set;
 pub mod subdivision;

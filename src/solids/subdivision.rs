@@ -18,7 +18,7 @@
 //!   later seeds in that region are skipped. If no seed stays inside, the solid is refused.
 
 use crate::error::{Error, Result};
-use crate::grid::{Coord, DenseMask, SparseGrid, Transform};
+use crate::grid::{Coord, DenseMask, Transform};
 use crate::ops::flood::padded;
 use crate::ops::flood_xyz::{FloodXyzStats, flood_xyz};
 use crate::ops::measure::SolidMeasures;
@@ -126,11 +126,4 @@ pub fn subdivision_solid(
         limit_volume: limit_volume.abs(),
         limit_area,
     })
-}
-
-/// The solid as one grid: surface and inside.
-pub fn whole(solid: &SubdivisionSolid) -> SparseGrid {
-    let mut whole = solid.solid.inside.clone();
-    whole.union(&solid.surface.surface);
-    whole
 }

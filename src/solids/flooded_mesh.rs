@@ -1,0 +1,75 @@
+//! A closed mesh's solid as Lai & Cheng compose it: the mesh's 26-separating surface (Huang
+//! et al.) and every voxel the exterior flood cannot reach through it; and the measures of
+//! the whole solid's shape, its components and genus.
+
+use super::exterior_flood::{FloodMethod, Solid, solid_from_surface};
+use crate::error::Result;
+use crate::grid::{Adjacency, DenseMask, SparseGrid, Transform};
+use crate::mesh::Mesh;
+use crate::ops::flood::padded;
+use crate::ops::topology::{components, euler_characteristic};
+use crate::progress::Progress;
+use crate::voxelize::Separability;
+use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
+
+/// Why the flood needs a closed mesh, for the error that refuses an open one.
+pub const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it and leave the solid hollow \
+     (the depth-layers method, option `method`, reports which voxels an open mesh leaves \
+     undecidable)";
+
+/// A surface, the solid inside it, and the two together.
+pub struct SurfaceAndInside {
+    pub surface: SparseGrid,
+    pub solid: Solid,
+    /// Surface and inside: the whole solid.
+    pub whole: SparseGrid,
+}
+
+impl SurfaceAndInside {
+    pub fn of(surface: SparseGrid, solid: Solid) -> SurfaceAndInside {
+        // The inside is mostly tiles: start from it and add the surface's leaves.
+        let mut whole = solid.inside.clone();
+        whole.union(&surface);
+        SurfaceAndInside {
+            surface,
+            solid,
+            whole,
+        }
+    }
+
+    /// The closed `surface` and what `flood` cannot reach from outside.
+    pub fn flooded(surface: SparseGrid, flood: FloodMethod, progress: &Progress) -> Result<Self> {
+        let solid = solid_from_surface(&surface, flood, progress)?;
+        Ok(SurfaceAndInside::of(surface, solid))
+    }
+}
+
+/// The 26-separating surface of a closed mesh, the surface a flood fills.
+pub fn flood_surface(mesh: &Mesh, t: Transform, progress: &Progress) -> Result<SparseGrid> {
+    mesh.require_closed(FLOOD_NEEDS_CLOSED)?;
+    let options = SeparatingOptions {
+        separability: Separability::TwentySix,
+        ..Default::default()
+    };
+    Ok(voxelize_mesh(mesh, t, &options, progress)?.0)
+}
+
+/// A closed mesh's solid: its 26-separating surface flooded by `flood`.
+pub fn flooded_mesh(
+    mesh: &Mesh,
+    t: Transform,
+    flood: FloodMethod,
+    progress: &Progress,
+) -> Result<SurfaceAndInside> {
+    SurfaceAndInside::flooded(flood_surface(mesh, t, progress)?, flood, progress)
+}
+
+/// Components (26-connected) and genus (components - Euler characteristic) of a solid.
+pub fn topology(whole: &SparseGrid) -> Result<(u64, i64)> {
+    let Some(bbox) = whole.bbox() else {
+        return Ok((0, 0));
+    };
+    let all = DenseMask::from_grid(whole, padded(bbox, 1))?;
+    let parts = components(&all, Adjacency::TwentySix);
+    Ok((parts, parts as i64 - euler_characteristic(&all)))
+}
