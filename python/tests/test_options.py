@@ -107,3 +107,13 @@ def test_pyopenvdb_reads_the_fit_and_separability_as_numbers(tmp_path):
     mesh = pyopenvdb.readAllGridMetadata(str(tmp_path / "h.vdb"))[0]
     assert mesh["voxel_size"] == 0.125 and isinstance(mesh["voxel_size"], float)
     assert mesh["separability"] == 6 and isinstance(mesh["separability"], int)
+
+
+def test_bad_dask_numbers_are_value_errors_naming_the_option(data, tmp_path):
+    distributed = pytest.importorskip("voxelkit.distributed")
+    path = data / "meshes" / "bunny-closed.obj"
+    with pytest.raises(ValueError, match="brick"):
+        distributed.mesh(path, tmp_path / "b.vdb", brick=-8)
+    with pytest.raises(ValueError, match="brick size must be a positive multiple of 8"):
+        distributed.mesh(path, tmp_path / "b.vdb", brick=12)
+    assert not list(tmp_path.iterdir())

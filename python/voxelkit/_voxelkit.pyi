@@ -195,13 +195,14 @@ class BrickPlan:
 
 def brick_plan(
     source: MeshSource,
-    brick: int,
+    solid: bool = False,
+    output: Optional[Path] = None,
+    brick: int = 1024,
     resolution: Optional[int] = None,
     voxel_size: Optional[float] = None,
-    solid: bool = False,
     up_axis: str = "z",
-    output: Optional[Path] = None,
-) -> BrickPlan: ...
+) -> BrickPlan:
+    """The plan of a distributed run; the keywords are OPTIONS["distributed"]'s."""
 def brick_surface_file(
     positions: npt.NDArray[np.float64],
     indices: npt.NDArray[np.uint32],

@@ -217,8 +217,8 @@ def run(
     start = time.perf_counter()
     output = os.fspath(output)
     plan = vk.brick_plan(
-        source, brick, resolution=resolution, voxel_size=voxel_size, solid=solid,
-        up_axis=up_axis, output=output,
+        source, solid=solid, output=output, brick=brick, resolution=resolution,
+        voxel_size=voxel_size, up_axis=up_axis,
     )
     folder = os.path.splitext(output)[0] + ".bricks"
     if os.path.exists(folder):

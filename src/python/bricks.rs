@@ -5,27 +5,26 @@
 
 use super::arrays::mesh_source;
 use super::grid::Grid;
+use super::jobs::Call;
 use super::to_py_err;
+use crate::choice::Choice;
 use crate::error::Result;
-use crate::grid::{CoordBox, Transform};
-use crate::io::brick_set::{BrickSet, brick_voxels};
-use crate::io::vdb::{WriteOptions, check_voxel_size, write_vdb_as};
-use crate::mesh::{GridFit, Mesh, UpAxis};
+use crate::io::brick_set::BrickSet;
+use crate::io::vdb::WriteOptions;
+use crate::mesh::Mesh;
 use crate::pipeline::Outcome;
 use crate::pipeline::brick_exterior::exterior_labels;
-use crate::pipeline::bricks::{
-    BrickIndex, BrickLayout, BrickOutside, FACES, brick_surface, check_brick_fits, sub_mesh,
-};
-use crate::progress::Progress;
+use crate::pipeline::bricks::{BrickIndex, BrickJob, BrickRun, sub_mesh, write_brick};
+use crate::pipeline::request::{BricksRequest, mib_limit};
 use crate::voxelize::Separability;
-use crate::voxelize::separating::SeparatingOptions;
 use glam::DVec3;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// A brick index as Python sees it: a tuple, so that it can key a dict.
 type PyBrick = (i64, i64, i64);
@@ -40,46 +39,42 @@ fn from_py(b: PyBrick) -> BrickIndex {
 
 /// A mesh placed on its grid and cut into bricks, with the faces each brick receives.
 #[pyclass(module = "voxelkit")]
-pub struct BrickPlan {
-    mesh: Mesh,
-    layout: BrickLayout,
-    bins: BTreeMap<BrickIndex, Vec<u32>>,
-}
+pub struct BrickPlan(BrickRun);
 
 #[pymethods]
 impl BrickPlan {
     /// World position of the centre of voxel (0, 0, 0).
     #[getter]
     fn origin(&self) -> [f64; 3] {
-        self.layout.transform.origin.to_array()
+        self.0.layout.transform.origin.to_array()
     }
 
     #[getter]
     fn voxel_size(&self) -> f64 {
-        self.layout.transform.voxel_size
+        self.0.layout.transform.voxel_size
     }
 
     /// Voxels along a brick's edge.
     #[getter]
     fn size(&self) -> i64 {
-        self.layout.size
+        self.0.layout.size
     }
 
     /// The first and last brick along each axis.
     #[getter]
     fn extent(&self) -> (PyBrick, PyBrick) {
-        (to_py(self.layout.min), to_py(self.layout.max))
+        (to_py(self.0.layout.min), to_py(self.0.layout.max))
     }
 
     /// The bricks that receive faces.
     #[getter]
     fn bricks(&self) -> Vec<PyBrick> {
-        self.bins.keys().copied().map(to_py).collect()
+        self.0.bins.keys().copied().map(to_py).collect()
     }
 
     #[getter]
     fn face_count(&self) -> usize {
-        self.mesh.face_count()
+        self.0.mesh.face_count()
     }
 
     /// The faces brick `b` receives, as (positions, indices, starts).
@@ -93,8 +88,8 @@ impl BrickPlan {
         Bound<'py, PyArray1<u32>>,
         Bound<'py, PyArray1<u32>>,
     ) {
-        let faces = self.bins.get(&from_py(b)).map_or(&[][..], Vec::as_slice);
-        let sub = sub_mesh(&self.mesh, faces);
+        let faces = self.0.bins.get(&from_py(b)).map_or(&[][..], Vec::as_slice);
+        let sub = sub_mesh(&self.0.mesh, faces);
         let flat: Vec<f64> = sub.positions.iter().flat_map(|p| p.to_array()).collect();
         (
             Array2::from_shape_vec((sub.positions.len(), 3), flat)
@@ -106,104 +101,55 @@ impl BrickPlan {
     }
 }
 
-/// Reads the mesh (as the CLI does), places it on the grid a single run would use, and cuts
-/// it into bricks of `brick` voxels; `solid`: the mesh must be closed.
+/// The plan of a distributed run (`BricksRequest`'s options as keywords: `brick`,
+/// `resolution`, `voxel_size`, `up_axis`): the mesh read, checked, fitted and cut into bricks
+/// by the pipeline; `solid`: the mesh must be closed.
 #[pyfunction]
-#[pyo3(signature = (source, brick, resolution = None, voxel_size = None, solid = false,
-    up_axis = "z", output = None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (source, solid = false, output = None, **options))]
 pub fn brick_plan(
     py: Python<'_>,
     source: &Bound<'_, PyAny>,
-    brick: u32,
-    resolution: Option<u32>,
-    voxel_size: Option<f64>,
     solid: bool,
-    up_axis: &str,
     output: Option<PathBuf>,
+    options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<BrickPlan> {
     let source = mesh_source(source)?;
-    let up: UpAxis = up_axis.parse().map_err(PyValueError::new_err)?;
-    let fit = GridFit::from_options(resolution, voxel_size);
-    py.detach(|| -> Result<BrickPlan> {
-        let mesh = source.load(false, up)?;
-        if solid {
-            mesh.require_closed(crate::pipeline::FLOOD_NEEDS_CLOSED)?;
-        }
-        let layout = BrickLayout::new(&mesh, fit, brick)?;
-        let named = output.unwrap_or_else(|| PathBuf::from("the bricks"));
-        check_voxel_size(&named, layout.transform.voxel_size)?;
-        let bins = layout.bin_faces(&mesh);
-        Ok(BrickPlan { mesh, layout, bins })
-    })
-    .map_err(to_py_err)
+    let request: BricksRequest = Call::new(options)?.request;
+    let named = output.unwrap_or_else(|| PathBuf::from("the bricks"));
+    py.detach(|| BrickRun::plan(&source, &request, solid, &named))
+        .map(BrickPlan)
+        .map_err(to_py_err)
 }
 
-/// One brick's work: its faces, grid and voxels.
-struct BrickJob {
-    faces: Mesh,
-    transform: Transform,
-    voxels: CoordBox,
-}
-
-impl BrickJob {
-    fn new(
-        positions: PyReadonlyArray2<f64>,
-        indices: PyReadonlyArray1<u32>,
-        starts: PyReadonlyArray1<u32>,
-        origin: [f64; 3],
-        voxel_size: f64,
-        brick: BrickIndex,
-        size: i64,
-    ) -> PyResult<BrickJob> {
-        let p = positions.as_array();
-        let faces = Mesh {
-            positions: p
-                .rows()
-                .into_iter()
-                .map(|r| DVec3::new(r[0], r[1], r[2]))
-                .collect(),
-            indices: indices.as_array().to_vec(),
-            face_starts: starts.as_array().to_vec(),
-            source: "a brick's faces".into(),
-            numbered_from_zero: true,
-            ..Default::default()
-        };
-        faces.validate().map_err(to_py_err)?;
-        Ok(BrickJob {
-            faces,
-            transform: Transform::new(DVec3::from_array(origin), voxel_size),
-            voxels: brick_voxels(brick, size),
-        })
-    }
-
-    fn surface(
-        &self,
-        separability: Separability,
-        solid: bool,
-        max_memory_mib: Option<u64>,
-    ) -> Result<crate::grid::SparseGrid> {
-        let limit = max_memory_mib.map(|m| m.saturating_mul(1 << 20));
-        check_brick_fits(&self.faces, &self.transform, self.voxels, solid, limit)?;
-        let options = SeparatingOptions {
-            separability,
-            ..Default::default()
-        };
-        brick_surface(
-            &self.faces,
-            self.transform,
-            self.voxels,
-            &options,
-            &Progress::none(),
-        )
-    }
-}
-
-/// Writes `grid` to `path` (atomically) and returns its voxel count.
-fn write_brick(grid: &crate::grid::SparseGrid, path: &Path) -> Result<u64> {
-    let meta = [("method", "voxelkit brick".into())];
-    write_vdb_as(path, grid, &[], &meta, &WriteOptions::default())?;
-    Ok(grid.voxel_count())
+/// One brick's job from its arrays: positions (k, 3), the faces' vertex indices back to back,
+/// and where each face starts.
+#[allow(clippy::too_many_arguments)]
+fn brick_job(
+    positions: PyReadonlyArray2<f64>,
+    indices: PyReadonlyArray1<u32>,
+    starts: PyReadonlyArray1<u32>,
+    origin: [f64; 3],
+    voxel_size: f64,
+    brick: PyBrick,
+    size: i64,
+    max_memory_mib: Option<u64>,
+) -> PyResult<BrickJob> {
+    let faces = Mesh {
+        positions: positions
+            .as_array()
+            .rows()
+            .into_iter()
+            .map(|r| DVec3::new(r[0], r[1], r[2]))
+            .collect(),
+        indices: indices.as_array().to_vec(),
+        face_starts: starts.as_array().to_vec(),
+        source: "a brick's faces".into(),
+        numbered_from_zero: true,
+        ..Default::default()
+    };
+    let origin = DVec3::from_array(origin);
+    let limit = mib_limit(max_memory_mib);
+    BrickJob::new(faces, origin, voxel_size, from_py(brick), size, limit).map_err(to_py_err)
 }
 
 /// A brick's part of the separating surface, written to `path`; returns its voxel count.
@@ -224,20 +170,19 @@ pub fn brick_surface_file(
     separability: u32,
     max_memory_mib: Option<u64>,
 ) -> PyResult<u64> {
-    let job = BrickJob::new(
+    let job = brick_job(
         positions,
         indices,
         starts,
         origin,
         voxel_size,
-        from_py(brick),
+        brick,
         size,
+        max_memory_mib,
     )?;
-    let separability: Separability = separability
-        .to_string()
-        .parse()
-        .map_err(PyValueError::new_err)?;
-    py.detach(|| write_brick(&job.surface(separability, false, max_memory_mib)?, &path))
+    let separability =
+        Separability::from_number(i64::from(separability)).map_err(PyValueError::new_err)?;
+    py.detach(|| write_brick(&job.surface(separability, false)?, &path))
         .map_err(to_py_err)
 }
 
@@ -258,22 +203,17 @@ pub fn brick_faces<'py>(
     size: i64,
     max_memory_mib: Option<u64>,
 ) -> PyResult<Vec<Bound<'py, PyArray1<u32>>>> {
-    let job = BrickJob::new(
+    let job = brick_job(
         positions,
         indices,
         starts,
         origin,
         voxel_size,
-        from_py(brick),
+        brick,
         size,
+        max_memory_mib,
     )?;
-    let faces = py
-        .detach(|| -> Result<Vec<Vec<u32>>> {
-            let surface = job.surface(Separability::TwentySix, true, max_memory_mib)?;
-            let outside = BrickOutside::label(&surface, job.voxels)?;
-            Ok((0..FACES).map(|f| outside.face(f)).collect())
-        })
-        .map_err(to_py_err)?;
+    let faces = py.detach(|| job.face_labels()).map_err(to_py_err)?;
     Ok(faces
         .into_iter()
         .map(|f| Array1::from_vec(f).into_pyarray(py))
@@ -299,22 +239,18 @@ pub fn brick_solid_file(
     path: PathBuf,
     max_memory_mib: Option<u64>,
 ) -> PyResult<u64> {
-    let job = BrickJob::new(
+    let job = brick_job(
         positions,
         indices,
         starts,
         origin,
         voxel_size,
-        from_py(brick),
+        brick,
         size,
+        max_memory_mib,
     )?;
-    exterior.sort_unstable();
-    py.detach(|| {
-        let surface = job.surface(Separability::TwentySix, true, max_memory_mib)?;
-        let outside = BrickOutside::label(&surface, job.voxels)?;
-        write_brick(&outside.solid(&surface, &exterior), &path)
-    })
-    .map_err(to_py_err)
+    py.detach(|| write_brick(&job.solid(&mut exterior)?, &path))
+        .map_err(to_py_err)
 }
 
 /// The exterior labels of every brick of `plan`, from the face labels of the bricks that
@@ -334,7 +270,7 @@ pub fn brick_exterior(
             )
         })
         .collect();
-    let layout = plan.layout;
+    let layout = plan.0.layout;
     let exterior = py
         .detach(|| exterior_labels(&layout, &faces))
         .map_err(to_py_err)?;
@@ -355,9 +291,9 @@ pub fn brick_finish(
 ) -> PyResult<Option<Grid>> {
     let set = BrickSet {
         format: crate::io::brick_set::BRICK_SET_FORMAT.into(),
-        voxel_size: plan.layout.transform.voxel_size,
-        origin: plan.layout.transform.origin.to_array(),
-        brick_size: plan.layout.size,
+        voxel_size: plan.0.layout.transform.voxel_size,
+        origin: plan.0.layout.transform.origin.to_array(),
+        brick_size: plan.0.layout.size,
         bricks: files
             .into_iter()
             .map(|(brick, file)| crate::io::brick_set::BrickFile {

@@ -60,14 +60,14 @@ fn to_json(v: &Bound<'_, PyAny>) -> Result<Value, String> {
 }
 
 /// One call's request, limits and progress function, from its keyword arguments.
-struct Call<R> {
-    request: R,
+pub(super) struct Call<R> {
+    pub(super) request: R,
     limits: LimitsRequest,
     progress: Option<Py<PyAny>>,
 }
 
 impl<R: Schema> Call<R> {
-    fn new(options: Option<&Bound<'_, PyDict>>) -> PyResult<Call<R>> {
+    pub(super) fn new(options: Option<&Bound<'_, PyDict>>) -> PyResult<Call<R>> {
         let own: Vec<&str> = R::fields().iter().map(|f| f.name).collect();
         let limits: Vec<&str> = LimitsRequest::fields().iter().map(|f| f.name).collect();
         let (mut fields, mut limit_fields) = (Map::new(), Map::new());
