@@ -716,3 +716,106 @@ fn a_tampered_brick_index_is_refused_alike_by_info_and_read_vdb() {
         );
     }
 }
+
+#[test]
+fn a_ply_declaring_a_property_or_an_element_twice_is_refused_at_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let body = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+    for (header, why, line) in [
+        (
+            "element vertex 4\nproperty float x\nproperty float x\nproperty float y\nproperty float z\n",
+            "the property `x` of element `vertex` is declared twice",
+            5,
+        ),
+        (
+            "element vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 4\nproperty list uchar int vertex_indices\nelement face 4\nproperty list uchar int vertex_indices\n",
+            "the element `face` is declared twice",
+            9,
+        ),
+    ] {
+        let ply = dir.path().join("twice.ply");
+        std::fs::write(
+            &ply,
+            format!("ply\nformat ascii 1.0\n{header}end_header\n{body}"),
+        )
+        .unwrap();
+        let e = Mesh::load(&ply).expect_err(why);
+        assert!(e.to_string().contains(why), "{e}");
+        assert_eq!(e.location().1, Some(line), "{e}");
+    }
+}
+
+/// A closed box of side `side` centred at the origin, as an OBJ.
+fn cube_obj(dir: &Path, side: f64) -> std::path::PathBuf {
+    let h = side / 2.0;
+    let mut text = String::new();
+    for i in 0..8 {
+        let c = |bit: usize| if i & bit != 0 { h } else { -h };
+        text += &format!("v {} {} {}\n", c(1), c(2), c(4));
+    }
+    text += "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+    let path = dir.join("cube.obj");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn distances_beyond_half_precision_are_refused_not_written_as_infinities() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = cube_obj(dir.path(), 4e6);
+    let out = dir.path().join("big.vdb");
+    let (c, o) = (cube.to_str().unwrap(), out.to_str().unwrap());
+    let refused = voxelkit(&["--half", "mesh", c, "--sdf", "-r", "32", "-o", o]);
+    assert!(!refused.status.success(), "{}", text(&refused));
+    assert!(
+        text(&refused).contains("exceed half precision's range (65504)"),
+        "{}",
+        text(&refused)
+    );
+    assert!(!out.exists());
+    let full = voxelkit(&["mesh", c, "--sdf", "-r", "32", "-o", o]);
+    assert!(full.status.success(), "{}", text(&full));
+}
+
+#[test]
+fn a_band_that_is_not_a_positive_finite_number_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = cube_obj(dir.path(), 1.0);
+    let out = dir.path().join("b.vdb");
+    for band in ["nan", "inf", "-1", "0"] {
+        for command in ["mesh", "solid"] {
+            let o = voxelkit(&[
+                command,
+                cube.to_str().unwrap(),
+                "--sdf",
+                &format!("--band={band}"),
+                "-o",
+                out.to_str().unwrap(),
+            ]);
+            assert!(!o.status.success(), "{command} --band {band}");
+            assert!(
+                text(&o).contains("band must be a positive number"),
+                "{command} --band {band}: {}",
+                text(&o)
+            );
+        }
+    }
+    assert!(!out.exists());
+}
+
+#[test]
+fn one_input_with_an_out_dir_that_does_not_exist_makes_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = cube_obj(dir.path(), 1.0);
+    let folder = dir.path().join("new/deeper");
+    let o = voxelkit(&[
+        "mesh",
+        cube.to_str().unwrap(),
+        "-r",
+        "16",
+        "--out-dir",
+        folder.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(folder.join("cube.vdb").exists());
+}

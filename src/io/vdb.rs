@@ -252,6 +252,9 @@ pub fn write_distance_band(
     if grid.leaves().iter().any(|l| l.value.is_none()) {
         return Err(vdb_error(path, "a distance band needs distances"));
     }
+    if options.half {
+        check_half_range(path, grid, background)?;
+    }
     let meta = meta_entries(metadata);
     let grid_out = |name, grid, values, class| GridOut {
         name,
@@ -291,6 +294,26 @@ pub fn write_distance_band(
         )],
     };
     write_chosen(path, grids, options)
+}
+
+/// Refuses half precision for distances beyond its range (65504), which it would store as
+/// infinities.
+fn check_half_range(path: &Path, grid: &SparseGrid, background: f32) -> Result<()> {
+    let largest = grid
+        .leaves()
+        .par_iter()
+        .filter_map(|l| l.value.as_deref())
+        .map(|values| values.iter().fold(0f32, |m, v| m.max(v.abs())))
+        .reduce(|| background.abs(), f32::max);
+    let most = half::f16::MAX.to_f32();
+    if largest > most {
+        return Err(Error::InvalidArgument(format!(
+            "{}: distances up to {largest} exceed half precision's range ({most}) and would be \
+             written as infinities; write at full precision (without option `half`)",
+            path.display()
+        )));
+    }
+    Ok(())
 }
 
 fn open(path: &Path) -> Result<VdbFile> {

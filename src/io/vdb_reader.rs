@@ -434,6 +434,12 @@ fn read_transform(c: &mut Cursor) -> Parsed<([f64; 3], [f64; 3], bool)> {
     linear_map(c, &name)
 }
 
+/// How far, relative to the voxel size, a matrix entry may stray from a uniform scale: a
+/// transform composed in single precision, or beside a large translation, rounds its
+/// diagonal apart by some 1e-8 (0.01 and 0.0099999998); a millionth keeps every voxel of a
+/// 2^20-voxel grid within a voxel of where the uniform scale puts it.
+const UNIFORM_SCALE_TOLERANCE: f64 = 1e-6;
+
 fn linear_map(c: &mut Cursor, name: &str) -> Parsed<([f64; 3], [f64; 3], bool)> {
     // Rows of the 4x4 matrix that maps (i, j, k, 1) to world coordinates.
     let rows: [[f64; 3]; 4] = match name {
@@ -466,7 +472,7 @@ fn linear_map(c: &mut Cursor, name: &str) -> Parsed<([f64; 3], [f64; 3], bool)> 
     };
     let size = std::array::from_fn(|a| rows[a].iter().map(|v| v * v).sum::<f64>().sqrt());
     let h = rows[0][0];
-    let close = |v: f64, want: f64| (v - want).abs() <= 1e-9 * h.abs();
+    let close = |v: f64, want: f64| (v - want).abs() <= UNIFORM_SCALE_TOLERANCE * h.abs();
     let uniform =
         h > 0.0 && (0..3).all(|a| (0..3).all(|b| close(rows[a][b], if a == b { h } else { 0.0 })));
     Ok((size, rows[3], uniform))

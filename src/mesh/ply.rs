@@ -9,6 +9,7 @@ use crate::error::{Error, Result};
 use glam::{DVec3, Vec3};
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Property};
+use std::io::Read;
 use std::path::Path;
 
 fn parse_error(path: &Path, message: String) -> Error {
@@ -47,9 +48,53 @@ fn indices(p: &Property) -> Option<Vec<i64>> {
     })
 }
 
+/// Refuses a header that declares an element twice, or a property twice in one element: the
+/// parser keeps one declaration of each name, so the file would be read as neither.
+fn check_header_names(path: &Path, reader: &mut impl std::io::BufRead) -> Result<()> {
+    let mut elements: Vec<(String, Vec<String>)> = Vec::new();
+    let mut line = Vec::new();
+    for number in 1.. {
+        line.clear();
+        let read = reader
+            .read_until(b'\n', &mut line)
+            .map_err(|e| Error::io(path, e))?;
+        let text = String::from_utf8_lossy(&line);
+        let words: Vec<&str> = text.split_whitespace().collect();
+        let at = |message: String| Error::Parse {
+            path: path.to_path_buf(),
+            line: number,
+            message,
+        };
+        match words.as_slice() {
+            _ if read == 0 => break,
+            ["end_header", ..] => break,
+            ["element", name, ..] => {
+                if elements.iter().any(|(e, _)| e == name) {
+                    return Err(at(format!("the element `{name}` is declared twice")));
+                }
+                elements.push((name.to_string(), Vec::new()));
+            }
+            ["property", .., name] => {
+                if let Some((element, properties)) = elements.last_mut() {
+                    if properties.iter().any(|p| p == name) {
+                        return Err(at(format!(
+                            "the property `{name}` of element `{element}` is declared twice"
+                        )));
+                    }
+                    properties.push(name.to_string());
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 pub(super) fn load_ply(path: &Path) -> Result<Mesh> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    let mut reader = std::io::BufReader::new(file);
+    let open = || std::fs::File::open(path).map_err(|e| Error::io(path, e));
+    // A header is text of a few lines: what follows a megabyte of it is left to the parser.
+    check_header_names(path, &mut std::io::BufReader::new(open()?.take(1 << 20)))?;
+    let mut reader = std::io::BufReader::new(open()?);
     let ply = Parser::<DefaultElement>::new()
         .read_ply(&mut reader)
         .map_err(|e| parse_error(path, format!("not a PLY file, or a damaged one: {e}")))?;

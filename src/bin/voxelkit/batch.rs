@@ -73,6 +73,14 @@ pub fn run(
     task: impl Fn(MeshSource) -> Result<Task> + Sync,
 ) -> Result<()> {
     let pairs = pairs(inputs, out)?;
+    // The folders of --out-dir and of an output pattern are made as needed.
+    if out.out_dir.is_some() || out.frames.is_some() {
+        for (_, output) in &pairs {
+            if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
+                std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+            }
+        }
+    }
     if let ([(input, output)], None, false) = (&pairs[..], out.frames, out.shared_grid) {
         let job = Job::new(task(MeshSource::File(input.clone()))?, fit);
         return run_and_report(job, output, global);
@@ -83,12 +91,6 @@ pub fn run(
     } else {
         fit
     };
-    // The folders of --out-dir and of an output pattern are made as needed.
-    for (_, output) in &pairs {
-        if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-        }
-    }
     run_all(&pairs, out.jobs, fit, global, &task)
 }
 
