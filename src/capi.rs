@@ -363,7 +363,17 @@ fn slice<'a, T>(p: *const T, len: usize, what: &str) -> std::result::Result<&'a 
             format!("{what} is NULL but {len} elements were announced"),
         ));
     }
-    // SAFETY: non-null and, by the caller's contract, `len` readable elements.
+    // No array in memory holds more than isize::MAX bytes: a larger count is a wrong one.
+    if len
+        .checked_mul(std::mem::size_of::<T>())
+        .is_none_or(|b| b > isize::MAX as usize)
+    {
+        return Err(invalid(format!(
+            "{what}: {len} elements cannot be an array in memory"
+        )));
+    }
+    // SAFETY: non-null and, by the caller's contract, `len` readable elements (no more bytes
+    // than an allocation can hold).
     Ok(unsafe { std::slice::from_raw_parts(p, len) })
 }
 
@@ -579,6 +589,15 @@ pub extern "C" fn vk_mesh_from_triangles(
             .ok_or_else(|| invalid("triangle_count is too large"))?;
         let p = slice(positions, coords, "positions")?;
         let t = slice(triangles, corners, "triangles")?;
+        // The copy: the points, one polygon per triangle, and the mesh's own vectors.
+        let bytes = (vertex_count as u64)
+            .saturating_mul(2 * 24)
+            .saturating_add((triangle_count as u64).saturating_mul(2 * 12 + 24 + 8));
+        crate::system::check_fits(
+            bytes,
+            None,
+            &format!("a mesh of {vertex_count} vertices and {triangle_count} triangles"),
+        )?;
         let points: Vec<DVec3> = p.chunks_exact(3).map(DVec3::from_slice).collect();
         let polygons: Vec<Vec<u32>> = t.chunks_exact(3).map(|c| c.to_vec()).collect();
         let mut mesh = Mesh::from_polygons("vk_mesh_from_triangles", points, &polygons);

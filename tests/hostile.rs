@@ -819,3 +819,38 @@ fn one_input_with_an_out_dir_that_does_not_exist_makes_it() {
     assert!(o.status.success(), "{}", text(&o));
     assert!(folder.join("cube.vdb").exists());
 }
+
+#[test]
+fn a_picture_beyond_the_memory_limit_is_refused_before_it_is_drawn() {
+    let dir = tempfile::tempdir().unwrap();
+    let vdb = sphere_vdb(dir.path());
+    let png = dir.path().join("p.png");
+    let o = voxelkit(&[
+        "--max-memory",
+        "64",
+        "render",
+        vdb.to_str().unwrap(),
+        "--size",
+        "16384x16384",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success(), "{}", text(&o));
+    assert!(
+        text(&o).contains("16384x16384") && text(&o).contains("MiB"),
+        "{}",
+        text(&o)
+    );
+    assert!(!png.exists());
+    let small = voxelkit(&[
+        "--max-memory",
+        "64",
+        "render",
+        vdb.to_str().unwrap(),
+        "--size",
+        "64x48",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(small.status.success(), "{}", text(&small));
+}

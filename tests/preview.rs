@@ -63,7 +63,7 @@ fn ball(radius: i64, channels: Channels) -> SparseGrid {
 }
 
 fn draw(grid: &SparseGrid, view: View, size: u32) -> Picture {
-    render(&Scene::of(grid), view, size, size).unwrap()
+    render(&Scene::of(grid), view, size, size, None).unwrap()
 }
 
 #[test]

@@ -37,3 +37,26 @@ def test_half_precision_is_refused_for_distances_beyond_its_range(tmp_path):
         grid.write(tmp_path / "big.vdb", half=True)
     assert not (tmp_path / "big.vdb").exists()
     grid.write(tmp_path / "big.vdb")
+
+
+def test_huge_arrays_and_tile_grids_are_memory_errors_not_aborts(tmp_path):
+    np = pytest.importorskip("numpy")
+    pyopenvdb = pytest.importorskip("pyopenvdb")
+    # 2^31 vertices as a strided view of three numbers: no memory until copied.
+    vertices = np.lib.stride_tricks.as_strided(np.zeros(3), shape=(2**31, 3), strides=(0, 8))
+    with pytest.raises(MemoryError):
+        voxelkit.mesh((vertices, [[0, 1, 2]]), max_memory_mib=500)
+    faces = np.lib.stride_tricks.as_strided(np.zeros(3, dtype=np.int64), shape=(2**31, 3), strides=(0, 8))
+    with pytest.raises(MemoryError):
+        voxelkit.mesh(([[0, 0, 0], [1, 0, 0], [0, 1, 0]], faces), max_memory_mib=500)
+    # One root tile of 4096^3 voxels: 6.9e10 indices do not fit.
+    grid = pyopenvdb.BoolGrid()
+    grid.fill((0, 0, 0), (4095, 4095, 4095), True)
+    grid.name = "voxels"
+    pyopenvdb.write(str(tmp_path / "tile.vdb"), [grid])
+    tiles = voxelkit.read_vdb(tmp_path / "tile.vdb")
+    assert len(tiles) == 4096**3
+    with pytest.raises(MemoryError):
+        tiles.ijk
+    with pytest.raises(MemoryError):
+        tiles.to_dense()

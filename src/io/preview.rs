@@ -265,12 +265,23 @@ fn visible_bits(mask: &[u64; 8]) -> [u64; 8] {
 }
 
 /// Draws `scene` from `view` on a `width` x `height` picture.
-pub fn render(scene: &Scene, view: View, width: u32, height: u32) -> Result<Picture> {
+pub fn render(
+    scene: &Scene,
+    view: View,
+    width: u32,
+    height: u32,
+    limit: Option<u64>,
+) -> Result<Picture> {
     if !(1..=MAX_PICTURE_SIDE).contains(&width) || !(1..=MAX_PICTURE_SIDE).contains(&height) {
         return Err(Error::InvalidArgument(format!(
             "the picture must be 1 to {MAX_PICTURE_SIDE} pixels on a side, got {width}x{height}"
         )));
     }
+    crate::system::check_fits(
+        picture_bytes(width, height),
+        limit,
+        &format!("a picture of {width}x{height} pixels"),
+    )?;
     let grid = scene.voxels;
     let mut buffer = Buffer::new(width as usize * height as usize);
     if let Some(b) = grid.bbox() {
@@ -426,6 +437,14 @@ impl Projection {
             .collect();
         pixels.concat()
     }
+}
+
+/// What drawing a picture holds: a depth buffer per worker's share of the leaves (rayon's
+/// fold makes about two per thread) and the main one, then the picture and its PNG.
+fn picture_bytes(width: u32, height: u32) -> u64 {
+    let pixels = u64::from(width) * u64::from(height);
+    let buffers = 2 * rayon::current_num_threads() as u64 + 2;
+    pixels * (buffers * std::mem::size_of::<Hit>() as u64 + 2 * 3)
 }
 
 /// A vertical grey gradient.

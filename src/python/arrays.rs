@@ -12,7 +12,9 @@ use std::path::PathBuf;
 /// What the arrays are called in messages.
 const ARRAYS: &str = "the (vertices, faces) arrays";
 
-pub fn mesh_source(source: &Bound<'_, PyAny>) -> PyResult<MeshSource> {
+/// The mesh `source` names; arrays are copied only once the copy's memory fits in `limit`
+/// bytes (none: the memory available).
+pub fn mesh_source(source: &Bound<'_, PyAny>, limit: Option<u64>) -> PyResult<MeshSource> {
     if let Ok(path) = source.extract::<PathBuf>() {
         return Ok(MeshSource::File(path));
     }
@@ -21,10 +23,30 @@ pub fn mesh_source(source: &Bound<'_, PyAny>) -> PyResult<MeshSource> {
             "a mesh is a path or a (vertices, faces) pair of arrays",
         ));
     };
-    Ok(MeshSource::Mesh(mesh_from_arrays(&vertices, &faces)?))
+    Ok(MeshSource::Mesh(mesh_from_arrays(
+        &vertices, &faces, limit,
+    )?))
 }
 
-fn mesh_from_arrays(vertices: &Bound<'_, PyAny>, faces: &Bound<'_, PyAny>) -> PyResult<Mesh> {
+/// Bytes a mesh of `vertices` and `corners` takes while it is built from arrays: the rows
+/// copied, the polygons, and the mesh's own vectors.
+const VERTEX_COPY_BYTES: u64 = 3 * 24;
+const CORNER_COPY_BYTES: u64 = 3 * 8 + 16;
+
+/// Refuses, with MemoryError, arrays whose copy does not fit.
+fn check_copy_fits(vertices: usize, corners: usize, limit: Option<u64>) -> PyResult<()> {
+    let bytes = (vertices as u64)
+        .saturating_mul(VERTEX_COPY_BYTES)
+        .saturating_add((corners as u64).saturating_mul(CORNER_COPY_BYTES));
+    let what = format!("{ARRAYS} ({vertices} vertices, {corners} face corners)");
+    crate::system::check_fits(bytes, limit, &what).map_err(super::to_py_err)
+}
+
+fn mesh_from_arrays(
+    vertices: &Bound<'_, PyAny>,
+    faces: &Bound<'_, PyAny>,
+    limit: Option<u64>,
+) -> PyResult<Mesh> {
     let vertices: PyArrayLike2<f64, AllowTypeChange> = vertices
         .extract()
         .map_err(|e| PyValueError::new_err(format!("vertices: an (n, 3) float array ({e})")))?;
@@ -35,12 +57,13 @@ fn mesh_from_arrays(vertices: &Bound<'_, PyAny>, faces: &Bound<'_, PyAny>) -> Py
             v.shape()
         )));
     }
+    check_copy_fits(v.nrows(), 0, limit)?;
     let positions: Vec<DVec3> = v
         .rows()
         .into_iter()
         .map(|r| DVec3::new(r[0], r[1], r[2]))
         .collect();
-    let polygons = polygons(faces)?;
+    let polygons = polygons(faces, |corners| check_copy_fits(v.nrows(), corners, limit))?;
     let mut polys = Vec::with_capacity(polygons.len());
     for (f, polygon) in polygons.into_iter().enumerate() {
         let p = polygon
@@ -58,9 +81,14 @@ fn mesh_from_arrays(vertices: &Bound<'_, PyAny>, faces: &Bound<'_, PyAny>) -> Py
     Ok(mesh)
 }
 
-/// Faces as polygons: from a rectangular integer array, else from a sequence of sequences.
-fn polygons(faces: &Bound<'_, PyAny>) -> PyResult<Vec<Vec<i64>>> {
+/// Faces as polygons: from a rectangular integer array, else from a sequence of sequences;
+/// `fits(corners)` refuses what would not fit before it is copied.
+fn polygons(
+    faces: &Bound<'_, PyAny>,
+    fits: impl Fn(usize) -> PyResult<()>,
+) -> PyResult<Vec<Vec<i64>>> {
     if let Ok(array) = faces.extract::<PyArrayLike2<i64, AllowTypeChange>>() {
+        fits(array.as_array().len())?;
         return Ok(array
             .as_array()
             .rows()
@@ -68,6 +96,7 @@ fn polygons(faces: &Bound<'_, PyAny>) -> PyResult<Vec<Vec<i64>>> {
             .map(|r| r.to_vec())
             .collect());
     }
+    fits(faces.len().unwrap_or(0).saturating_mul(3))?;
     faces.extract::<Vec<Vec<i64>>>().map_err(|e| {
         PyValueError::new_err(format!(
             "faces: an (m, 3) integer array or a list of polygons ({e})"

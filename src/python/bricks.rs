@@ -113,8 +113,8 @@ pub fn brick_plan(
     output: Option<PathBuf>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<BrickPlan> {
-    let source = mesh_source(source)?;
     let request: BricksRequest = Call::new(options)?.request;
+    let source = mesh_source(source, mib_limit(request.max_memory_mib))?;
     let named = output.unwrap_or_else(|| PathBuf::from("the bricks"));
     py.detach(|| BrickRun::plan(&source, &request, solid, &named))
         .map(BrickPlan)

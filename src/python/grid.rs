@@ -37,6 +37,15 @@ impl Grid {
         self.outcome.grid.transform
     }
 
+    /// Refuses, with MemoryError, an array of `bytes_per_voxel` per active voxel that does
+    /// not fit in the memory available (built once, then copied into numpy: twice over).
+    fn check_per_voxel(&self, bytes_per_voxel: u64, what: &str) -> PyResult<()> {
+        let voxels = self.outcome.grid.voxel_count();
+        let bytes = voxels.saturating_mul(bytes_per_voxel).saturating_mul(2);
+        crate::system::check_fits(bytes, None, &format!("{what} of {voxels} voxels"))
+            .map_err(super::to_py_err)
+    }
+
     /// A channel per active voxel, `width` floats each, NaN on whole tiles (which carry
     /// no channels).
     fn channel(
@@ -73,12 +82,13 @@ impl Grid {
 impl Grid {
     /// The active voxels as an (N, 3) int64 array of indices.
     #[getter]
-    fn ijk<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
+    fn ijk<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        self.check_per_voxel(24, "the indices")?;
         let flat: Vec<i64> = self.outcome.grid.voxels().flatten().collect();
         let n = flat.len() / 3;
-        Array2::from_shape_vec((n, 3), flat)
+        Ok(Array2::from_shape_vec((n, 3), flat)
             .expect("three indices per voxel")
-            .into_pyarray(py)
+            .into_pyarray(py))
     }
 
     /// A channel in the order of `ijk`: `"distance"` (N,): world units for `sdf`/`udf` bands,
@@ -86,6 +96,10 @@ impl Grid {
     /// Whole tiles give NaN.
     fn values<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
         let c = self.outcome.grid.channels();
+        if self.channel_names().contains(&name) {
+            let width = if name == "distance" { 1 } else { 3 };
+            self.check_per_voxel(4 * width, &format!("the values `{name}`"))?;
+        }
         let (width, data) = match name {
             "distance" if c.value => (
                 1,
@@ -239,7 +253,7 @@ impl Grid {
         let grid = &self.outcome.grid;
         py.detach(|| {
             check_picture_output(&path, &inputs)?;
-            let picture = render(&Scene::of(grid), view, size.0, size.1)?;
+            let picture = render(&Scene::of(grid), view, size.0, size.1, None)?;
             write_png(&path, &picture)
         })
         .map_err(to_py_err)

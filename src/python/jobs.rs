@@ -127,7 +127,9 @@ fn on_mesh<R: Request<Input = MeshSource>>(
     source: &Bound<'_, PyAny>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Grid> {
-    Call::<R>::new(options)?.run(py, mesh_source(source)?)
+    let call = Call::<R>::new(options)?;
+    let mesh = mesh_source(source, call.limits.limits().max_memory)?;
+    call.run(py, mesh)
 }
 
 #[pyfunction]
@@ -228,7 +230,7 @@ pub fn measure(
     {
         MeasureSource::Vdb(path)
     } else {
-        MeasureSource::Mesh(mesh_source(source)?)
+        MeasureSource::Mesh(mesh_source(source, call.limits.limits().max_memory)?)
     };
     call.run(py, source)
 }

@@ -8,6 +8,7 @@
 
 #include "check.h"
 
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -243,6 +244,10 @@ int main(int argc, char **argv) {
     /* Arrays count vertices from 0, and so do the messages about them. */
     CHECK(strstr(vk_last_error(), "vertex index 7 ") != NULL);
     CHECK(vk_mesh_from_triangles(NULL, 3, bad_t, 1, &bad) == VK_ERROR_INVALID_ARGUMENT);
+    /* Counts whose copy cannot be held are refused before anything is read or allocated. */
+    CHECK(vk_mesh_from_triangles(bad_p, 3, bad_t, SIZE_MAX / 24 + 1, &bad) == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(vk_mesh_from_triangles(bad_p, SIZE_MAX / 3, bad_t, 1, &bad) == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(vk_mesh_from_triangles(bad_p, 3, bad_t, (size_t)1 << 40, &bad) == VK_ERROR_TOO_LARGE);
     CHECK(bad == NULL);
     CHECK(vk_grid_write_vdb(surface, "/no/such/dir/out.vdb") != VK_OK);
     CHECK(vk_debug_panic() == VK_ERROR_INTERNAL);

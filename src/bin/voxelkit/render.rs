@@ -64,10 +64,10 @@ pub struct RenderArgs {
 }
 
 /// Draws `scene` into `output` and says so.
-fn draw(scene: &Scene, picture: PictureArgs, output: &Path) -> Result<String> {
+fn draw(scene: &Scene, picture: PictureArgs, output: &Path, limit: Option<u64>) -> Result<String> {
     let start = Instant::now();
     let (w, h) = picture.size;
-    let image = render(scene, picture.view, w, h)?;
+    let image = render(scene, picture.view, w, h, limit)?;
     write_png(output, &image)?;
     Ok(format!(
         "{}: {w}x{h} picture of {} voxels, {:.2} s",
@@ -105,7 +105,12 @@ pub fn run(args: &RenderArgs, global: &Global) -> Result<()> {
         colors: colors.as_ref(),
     };
     let said = on_threads(global.limits().threads, || {
-        draw(&scene, args.picture, &args.output)
+        draw(
+            &scene,
+            args.picture,
+            &args.output,
+            global.limits().max_memory,
+        )
     })?;
     if global.json {
         println!(
@@ -124,7 +129,12 @@ pub fn run(args: &RenderArgs, global: &Global) -> Result<()> {
 
 /// `--preview`: the picture beside `output` (`out.vdb` gives `out.png`), drawn from the
 /// result in memory.
-pub fn beside(grid: &SparseGrid, output: &Path, picture: PictureArgs) -> Result<PathBuf> {
+pub fn beside(
+    grid: &SparseGrid,
+    output: &Path,
+    picture: PictureArgs,
+    limit: Option<u64>,
+) -> Result<PathBuf> {
     if output == Path::new("-") {
         return Err(Error::InvalidArgument(
             "--preview needs an output file to write the picture beside".into(),
@@ -132,6 +142,6 @@ pub fn beside(grid: &SparseGrid, output: &Path, picture: PictureArgs) -> Result<
     }
     let png = output.with_extension("png");
     check_picture_output(&png, &[output])?;
-    draw(&Scene::of(grid), picture, &png)?;
+    draw(&Scene::of(grid), picture, &png, limit)?;
     Ok(png)
 }

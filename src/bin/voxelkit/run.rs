@@ -113,7 +113,8 @@ pub fn finish_job(
     if let Some(out) = output {
         outcome.write(out, &inputs, &global.write)?;
         if global.preview {
-            let png = crate::render::beside(&outcome.grid, out, Default::default())?;
+            let limit = global.limits().max_memory;
+            let png = crate::render::beside(&outcome.grid, out, Default::default(), limit)?;
             outcome.report.preview = Some(png.display().to_string());
         }
     }
