@@ -117,3 +117,25 @@ def test_bad_dask_numbers_are_value_errors_naming_the_option(data, tmp_path):
     with pytest.raises(ValueError, match="brick size must be a positive multiple of 8"):
         distributed.mesh(path, tmp_path / "b.vdb", brick=12)
     assert not list(tmp_path.iterdir())
+
+
+def test_the_write_stub_declares_the_tables_write_options():
+    tree = ast.parse(STUBS.read_text())
+    grid = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Grid")
+    table = [(f["name"], f["default"]) for f in voxelkit.OPTIONS["write"]["fields"]]
+    for method in ("write", "write_vdb"):
+        args = next(n for n in grid.body if isinstance(n, ast.FunctionDef) and n.name == method).args
+        names = [a.arg for a in args.args][2:]
+        defaults = [plain(ast.literal_eval(d)) for d in args.defaults]
+        # `grids=None` in the stub means the table's empty list: every grid but `voxels`.
+        defaults = [[] if d is None and n == "grids" else d for n, d in zip(names, defaults)]
+        assert list(zip(names, defaults)) == table, method
+
+
+def test_write_takes_the_tables_options_and_refuses_a_bad_one(tmp_path):
+    grid = voxelkit.implicit(SPHERE, resolution=16)
+    grid.write(tmp_path / "z.vdb", compression="zip", grids=["density"])
+    with pytest.raises(ValueError, match="the compression must be blosc, zip or none, not `lz4`"):
+        grid.write(tmp_path / "x.vdb", compression="lz4")
+    with pytest.raises(TypeError, match="unexpected keyword argument 'compress'"):
+        grid.write(tmp_path / "x.vdb", compress="zip")

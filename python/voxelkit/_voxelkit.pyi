@@ -212,7 +212,7 @@ def brick_surface_file(
     brick: Index,
     size: int,
     path: Path,
-    separability: int = 26,
+    separability: int,
     max_memory_mib: Optional[int] = None,
 ) -> int: ...
 def brick_faces(

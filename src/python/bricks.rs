@@ -155,7 +155,7 @@ fn brick_job(
 /// A brick's part of the separating surface, written to `path`; returns its voxel count.
 #[pyfunction]
 #[pyo3(signature = (positions, indices, starts, origin, voxel_size, brick, size, path,
-    separability = 26, max_memory_mib = None))]
+    separability, max_memory_mib = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn brick_surface_file(
     py: Python<'_>,

@@ -1,15 +1,17 @@
 //! `voxelkit.Grid`: what every Python call returns — the voxels as numpy arrays, the
 //! channels, the transform, the report, the extra grids, and writing.
 
+use super::jobs::Call;
 use super::to_py_err;
 use crate::grid::{SparseGrid, Transform};
 use crate::io::preview::{Scene, View, check_picture_output, render, write_png};
-use crate::io::vdb::{Compression, WriteOptions};
 use crate::pipeline::Outcome;
+use crate::pipeline::request::WriteRequest;
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayLike2};
 use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use std::path::PathBuf;
 
 /// A sparse voxel grid with the report of the job that made it.
@@ -220,23 +222,16 @@ impl Grid {
 
     /// Writes the grid as the CLI does, by extension: `.vdb` (all grids, or those `grids`
     /// names: `density`, `voxels`, `normal`, `Cd`, `shell`, ...), `.binvox` or `.vox`;
-    /// atomically, never over an input of the job.
-    #[pyo3(signature = (path, grids = None, compression = "blosc", half = false))]
+    /// atomically, never over an input of the job. The keywords are `OPTIONS["write"]`'s:
+    /// `grids`, `compression` (blosc, zip or none) and `half`.
+    #[pyo3(signature = (path, **options))]
     fn write(
         &mut self,
         py: Python<'_>,
         path: PathBuf,
-        grids: Option<Vec<String>>,
-        compression: &str,
-        half: bool,
+        options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<()> {
-        let options = WriteOptions {
-            grids: grids.unwrap_or_default(),
-            compression: compression
-                .parse::<Compression>()
-                .map_err(PyValueError::new_err)?,
-            half,
-        };
+        let options = Call::<WriteRequest>::new(options)?.request.options();
         let inputs: Vec<&std::path::Path> = self.inputs.iter().map(PathBuf::as_path).collect();
         let outcome = &mut self.outcome;
         py.detach(|| outcome.write(&path, &inputs, &options))
@@ -260,16 +255,14 @@ impl Grid {
     }
 
     /// `write` for a `.vdb` path.
-    #[pyo3(signature = (path, grids = None, compression = "blosc", half = false))]
+    #[pyo3(signature = (path, **options))]
     fn write_vdb(
         &mut self,
         py: Python<'_>,
         path: PathBuf,
-        grids: Option<Vec<String>>,
-        compression: &str,
-        half: bool,
+        options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<()> {
-        self.write(py, path, grids, compression, half)
+        self.write(py, path, options)
     }
 
     /// Whether `other` holds exactly the same voxel indices (compared block by block, never

@@ -210,7 +210,7 @@ pub fn csg(args: &CsgArgs, global: &Global) -> Result<()> {
         _ => unreachable!("clap requires --tree or A and B"),
     };
     // The grid comes from the inputs (the first grid, or the tree's resolution).
-    let job = Job::new(task, voxelkit::mesh::GridFit::Resolution(256));
+    let job = Job::new(task, voxelkit::mesh::GridFit::from_options(None, None));
     run_and_report(job, &args.output, global)
 }
 
@@ -223,6 +223,6 @@ pub fn intersect(args: &IntersectArgs, global: &Global) -> Result<()> {
         resample: args.resample,
         curve: true,
     };
-    let job = Job::new(task, voxelkit::mesh::GridFit::Resolution(256));
+    let job = Job::new(task, voxelkit::mesh::GridFit::from_options(None, None));
     run_and_report(job, &args.output, global)
 }
