@@ -221,7 +221,14 @@ int main(int argc, char **argv) {
     OK(vk_options_set_resolution(opts, 40));
     OK(vk_options_set_max_memory(opts, 1));
     CHECK(vk_voxelize_mesh(mesh, opts, &g) == VK_ERROR_TOO_LARGE);
+    /* 0 MiB and 0 threads mean the defaults, as in every front end: the memory available and
+     * every core. */
     OK(vk_options_set_max_memory(opts, 0));
+    OK(vk_options_set_threads(opts, 0));
+    vk_grid *defaults = NULL;
+    OK(vk_voxelize_mesh(mesh, opts, &defaults));
+    OK(vk_grid_free(defaults));
+    OK(vk_options_set_threads(opts, 2));
 
     /* Misuse: NULL, wrong kinds, bad values, bad files, double frees, panics. */
     CHECK(vk_voxelize_mesh(NULL, opts, &g) == VK_ERROR_INVALID_HANDLE);
