@@ -9,6 +9,7 @@
 
 use super::atomic::write_atomic;
 use super::vdb_format::{COVARIANT_NORMALIZE, FOG_VOLUME, LEVEL_SET};
+pub use super::vdb_format::{Compression, MetaValue};
 use super::vdb_writer::{Encoding, GridOut, GridValues, compression_flags, write_grids};
 use crate::error::{Error, Result};
 use crate::grid::{Channels, LEAF_VOXELS, Leaf, SparseGrid, Transform};
@@ -161,69 +162,6 @@ impl WriteOptions {
         }
     }
 }
-
-/// `.vdb` compression.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Compression {
-    /// OpenVDB's default: fast, good ratios.
-    #[default]
-    Blosc,
-    Zip,
-    None,
-}
-
-crate::named_choices! {
-    Compression, "the compression":
-    "blosc" => Blosc,
-    "zip" => Zip,
-    "none" => None,
-}
-
-/// A grid's metadata value, written with OpenVDB's type for it (so Houdini and pyopenvdb
-/// read numbers as numbers).
-#[derive(Clone, Debug, PartialEq)]
-pub enum MetaValue {
-    Text(String),
-    Int(i64),
-    Real(f64),
-}
-
-impl std::fmt::Display for MetaValue {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            MetaValue::Text(s) => f.write_str(s),
-            MetaValue::Int(n) => write!(f, "{n}"),
-            MetaValue::Real(x) => write!(f, "{x}"),
-        }
-    }
-}
-
-impl From<String> for MetaValue {
-    fn from(s: String) -> Self {
-        MetaValue::Text(s)
-    }
-}
-
-impl From<&str> for MetaValue {
-    fn from(s: &str) -> Self {
-        MetaValue::Text(s.to_string())
-    }
-}
-
-impl From<f64> for MetaValue {
-    fn from(x: f64) -> Self {
-        MetaValue::Real(x)
-    }
-}
-
-macro_rules! int_meta {
-    ($($t:ty),*) => {$(impl From<$t> for MetaValue {
-        fn from(n: $t) -> Self {
-            MetaValue::Int(i64::try_from(n).unwrap_or(i64::MAX))
-        }
-    })*};
-}
-int_meta!(u32, u64, usize, i64);
 
 /// The metadata entries of every grid: the caller's plus `voxelkit_version`.
 fn meta_entries(metadata: &[(&str, MetaValue)]) -> Vec<(String, MetaValue)> {

@@ -1,6 +1,7 @@
-//! The `.vdb` format's constants, declared once for the writer, the structure check and the
-//! reader: the header, OpenVDB's standard 5-4-3 tree, compression flags, grid classes and
-//! tree type names (OpenVDB 10's `io/` and `tree/` headers).
+//! The `.vdb` format's vocabulary, declared once for the writer, the structure check and the
+//! reader: the header, OpenVDB's standard 5-4-3 tree, compression (flags and the user's
+//! choice), grid classes, tree type names, typed metadata values (OpenVDB 10's `io/`,
+//! `tree/` and `Metadata.h` headers), and what the reader can find wrong.
 
 /// OpenVDB's magic number, the file's first eight bytes.
 pub(super) const MAGIC: i64 = 0x5644_4220;
@@ -57,6 +58,69 @@ pub(super) fn value_type(type_name: &str) -> &str {
         .and_then(|t| t.strip_suffix(TREE_SUFFIX))
         .unwrap_or("")
 }
+
+/// `.vdb` compression.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Compression {
+    /// OpenVDB's default: fast, good ratios.
+    #[default]
+    Blosc,
+    Zip,
+    None,
+}
+
+crate::named_choices! {
+    Compression, "the compression":
+    "blosc" => Blosc,
+    "zip" => Zip,
+    "none" => None,
+}
+
+/// A grid's metadata value, written with OpenVDB's type for it (so Houdini and pyopenvdb
+/// read numbers as numbers).
+#[derive(Clone, Debug, PartialEq)]
+pub enum MetaValue {
+    Text(String),
+    Int(i64),
+    Real(f64),
+}
+
+impl std::fmt::Display for MetaValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            MetaValue::Text(s) => f.write_str(s),
+            MetaValue::Int(n) => write!(f, "{n}"),
+            MetaValue::Real(x) => write!(f, "{x}"),
+        }
+    }
+}
+
+impl From<String> for MetaValue {
+    fn from(s: String) -> Self {
+        MetaValue::Text(s)
+    }
+}
+
+impl From<&str> for MetaValue {
+    fn from(s: &str) -> Self {
+        MetaValue::Text(s.to_string())
+    }
+}
+
+impl From<f64> for MetaValue {
+    fn from(x: f64) -> Self {
+        MetaValue::Real(x)
+    }
+}
+
+macro_rules! int_meta {
+    ($($t:ty),*) => {$(impl From<$t> for MetaValue {
+        fn from(n: $t) -> Self {
+            MetaValue::Int(i64::try_from(n).unwrap_or(i64::MAX))
+        }
+    })*};
+}
+int_meta!(u32, u64, usize, i64);
 
 /// Why the reader cannot read a file whose structure was checked: what it found, typed.
 #[derive(Clone, Debug, PartialEq)]

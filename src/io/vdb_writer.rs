@@ -169,7 +169,7 @@ pub(super) struct GridOut<'g> {
     pub class: Option<&'static str>,
     /// OpenVDB's vector type of a Vec3 grid (`covariant normalize`, `invariant`).
     pub vector_type: Option<&'static str>,
-    pub metadata: &'g [(String, super::vdb::MetaValue)],
+    pub metadata: &'g [(String, super::vdb_format::MetaValue)],
 }
 
 /// How the file is written.
@@ -575,7 +575,7 @@ fn push_metadata(
     internal: [u64; 2],
     leaves: u64,
 ) {
-    use super::vdb::MetaValue;
+    use super::vdb_format::MetaValue;
     enum Meta {
         Str(String),
         Vec3i([i32; 3]),
@@ -657,8 +657,8 @@ fn push_transform(out: &mut Vec<u8>, t: Transform) {
 }
 
 /// The compression flags of `compression`.
-pub(super) fn compression_flags(compression: super::vdb::Compression) -> u32 {
-    use super::vdb::Compression;
+pub(super) fn compression_flags(compression: super::vdb_format::Compression) -> u32 {
+    use super::vdb_format::Compression;
     match compression {
         Compression::Blosc => COMPRESS_BLOSC,
         Compression::Zip => COMPRESS_ZIP,

@@ -5,7 +5,7 @@
 
 use super::arrays::mesh_source;
 use super::grid::Grid;
-use super::jobs::Call;
+use super::keywords::Keywords;
 use super::to_py_err;
 use crate::choice::Choice;
 use crate::error::Result;
@@ -113,7 +113,7 @@ pub fn brick_plan(
     output: Option<PathBuf>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<BrickPlan> {
-    let request: BricksRequest = Call::new(options)?.request;
+    let request: BricksRequest = Keywords::new(options)?.request;
     let source = mesh_source(source, mib_limit(request.max_memory_mib))?;
     let named = output.unwrap_or_else(|| PathBuf::from("the bricks"));
     py.detach(|| BrickRun::plan(&source, &request, solid, &named))

@@ -1,7 +1,7 @@
 //! `voxelkit.Grid`: what every Python call returns — the voxels as numpy arrays, the
 //! channels, the transform, the report, the extra grids, and writing.
 
-use super::jobs::Call;
+use super::keywords::Keywords;
 use super::to_py_err;
 use crate::grid::{SparseGrid, Transform};
 use crate::io::preview::{Scene, View, check_picture_output, render, write_png};
@@ -231,7 +231,7 @@ impl Grid {
         path: PathBuf,
         options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<()> {
-        let options = Call::<WriteRequest>::new(options)?.request.options();
+        let options = Keywords::<WriteRequest>::new(options)?.request.options();
         let inputs: Vec<&std::path::Path> = self.inputs.iter().map(PathBuf::as_path).collect();
         let outcome = &mut self.outcome;
         py.detach(|| outcome.write(&path, &inputs, &options))

@@ -1,117 +1,29 @@
 //! The module's functions: each fills the request of `pipeline::request` from its keyword
-//! arguments (by name, as the schema declares them), turns it into the job every front end
-//! runs (see `watch`) and returns a `Grid`. The package wraps them with the schema's
+//! arguments (see `keywords`), turns it into the job every front end runs (see `watch`) and
+//! returns a `Grid`. The package wraps them with the schema's
 //! signatures and docs (`python/voxelkit/__init__.py`).
 
 use super::arrays::mesh_source;
 use super::grid::Grid;
+use super::keywords::Keywords;
 use super::to_py_err;
 use super::watch::run_job;
 use crate::mesh::GridFit;
 use crate::pipeline::request::{
     CombineRequest, ImplicitRequest, LimitsRequest, LinesRequest, MeasureRequest, MeshRequest,
-    Request, Schema, SolidRequest, SubdivRequest,
+    Request, SolidRequest, SubdivRequest,
 };
 use crate::pipeline::{CsgSource, GridSource, Job, MeasureSource, MeshSource, Outcome, Task};
-use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyString};
-use serde_json::{Map, Value};
+use pyo3::types::PyDict;
 use std::path::PathBuf;
 
-/// The keyword that takes the progress function (not an option of the request).
-const PROGRESS: &str = "progress";
-
-/// A keyword's value as JSON: booleans, integers (numpy's too), finite floats, strings and
-/// sequences of these. `None` is left to the caller (it means the default).
-fn to_json(v: &Bound<'_, PyAny>) -> Result<Value, String> {
-    if v.is_instance_of::<PyBool>() {
-        return Ok(Value::Bool(v.extract::<bool>().unwrap_or_default()));
-    }
-    if v.is_instance_of::<PyString>() {
-        return v
-            .extract::<String>()
-            .map(Value::String)
-            .map_err(|e| e.to_string());
-    }
-    if let Ok(n) = v.extract::<i64>() {
-        return Ok(Value::from(n));
-    }
-    if let Ok(x) = v.extract::<f64>() {
-        return serde_json::Number::from_f64(x)
-            .map(Value::Number)
-            .ok_or_else(|| format!("must be a finite number, not {x}"));
-    }
-    if let Ok(b) = v.extract::<bool>() {
-        return Ok(Value::Bool(b));
-    }
-    if let Ok(items) = v.try_iter() {
-        return items
-            .map(|item| item.map_err(|e| e.to_string()).and_then(|i| to_json(&i)))
-            .collect::<Result<Vec<_>, _>>()
-            .map(Value::Array);
-    }
-    Err(format!(
-        "cannot take a {}",
-        v.get_type()
-            .name()
-            .map_or("value".into(), |n| n.to_string())
-    ))
-}
-
-/// One call's request, limits and progress function, from its keyword arguments.
-pub(super) struct Call<R> {
-    pub(super) request: R,
-    limits: LimitsRequest,
-    progress: Option<Py<PyAny>>,
-}
-
-impl<R: Schema> Call<R> {
-    pub(super) fn new(options: Option<&Bound<'_, PyDict>>) -> PyResult<Call<R>> {
-        let own: Vec<&str> = R::fields().iter().map(|f| f.name).collect();
-        let limits: Vec<&str> = LimitsRequest::fields().iter().map(|f| f.name).collect();
-        let (mut fields, mut limit_fields) = (Map::new(), Map::new());
-        let mut progress = None;
-        for (key, value) in options.into_iter().flatten() {
-            let key: String = key.extract()?;
-            let into = if key == PROGRESS {
-                progress = (!value.is_none()).then(|| value.unbind());
-                continue;
-            } else if own.contains(&key.as_str()) {
-                &mut fields
-            } else if limits.contains(&key.as_str()) {
-                &mut limit_fields
-            } else {
-                return Err(PyTypeError::new_err(format!(
-                    "{}() got an unexpected keyword argument '{key}' (it takes {})",
-                    R::NAME,
-                    [own.as_slice(), limits.as_slice(), &[PROGRESS]]
-                        .concat()
-                        .join(", ")
-                )));
-            };
-            if value.is_none() {
-                continue;
-            }
-            let json = to_json(&value).map_err(|e| PyValueError::new_err(format!("{key}: {e}")))?;
-            into.insert(key, json);
-        }
-        Ok(Call {
-            request: R::from_json(Value::Object(fields)).map_err(to_py_err)?,
-            limits: LimitsRequest::from_json(Value::Object(limit_fields)).map_err(to_py_err)?,
-            progress,
-        })
-    }
-
-    fn run(self, py: Python<'_>, input: R::Input) -> PyResult<Grid>
-    where
-        R: Request,
-    {
-        let job = self.request.job(input, &self.limits).map_err(to_py_err)?;
-        let inputs = job.task.input_files();
-        let outcome = run_job(py, job, self.progress)?;
-        Ok(Grid::new(outcome, inputs))
-    }
+/// Runs the job of `call`'s request on `input` under its limits and progress function.
+fn run<R: Request>(py: Python<'_>, call: Keywords<R>, input: R::Input) -> PyResult<Grid> {
+    let job = call.request.job(input, &call.limits).map_err(to_py_err)?;
+    let inputs = job.task.input_files();
+    let outcome = run_job(py, job, call.progress)?;
+    Ok(Grid::new(outcome, inputs))
 }
 
 /// The schema of every request (JSON): what `voxelkit.OPTIONS` and the package's signatures,
@@ -127,9 +39,9 @@ fn on_mesh<R: Request<Input = MeshSource>>(
     source: &Bound<'_, PyAny>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Grid> {
-    let call = Call::<R>::new(options)?;
+    let call = Keywords::<R>::new(options)?;
     let mesh = mesh_source(source, call.limits.limits().max_memory)?;
-    call.run(py, mesh)
+    run(py, call, mesh)
 }
 
 #[pyfunction]
@@ -179,7 +91,7 @@ pub fn implicit(
     formula: String,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Grid> {
-    Call::<ImplicitRequest>::new(options)?.run(py, formula)
+    run(py, Keywords::<ImplicitRequest>::new(options)?, formula)
 }
 
 /// A CSG tree (the CLI's `csg --tree` JSON): a path to the JSON file, or the tree as a dict
@@ -204,7 +116,7 @@ pub fn csg(
         CsgSource::File(tree.extract::<PathBuf>()?)
     };
     // A tree's options are in the tree: its only keywords are the limits.
-    let call = Call::<LimitsRequest>::new(options)?;
+    let call = Keywords::<LimitsRequest>::new(options)?;
     let job = Job {
         limits: call.request.limits(),
         ..Job::new(Task::CsgTree(source), GridFit::from_options(None, None))
@@ -220,7 +132,7 @@ pub fn measure(
     source: &Bound<'_, PyAny>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Grid> {
-    let call = Call::<MeasureRequest>::new(options)?;
+    let call = Keywords::<MeasureRequest>::new(options)?;
     let source = if let Ok(grid) = source.cast::<Grid>() {
         MeasureSource::Grid(grid.borrow().sparse().clone())
     } else if let Ok(path) = source.extract::<PathBuf>()
@@ -232,7 +144,7 @@ pub fn measure(
     } else {
         MeasureSource::Mesh(mesh_source(source, call.limits.limits().max_memory)?)
     };
-    call.run(py, source)
+    run(py, call, source)
 }
 
 /// `a` and `b` are Grids, or `.vdb` paths whose grid `grid` or voxel set is read.
@@ -250,7 +162,8 @@ pub fn combine(
             Err(_) => Ok(GridSource::File(g.extract::<PathBuf>()?)),
         }
     };
-    Call::<CombineRequest>::new(options)?.run(py, (source(a)?, source(b)?))
+    let call = Keywords::<CombineRequest>::new(options)?;
+    run(py, call, (source(a)?, source(b)?))
 }
 
 /// A grid of a `.vdb` file: the one named `grid`, else the voxel set voxelkit writes

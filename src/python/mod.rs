@@ -5,6 +5,7 @@ mod arrays;
 mod bricks;
 mod grid;
 mod jobs;
+mod keywords;
 mod watch;
 
 use crate::error::Error;
