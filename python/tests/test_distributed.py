@@ -178,3 +178,21 @@ def test_a_killed_worker_is_retried_and_the_result_is_whole(data, dask, tmp_path
     assert run.returncode == 0, err
     assert "Traceback" not in err, err
     assert voxel_set(voxelkit.read_vdb(out).ijk) == voxel_set(voxelkit.mesh(path, resolution=1024).ijk)
+
+
+def test_a_scheduler_that_never_answers_is_an_error_within_seconds(data, dask, tmp_path):
+    import socket
+
+    silent = socket.socket()
+    silent.bind(("127.0.0.1", 0))
+    silent.listen(4)
+    port = silent.getsockname()[1]
+    started = time.monotonic()
+    try:
+        with pytest.raises(OSError, match="did not answer"):
+            vd.mesh(data / "meshes" / "cow.obj", tmp_path / "cow.vdb", resolution=64, brick=64,
+                    scheduler=f"tcp://127.0.0.1:{port}")
+    finally:
+        silent.close()
+    assert time.monotonic() - started < 60
+    assert not list(tmp_path.iterdir()), "nothing is left behind"

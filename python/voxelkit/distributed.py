@@ -102,11 +102,36 @@ class _Progress:
                 sys.stderr.write("\n")
 
 
+#: Seconds a scheduler has to answer before the run gives up on it.
+_SCHEDULER_TIMEOUT = 10
+
+
+def _connect(client_class, scheduler):
+    """A client of `scheduler`, or OSError when it does not answer in time. Dask's own timeout
+    does not bound a server that accepts the connection and never answers, so the client is
+    made on a thread of its own, waited for no longer than the timeout."""
+    made = {}
+
+    def connect():
+        try:
+            made["client"] = client_class(scheduler, timeout=_SCHEDULER_TIMEOUT)
+        except Exception as e:
+            made["error"] = e
+
+    thread = threading.Thread(target=connect, daemon=True, name="voxelkit-connect")
+    thread.start()
+    thread.join(_SCHEDULER_TIMEOUT + 1)
+    if "client" in made:
+        return made["client"]
+    reason = f" ({made['error']})" if "error" in made else ""
+    raise OSError(f"the scheduler at {scheduler} did not answer within {_SCHEDULER_TIMEOUT} s{reason}")
+
+
 def _client(scheduler, workers, threads):
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
-        return Client(scheduler), None
+        return _connect(Client, scheduler), None
     cluster = LocalCluster(
         n_workers=workers,
         threads_per_worker=1,
