@@ -639,7 +639,8 @@ fn a_tampered_brick_index_is_refused_alike_by_info_and_read_vdb() {
             .unwrap()
             .success()
     );
-    let cases: Vec<(&str, Box<dyn Fn(&mut serde_json::Value)>, &str)> = vec![
+    type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+    let cases: Vec<(&str, Edit, &str)> = vec![
         (
             "outside",
             Box::new(|j| j["bricks"][0]["file"] = "../outside.vdb".into()),
