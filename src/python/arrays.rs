@@ -57,13 +57,13 @@ fn mesh_from_arrays(
             v.shape()
         )));
     }
-    check_copy_fits(v.nrows(), 0, limit)?;
+    // The faces are counted first, so that one check covers every copy before any is made.
+    let polygons = polygons(faces, |corners| check_copy_fits(v.nrows(), corners, limit))?;
     let positions: Vec<DVec3> = v
         .rows()
         .into_iter()
         .map(|r| DVec3::new(r[0], r[1], r[2]))
         .collect();
-    let polygons = polygons(faces, |corners| check_copy_fits(v.nrows(), corners, limit))?;
     let mut polys = Vec::with_capacity(polygons.len());
     for (f, polygon) in polygons.into_iter().enumerate() {
         let p = polygon
