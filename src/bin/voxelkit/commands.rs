@@ -165,14 +165,9 @@ pub fn mesh(
     })
 }
 
+/// The library's check of a positive, finite number, naming the flag.
 fn positive(name: &str, v: f64) -> Result<()> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::InvalidArgument(format!(
-            "--{name} must be a positive number, got {v}"
-        )))
-    }
+    voxelkit::pipeline::request::positive(&format!("--{name}"), v)
 }
 
 pub fn shape(kind: &ShapeKind, global: &Global) -> Result<()> {
