@@ -2,7 +2,7 @@
 //! overflowed the stack, numbers that silently became infinite, a byte-order mark that ate
 //! the first OBJ line, STL files read wrongly, volumes lost to cancellation far from the
 //! origin, voxel sizes whose cube overflows. Every one is now a clear error or a right answer.
-#![cfg(feature = "vdb")]
+#![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 use std::path::Path;
 use std::process::Command;
@@ -746,17 +746,11 @@ fn a_ply_declaring_a_property_or_an_element_twice_is_refused_at_its_line() {
     }
 }
 
-/// A closed box of side `side` centred at the origin, as an OBJ.
+/// A closed box of side `side` centred at the origin, as an OBJ (the project's fixture).
 fn cube_obj(dir: &Path, side: f64) -> std::path::PathBuf {
-    let h = side / 2.0;
-    let mut text = String::new();
-    for i in 0..8 {
-        let c = |bit: usize| if i & bit != 0 { h } else { -h };
-        text += &format!("v {} {} {}\n", c(1), c(2), c(4));
-    }
-    text += "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+    let h = glam::DVec3::splat(side / 2.0);
     let path = dir.join("cube.obj");
-    std::fs::write(&path, text).unwrap();
+    voxelkit::mesh::generate::cuboid(-h, h).write_obj(&path).unwrap();
     path
 }
 
