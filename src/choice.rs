@@ -127,7 +127,7 @@ pub fn deserialize_choice<'de, T: Choice, D: serde::Deserializer<'de>>(
             T::parse_choice(s).map_err(E::custom)
         }
         fn visit_i64<E: serde::de::Error>(self, n: i64) -> Result<T, E> {
-            T::parse_choice(&n.to_string()).map_err(E::custom)
+            T::from_number(n).map_err(E::custom)
         }
         fn visit_u64<E: serde::de::Error>(self, n: u64) -> Result<T, E> {
             T::parse_choice(&n.to_string()).map_err(E::custom)

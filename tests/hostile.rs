@@ -750,7 +750,9 @@ fn a_ply_declaring_a_property_or_an_element_twice_is_refused_at_its_line() {
 fn cube_obj(dir: &Path, side: f64) -> std::path::PathBuf {
     let h = glam::DVec3::splat(side / 2.0);
     let path = dir.join("cube.obj");
-    voxelkit::mesh::generate::cuboid(-h, h).write_obj(&path).unwrap();
+    voxelkit::mesh::generate::cuboid(-h, h)
+        .write_obj(&path)
+        .unwrap();
     path
 }
 

@@ -79,11 +79,24 @@ impl<T: Choice> FieldChoices for T {
     }
 }
 
-/// A plain (non-choice) field type.
+/// Field types that are not choices.
 macro_rules! plain_fields {
-    ($($t:ty),*) => {$(impl FieldChoices for Option<$t> {})*};
+    ($($t:ty),*) => {$(impl FieldChoices for $t {})*};
 }
-plain_fields!(u32, u64, f64, String, [f32; 3]);
+plain_fields!(
+    bool,
+    f64,
+    u32,
+    usize,
+    Vec<String>,
+    Directions,
+    Bounds,
+    Option<u32>,
+    Option<u64>,
+    Option<f64>,
+    Option<String>,
+    Option<[f32; 3]>
+);
 
 macro_rules! request {
     // A request on a mesh: the grid fit first, its up axis last.
@@ -134,14 +147,6 @@ macro_rules! request {
         }
     };
 }
-
-impl FieldChoices for bool {}
-impl FieldChoices for f64 {}
-impl FieldChoices for u32 {}
-impl FieldChoices for usize {}
-impl FieldChoices for Vec<String> {}
-impl FieldChoices for Directions {}
-impl FieldChoices for Bounds {}
 
 /// How a polygon mesh becomes a surface.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
