@@ -55,15 +55,16 @@ def _from_schema(name, inputs, request, summary):
         positional = [given.pop(i) for i in inputs]
         return native(*positional, **given)
 
-    lines = [OPTIONS[request]["doc"] if request else summary, "", summary if request else "", ""]
+    paragraphs = ([OPTIONS[request]["doc"]] if request else []) + [summary]
+    options = []
     for f in fields:
         choices = f" (one of {', '.join(map(str, f['choices']))})" if f["choices"] else ""
-        lines.append(f"{f['name']} = {f['default']!r}{choices}: {f['doc']}")
-    lines.append(_PROGRESS_DOC)
+        options.append(f"{f['name']} = {f['default']!r}{choices}: {f['doc']}")
+    options.append(_PROGRESS_DOC)
     call.__name__ = call.__qualname__ = name
     call.__module__ = __name__
     call.__signature__ = signature
-    call.__doc__ = "\n".join(lines).replace("\n\n\n", "\n\n")
+    call.__doc__ = "\n\n".join(paragraphs + ["\n".join(options)])
     return call
 
 
