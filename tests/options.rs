@@ -28,14 +28,11 @@ const SUBCOMMANDS: [(&str, &[&str]); 9] = [
 ];
 
 /// Fields whose flag is not `--` and the field's name in kebab case.
-const FLAGS: [(&str, &str, &str); 7] = [
+const FLAGS: [(&str, &str, &str); 4] = [
     ("mesh", "colors", "--no-color"),
     ("lines", "colors", "--no-color"),
-    ("mesh", "method", "--method"),
-    ("solid", "fill", "--fill"),
     ("combine", "op", "[OPERATION]"),
     ("limits", "max_memory_mib", "--max-memory"),
-    ("implicit", "coords", "--coords"),
 ];
 
 fn help(args: &[&str]) -> String {

@@ -437,7 +437,7 @@ fn read_transform(c: &mut Cursor) -> Parsed<([f64; 3], [f64; 3], bool)> {
 /// How far, relative to the voxel size, a matrix entry may stray from a uniform scale: a
 /// transform composed in single precision, or beside a large translation, rounds its
 /// diagonal apart by some 1e-8 (0.01 and 0.0099999998); a millionth keeps every voxel of a
-/// 2^20-voxel grid within a voxel of where the uniform scale puts it.
+/// grid a million voxels wide within one voxel of where the uniform scale puts it.
 const UNIFORM_SCALE_TOLERANCE: f64 = 1e-6;
 
 fn linear_map(c: &mut Cursor, name: &str) -> Parsed<([f64; 3], [f64; 3], bool)> {
