@@ -271,7 +271,7 @@ pub struct PlannedJob {
 }
 
 impl GridFit {
-    /// The `resolution` metadata: `256`, or `voxel size 0.1`.
+    /// The fit in words, for reports: `256`, or `voxel size 0.1`.
     pub fn describe(&self) -> String {
         match self {
             GridFit::Resolution(r) => r.to_string(),

@@ -106,12 +106,18 @@ pub struct DistanceArgs {
 }
 
 impl SurfaceArgs {
-    pub fn separating(&self) -> SeparatingOptions {
-        SeparatingOptions {
+    /// The mesh request of these flags (every other option at its default).
+    pub fn request(&self) -> MeshRequest {
+        MeshRequest {
             separability: self.separability,
             criterion: self.criterion,
             normals: self.normals,
+            ..MeshRequest::default()
         }
+    }
+
+    pub fn separating(&self) -> SeparatingOptions {
+        self.request().separating()
     }
 }
 
@@ -150,15 +156,12 @@ pub fn mesh(
         } else {
             SurfaceKind::Separating
         },
-        separability: surface.separability,
-        criterion: surface.criterion,
-        normals: surface.normals,
         colors,
         color,
         sdf: distance.sdf,
         udf: distance.udf,
         band: distance.band,
-        ..MeshRequest::default()
+        ..surface.request()
     };
     batch::run(inputs, out, fit.grid_fit(), global, |mesh| {
         request.task(mesh)
