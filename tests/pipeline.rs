@@ -12,7 +12,8 @@ use voxelkit::Error;
 use voxelkit::implicit::Coordinates;
 use voxelkit::mesh::{GridFit, generate};
 use voxelkit::pipeline::{
-    ColorChoice, CsgSource, Fill, Job, MeasureSource, MeshSource, Shape, SurfaceMethod, Task,
+    ColorChoice, CsgSource, Fill, Job, MeasureSource, MeshSource, Shape, ShapeTask, SurfaceMethod,
+    Task,
 };
 use voxelkit::progress::Observer;
 use voxelkit::shapes::Sphere;
@@ -72,7 +73,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
         ),
         (
             "shape",
-            Task::Shape {
+            Task::Shape(ShapeTask {
                 shape: Shape::Sphere(Sphere {
                     center: DVec3::ZERO,
                     radius: 1.0,
@@ -80,7 +81,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
                 separability: Separability::TwentySix,
                 normals: false,
                 curvature_margin: true,
-            },
+            }),
         ),
         (
             "subdivision",

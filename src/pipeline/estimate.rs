@@ -1,4 +1,4 @@
-//! Planning: read the inputs, place the grid, and estimate the peak memory and the work
+//! Pricing: place the grid of a loaded task and estimate the peak memory and the work
 //! items of every task, so that a job that cannot fit is refused before it allocates.
 //!
 //! Peak memory is counted in 8^3 leaves. Mesh surfaces and mesh solids have their own
@@ -9,17 +9,18 @@
 //! A surface of area A (in voxels) crosses about A/32 leaves; a solid is assumed to fill half
 //! its box.
 
-use super::{CsgSource, Job, Loaded, MeasureSource, MeshSource, Plan, Task, lines_source};
+use super::load::Work;
+use super::{Fill, Plan, ShapeTask, SurfaceMethod};
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, MAX_DENSE_VOXELS, SparseGrid, Transform};
 use crate::implicit::Formula;
-use crate::io::vdb::read_vdb_grid;
-use crate::mesh::{Aabb, GridFit, Mesh, UpAxis, fit_transform, index_box};
+use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
 use crate::ops::flood::padded;
-use crate::solids::csg_tree::{CsgNode, parse_csg_tree, read_csg_tree};
+use crate::solids::csg_tree::CsgNode;
 use crate::solids::exterior_flood::FloodMethod;
 use crate::subd::ControlMesh;
-use crate::voxelize::{projective, separating};
+use crate::voxelize::projective::{self, Coloring};
+use crate::voxelize::separating;
 use glam::DVec3;
 
 /// Peak bytes per leaf of a voxel set, and per leaf of a normal or colour channel.
@@ -407,55 +408,51 @@ fn mesh_plan(mesh: &Mesh, fit: GridFit) -> Result<(Transform, CoordBox)> {
     Ok((t, b))
 }
 
-pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
-    let (fit, up) = (job.fit, job.up_axis);
-    Ok(match &job.task {
-        Task::MeshSurface { mesh, method } => {
-            let mesh = mesh.load(false, up)?;
-            let (t, _) = mesh_plan(&mesh, fit)?;
+/// Places the grid of `work` and prices it; `what` names the input in errors.
+pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
+    Ok(match work {
+        Work::MeshSurface { mesh, method } => {
+            let (t, _) = mesh_plan(mesh, fit)?;
             let (channels, items) = match method {
-                super::SurfaceMethod::Separating(o) => {
-                    (u32::from(o.normals), separating::work_items(&mesh))
+                SurfaceMethod::Separating(o) => {
+                    (u32::from(o.normals), separating::work_items(mesh))
                 }
-                super::SurfaceMethod::Projective(c) => {
-                    let colour = c.coloring(&mesh) != projective::Coloring::None;
+                SurfaceMethod::Projective(c) => {
+                    let colour = c.coloring(mesh) != Coloring::None;
                     (u32::from(colour), mesh.face_count() as u64)
                 }
             };
-            let bytes = mesh_surface_bytes(&mesh, &t, channels);
-            let p = plan_of(t, &mesh.bbox(), bytes, items);
-            (Loaded::Mesh(mesh), p)
+            let bytes = mesh_surface_bytes(mesh, &t, channels);
+            plan_of(t, &mesh.bbox(), bytes, items)
         }
-        Task::DistanceBand { mesh, band, signed } => {
-            let mesh = mesh.load(false, up)?;
-            let (t, _) = mesh_plan(&mesh, fit)?;
+        Work::DistanceBand { mesh, band, signed } => {
+            let (t, _) = mesh_plan(mesh, fit)?;
             // A band 2w+1 voxels thick crosses about that many eighths of each leaf it meets.
-            let leaves = surface_leaves(area_in_voxels(&mesh, &t)) * (2.0 * band + 1.0) / 4.0;
+            let leaves = surface_leaves(area_in_voxels(mesh, &t)) * (2.0 * band + 1.0) / 4.0;
             let per_leaf = if *signed {
                 SIGNED_BAND_LEAF_BYTES
             } else {
                 UNSIGNED_BAND_LEAF_BYTES
             };
             let bytes = leaves * per_leaf + mesh.triangle_count() as f64 * BAND_TRIANGLE_BYTES;
-            let p = plan_of(t, &mesh.bbox(), bytes, separating::work_items(&mesh));
-            (Loaded::Mesh(mesh), p)
+            plan_of(t, &mesh.bbox(), bytes, separating::work_items(mesh))
         }
-        Task::SeparationCheck { mesh, options } => {
-            let mesh = mesh.load(false, up)?;
-            let (t, b) = mesh_plan(&mesh, fit)?;
-            let leaves = surface_leaves(area_in_voxels(&mesh, &t));
+        Work::SeparationCheck { mesh, options } => {
+            let (t, b) = mesh_plan(mesh, fit)?;
+            let leaves = surface_leaves(area_in_voxels(mesh, &t));
             let bytes = CHECK_VOLUMES * cells(&padded(b, 3)) / 8.0
                 + leaves * CHECK_LEAF_BYTES
                 + leaves * f64::from(u32::from(options.normals)) * MESH_VECTOR_LEAF_BYTES
                 + mesh.triangle_count() as f64 * TRIANGLE_BYTES;
-            let p = plan_of(t, &mesh.bbox(), bytes, separating::work_items(&mesh));
-            (Loaded::Mesh(mesh), p)
+            plan_of(t, &mesh.bbox(), bytes, separating::work_items(mesh))
         }
-        Task::Lines { mesh, edges, color } => {
-            let mesh = mesh.load(true, up)?;
-            let (t, _) = mesh_plan(&mesh, fit)?;
-            let source = lines_source(&mesh, *edges);
-            let segments = projective::line_segments(&mesh, source);
+        Work::Lines {
+            mesh,
+            source,
+            coloring,
+        } => {
+            let (t, _) = mesh_plan(mesh, fit)?;
+            let segments = projective::line_segments(mesh, *source);
             let length: f64 = segments
                 .iter()
                 .map(|&[a, b]| mesh.p(a).distance(mesh.p(b)))
@@ -463,138 +460,88 @@ pub(super) fn plan_job(job: &Job) -> Result<(Loaded, Plan)> {
             let mut leaves =
                 (length / t.voxel_size + mesh.positions.len() as f64) / LINE_LENGTH_PER_LEAF;
             if mesh.face_count() > 0 {
-                leaves = edge_leaves(leaves, surface_leaves(area_in_voxels(&mesh, &t)));
+                leaves = edge_leaves(leaves, surface_leaves(area_in_voxels(mesh, &t)));
             }
-            let colour = color.coloring(&mesh) != projective::Coloring::None;
+            let colour = *coloring != Coloring::None;
             let bytes = surface_leaf_bytes(leaves, u32::from(colour))
                 + mesh.triangle_count() as f64 * LINE_TRIANGLE_BYTES;
-            let p = plan_of(t, &mesh.bbox(), bytes, segments.len() as u64);
-            (Loaded::Mesh(mesh), p)
+            plan_of(t, &mesh.bbox(), bytes, segments.len() as u64)
         }
-        Task::Shape { shape, normals, .. } => {
+        Work::Shape(ShapeTask { shape, normals, .. }) => {
             let bbox = shape.surface().bbox();
             let t = fit_transform(&bbox, fit)?;
             let b = checked_box(&bbox, &t)?;
             let area = shape.area() / (t.voxel_size * t.voxel_size);
             let bytes = surface_leaf_bytes(surface_leaves(area), u32::from(*normals))
                 + cells(&b) / 512.0 * SHAPE_BLOCK_BYTES;
-            let p = plan_of(t, &bbox, bytes, (cells(&b) / 512.0).ceil() as u64);
-            (Loaded::Shape, p)
+            plan_of(t, &bbox, bytes, (cells(&b) / 512.0).ceil() as u64)
         }
-        Task::Subdivision { mesh, solid, .. } => {
-            let control = match mesh {
-                super::MeshSource::File(path) => ControlMesh::load(path)?,
-                super::MeshSource::Mesh(m) => ControlMesh::from_mesh(m)?,
-            };
+        Work::Subdivision { control, solid, .. } => {
             let bbox = control.bbox();
             let t = fit_transform(&bbox, fit)?;
             checked_box(&bbox, &t)?;
             let patches = control.patch_count() as f64;
             let bytes = patches * PATCH_BYTES
                 + if solid.is_some() {
-                    subdivision_solid_bytes(&control, &t)
+                    subdivision_solid_bytes(control, &t)
                 } else {
                     surface_leaves(area_in_voxels(&control.polygon_mesh(), &t)) * SUBDIV_LEAF_BYTES
                 };
-            let p = plan_of(t, &bbox, bytes, control.patch_count() as u64);
-            (Loaded::Control(control), p)
+            plan_of(t, &bbox, bytes, control.patch_count() as u64)
         }
-        Task::Implicit {
+        Work::Implicit {
             formula,
-            coordinates,
             min,
             max,
             levels,
             negative_r,
-            theta_range,
-            squared,
+            ..
         } => {
-            let parsed = Formula {
-                theta_range: *theta_range,
-                squared: *squared,
-                ..Formula::parse(formula, *coordinates)?
-            };
             let resolution = octree_resolution(fit, *min, *max)?;
             let bbox = Aabb {
                 min: *min,
                 max: *max,
             };
             let longest = (*max - *min).max_element();
-            if !(longest.is_finite() && longest > 0.0 && (*max - *min).min_element() > 0.0) {
-                return Err(Error::InvalidArgument(format!(
-                    "the bounds {min} .. {max} must be a box with positive size on every axis"
-                )));
-            }
             let t = Transform::new(
                 *min + 0.5 * longest / f64::from(resolution.max(1)),
                 longest / f64::from(resolution.max(1)),
             );
             // Every level holds about a quarter of the one below it.
             let levels = if *levels { 4.0 / 3.0 } else { 1.0 };
-            let leaves = implicit_leaves(&parsed, *min, *max, resolution, *negative_r)?;
+            let leaves = implicit_leaves(formula, *min, *max, resolution, *negative_r)?;
             let bytes = (leaves + 1.0) * IMPLICIT_LEAF_BYTES * levels;
             let options = crate::voxelize::interval_octree::OctreeOptions {
                 resolution,
                 ..Default::default()
             };
             let items = crate::voxelize::interval_octree::progress_total(&options);
-            let p = plan_of(t, &bbox, bytes, items);
-            (Loaded::Formula(parsed), p)
+            plan_of(t, &bbox, bytes, items)
         }
-        Task::Solid { mesh, fill, .. } => solid_plan(mesh, fit, up, *fill)?,
+        Work::Solid { mesh, fill, .. } => solid_plan(mesh, fit, *fill)?,
         // Measuring a mesh fills its flooded surface.
-        Task::Measure {
-            source: MeasureSource::Mesh(mesh),
-            flood,
-            ..
-        } => fill_plan(mesh, fit, up, flood_cost(*flood, &MEASURE_COST), |m, _| {
-            separating::work_items(m)
-        })?,
-        Task::Measure {
-            source: MeasureSource::Vdb(path),
-            ..
-        } => grid_plan(read_surface(path)?, &path.display().to_string())?,
-        Task::Measure {
-            source: MeasureSource::Grid(grid),
-            ..
-        } => grid_plan(grid.clone(), "the grid")?,
-        Task::CsgTree(source) => {
-            let tree = match source {
-                CsgSource::File(path) => read_csg_tree(path)?,
-                CsgSource::Json { text, folder } => {
-                    parse_csg_tree(text, std::path::Path::new("the CSG tree"), folder)?
-                }
-            };
+        Work::MeasureMesh { mesh, flood, .. } => {
+            fill_plan(mesh, fit, flood_cost(*flood, &MEASURE_COST), |m, _| {
+                separating::work_items(m)
+            })?
+        }
+        Work::MeasureSurface { surface, .. } => grid_plan(surface, what)?,
+        Work::CsgTree(tree) => {
             let (t, bounds) = tree.transform()?;
             let b = checked_box(&bounds, &t)?;
             let bytes = csg_tree_bytes(&tree.root, &t, &b);
-            let p = plan_of(t, &bounds, bytes, tree.node_count() as u64);
-            (Loaded::Tree(Box::new(tree)), p)
+            plan_of(t, &bounds, bytes, tree.node_count() as u64)
         }
-        Task::Combine {
-            a,
-            b,
-            grid,
-            resample,
-            ..
-        } => {
-            let load = |g: &super::GridSource| match g {
-                super::GridSource::File(path) => read_vdb_grid(path, grid.as_deref()),
-                super::GridSource::Grid(g) => Ok(g.clone()),
-            };
-            let (ga, gb) = (load(a)?, load(b)?);
+        Work::Combine { a, b, resample, .. } => {
             // Resampled onto the first grid, each voxel of the second becomes (hb/ha)^3.
-            let scale = gb.transform.voxel_size / ga.transform.voxel_size;
+            let scale = b.transform.voxel_size / a.transform.voxel_size;
             let second = if *resample {
-                (gb.voxel_count() as f64 * scale.powi(3) / 64.0).max(gb.leaf_count() as f64)
+                (b.voxel_count() as f64 * scale.powi(3) / 64.0).max(b.leaf_count() as f64)
             } else {
-                gb.leaf_count() as f64
+                b.leaf_count() as f64
             };
-            let leaves = ga.leaf_count() as f64 + second;
-            let t = ga.transform;
-            let bbox = world_box(&ga);
-            let p = plan_of(t, &bbox, leaf_bytes(leaves, 0), 1);
-            (Loaded::Grids(ga, gb), p)
+            let leaves = a.leaf_count() as f64 + second;
+            plan_of(a.transform, &world_box(a), leaf_bytes(leaves, 0), 1)
         }
     })
 }
@@ -610,21 +557,16 @@ fn plan_of(transform: Transform, bbox: &Aabb, bytes: f64, work_items: u64) -> Pl
 }
 
 /// Filling `mesh` by `fill`: its surface, the bit volumes over its box and the solid.
-fn solid_plan(
-    mesh: &MeshSource,
-    fit: GridFit,
-    up: UpAxis,
-    fill: super::Fill,
-) -> Result<(Loaded, Plan)> {
+fn solid_plan(mesh: &Mesh, fit: GridFit, fill: Fill) -> Result<Plan> {
     match fill {
-        super::Fill::Flood(method) => {
+        Fill::Flood(method) => {
             let cost = flood_cost(method, &BLOCK_FLOOD_COST);
-            fill_plan(mesh, fit, up, cost, |m, _| separating::work_items(m))
+            fill_plan(mesh, fit, cost, |m, _| separating::work_items(m))
         }
-        super::Fill::DepthLayers(o) => fill_plan(mesh, fit, up, &DEPTH_LAYERS_COST, |_, b| {
+        Fill::DepthLayers(o) => fill_plan(mesh, fit, &DEPTH_LAYERS_COST, |_, b| {
             o.directions.len() as u64 + (b.max[0] - b.min[0] + 1) as u64
         }),
-        super::Fill::Beam(_) => fill_plan(mesh, fit, up, &BEAM_COST, |m, _| m.face_count() as u64),
+        Fill::Beam(_) => fill_plan(mesh, fit, &BEAM_COST, |m, _| m.face_count() as u64),
     }
 }
 
@@ -639,22 +581,14 @@ fn flood_cost(method: FloodMethod, blocks: &'static FillCost) -> &'static FillCo
 
 /// Filling `mesh` at `cost`, with `work_items` for the progress bar.
 fn fill_plan(
-    mesh: &MeshSource,
+    mesh: &Mesh,
     fit: GridFit,
-    up: UpAxis,
     cost: &FillCost,
     work_items: impl Fn(&Mesh, &CoordBox) -> u64,
-) -> Result<(Loaded, Plan)> {
-    let mesh = mesh.load(false, up)?;
-    let (t, b) = mesh_plan(&mesh, fit)?;
-    let bytes = mesh_solid_bytes(&mesh, &t, &padded(b, 2), cost);
-    let p = plan_of(t, &mesh.bbox(), bytes, work_items(&mesh, &b));
-    Ok((Loaded::Mesh(mesh), p))
-}
-
-/// The surface of a `.vdb` to measure: a solid's `shell` when it is one, else its voxel set.
-fn read_surface(path: &std::path::Path) -> Result<SparseGrid> {
-    read_vdb_grid(path, Some("shell")).or_else(|_| read_vdb_grid(path, None))
+) -> Result<Plan> {
+    let (t, b) = mesh_plan(mesh, fit)?;
+    let bytes = mesh_solid_bytes(mesh, &t, &padded(b, 2), cost);
+    Ok(plan_of(t, &mesh.bbox(), bytes, work_items(mesh, &b)))
 }
 
 /// A grid's index box (the voxel at the origin when it is empty).
@@ -681,12 +615,12 @@ fn world_box(grid: &SparseGrid) -> Aabb {
 /// values, 300 bytes of a bool grid). Estimate/peak 0.93-1.17 on solids' shells and a
 /// surface at 512-1024 (was 5-14). A box past the dense volume's limit is refused here,
 /// with the input's name.
-fn grid_plan(grid: SparseGrid, what: &str) -> Result<(Loaded, Plan)> {
-    let box_cells = cells(&padded(grid_box(&grid), 2));
+fn grid_plan(grid: &SparseGrid, what: &str) -> Result<Plan> {
+    let box_cells = cells(&padded(grid_box(grid), 2));
     let read_bytes = if grid.channels().value { 4300.0 } else { 300.0 };
     let bytes = (1.0 + 0.3 * MEASURE_COST.inside_volumes) * box_cells / 8.0
         + grid.leaf_count() as f64 * (MEASURE_COST.leaf_bytes + read_bytes);
-    let p = plan_of(grid.transform, &world_box(&grid), bytes, 1);
+    let p = plan_of(grid.transform, &world_box(grid), bytes, 1);
     if box_cells > MAX_DENSE_VOXELS as f64 {
         return Err(Error::TooLarge {
             estimated_mib: p.estimated_bytes >> 20,
@@ -698,5 +632,5 @@ fn grid_plan(grid: SparseGrid, what: &str) -> Result<(Loaded, Plan)> {
             ),
         });
     }
-    Ok((Loaded::Grid(grid), p))
+    Ok(p)
 }

@@ -8,6 +8,7 @@ pub mod batch;
 pub mod brick_exterior;
 pub mod bricks;
 mod estimate;
+mod load;
 mod outcome;
 mod report;
 pub mod request;
@@ -19,22 +20,21 @@ pub use report::*;
 
 use crate::error::{Error, Result};
 use crate::grid::{SparseGrid, Transform};
-use crate::implicit::{Coordinates, Formula, ThetaRange};
+use crate::implicit::{Coordinates, ThetaRange};
 use crate::mesh::{GridFit, Mesh, UpAxis};
 use crate::ops::csg::BooleanOp;
 use crate::progress::{Observer, Progress};
 use crate::shapes::{Cylinder, Quadric, Sphere};
 use crate::solids::beam::BeamFill;
-use crate::solids::csg_tree::CsgTree;
 use crate::solids::depth_layers::DepthLayerOptions;
 use crate::solids::exterior_flood::FloodMethod;
-use crate::subd::ControlMesh;
 use crate::voxelize::Separability;
 use crate::voxelize::parametric::ParametricOptions;
 use crate::voxelize::projective::{Coloring, LineSource};
 use crate::voxelize::separating::SeparatingOptions;
 use crate::voxelize::separating_analytic::AnalyticSurface;
 use glam::{DVec3, Vec3};
+use load::Work;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -130,13 +130,7 @@ pub enum Task {
         edges: bool,
         color: ColorChoice,
     },
-    Shape {
-        shape: Shape,
-        separability: Separability,
-        normals: bool,
-        /// Widen the slabs by the curvature margin (false: the paper's plain rule).
-        curvature_margin: bool,
-    },
+    Shape(ShapeTask),
     /// A Catmull-Clark limit surface from its control mesh; with `solid`, the solid it
     /// bounds (seeds from the limit normals, FloodingXYZ from them).
     Subdivision {
@@ -189,6 +183,16 @@ pub enum Task {
         resample: bool,
         curve: bool,
     },
+}
+
+/// An analytic surface and how it is voxelized.
+#[derive(Clone, Copy, Debug)]
+pub struct ShapeTask {
+    pub shape: Shape,
+    pub separability: Separability,
+    pub normals: bool,
+    /// Widen the slabs by the curvature margin (false: the paper's plain rule).
+    pub curvature_margin: bool,
 }
 
 /// How a Catmull-Clark solid is filled and weighed.
@@ -250,21 +254,10 @@ impl Plan {
     }
 }
 
-/// The inputs a task reads, loaded during planning.
-pub(crate) enum Loaded {
-    Mesh(Mesh),
-    Control(ControlMesh),
-    Formula(Formula),
-    Shape,
-    Tree(Box<CsgTree>),
-    Grids(SparseGrid, SparseGrid),
-    Grid(SparseGrid),
-}
-
 /// A job whose inputs are read and whose plan fits.
 pub struct PlannedJob {
     job: Job,
-    loaded: Loaded,
+    work: Work,
     plan: Plan,
     warnings: Vec<String>,
     start: Instant,
@@ -354,7 +347,6 @@ impl Shape {
 }
 
 impl Task {
-    /// The files the task reads (an output must not be one of them).
     /// The mesh a mesh-based task reads.
     fn mesh(&self) -> Option<&MeshSource> {
         match self {
@@ -372,6 +364,7 @@ impl Task {
         }
     }
 
+    /// The files the task reads (an output must not be one of them).
     pub fn input_files(&self) -> Vec<PathBuf> {
         if let Some(mesh) = self.mesh() {
             return mesh.path().map(Path::to_path_buf).into_iter().collect();
@@ -419,7 +412,8 @@ impl Job {
                 warnings.push(format!("{n} threads asked for; using {MAX_THREADS}"));
             }
         }
-        let (loaded, plan) = estimate::plan_job(&self)?;
+        let work = load::load(&self.task, self.up_axis)?;
+        let plan = estimate::price(&work, self.fit, &self.describe_input())?;
         let limit = self.limits.max_memory;
         crate::system::check_fits(
             plan.estimated_bytes,
@@ -432,7 +426,7 @@ impl Job {
         )?;
         Ok(PlannedJob {
             job: self,
-            loaded,
+            work,
             plan,
             warnings,
             start,
@@ -454,7 +448,7 @@ impl Job {
         match (&self.task, self.task.mesh()) {
             (_, Some(MeshSource::File(p))) => p.display().to_string(),
             (_, Some(MeshSource::Mesh(m))) => m.source.display().to_string(),
-            (Task::Shape { shape, .. }, _) => shape.describe(),
+            (Task::Shape(s), _) => s.shape.describe(),
             (Task::Implicit { formula, .. }, _) => formula.clone(),
             (Task::Combine { a, b, .. }, _) => format!("{} {}", grid(a), grid(b)),
             (
@@ -500,8 +494,8 @@ impl PlannedJob {
 
     /// Every file the job reads, those a CSG tree names included.
     pub fn input_files(&self) -> Vec<PathBuf> {
-        match &self.loaded {
-            Loaded::Tree(tree) => tree.input_files(),
+        match &self.work {
+            Work::CsgTree(tree) => tree.input_files(),
             _ => self.job.task.input_files(),
         }
     }
@@ -525,7 +519,7 @@ impl PlannedJob {
         match &self.job.task {
             Task::MeshSurface { .. }
             | Task::SeparationCheck { .. }
-            | Task::Shape { .. }
+            | Task::Shape(_)
             | Task::Subdivision { .. } => "voxelizing",
             Task::Lines { .. } => "lines",
             Task::DistanceBand { .. } => "distances",
@@ -539,93 +533,72 @@ impl PlannedJob {
         let t = self.plan.transform;
         let fit = self.job.fit;
         let source = self.job.describe_input();
-        match (&self.job.task, &self.loaded) {
-            (Task::MeshSurface { method, .. }, Loaded::Mesh(mesh)) => {
+        match &self.work {
+            Work::MeshSurface { mesh, method } => {
                 outcome::mesh_surface(mesh, t, *method, fit, progress)
             }
-            (Task::SeparationCheck { options, .. }, Loaded::Mesh(mesh)) => {
+            Work::SeparationCheck { mesh, options } => {
                 outcome::separation_check(mesh, t, *options, fit, progress)
             }
-            (Task::Lines { edges, color, .. }, Loaded::Mesh(mesh)) => {
-                let source = lines_source(mesh, *edges);
-                outcome::lines(mesh, t, source, color.coloring(mesh), fit, progress)
-            }
-            (
-                Task::Shape {
-                    shape,
-                    separability,
-                    normals,
-                    curvature_margin,
-                },
-                Loaded::Shape,
-            ) => {
-                let margin = *curvature_margin;
-                outcome::shape(shape, t, *separability, *normals, margin, fit, progress)
-            }
-            (
-                Task::Subdivision {
-                    options,
-                    solid: None,
-                    ..
-                },
-                Loaded::Control(control),
-            ) => outcome::subdivision(control, t, options, fit, progress),
-            (
-                Task::Subdivision {
-                    options,
-                    solid: Some(fill),
-                    ..
-                },
-                Loaded::Control(control),
-            ) => solid::subdivision_solid(control, t, options, *fill, fit, progress),
-            (
-                Task::Implicit {
-                    min,
-                    max,
-                    levels,
-                    negative_r,
-                    formula: text,
-                    ..
-                },
-                Loaded::Formula(formula),
-            ) => {
+            Work::Lines {
+                mesh,
+                source,
+                coloring,
+            } => outcome::lines(mesh, t, *source, *coloring, fit, progress),
+            Work::Shape(s) => outcome::shape(s, t, fit, progress),
+            Work::Subdivision {
+                control,
+                options,
+                solid: None,
+            } => outcome::subdivision(control, t, options, fit, progress),
+            Work::Subdivision {
+                control,
+                options,
+                solid: Some(fill),
+            } => solid::subdivision_solid(control, t, options, *fill, fit, progress),
+            Work::Implicit {
+                formula,
+                text,
+                min,
+                max,
+                levels,
+                negative_r,
+            } => {
                 let options = crate::voxelize::interval_octree::OctreeOptions {
-                    resolution: estimate::octree_resolution(self.job.fit, *min, *max)?,
+                    resolution: estimate::octree_resolution(fit, *min, *max)?,
                     both_signs: *negative_r,
                     levels: *levels,
                     max_leaves: Some(estimate::leaf_budget(self.job.limits.max_memory, 1)),
                 };
                 outcome::implicit(formula, text, *min, *max, &options, progress)
             }
-            (Task::DistanceBand { band, signed, .. }, Loaded::Mesh(mesh)) => {
+            Work::DistanceBand { mesh, band, signed } => {
                 solid::distance_band(mesh, t, *band, *signed, fit, progress)
             }
-            (
-                Task::Solid {
-                    fill,
-                    density,
-                    topology,
-                    ..
-                },
-                Loaded::Mesh(mesh),
-            ) => solid::mesh_solid(mesh, t, *fill, *density, *topology, fit, progress),
-            (Task::Measure { flood, density, .. }, Loaded::Mesh(mesh)) => {
-                solid::measure_mesh(mesh, t, *flood, *density, progress)
-            }
-            (Task::Measure { flood, density, .. }, Loaded::Grid(surface)) => {
-                solid::measure_surface(surface, &source, *flood, *density, progress)
-            }
-            (Task::CsgTree(_), Loaded::Tree(tree)) => solid::csg_tree(tree, progress),
-            (
-                Task::Combine {
-                    op,
-                    resample,
-                    curve,
-                    ..
-                },
-                Loaded::Grids(a, b),
-            ) => outcome::combine(a, b, *op, *resample, *curve, &source),
-            _ => unreachable!("planning loads what the task needs"),
+            Work::Solid {
+                mesh,
+                fill,
+                density,
+                topology,
+            } => solid::mesh_solid(mesh, t, *fill, *density, *topology, fit, progress),
+            Work::MeasureMesh {
+                mesh,
+                flood,
+                density,
+            } => solid::measure_mesh(mesh, t, *flood, *density, progress),
+            Work::MeasureSurface {
+                surface,
+                flood,
+                density,
+            } => solid::measure_surface(surface, &source, *flood, *density, progress),
+            Work::CsgTree(tree) => solid::csg_tree(tree, progress),
+            Work::Combine {
+                a,
+                b,
+                op,
+                resample,
+                curve,
+            } => outcome::combine(a, b, *op, *resample, *curve, &source),
         }
     }
 }

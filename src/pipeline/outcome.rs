@@ -5,7 +5,7 @@ use super::report::{
     Details, ImplicitDetails, ProjectiveDetails, Report, SeparatingClasses, SeparationCheckDetails,
     SubdivisionDetails,
 };
-use super::{Shape, SurfaceMethod, on_threads};
+use super::{ShapeTask, SurfaceMethod, on_threads};
 use crate::error::{Error, Result};
 use crate::grid::{SparseGrid, Transform};
 use crate::implicit::Formula;
@@ -20,7 +20,6 @@ use crate::ops::minimality::simple_voxel_count;
 use crate::ops::separability::check_mesh_separation;
 use crate::progress::Progress;
 use crate::subd::ControlMesh;
-use crate::voxelize::Separability;
 use crate::voxelize::interval_octree::{OctreeOptions, voxelize_implicit};
 use crate::voxelize::parametric::{ParametricOptions, voxelize_subdivision};
 use crate::voxelize::projective::{self, Coloring, LineSource};
@@ -389,14 +388,17 @@ pub(super) fn lines(
 }
 
 pub(super) fn shape(
-    shape: &Shape,
+    task: &ShapeTask,
     t: Transform,
-    separability: Separability,
-    normals: bool,
-    curvature_margin: bool,
     fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
+    let &ShapeTask {
+        ref shape,
+        separability,
+        normals,
+        curvature_margin,
+    } = task;
     let start = Instant::now();
     let grid = voxelize_surface(
         shape.surface(),

@@ -12,7 +12,7 @@ use voxelkit::io::vdb::{DENSITY_GRID, VOXELS_GRID, read_vdb_info};
 use voxelkit::mesh::{GridFit, generate};
 use voxelkit::ops::separability::check_mesh_separation;
 use voxelkit::pipeline::request::{MeshRequest, Request, SurfaceKind};
-use voxelkit::pipeline::{Details, Job, MeshSource, Shape, SurfaceMethod, Task};
+use voxelkit::pipeline::{Details, Job, MeshSource, Shape, ShapeTask, SurfaceMethod, Task};
 use voxelkit::shapes::{Cylinder, Quadric, Sphere};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{Criterion, SeparatingOptions};
@@ -221,12 +221,12 @@ pub fn shape(kind: &ShapeKind, global: &Global) -> Result<()> {
             (Shape::Quadric(q), common)
         }
     };
-    let task = Task::Shape {
+    let task = Task::Shape(ShapeTask {
         shape,
         separability: common.surface.separability,
         normals: common.surface.normals,
         curvature_margin: !common.surface.no_curvature_margin,
-    };
+    });
     run_and_report(
         Job::new(task, common.fit.grid_fit()),
         &common.output,

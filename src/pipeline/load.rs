@@ -1,0 +1,224 @@
+//! Loading: a task's inputs read and checked (meshes, control meshes, formulas, CSG trees,
+//! grids), each kept beside the options that act on it, so that pricing and running match
+//! one enum and never a task against what was loaded for it.
+
+use super::{
+    CsgSource, Fill, GridSource, MeasureSource, MeshSource, ShapeTask, SubdivisionFill,
+    SurfaceMethod, Task, lines_source,
+};
+use crate::error::{Error, Result};
+use crate::grid::SparseGrid;
+use crate::implicit::Formula;
+use crate::io::vdb::read_vdb_grid;
+use crate::mesh::{Mesh, UpAxis};
+use crate::ops::csg::BooleanOp;
+use crate::solids::csg_tree::{CsgTree, parse_csg_tree, read_csg_tree};
+use crate::solids::exterior_flood::FloodMethod;
+use crate::subd::ControlMesh;
+use crate::voxelize::parametric::ParametricOptions;
+use crate::voxelize::projective::{Coloring, LineSource};
+use crate::voxelize::separating::SeparatingOptions;
+use glam::DVec3;
+use std::path::Path;
+
+/// A task with its inputs in memory.
+pub(super) enum Work {
+    MeshSurface {
+        mesh: Mesh,
+        method: SurfaceMethod,
+    },
+    SeparationCheck {
+        mesh: Mesh,
+        options: SeparatingOptions,
+    },
+    Lines {
+        mesh: Mesh,
+        source: LineSource,
+        coloring: Coloring,
+    },
+    Shape(ShapeTask),
+    Subdivision {
+        control: ControlMesh,
+        options: ParametricOptions,
+        solid: Option<SubdivisionFill>,
+    },
+    Implicit {
+        formula: Formula,
+        text: String,
+        min: DVec3,
+        max: DVec3,
+        levels: bool,
+        negative_r: bool,
+    },
+    DistanceBand {
+        mesh: Mesh,
+        band: f64,
+        signed: bool,
+    },
+    Solid {
+        mesh: Mesh,
+        fill: Fill,
+        density: f64,
+        topology: bool,
+    },
+    MeasureMesh {
+        mesh: Mesh,
+        flood: FloodMethod,
+        density: f64,
+    },
+    /// A surface grid to fill and weigh.
+    MeasureSurface {
+        surface: SparseGrid,
+        flood: FloodMethod,
+        density: f64,
+    },
+    CsgTree(Box<CsgTree>),
+    Combine {
+        a: SparseGrid,
+        b: SparseGrid,
+        op: BooleanOp,
+        resample: bool,
+        curve: bool,
+    },
+}
+
+/// Reads what `task` needs; mesh files are turned `up`.
+pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
+    let mesh = |source: &MeshSource| source.load(false, up);
+    Ok(match task {
+        Task::MeshSurface { mesh: m, method } => Work::MeshSurface {
+            mesh: mesh(m)?,
+            method: *method,
+        },
+        Task::SeparationCheck { mesh: m, options } => Work::SeparationCheck {
+            mesh: mesh(m)?,
+            options: *options,
+        },
+        Task::Lines {
+            mesh: m,
+            edges,
+            color,
+        } => {
+            let mesh = m.load(true, up)?;
+            Work::Lines {
+                source: lines_source(&mesh, *edges),
+                coloring: color.coloring(&mesh),
+                mesh,
+            }
+        }
+        Task::Shape(s) => Work::Shape(*s),
+        Task::Subdivision {
+            mesh,
+            options,
+            solid,
+        } => Work::Subdivision {
+            control: match mesh {
+                MeshSource::File(path) => ControlMesh::load(path)?,
+                MeshSource::Mesh(m) => ControlMesh::from_mesh(m)?,
+            },
+            options: *options,
+            solid: *solid,
+        },
+        Task::Implicit {
+            formula,
+            coordinates,
+            min,
+            max,
+            levels,
+            negative_r,
+            theta_range,
+            squared,
+        } => {
+            let size = *max - *min;
+            if !(size.max_element().is_finite() && size.min_element() > 0.0) {
+                return Err(Error::InvalidArgument(format!(
+                    "the bounds {min} .. {max} must be a box with positive size on every axis"
+                )));
+            }
+            Work::Implicit {
+                formula: Formula {
+                    theta_range: *theta_range,
+                    squared: *squared,
+                    ..Formula::parse(formula, *coordinates)?
+                },
+                text: formula.clone(),
+                min: *min,
+                max: *max,
+                levels: *levels,
+                negative_r: *negative_r,
+            }
+        }
+        Task::DistanceBand {
+            mesh: m,
+            band,
+            signed,
+        } => Work::DistanceBand {
+            mesh: mesh(m)?,
+            band: *band,
+            signed: *signed,
+        },
+        Task::Solid {
+            mesh: m,
+            fill,
+            density,
+            topology,
+        } => Work::Solid {
+            mesh: mesh(m)?,
+            fill: *fill,
+            density: *density,
+            topology: *topology,
+        },
+        Task::Measure {
+            source,
+            flood,
+            density,
+        } => match source {
+            MeasureSource::Mesh(m) => Work::MeasureMesh {
+                mesh: mesh(m)?,
+                flood: *flood,
+                density: *density,
+            },
+            MeasureSource::Vdb(path) => Work::MeasureSurface {
+                surface: read_surface(path)?,
+                flood: *flood,
+                density: *density,
+            },
+            MeasureSource::Grid(grid) => Work::MeasureSurface {
+                surface: grid.clone(),
+                flood: *flood,
+                density: *density,
+            },
+        },
+        Task::CsgTree(source) => Work::CsgTree(Box::new(match source {
+            CsgSource::File(path) => read_csg_tree(path)?,
+            CsgSource::Json { text, folder } => {
+                parse_csg_tree(text, Path::new("the CSG tree"), folder)?
+            }
+        })),
+        Task::Combine {
+            a,
+            b,
+            grid,
+            op,
+            resample,
+            curve,
+        } => {
+            let read = |g: &GridSource| match g {
+                GridSource::File(path) => read_vdb_grid(path, grid.as_deref()),
+                GridSource::Grid(g) => Ok(g.clone()),
+            };
+            Work::Combine {
+                a: read(a)?,
+                b: read(b)?,
+                op: *op,
+                resample: *resample,
+                curve: *curve,
+            }
+        }
+    })
+}
+
+/// The surface of a `.vdb` to measure: a solid's `shell` when it is one, else its voxel set.
+fn read_surface(path: &Path) -> Result<SparseGrid> {
+    read_vdb_grid(path, Some("shell")).or_else(|_| read_vdb_grid(path, None))
+}
