@@ -1,6 +1,6 @@
-//! Voxelizing in bricks (the Dask front end's library side) gives the single run's voxels:
-//! the surface of each brick's binned faces clipped to the brick, and solids whose outside
-//! components are joined across bricks. Generated fixtures with pockets, holes and nested
+//! Voxelizing in bricks (the Dask front end's library side), each brick a pipeline job, gives
+//! the single run's voxels: the surface of each brick's binned faces clipped to the brick,
+//! and solids whose outside components are joined across bricks. Generated fixtures with pockets, holes and nested
 //! shells, at brick sizes that cut them anywhere.
 #![cfg(feature = "fixtures")]
 
@@ -10,8 +10,9 @@ use voxelkit::grid::SparseGrid;
 use voxelkit::io::brick_set::fill_box;
 use voxelkit::mesh::{GridFit, Mesh, generate};
 use voxelkit::pipeline::brick_exterior::exterior_labels;
-use voxelkit::pipeline::bricks::{BrickLayout, BrickOutside, FACES, brick_surface, sub_mesh};
-use voxelkit::progress::Progress;
+use voxelkit::pipeline::bricks::{BrickIndex, BrickLayout, FACES, sub_mesh};
+use voxelkit::pipeline::{BrickStage, BrickTask, Details, Job, Outcome, Task};
+use voxelkit::progress::{Progress, Unobserved};
 use voxelkit::solids::exterior_flood::{FloodMethod, solid_from_surface};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::{SeparatingOptions, voxelize_mesh};
@@ -23,7 +24,20 @@ fn options(separability: Separability) -> SeparatingOptions {
     }
 }
 
-/// The surface and the solid, assembled from bricks of `size`.
+/// One brick's job, as a distributed run's worker runs it.
+fn brick_job(layout: &BrickLayout, faces: &Mesh, b: BrickIndex, stage: BrickStage) -> Outcome {
+    let task = Task::Brick(BrickTask {
+        faces: faces.clone(),
+        brick: b,
+        size: layout.size,
+        stage,
+    });
+    Job::new(task, GridFit::Placed(layout.transform))
+        .run(&Unobserved)
+        .unwrap()
+}
+
+/// The surface and the solid, assembled from bricks of `size`, each brick a job.
 fn in_bricks(
     mesh: &Mesh,
     resolution: u32,
@@ -32,40 +46,29 @@ fn in_bricks(
 ) -> (SparseGrid, SparseGrid) {
     let layout = BrickLayout::new(mesh, GridFit::Resolution(resolution), size).unwrap();
     let bins = layout.bin_faces(mesh);
-    let none = Progress::none();
     let mut surface = SparseGrid::new(layout.transform, Default::default());
-    let mut parts = BTreeMap::new();
-    for (b, faces) in &bins {
-        let sub = sub_mesh(mesh, faces);
-        let brick = brick_surface(
-            &sub,
-            layout.transform,
-            layout.voxels(*b),
-            &options(sep),
-            &none,
-        )
-        .unwrap();
-        surface.union(&brick);
-        let solid_surface = brick_surface(
-            &sub,
-            layout.transform,
-            layout.voxels(*b),
-            &options(Separability::TwentySix),
-            &none,
-        )
-        .unwrap();
-        let outside = BrickOutside::label(&solid_surface, layout.voxels(*b)).unwrap();
-        parts.insert(*b, (solid_surface, outside));
+    let mut faces = BTreeMap::new();
+    let subs: BTreeMap<BrickIndex, Mesh> =
+        bins.iter().map(|(b, f)| (*b, sub_mesh(mesh, f))).collect();
+    for (b, sub) in &subs {
+        surface.union(&brick_job(&layout, sub, *b, BrickStage::Surface(sep)).grid);
+        let labels = brick_job(&layout, sub, *b, BrickStage::FaceLabels);
+        let Details::BrickFaces(d) = labels.report.details else {
+            panic!("no labels for brick {b:?}");
+        };
+        assert_eq!(d.labels.len(), FACES);
+        faces.insert(*b, d.labels);
     }
-    let faces: BTreeMap<_, Vec<Vec<u32>>> = parts
-        .iter()
-        .map(|(b, (_, o))| (*b, (0..FACES).map(|f| o.face(f)).collect()))
-        .collect();
     let exterior = exterior_labels(&layout, &faces).unwrap();
     let mut solid = SparseGrid::new(layout.transform, Default::default());
     for (b, labels) in &exterior {
-        match parts.get(b) {
-            Some((s, outside)) => solid.union(&outside.solid(s, labels)),
+        match subs.get(b) {
+            Some(sub) => {
+                let stage = BrickStage::Solid {
+                    exterior: labels.clone(),
+                };
+                solid.union(&brick_job(&layout, sub, *b, stage).grid)
+            }
             None if labels.is_empty() => fill_box(&mut solid, layout.voxels(*b)),
             None => assert_eq!(labels, &[1]),
         }
@@ -130,4 +133,31 @@ fn brick_sizes_must_be_multiples_of_eight() {
         let e = BrickLayout::new(&mesh, GridFit::Resolution(64), bad).unwrap_err();
         assert!(e.to_string().contains("multiple of 8"), "{e}");
     }
+}
+
+/// A brick is a pipeline job: its memory plan refuses it with the brick named, and it runs
+/// only on its run's placement.
+#[test]
+fn a_brick_job_is_planned_and_refused_as_a_job() {
+    let mesh = generate::cuboid(DVec3::ZERO, DVec3::ONE);
+    let layout = BrickLayout::new(&mesh, GridFit::Resolution(64), 64).unwrap();
+    let (b, faces) = layout.bin_faces(&mesh).into_iter().next().unwrap();
+    let task = Task::Brick(BrickTask {
+        faces: sub_mesh(&mesh, &faces),
+        brick: b,
+        size: layout.size,
+        stage: BrickStage::FaceLabels,
+    });
+    let mut job = Job::new(task.clone(), GridFit::Placed(layout.transform));
+    job.limits.max_memory = Some(1 << 20);
+    let refused = job.plan().err().expect("1 MiB is too little").to_string();
+    assert!(
+        refused.contains("the brick of 64^3 voxels") && refused.contains("use smaller bricks"),
+        "{refused}"
+    );
+    let unplaced = Job::new(task, GridFit::Resolution(64)).plan().err();
+    assert!(
+        unplaced.is_some_and(|e| e.to_string().contains("GridFit::Placed")),
+        "a brick without its run's placement must be refused"
+    );
 }

@@ -10,12 +10,12 @@
 //! them across bricks and finds those connected to the layout's border, which lies at
 //! least one voxel beyond the surface; each brick then keeps the rest as inside.
 
-use super::MeshSource;
 use super::request::BricksRequest;
+use super::{BrickFaceDetails, BrickStage, BrickTask, Details, MeshSource, Outcome};
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
 use crate::io::brick_set::brick_voxels;
-use crate::io::vdb::{WriteOptions, check_voxel_size, write_vdb_as};
+use crate::io::vdb::check_voxel_size;
 use crate::mesh::{GridFit, Mesh, fit_transform, index_box};
 use crate::ops::flood::padded;
 use crate::ops::labels::{ClearRuns, label_clear_runs};
@@ -23,9 +23,9 @@ use crate::progress::Progress;
 use crate::solids::flooded_mesh::FLOOD_NEEDS_CLOSED;
 use crate::voxelize::Separability;
 use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
-use glam::DVec3;
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::time::Instant;
 
 /// A brick's coordinates: brick `b` covers voxels `b * size ..= b * size + size - 1`.
 pub type BrickIndex = [i64; 3];
@@ -210,28 +210,6 @@ impl BrickOutside {
     }
 }
 
-/// Refuses a brick whose work is estimated above `limit` bytes (default: the memory
-/// available), naming the brick.
-pub fn check_brick_fits(
-    faces: &Mesh,
-    transform: &Transform,
-    brick: CoordBox,
-    solid: bool,
-    limit: Option<u64>,
-) -> Result<()> {
-    let size = (brick.max[0] - brick.min[0] + 1) as u32;
-    let bytes = super::estimate::brick_bytes(faces, transform, size, solid);
-    crate::system::check_fits(
-        bytes,
-        limit,
-        &format!(
-            "the brick of {size}^3 voxels at {:?} with {} faces; use smaller bricks",
-            brick.min,
-            faces.face_count()
-        ),
-    )
-}
-
 /// A distributed run's plan: the mesh read as the CLI reads it (checked closed for a solid),
 /// placed on the grid one run would use, its voxel size one a `.vdb` holds, and cut into
 /// bricks with the faces each receives.
@@ -260,72 +238,37 @@ impl BrickRun {
     }
 }
 
-/// One brick's work on a worker: the faces it received, the grid and its voxels, under a
-/// memory limit (bytes; none: the memory available).
-pub struct BrickJob {
-    pub faces: Mesh,
-    pub transform: Transform,
-    pub voxels: CoordBox,
-    pub limit: Option<u64>,
-}
-
-impl BrickJob {
-    /// The job of brick `brick` (edge `size`) on the grid of `origin` and `voxel_size`, its
-    /// faces checked.
-    pub fn new(
-        faces: Mesh,
-        origin: DVec3,
-        voxel_size: f64,
-        brick: BrickIndex,
-        size: i64,
-        limit: Option<u64>,
-    ) -> Result<BrickJob> {
-        faces.validate()?;
-        check_voxel_size(Path::new("the brick"), voxel_size)?;
-        Ok(BrickJob {
-            faces,
-            transform: Transform::new(origin, voxel_size),
-            voxels: brick_voxels(brick, size),
-            limit,
-        })
-    }
-
-    /// The brick's part of the `separability` surface (26 for a solid), once its estimate
-    /// fits the limit.
-    pub fn surface(&self, separability: Separability, solid: bool) -> Result<SparseGrid> {
-        check_brick_fits(&self.faces, &self.transform, self.voxels, solid, self.limit)?;
+/// A brick's job (see `Task::Brick`): its part of the surface, its outside labels or its
+/// part of the solid.
+pub(super) fn run_brick(task: &BrickTask, t: Transform, progress: &Progress) -> Result<Outcome> {
+    let start = Instant::now();
+    let voxels = brick_voxels(task.brick, task.size);
+    let surface = |separability| {
         let options = SeparatingOptions {
             separability,
             ..Default::default()
         };
-        brick_surface(
-            &self.faces,
-            self.transform,
-            self.voxels,
-            &options,
-            &Progress::none(),
-        )
-    }
-
-    /// The labels of the brick's outside components on its six faces.
-    pub fn face_labels(&self) -> Result<Vec<Vec<u32>>> {
-        let surface = self.surface(Separability::TwentySix, true)?;
-        let outside = BrickOutside::label(&surface, self.voxels)?;
-        Ok((0..FACES).map(|f| outside.face(f)).collect())
-    }
-
-    /// The brick's part of the solid: its surface and the components not in `exterior`.
-    pub fn solid(&self, exterior: &mut [u32]) -> Result<SparseGrid> {
-        exterior.sort_unstable();
-        let surface = self.surface(Separability::TwentySix, true)?;
-        let outside = BrickOutside::label(&surface, self.voxels)?;
-        Ok(outside.solid(&surface, exterior))
-    }
-}
-
-/// Writes a brick's grid to `path` (atomically) and returns its voxel count.
-pub fn write_brick(grid: &SparseGrid, path: &Path) -> Result<u64> {
-    let meta = [("method", "voxelkit brick".into())];
-    write_vdb_as(path, grid, &[], &meta, &WriteOptions::default())?;
-    Ok(grid.voxel_count())
+        brick_surface(&task.faces, t, voxels, &options, progress)
+    };
+    let (grid, details) = match &task.stage {
+        BrickStage::Surface(separability) => (surface(*separability)?, Details::None),
+        BrickStage::FaceLabels => {
+            let surface = surface(Separability::TwentySix)?;
+            let outside = BrickOutside::label(&surface, voxels)?;
+            let details = BrickFaceDetails {
+                outside_components: outside.runs.components,
+                labels: (0..FACES).map(|f| outside.face(f)).collect(),
+            };
+            (surface, Details::BrickFaces(details))
+        }
+        BrickStage::Solid { exterior } => {
+            let mut exterior = exterior.clone();
+            exterior.sort_unstable();
+            let surface = surface(Separability::TwentySix)?;
+            let outside = BrickOutside::label(&surface, voxels)?;
+            (outside.solid(&surface, &exterior), Details::None)
+        }
+    };
+    let meta = vec![("method", "voxelkit brick".into())];
+    Ok(Outcome::new(grid, meta, details).timed(start))
 }

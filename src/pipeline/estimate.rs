@@ -10,10 +10,12 @@
 //! its box.
 
 use super::load::Work;
-use super::{Fill, Plan, ShapeTask, SurfaceMethod};
+use super::{BrickStage, BrickTask, Fill, Plan, ShapeTask, SurfaceMethod};
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, MAX_DENSE_VOXELS, SparseGrid, Transform};
 use crate::implicit::Formula;
+use crate::io::brick_set::brick_voxels;
+use crate::io::vdb::check_voxel_size;
 use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
 use crate::ops::flood::padded;
 use crate::solids::csg_tree::CsgNode;
@@ -22,6 +24,7 @@ use crate::subd::ControlMesh;
 use crate::voxelize::projective::{self, Coloring};
 use crate::voxelize::separating;
 use glam::DVec3;
+use std::path::Path;
 
 /// Peak bytes per leaf of a voxel set, and per leaf of a normal or colour channel.
 const LEAF_BYTES: f64 = 3500.0;
@@ -273,15 +276,38 @@ const RUN_BYTES: f64 = 16.0;
 /// Peak bytes of one brick's work (see `bricks`): the surface of its `faces`, and for a
 /// solid the two bit masks over its `size^3` voxels, the labelled runs (a few per row) and
 /// the solid's leaves.
-pub(super) fn brick_bytes(faces: &Mesh, t: &Transform, size: u32, solid: bool) -> u64 {
-    let cells = f64::from(size).powi(3);
+fn brick_bytes(faces: &Mesh, t: &Transform, size: i64, solid: bool) -> f64 {
+    let edge = size as f64;
     let fill = if solid {
-        let runs = 4.0 * f64::from(size).powi(2);
-        cells / 4.0 + runs * RUN_BYTES + leaf_bytes(cells * SOLID_FILL / 512.0, 0)
+        let runs = 4.0 * edge * edge;
+        edge.powi(3) / 4.0 + runs * RUN_BYTES + leaf_bytes(edge.powi(3) * SOLID_FILL / 512.0, 0)
     } else {
         0.0
     };
-    (BASE_BYTES + surface_bytes(area_in_voxels(faces, t), 0) + fill) as u64
+    surface_bytes(area_in_voxels(faces, t), 0) + fill
+}
+
+/// A brick on its run's grid, which only `GridFit::Placed` gives.
+fn brick_plan(brick: &BrickTask, fit: GridFit) -> Result<Plan> {
+    let GridFit::Placed(t) = fit else {
+        return Err(Error::InvalidArgument(
+            "a brick is placed on its run's grid (GridFit::Placed)".into(),
+        ));
+    };
+    check_voxel_size(Path::new("the brick"), t.voxel_size)?;
+    let voxels = brick_voxels(brick.brick, brick.size);
+    let bbox = Aabb {
+        min: t.index_to_world(voxels.min),
+        max: t.index_to_world(voxels.max),
+    };
+    let solid = !matches!(brick.stage, BrickStage::Surface(_));
+    let bytes = brick_bytes(&brick.faces, &t, brick.size, solid);
+    Ok(plan_of(
+        t,
+        &bbox,
+        bytes,
+        separating::work_items(&brick.faces),
+    ))
 }
 
 /// Voxels of a box, as a float (boxes past 2^64 voxels must still be refused, not wrap).
@@ -532,6 +558,7 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
             let bytes = csg_tree_bytes(&tree.root, &t, &b);
             plan_of(t, &bounds, bytes, tree.node_count() as u64)
         }
+        Work::Brick(brick) => brick_plan(brick, fit)?,
         Work::Combine { a, b, resample, .. } => {
             // Resampled onto the first grid, each voxel of the second becomes (hb/ha)^3.
             let scale = b.transform.voxel_size / a.transform.voxel_size;

@@ -3,7 +3,7 @@
 //! one enum and never a task against what was loaded for it.
 
 use super::{
-    CsgSource, Fill, GridSource, MeasureSource, MeshSource, ShapeTask, SubdivisionFill,
+    BrickTask, CsgSource, Fill, GridSource, MeasureSource, MeshSource, ShapeTask, SubdivisionFill,
     SurfaceMethod, Task, lines_source,
 };
 use crate::error::{Error, Result};
@@ -73,6 +73,7 @@ pub(super) enum Work {
         density: f64,
     },
     CsgTree(Box<CsgTree>),
+    Brick(BrickTask),
     Combine {
         a: SparseGrid,
         b: SparseGrid,
@@ -195,6 +196,10 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
                 parse_csg_tree(text, Path::new("the CSG tree"), folder)?
             }
         })),
+        Task::Brick(brick) => {
+            brick.faces.validate()?;
+            Work::Brick(brick.clone())
+        }
         Task::Combine {
             a,
             b,

@@ -173,6 +173,8 @@ pub enum Task {
     },
     /// A CSG tree in JSON (see `ops::csg_tree`); the tree sets the grid.
     CsgTree(CsgSource),
+    /// One brick of a distributed run, on the run's grid (`GridFit::Placed`).
+    Brick(BrickTask),
     /// A Boolean of two grids (from files: their grid `grid`, or the voxel set voxelkit
     /// writes); `curve`: the intersection of two surfaces.
     Combine {
@@ -193,6 +195,30 @@ pub struct ShapeTask {
     pub normals: bool,
     /// Widen the slabs by the curvature margin (false: the paper's plain rule).
     pub curvature_margin: bool,
+}
+
+/// One brick of a distributed run (see `bricks`): the faces it received and what to make of
+/// them.
+#[derive(Clone, Debug)]
+pub struct BrickTask {
+    pub faces: Mesh,
+    pub brick: bricks::BrickIndex,
+    /// Voxels along the brick's edge.
+    pub size: i64,
+    pub stage: BrickStage,
+}
+
+/// What a brick's job makes.
+#[derive(Clone, Debug)]
+pub enum BrickStage {
+    /// Its part of the separating surface.
+    Surface(Separability),
+    /// Its 26-separating surface, with the labels of its outside components on its six faces
+    /// in the report (`Details::BrickFaces`) for the client to join.
+    FaceLabels,
+    /// Its part of the solid: the surface and the components not in `exterior` (labels of
+    /// the face-label stage).
+    Solid { exterior: Vec<u32> },
 }
 
 /// How a Catmull-Clark solid is filled and weighed.
@@ -419,9 +445,13 @@ impl Job {
             plan.estimated_bytes,
             limit,
             &format!(
-                "{} at {} voxels; lower the resolution or raise the memory limit",
+                "{} at {} voxels; {}",
                 self.describe_input(),
-                plan.describe_extent()
+                plan.describe_extent(),
+                match self.task {
+                    Task::Brick(_) => "use smaller bricks or raise the memory limit",
+                    _ => "lower the resolution or raise the memory limit",
+                }
             ),
         )?;
         Ok(PlannedJob {
@@ -450,6 +480,12 @@ impl Job {
             (_, Some(MeshSource::Mesh(m))) => m.source.display().to_string(),
             (Task::Shape(s), _) => s.shape.describe(),
             (Task::Implicit { formula, .. }, _) => formula.clone(),
+            (Task::Brick(b), _) => format!(
+                "the brick of {}^3 voxels at {:?} with {} faces",
+                b.size,
+                crate::io::brick_set::brick_voxels(b.brick, b.size).min,
+                b.faces.face_count()
+            ),
             (Task::Combine { a, b, .. }, _) => format!("{} {}", grid(a), grid(b)),
             (
                 Task::Measure {
@@ -526,6 +562,7 @@ impl PlannedJob {
             Task::Implicit { .. } => "octree",
             Task::Solid { .. } | Task::Measure { .. } => "surface",
             Task::CsgTree(_) | Task::Combine { .. } => "combining",
+            Task::Brick(_) => "brick",
         }
     }
 
@@ -599,6 +636,7 @@ impl PlannedJob {
                 resample,
                 curve,
             } => outcome::combine(a, b, *op, *resample, *curve, &source),
+            Work::Brick(brick) => bricks::run_brick(brick, t, progress),
         }
     }
 }

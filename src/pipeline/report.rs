@@ -59,6 +59,17 @@ pub enum Details {
     DistanceBand(DistanceBandDetails),
     DepthLayers(DepthLayerDetails),
     Csg(CsgDetails),
+    BrickFaces(BrickFaceDetails),
+}
+
+/// A brick's outside components, and their labels on its faces.
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct BrickFaceDetails {
+    pub outside_components: u32,
+    /// The labels on the six faces (see `bricks::FACES`), for the client's join; 0 on the
+    /// surface.
+    #[serde(skip)]
+    pub labels: Vec<Vec<u32>>,
 }
 
 /// Voxels by the part of Huang et al.'s criterion that first produced them.
@@ -342,6 +353,10 @@ impl Report {
                 self.voxel_size
             ),
             Details::DepthLayers(d) => depth_layer_summary(place, &self.method, d, &timing),
+            Details::BrickFaces(b) => format!(
+                "{place}: {} surface voxels, {} outside components, {timing}",
+                self.voxels, b.outside_components
+            ),
             Details::Csg(c) => {
                 let mut t = format!(
                     "{place}: {} voxels (volume {:.6}) at voxel size {:.6} from {} leaves; {timing}",

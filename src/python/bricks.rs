@@ -9,13 +9,16 @@ use super::keywords::Keywords;
 use super::to_py_err;
 use crate::choice::Choice;
 use crate::error::Result;
+use crate::grid::Transform;
 use crate::io::brick_set::BrickSet;
 use crate::io::vdb::WriteOptions;
+use crate::mesh::GridFit;
 use crate::mesh::Mesh;
-use crate::pipeline::Outcome;
 use crate::pipeline::brick_exterior::exterior_labels;
-use crate::pipeline::bricks::{BrickIndex, BrickJob, BrickRun, sub_mesh, write_brick};
+use crate::pipeline::bricks::{BrickIndex, BrickRun, sub_mesh};
 use crate::pipeline::request::{BricksRequest, mib_limit};
+use crate::pipeline::{BrickStage, BrickTask, Details, Job, Limits, Outcome, Task};
+use crate::progress::Unobserved;
 use crate::voxelize::Separability;
 use glam::DVec3;
 use numpy::ndarray::{Array1, Array2};
@@ -24,7 +27,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// A brick index as Python sees it: a tuple, so that it can key a dict.
 type PyBrick = (i64, i64, i64);
@@ -121,19 +124,19 @@ pub fn brick_plan(
         .map_err(to_py_err)
 }
 
-/// One brick's job from its arrays: positions (k, 3), the faces' vertex indices back to back,
-/// and where each face starts.
+/// Runs one brick's job from its arrays (positions (k, 3), the faces' vertex indices back to
+/// back, where each face starts) on the run's grid, under `max_memory_mib`.
 #[allow(clippy::too_many_arguments)]
-fn brick_job(
-    positions: PyReadonlyArray2<f64>,
-    indices: PyReadonlyArray1<u32>,
-    starts: PyReadonlyArray1<u32>,
+fn run_brick(
+    py: Python<'_>,
+    (positions, indices, starts): BrickArrays,
     origin: [f64; 3],
     voxel_size: f64,
     brick: PyBrick,
     size: i64,
+    stage: BrickStage,
     max_memory_mib: Option<u64>,
-) -> PyResult<BrickJob> {
+) -> PyResult<Outcome> {
     let faces = Mesh {
         positions: positions
             .as_array()
@@ -147,9 +150,35 @@ fn brick_job(
         numbered_from_zero: true,
         ..Default::default()
     };
-    let origin = DVec3::from_array(origin);
-    let limit = mib_limit(max_memory_mib);
-    BrickJob::new(faces, origin, voxel_size, from_py(brick), size, limit).map_err(to_py_err)
+    let task = Task::Brick(BrickTask {
+        faces,
+        brick: from_py(brick),
+        size,
+        stage,
+    });
+    let placed = GridFit::Placed(Transform::new(DVec3::from_array(origin), voxel_size));
+    let job = Job {
+        limits: Limits {
+            max_memory: mib_limit(max_memory_mib),
+            ..Limits::default()
+        },
+        ..Job::new(task, placed)
+    };
+    py.detach(|| job.run(&Unobserved)).map_err(to_py_err)
+}
+
+/// A brick's faces as Python hands them in.
+type BrickArrays<'py> = (
+    PyReadonlyArray2<'py, f64>,
+    PyReadonlyArray1<'py, u32>,
+    PyReadonlyArray1<'py, u32>,
+);
+
+/// Writes a brick's grid to `path` (atomically) and returns its voxel count.
+fn write_brick(py: Python<'_>, mut outcome: Outcome, path: &Path) -> PyResult<u64> {
+    py.detach(|| outcome.write(path, &[], &WriteOptions::default()))
+        .map_err(to_py_err)?;
+    Ok(outcome.grid.voxel_count())
 }
 
 /// A brick's part of the separating surface, written to `path`; returns its voxel count.
@@ -170,20 +199,21 @@ pub fn brick_surface_file(
     separability: u32,
     max_memory_mib: Option<u64>,
 ) -> PyResult<u64> {
-    let job = brick_job(
-        positions,
-        indices,
-        starts,
+    let separability =
+        Separability::from_number(i64::from(separability)).map_err(PyValueError::new_err)?;
+    let arrays = (positions, indices, starts);
+    let stage = BrickStage::Surface(separability);
+    let outcome = run_brick(
+        py,
+        arrays,
         origin,
         voxel_size,
         brick,
         size,
+        stage,
         max_memory_mib,
     )?;
-    let separability =
-        Separability::from_number(i64::from(separability)).map_err(PyValueError::new_err)?;
-    py.detach(|| write_brick(&job.surface(separability, false)?, &path))
-        .map_err(to_py_err)
+    write_brick(py, outcome, &path)
 }
 
 /// The labels of a brick's outside components on its six faces (-x, +x, -y, +y, -z, +z),
@@ -203,18 +233,25 @@ pub fn brick_faces<'py>(
     size: i64,
     max_memory_mib: Option<u64>,
 ) -> PyResult<Vec<Bound<'py, PyArray1<u32>>>> {
-    let job = brick_job(
-        positions,
-        indices,
-        starts,
+    let arrays = (positions, indices, starts);
+    let stage = BrickStage::FaceLabels;
+    let outcome = run_brick(
+        py,
+        arrays,
         origin,
         voxel_size,
         brick,
         size,
+        stage,
         max_memory_mib,
     )?;
-    let faces = py.detach(|| job.face_labels()).map_err(to_py_err)?;
+    let Details::BrickFaces(faces) = outcome.report.details else {
+        return Err(PyValueError::new_err(
+            "a brick's labels job returned no labels",
+        ));
+    };
     Ok(faces
+        .labels
         .into_iter()
         .map(|f| Array1::from_vec(f).into_pyarray(py))
         .collect())
@@ -235,22 +272,23 @@ pub fn brick_solid_file(
     voxel_size: f64,
     brick: PyBrick,
     size: i64,
-    mut exterior: Vec<u32>,
+    exterior: Vec<u32>,
     path: PathBuf,
     max_memory_mib: Option<u64>,
 ) -> PyResult<u64> {
-    let job = brick_job(
-        positions,
-        indices,
-        starts,
+    let arrays = (positions, indices, starts);
+    let stage = BrickStage::Solid { exterior };
+    let outcome = run_brick(
+        py,
+        arrays,
         origin,
         voxel_size,
         brick,
         size,
+        stage,
         max_memory_mib,
     )?;
-    py.detach(|| write_brick(&job.solid(&mut exterior)?, &path))
-        .map_err(to_py_err)
+    write_brick(py, outcome, &path)
 }
 
 /// The exterior labels of every brick of `plan`, from the face labels of the bricks that
