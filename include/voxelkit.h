@@ -94,6 +94,13 @@ typedef enum vk_coordinates {
     VK_CYLINDRICAL = 2  /* r theta y */
 } vk_coordinates;
 
+/* How vk_grid_write_vdb_with compresses a .vdb. */
+typedef enum vk_compression {
+    VK_COMPRESSION_BLOSC = 0, /* OpenVDB's default */
+    VK_COMPRESSION_ZIP = 1,
+    VK_COMPRESSION_NONE = 2
+} vk_compression;
+
 typedef enum vk_boolean {
     VK_UNION = 0,
     VK_INTERSECTION = 1,
@@ -161,7 +168,7 @@ vk_status vk_options_set_surface_method(vk_options *options, vk_surface_method m
 vk_status vk_options_set_fill_method(vk_options *options, vk_fill_method method);
 /* The exterior flood of VK_FILL_FLOOD: non-zero `flooding_xyz` for Lai & Cheng's
  * FloodingXYZ with a GRAYSTACK of `graystack` entries (sweeps resume it when full), zero for
- * the scan-line span flood (the default). */
+ * the block flood (the default). */
 vk_status vk_options_set_flood(vk_options *options, int flooding_xyz, size_t graystack);
 /* VK_FILL_DEPTH_LAYERS: 3 (the axes) to 16 directions (default 16), double layers with a
  * stencil count (non-zero, the default) or Karabassi's single layers (zero). */
@@ -181,6 +188,18 @@ vk_status vk_options_set_progress(vk_options *options, vk_progress_fn callback, 
  * NULL to remove. It must stay valid while calls with these options run.
  */
 vk_status vk_options_set_cancel_flag(vk_options *options, const int32_t *flag);
+/* Compression and half-precision floats of vk_grid_write_vdb_with (default blosc, full). */
+vk_status vk_options_set_compression(vk_options *options, vk_compression compression);
+vk_status vk_options_set_half(vk_options *options, int half);
+/*
+ * Any option by name: field `field` of request `request` (mesh, solid, subdiv, lines, limits
+ * or write: the tables of Python's voxelkit.OPTIONS) set to `value`, a JSON text such as
+ * "2.5", "\"projective\"", "true", "null" or "[\"shell\"]". Checked and refused with the same
+ * message as Python's keyword. A `resolution` or `voxel_size` of any request sets the grid
+ * every call shares, as vk_options_set_resolution does.
+ */
+vk_status vk_options_set(vk_options *options, const char *request, const char *field,
+                         const char *value);
 
 /* ---- voxelization ----------------------------------------------------------------------- */
 
@@ -234,6 +253,10 @@ vk_status vk_grid_read_vdb(const char *path, const char *name, vk_grid **out);
 /* Writes `density` (a fog volume, whole blocks as tiles) and, when the grid has them,
  * `normal` and `Cd` grids (written to a temporary file, then renamed). */
 vk_status vk_grid_write_vdb(const vk_grid *grid, const char *path);
+/* vk_grid_write_vdb with the write options of `options`: the grids named (write.grids),
+ * the compression and half precision. */
+vk_status vk_grid_write_vdb_with(const vk_grid *grid, const char *path,
+                                 const vk_options *options);
 
 vk_status vk_grid_voxel_count(const vk_grid *grid, uint64_t *count);
 vk_status vk_grid_leaf_count(const vk_grid *grid, size_t *count);

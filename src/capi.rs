@@ -9,15 +9,16 @@
 //! returns `VK_ERROR_CANCELLED`. No algorithm and no orchestration lives here.
 
 use crate::choice::Choice;
-use crate::error::Error;
+use crate::error::{Error, Result};
 use crate::grid::{LEAF_VOXELS, SparseGrid};
 use crate::implicit::Coordinates;
-use crate::io::vdb::{MetaValue, read_vdb_grid, write_vdb};
+use crate::io::vdb::{Compression, MetaValue, read_vdb_grid, write_vdb, write_vdb_as};
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::BooleanOp;
 use crate::pipeline::request::{
     CombineRequest, Directions, FillKind, FloodKind, ImplicitRequest, LimitsRequest, LinesRequest,
-    MeasureRequest, MeshRequest, Request, SolidRequest, SubdivRequest, SurfaceKind, grid_fit,
+    MeasureRequest, MeshRequest, Request, Schema, SolidRequest, SubdivRequest, SurfaceKind,
+    WriteRequest, grid_fit,
 };
 use crate::pipeline::{Details, GridSource, Job, MeasureSource, MeshSource, Outcome, Task};
 use crate::progress::Observer;
@@ -25,6 +26,7 @@ use crate::solids::depth_layers::Layers;
 use crate::voxelize::Separability;
 use crate::voxelize::separating::Criterion;
 use glam::DVec3;
+use serde_json::Value;
 use std::any::Any;
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -96,7 +98,9 @@ struct Options {
     mesh: MeshRequest,
     solid: SolidRequest,
     subdivision: SubdivRequest,
+    lines: LinesRequest,
     limits: LimitsRequest,
+    write: WriteRequest,
     progress: Option<(VkProgressFn, *mut c_void)>,
     cancel: *const AtomicI32,
 }
@@ -108,7 +112,9 @@ impl Default for Options {
             mesh: MeshRequest::default(),
             solid: SolidRequest::default(),
             subdivision: SubdivRequest::default(),
+            lines: LinesRequest::default(),
             limits: LimitsRequest::default(),
+            write: WriteRequest::default(),
             progress: None,
             cancel: std::ptr::null(),
         }
@@ -655,6 +661,90 @@ fn set(
     })
 }
 
+/// `request` with `changes` made as its JSON would have them: the check and error text of
+/// Python's keywords.
+fn changed<R: Schema>(request: &R, changes: Vec<(&str, Value)>) -> Result<R> {
+    let mut values =
+        serde_json::to_value(request).map_err(|e| Error::InvalidArgument(e.to_string()))?;
+    for (field, value) in changes {
+        values[field] = value;
+    }
+    R::from_json(values)
+}
+
+/// Sets `field` of a request that places the grid; `resolution` and `voxel_size` set the
+/// grid every call shares, each replacing the other.
+fn set_field<R: Request>(
+    request: &mut R,
+    fit: &mut GridFit,
+    field: &str,
+    value: Value,
+) -> Result<()> {
+    if !matches!(field, "resolution" | "voxel_size") {
+        *request = changed(request, vec![(field, value)])?;
+        return Ok(());
+    }
+    let grid = vec![
+        ("resolution", Value::Null),
+        ("voxel_size", Value::Null),
+        (field, value),
+    ];
+    let new = changed(request, grid)?;
+    *fit = new.fit()?;
+    *request = new;
+    Ok(())
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set(
+    options: *mut VkOptions,
+    request: *const c_char,
+    field: *const c_char,
+    value: *const c_char,
+) -> VkStatus {
+    set(options, |o| {
+        let request = c_str(request, "request")?;
+        let field = c_str(field, "field")?;
+        let text = c_str(value, "value")?;
+        let value: Value = serde_json::from_str(text)
+            .map_err(|e| invalid(format!("{field}: {text:?} is not a JSON value ({e})")))?;
+        match request {
+            "mesh" => set_field(&mut o.mesh, &mut o.fit, field, value)?,
+            "solid" => set_field(&mut o.solid, &mut o.fit, field, value)?,
+            "subdiv" => set_field(&mut o.subdivision, &mut o.fit, field, value)?,
+            "lines" => set_field(&mut o.lines, &mut o.fit, field, value)?,
+            "limits" => o.limits = changed(&o.limits, vec![(field, value)])?,
+            "write" => o.write = changed(&o.write, vec![(field, value)])?,
+            other => {
+                return Err(invalid(format!(
+                    "no request {other:?} in the C options: mesh, solid, subdiv, lines, limits \
+                     or write"
+                )));
+            }
+        }
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_compression(
+    options: *mut VkOptions,
+    compression: c_int,
+) -> VkStatus {
+    set(options, |o| {
+        o.write.compression = Compression::from_code(i64::from(compression)).map_err(invalid)?;
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_half(options: *mut VkOptions, half: c_int) -> VkStatus {
+    set(options, |o| {
+        o.write.half = half != 0;
+        Ok(())
+    })
+}
+
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_resolution(options: *mut VkOptions, resolution: u32) -> VkStatus {
     set(options, |o| {
@@ -837,9 +927,7 @@ pub extern "C" fn vk_voxelize_lines(
     options: *const VkOptions,
     out: *mut *mut VkGrid,
 ) -> VkStatus {
-    grid_from_job(options, out, |_| {
-        Ok(LinesRequest::default().task(mesh_source(mesh)?)?)
-    })
+    grid_from_job(options, out, |o| Ok(o.lines.task(mesh_source(mesh)?)?))
 }
 
 #[unsafe(no_mangle)]
@@ -989,6 +1077,25 @@ pub extern "C" fn vk_grid_write_vdb(grid: *const VkGrid, path: *const c_char) ->
             .map(|(k, v)| (k.as_str(), v.clone()))
             .collect();
         Ok(write_vdb(&path, &g.grid, &meta)?)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_write_vdb_with(
+    grid: *const VkGrid,
+    path: *const c_char,
+    options: *const VkOptions,
+) -> VkStatus {
+    guard(|| {
+        let g = borrow(grid, Kind::Grid)?;
+        let path = PathBuf::from(c_str(path, "path")?);
+        let write = options_of(options)?.write.options();
+        let meta: Vec<(&str, MetaValue)> = g
+            .metadata
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.clone()))
+            .collect();
+        Ok(write_vdb_as(&path, &g.grid, &[], &meta, &write)?)
     })
 }
 

@@ -309,3 +309,108 @@ fn handles_survive_racing_frees_and_are_never_reused() {
     let report = String::from_utf8_lossy(&out.stderr);
     assert!(report.contains("ERROR SUMMARY: 0 errors"), "{report}");
 }
+
+/// Python's error for `value` as field `field` of request `request`: what the C setter must
+/// say too.
+fn schema_error(request: &str, field: &str, value: &serde_json::Value) -> String {
+    use voxelkit::pipeline::request::*;
+    let values = serde_json::json!({ field: value });
+    let refused = match request {
+        "mesh" => MeshRequest::from_json(values).err(),
+        "solid" => SolidRequest::from_json(values).err(),
+        "subdiv" => SubdivRequest::from_json(values).err(),
+        "lines" => LinesRequest::from_json(values).err(),
+        "limits" => LimitsRequest::from_json(values).err(),
+        "write" => WriteRequest::from_json(values).err(),
+        other => panic!("the C options hold no {other}"),
+    };
+    refused
+        .unwrap_or_else(|| panic!("{request}.{field} took {value}"))
+        .to_string()
+}
+
+#[test]
+fn every_field_of_the_c_options_is_settable_by_name_with_pythons_checks() {
+    if !have("pkg-config") || !have("gcc") {
+        return common::skip_or_fail("gcc or pkg-config is missing: the C options test");
+    }
+    let work = tempfile::tempdir().unwrap();
+    let flags = run(Command::new("pkg-config")
+        .env("PKG_CONFIG_PATH", prefix().join("lib/pkgconfig"))
+        .args(["--cflags", "--libs", "voxelkit"]));
+    let exe = work.path().join("set_options");
+    run(Command::new("gcc")
+        .args(["-std=c11", "-Wall", "-Wextra", "-Werror"])
+        .arg(repo().join("tests/c/set_options.c"))
+        .args(String::from_utf8_lossy(&flags.stdout).split_whitespace())
+        .arg("-o")
+        .arg(&exe));
+    // Every field at its default, then a value of the wrong kind; then the write options and
+    // a small grid for the file, 0 MiB meaning the memory available.
+    let schema = voxelkit::pipeline::request::schema();
+    let bad = serde_json::json!("nonsense");
+    let (mut lines, mut expected) = (String::new(), Vec::new());
+    for request in ["mesh", "solid", "subdiv", "lines", "limits", "write"] {
+        for field in schema[request]["fields"].as_array().unwrap() {
+            let name = field["name"].as_str().unwrap();
+            lines.push_str(&format!("{request}\t{name}\t{}\n", field["default"]));
+            expected.push("ok".to_string());
+            lines.push_str(&format!("{request}\t{name}\t{bad}\n"));
+            expected.push(format!("error: {}", schema_error(request, name, &bad)));
+        }
+    }
+    for (request, field, value) in [
+        ("mesh", "resolution", "16"),
+        // Another field of the request keeps the grid.
+        ("mesh", "band", "2.0"),
+        ("limits", "max_memory_mib", "0"),
+        ("limits", "threads", "0"),
+        ("write", "grids", r#"["voxels"]"#),
+        ("write", "compression", r#""zip""#),
+    ] {
+        lines.push_str(&format!("{request}\t{field}\t{value}\n"));
+        expected.push("ok".to_string());
+    }
+    lines.push_str("mesh\tno_such_field\t1\n");
+    expected.push(format!(
+        "error: {}",
+        schema_error("mesh", "no_such_field", &serde_json::json!(1))
+    ));
+    let out = work.path().join("cube.vdb");
+    let mut child = Command::new(&exe)
+        .arg(&out)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    use std::io::Write;
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(lines.as_bytes())
+        .unwrap();
+    let done = child.wait_with_output().unwrap();
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    let said: Vec<String> = String::from_utf8_lossy(&done.stdout)
+        .lines()
+        .map(str::to_string)
+        .collect();
+    let sent: Vec<&str> = lines.lines().collect();
+    assert!(expected.len() > 50, "only {} settings", expected.len());
+    for ((line, want), got) in sent.iter().zip(&expected).zip(&said) {
+        assert_eq!(got, want, "{line}");
+    }
+    assert_eq!(said.len(), expected.len());
+    // The write options reached the file: only `voxels`, at 16 voxels across.
+    let voxels = read_vdb_grid(&out, Some("voxels")).unwrap();
+    assert!(voxels.voxel_count() > 0);
+    assert!(read_vdb_grid(&out, Some("density")).is_err());
+    let t = voxels.transform;
+    assert!((t.voxel_size - 1.0 / 16.0).abs() < 1e-9, "{}", t.voxel_size);
+}

@@ -10,6 +10,7 @@ use cli_support::{text, voxelkit};
 use serde_json::Value;
 use voxelkit::choice::Choice;
 use voxelkit::implicit::Coordinates;
+use voxelkit::io::vdb::Compression;
 use voxelkit::ops::csg::BooleanOp;
 use voxelkit::pipeline::request::{FillKind, SurfaceKind, schema};
 use voxelkit::voxelize::separating::Criterion;
@@ -210,6 +211,7 @@ fn the_c_headers_enum_codes_are_the_name_tables() {
     check_codes::<Criterion>(&header, "vk_criterion", "VK_CRITERION_");
     check_codes::<Coordinates>(&header, "vk_coordinates", "VK_");
     check_codes::<BooleanOp>(&header, "vk_boolean", "VK_");
+    check_codes::<Compression>(&header, "vk_compression", "VK_COMPRESSION_");
 }
 
 #[test]

@@ -229,6 +229,20 @@ int main(int argc, char **argv) {
     OK(vk_voxelize_mesh(mesh, opts, &defaults));
     OK(vk_grid_free(defaults));
     OK(vk_options_set_threads(opts, 2));
+    /* The write options: every compression, half floats, and a bad code. */
+    for (int c = VK_COMPRESSION_BLOSC; c <= VK_COMPRESSION_NONE; c++) {
+        OK(vk_options_set_compression(opts, (vk_compression)c));
+        OK(vk_grid_write_vdb_with(surface, argv[2], opts));
+    }
+    OK(vk_options_set_half(opts, 1));
+    OK(vk_grid_write_vdb_with(surface, argv[2], opts));
+    CHECK(vk_options_set_compression(opts, (vk_compression)7) == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(vk_last_error(), "compression") != NULL);
+    CHECK(vk_options_set(opts, "mesh", "band", "\"wide\"") == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(vk_last_error(), "band") != NULL);
+    CHECK(vk_options_set(opts, "nothing", "band", "1") == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(vk_options_set(opts, "mesh", "band", "not json") == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(vk_options_set(opts, "mesh", NULL, "1") == VK_ERROR_INVALID_ARGUMENT);
 
     /* Misuse: NULL, wrong kinds, bad values, bad files, double frees, panics. */
     CHECK(vk_voxelize_mesh(NULL, opts, &g) == VK_ERROR_INVALID_HANDLE);
