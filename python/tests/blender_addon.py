@@ -60,6 +60,15 @@ imported = bpy.context.selected_objects[0]
 imported.location = (0.0, 3.0, 0.0)
 voxelize(imported, resolution=96, fill="solid")
 voxelize(imported, resolution=64, fill="sdf")
+operator = bpy.ops.object.voxelkit_voxelize.get_rna_type().properties
+print("PROPERTIES " + json.dumps({
+    name: {
+        "default": operator[name].default,
+        "items": [i.identifier for i in getattr(operator[name], "enum_items", [])],
+        "description": [i.description for i in getattr(operator[name], "enum_items", [])],
+    }
+    for name in ("resolution", "voxel_size", "separability", "method", "fill")
+}))
 print("PANEL", hasattr(bpy.types, "VOXELKIT_PT_panel"), hasattr(bpy.types.Scene, "voxelkit"))
 voxelkit.unregister()
 print("UNREGISTERED", hasattr(bpy.types, "VOXELKIT_PT_panel"))

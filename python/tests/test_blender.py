@@ -42,4 +42,14 @@ def test_the_add_on_voxelizes_into_volume_objects(data, tmp_path):
         mesh_lo, mesh_hi = np.array(r["mesh_box"])
         assert (np.abs(lo - mesh_lo) <= h).all() and (np.abs(hi - mesh_hi) <= h).all(), r
     assert "surface" in results[2]["grids"], "the level set is written as `surface`"
+    # The properties the add-on exposes have the table's defaults and choices.
+    [shown] = [json.loads(l[len("PROPERTIES "):]) for l in done.stdout.splitlines() if l.startswith("PROPERTIES ")]
+    table = {f["name"]: f for f in voxelkit.OPTIONS["mesh"]["fields"]}
+    for name in ("separability", "method"):
+        assert shown[name]["default"] == str(table[name]["default"]), name
+        assert shown[name]["items"] == [str(c) for c in table[name]["choices"]], name
+    assert shown["resolution"]["default"] == voxelkit.DEFAULT_RESOLUTION
+    assert table["resolution"]["default"] is None and table["voxel_size"]["default"] is None
+    band = next(f["default"] for f in voxelkit.OPTIONS["solid"]["fields"] if f["name"] == "band")
+    assert f"within {band:g} voxels" in shown["fill"]["description"][2]
     assert "PANEL True True" in done.stdout and "UNREGISTERED False" in done.stdout

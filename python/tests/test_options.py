@@ -83,15 +83,36 @@ def test_numpy_numbers_are_options():
     assert grid.same_voxels(voxelkit.implicit(SPHERE, resolution=24))
 
 
-def test_the_dask_command_line_takes_the_tables_defaults(capsys):
+def test_every_dask_option_is_the_tables_in_run_and_on_the_command_line(capsys):
     distributed = pytest.importorskip("voxelkit.distributed")
     with pytest.raises(SystemExit):
         distributed.main(["mesh", "--help"])
     text = " ".join(capsys.readouterr().out.split())
-    fields = {f["name"]: f for f in voxelkit.OPTIONS["distributed"]["fields"]}
-    assert f"(default {fields['brick']['default']})" in text
-    assert "{6,26}" in text and "--max-memory" in text and "--up-axis" in text
-    assert inspect.signature(distributed.run).parameters["brick"].default == fields["brick"]["default"]
+    params = inspect.signature(distributed.run).parameters
+    flags = {"max_memory_mib": "--max-memory"}
+    fields = voxelkit.OPTIONS["distributed"]["fields"]
+    for f in fields:
+        name, default = f["name"], f["default"]
+        assert params[name].default == default, name
+        assert f"\n{name} = " in distributed.run.__doc__, name
+        assert flags.get(name, "--" + name.replace("_", "-")) in text, name
+        if default is not None:
+            assert f"(default {default})" in text, name
+        for choice in f["choices"]:
+            assert str(choice) in text, (name, choice)
+    assert len(fields) >= 6
+
+
+def test_a_bad_dask_option_gets_the_tables_error_before_any_work(data, tmp_path):
+    distributed = pytest.importorskip("voxelkit.distributed")
+    path = data / "meshes" / "bunny-closed.obj"
+    with pytest.raises(ValueError, match="separability must be 6 or 26, not `7`"):
+        distributed.mesh(path, tmp_path / "b.vdb", separability=7)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'separabilty'"):
+        distributed.mesh(path, tmp_path / "b.vdb", separabilty=6)
+    with pytest.raises(TypeError, match="threads"):
+        distributed.mesh(path, tmp_path / "b.vdb", threads=2)
+    assert not list(tmp_path.iterdir())
 
 
 def test_pyopenvdb_reads_the_fit_and_separability_as_numbers(tmp_path):

@@ -34,7 +34,13 @@ METHOD = _items("method", lambda c: str(c).capitalize())
 FILL = [
     ("none", "Surface", "The surface voxels"),
     ("solid", "Solid", "The surface and everything inside it (closed meshes)"),
-    ("sdf", "Level set", "Exact signed distances within 3 voxels (closed meshes)"),
+    (
+        "sdf",
+        "Level set",
+        "Exact signed distances within {:g} voxels (closed meshes)".format(
+            next(f["default"] for f in voxelkit.OPTIONS["solid"]["fields"] if f["name"] == "band")
+        ),
+    ),
 ]
 
 

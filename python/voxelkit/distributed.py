@@ -24,6 +24,7 @@ calls ``run`` must do so under ``if __name__ == "__main__":``. ``--max-memory`` 
 
 import argparse
 import contextlib
+import inspect
 import logging
 import os
 import shutil
@@ -37,7 +38,6 @@ from . import _voxelkit as vk
 
 #: The options of a distributed run, their defaults, choices and docs: the library's table.
 _FIELDS = OPTIONS["distributed"]["fields"]
-_DEFAULT = {f["name"]: f["default"] for f in _FIELDS}
 
 #: Bytes of memory per merged voxel, generously (leaves hold 512 voxels in about 3.5 KiB).
 _MERGED_BYTES_PER_VOXEL = 16
@@ -215,52 +215,29 @@ def _brick_file(b):
     return "brick_{}_{}_{}.vdb".format(*b)
 
 
-def run(
-    source,
-    output,
-    solid=False,
-    resolution=_DEFAULT["resolution"],
-    voxel_size=_DEFAULT["voxel_size"],
-    brick=_DEFAULT["brick"],
-    separability=_DEFAULT["separability"],
-    scheduler=None,
-    workers=2,
-    max_memory_mib=_DEFAULT["max_memory_mib"],
-    keep_bricks=False,
-    up_axis=_DEFAULT["up_axis"],
-    progress=False,
-    client=None,
-):
-    """Voxelizes ``source`` (a path or a (vertices, faces) pair) in bricks on Dask: on
-    ``client`` (a dask.distributed.Client) when given, else on the scheduler at
-    ``scheduler``, else on a local cluster of ``workers`` processes started for the call.
-
-    Returns a dict: the merged ``grid`` (a voxelkit.Grid, or None when the bricks were kept),
-    ``output`` (the .vdb, or the brick set's index), ``bricks`` (with faces), ``full_bricks``,
-    ``voxels``, ``seconds``, and ``worker_peak_mib`` (each worker process's peak memory).
-    """
+def run(source, output, solid=False, scheduler=None, workers=2, keep_bricks=False,
+        progress=False, client=None, **options):
     start = time.perf_counter()
     output = os.fspath(output)
-    plan = vk.brick_plan(
-        source, solid=solid, output=output, brick=brick, resolution=resolution,
-        voxel_size=voxel_size, up_axis=up_axis,
-    )
+    # The library checks every option (the table's names, values and messages) before any work.
+    plan = vk.brick_plan(source, solid=solid, output=output, **options)
     folder = os.path.splitext(output)[0] + ".bricks"
     if os.path.exists(folder):
         raise OSError(f"{folder}: already exists; remove it or choose another output")
     with _stopped_by_signals() as check:
         os.makedirs(folder)
         try:
-            return _run_in(plan, folder, output, solid, separability, scheduler, workers,
-                           max_memory_mib, keep_bricks, progress, client, start, check)
+            return _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks,
+                           progress, client, start, check)
         except BaseException:
             # No half-written output: the bricks of a failed or interrupted run go.
             shutil.rmtree(folder, ignore_errors=True)
             raise
 
 
-def _run_in(plan, folder, output, solid, separability, scheduler, workers, max_memory_mib,
-            keep_bricks, progress, client, start, check):
+def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progress, client,
+            start, check):
+    separability, max_memory_mib = plan.separability, plan.max_memory_mib
     show = _Progress(progress)
     threads = max(1, (os.cpu_count() or 1) // max(1, workers))
     own = client is None
@@ -321,6 +298,32 @@ def _run_in(plan, folder, output, solid, separability, scheduler, workers, max_m
     }
 
 
+def _with_table_options(fn):
+    """``fn`` with the table's options in its signature and docs, after its own."""
+    own = [p for p in inspect.signature(fn).parameters.values() if p.kind != p.VAR_KEYWORD]
+    table = [
+        inspect.Parameter(f["name"], inspect.Parameter.KEYWORD_ONLY, default=f["default"])
+        for f in _FIELDS
+    ]
+    fn.__signature__ = inspect.Signature(own + table)
+    lines = [f"{f['name']} = {f['default']!r}: {f['doc']}" for f in _FIELDS]
+    fn.__doc__ = fn.__doc__ + "\n" + "\n".join(lines) + "\n"
+    return fn
+
+
+run.__doc__ = """Voxelizes ``source`` (a path or a (vertices, faces) pair) in bricks on Dask: on
+``client`` (a dask.distributed.Client) when given, else on the scheduler at ``scheduler``,
+else on a local cluster of ``workers`` processes started for the call.
+
+Returns a dict: the merged ``grid`` (a voxelkit.Grid, or None when the bricks were kept),
+``output`` (the .vdb, or the brick set's index), ``bricks`` (with faces), ``full_bricks``,
+``voxels``, ``seconds``, and ``worker_peak_mib`` (each worker process's peak memory).
+
+The options, as for every voxelkit function (``voxelkit.OPTIONS["distributed"]``):
+"""
+run = _with_table_options(run)
+
+
 def mesh(source, output, **options):
     """The separating surface of ``source`` in bricks (see ``run`` for the options)."""
     return run(source, output, solid=False, **options)
@@ -376,20 +379,16 @@ def main(argv=None):
         p.add_argument("--keep-bricks", action="store_true", help="keep the brick set instead of merging")
     args = parser.parse_args(argv)
     try:
+        given = vars(args)
         result = run(
             args.input,
             args.output,
             solid=args.command == "solid",
-            resolution=args.resolution,
-            voxel_size=args.voxel_size,
-            brick=args.brick,
-            separability=getattr(args, "separability", _DEFAULT["separability"]),
             scheduler=args.scheduler,
             workers=args.workers,
-            max_memory_mib=args.max_memory_mib,
             keep_bricks=args.keep_bricks,
-            up_axis=args.up_axis,
             progress=True,
+            **{f["name"]: given[f["name"]] for f in _FIELDS if f["name"] in given},
         )
     except (ValueError, MemoryError, OSError, RuntimeError) as e:
         print(f"error: {e}", file=sys.stderr)

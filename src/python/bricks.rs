@@ -23,7 +23,7 @@ use crate::voxelize::Separability;
 use glam::DVec3;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::collections::BTreeMap;
@@ -40,9 +40,10 @@ fn from_py(b: PyBrick) -> BrickIndex {
     [b.0, b.1, b.2]
 }
 
-/// A mesh placed on its grid and cut into bricks, with the faces each brick receives.
+/// A mesh placed on its grid and cut into bricks, with the faces each brick receives, and the
+/// run's options.
 #[pyclass(module = "voxelkit")]
-pub struct BrickPlan(BrickRun);
+pub struct BrickPlan(BrickRun, BricksRequest);
 
 #[pymethods]
 impl BrickPlan {
@@ -67,6 +68,18 @@ impl BrickPlan {
     #[getter]
     fn extent(&self) -> (PyBrick, PyBrick) {
         (to_py(self.0.layout.min), to_py(self.0.layout.max))
+    }
+
+    /// The separability of a surface run.
+    #[getter]
+    fn separability(&self) -> u32 {
+        self.1.separability.adjacency()
+    }
+
+    /// Each brick's memory limit in MiB (none: the memory available).
+    #[getter]
+    fn max_memory_mib(&self) -> Option<u64> {
+        mib_limit(self.1.max_memory_mib).map(|bytes| bytes >> 20)
     }
 
     /// The bricks that receive faces.
@@ -104,8 +117,7 @@ impl BrickPlan {
     }
 }
 
-/// The plan of a distributed run (`BricksRequest`'s options as keywords: `brick`,
-/// `resolution`, `voxel_size`, `up_axis`): the mesh read, checked, fitted and cut into bricks
+/// The plan of a distributed run (`BricksRequest`'s options as keywords): the mesh read, checked, fitted and cut into bricks
 /// by the pipeline; `solid`: the mesh must be closed.
 #[pyfunction]
 #[pyo3(signature = (source, solid = false, output = None, **options))]
@@ -116,11 +128,17 @@ pub fn brick_plan(
     output: Option<PathBuf>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<BrickPlan> {
-    let request: BricksRequest = Keywords::new(options)?.request;
+    let keywords: Keywords<BricksRequest> = Keywords::new(options)?;
+    if keywords.limits.threads.is_some() {
+        return Err(PyTypeError::new_err(
+            "a distributed run takes no threads: each worker runs its bricks on its own threads",
+        ));
+    }
+    let request = keywords.request;
     let source = mesh_source(source, mib_limit(request.max_memory_mib))?;
     let named = output.unwrap_or_else(|| PathBuf::from("the bricks"));
     py.detach(|| BrickRun::plan(&source, &request, solid, &named))
-        .map(BrickPlan)
+        .map(|run| BrickPlan(run, request))
         .map_err(to_py_err)
 }
 
