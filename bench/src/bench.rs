@@ -57,6 +57,9 @@ enum BenchKind {
     /// The whole `voxelkit` process (`mesh`, `solid` or `mesh --sdf`) against the cheapest
     /// OpenVDB call with the same output, with file sizes and both processes' peaks.
     Whole(crate::bench_whole::WholeBenchArgs),
+    /// Planning's memory estimates against whole runs' peaks, family by family, with the
+    /// factor that refits each family's constants.
+    Calibrate(crate::calibrate::CalibrateArgs),
     /// One OpenVDB reference run, in a process of its own (used by `whole`).
     #[command(hide = true)]
     Openvdb(crate::bench_whole::OpenVdbRunArgs),
@@ -115,6 +118,7 @@ pub fn best_of<T>(repeat: usize, mut f: impl FnMut() -> Result<T>) -> Result<(f6
 pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
     match &args.kind {
         Some(BenchKind::Subdiv(sub)) => return crate::bench_subdiv::run(sub, json),
+        Some(BenchKind::Calibrate(c)) => return crate::calibrate::run(c, json),
         Some(BenchKind::Implicit(imp)) => return crate::bench_implicit::run(imp, json),
         Some(BenchKind::Solid(solid)) => return crate::bench_solid::run(solid, json),
         Some(BenchKind::Measure(m)) => return crate::bench_measure::run(m, json),

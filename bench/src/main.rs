@@ -9,6 +9,7 @@ mod bench_projective;
 mod bench_solid;
 mod bench_subdiv;
 mod bench_whole;
+mod calibrate;
 mod json;
 
 use clap::Parser;
@@ -22,7 +23,8 @@ use voxelkit::voxelize::separating::Criterion;
     about = "Benchmark voxelkit against OpenVDB's meshToUnsignedDistanceField with a one-voxel band, \
              in the same run (`whole`: the whole voxelkit process against OpenVDB; `subdiv`: the \
              Catmull-Clark voxelizer; `implicit`: the interval octree; `solid`: filled solids; \
-             `measure`: volume convergence; `projective`: triangles/s)"
+             `measure`: volume convergence; `projective`: triangles/s; `calibrate`: memory estimates \
+             against peaks)"
 )]
 struct Cli {
     /// Print one JSON object instead of the tables.

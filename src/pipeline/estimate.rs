@@ -18,6 +18,7 @@ use crate::io::brick_set::brick_voxels;
 use crate::io::vdb::check_voxel_size;
 use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
 use crate::ops::flood::padded;
+use crate::solids::cavities::cavity_bytes;
 use crate::solids::csg_tree::CsgNode;
 use crate::solids::exterior_flood::FloodMethod;
 use crate::subd::ControlMesh;
@@ -35,7 +36,7 @@ const AREA_PER_LEAF: f64 = 32.0;
 const SOLID_FILL: f64 = 0.5;
 /// The process itself: code and the allocator's own memory (9 MiB measured for a surface of
 /// 211 leaves; 39 MiB while OpenVDB was loaded).
-const BASE_BYTES: f64 = 10.0 * (1 << 20) as f64;
+pub const BASE_BYTES: f64 = 10.0 * (1 << 20) as f64;
 
 /// Peak bytes of a set of `leaves` leaves with `vector_channels` normal or colour channels.
 fn leaf_bytes(leaves: f64, vector_channels: u32) -> f64 {
@@ -257,10 +258,11 @@ fn subdivision_solid_bytes(control: &ControlMesh, t: &Transform) -> f64 {
         + control.irregular_corner_count() as f64 * IRREGULAR_CORNER_BYTES
 }
 
-/// A distance band's leaf with its values and encoded buffers: 2.2 KB; a level set's also
+/// A distance band's leaf with its values and encoded buffers: 2.4 KB; a level set's also
 /// holds its interior's leaf and the fog volume's buffers, 3 KB. Each triangle 150 bytes
-/// (its corners, the bins). Fitted on bunny-closed (`--sdf`) and igea (`--udf`) at 1024.
-const UNSIGNED_BAND_LEAF_BYTES: f64 = 2200.0;
+/// (its corners, the bins). Fitted on bunny-closed (`--sdf`) and igea (`--udf`) at 1024; the
+/// unsigned leaf refitted by `voxelkit-bench calibrate` on the five meshes (factor 1.15).
+const UNSIGNED_BAND_LEAF_BYTES: f64 = 2400.0;
 const SIGNED_BAND_LEAF_BYTES: f64 = 3000.0;
 const BAND_TRIANGLE_BYTES: f64 = 150.0;
 
@@ -547,9 +549,7 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
         Work::Solid { mesh, fill, .. } => solid_plan(mesh, fit, *fill)?,
         // Measuring a mesh fills its flooded surface.
         Work::MeasureMesh { mesh, flood, .. } => {
-            fill_plan(mesh, fit, flood_cost(*flood, &MEASURE_COST), |m, _| {
-                separating::work_items(m)
-            })?
+            flood_plan(mesh, fit, flood_cost(*flood, &MEASURE_COST))?
         }
         Work::MeasureSurface { surface, .. } => grid_plan(surface, what)?,
         Work::CsgTree(tree) => {
@@ -586,10 +586,7 @@ fn plan_of(transform: Transform, bbox: &Aabb, bytes: f64, work_items: u64) -> Pl
 /// Filling `mesh` by `fill`: its surface, the bit volumes over its box and the solid.
 fn solid_plan(mesh: &Mesh, fit: GridFit, fill: Fill) -> Result<Plan> {
     match fill {
-        Fill::Flood(method) => {
-            let cost = flood_cost(method, &BLOCK_FLOOD_COST);
-            fill_plan(mesh, fit, cost, |m, _| separating::work_items(m))
-        }
+        Fill::Flood(method) => flood_plan(mesh, fit, flood_cost(method, &BLOCK_FLOOD_COST)),
         Fill::DepthLayers(o) => fill_plan(mesh, fit, &DEPTH_LAYERS_COST, |_, b| {
             o.directions.len() as u64 + (b.max[0] - b.min[0] + 1) as u64
         }),
@@ -604,6 +601,14 @@ fn flood_cost(method: FloodMethod, blocks: &'static FillCost) -> &'static FillCo
         FloodMethod::Blocks => blocks,
         _ => &DENSE_FLOOD_COST,
     }
+}
+
+/// Flooding `mesh` at `cost`, and taking its cavities out (see `solids::cavities`).
+fn flood_plan(mesh: &Mesh, fit: GridFit, cost: &FillCost) -> Result<Plan> {
+    let mut plan = fill_plan(mesh, fit, cost, |m, _| separating::work_items(m))?;
+    let cavities = cavity_bytes(mesh, plan.transform.voxel_size);
+    plan.estimated_bytes = plan.estimated_bytes.saturating_add(cavities as u64);
+    Ok(plan)
 }
 
 /// Filling `mesh` at `cost`, with `work_items` for the progress bar.
