@@ -851,3 +851,63 @@ fn a_picture_beyond_the_memory_limit_is_refused_before_it_is_drawn() {
     ]);
     assert!(small.status.success(), "{}", text(&small));
 }
+
+/// A solid with a void (an outward cube around an inward one, the void's wall facing into
+/// it): the flood cannot reach the void, but its winding number is 0, so it is not inside.
+/// The volume bracket of `solid` and `measure` holds the exact volume, 1 - 0.4^3, for every
+/// flood; the void's shell alone, or a cube nested the same way but outward, keeps it.
+#[test]
+fn an_inward_shell_leaves_a_void_that_the_volume_bracket_excludes() {
+    use glam::DVec3;
+    use voxelkit::mesh::generate;
+    let dir = tempfile::tempdir().unwrap();
+    let mut void = generate::cuboid(DVec3::splat(0.3), DVec3::splat(0.7));
+    generate::reverse_faces(&mut void);
+    let hollow = generate::combine(
+        "hollow cube",
+        &[generate::cuboid(DVec3::ZERO, DVec3::ONE), void],
+    );
+    let exact = 1.0 - 0.4f64.powi(3);
+    assert!((hollow.signed_volume() - exact).abs() < 1e-12);
+    let path = dir.path().join("hollow.obj");
+    hollow.write_obj(&path).unwrap();
+    let out = dir.path().join("hollow.vdb");
+    for args in [
+        vec!["solid"],
+        vec!["solid", "--flood", "spans"],
+        vec!["solid", "--flood", "xyz"],
+        vec!["measure"],
+    ] {
+        let mut all = vec!["--json"];
+        all.extend(&args);
+        all.extend([path.to_str().unwrap(), "-r", "100"]);
+        if args[0] == "solid" {
+            all.extend(["-o", out.to_str().unwrap()]);
+        }
+        let o = voxelkit(&all);
+        assert!(o.status.success(), "{args:?}: {}", text(&o));
+        let report = text(&o);
+        let (lo, hi) = (
+            json_field(&report, "volume_inside"),
+            json_field(&report, "volume_with_surface"),
+        );
+        assert!(
+            lo <= exact && exact <= hi,
+            "{args:?}: [{lo}, {hi}] excludes {exact}"
+        );
+    }
+    // Nested outward cubes enclose no void: the inner one's region winds twice.
+    let nested = generate::combine(
+        "nested cubes",
+        &[
+            generate::cuboid(DVec3::ZERO, DVec3::ONE),
+            generate::cuboid(DVec3::splat(0.3), DVec3::splat(0.7)),
+        ],
+    );
+    let path = dir.path().join("nested.obj");
+    nested.write_obj(&path).unwrap();
+    let o = voxelkit(&["--json", "measure", path.to_str().unwrap(), "-r", "100"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let hi = json_field(&text(&o), "volume_with_surface");
+    assert!(hi >= 1.0, "the nested cube's inside was taken out: {hi}");
+}

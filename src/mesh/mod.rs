@@ -13,8 +13,10 @@ pub mod key_groups;
 mod obj;
 mod off;
 mod ply;
+pub mod shells;
 mod stl;
 mod up_axis;
+pub mod winding;
 pub use gltf_scene::GltfLayout;
 pub use up_axis::UpAxis;
 

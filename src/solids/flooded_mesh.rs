@@ -1,12 +1,15 @@
 //! A closed mesh's solid as Lai & Cheng compose it: the mesh's 26-separating surface (Huang
-//! et al.) and every voxel the exterior flood cannot reach through it; and the measures of
+//! et al.) and every voxel the exterior flood cannot reach through it but its cavities; and
+//! the measures of
 //! the whole solid's shape, its components and genus.
 
+use super::cavities::remove_cavities;
 use super::exterior_flood::{FloodMethod, Solid, solid_from_surface};
 use crate::error::Result;
 use crate::grid::{Adjacency, DenseMask, SparseGrid, Transform};
 use crate::mesh::Mesh;
 use crate::ops::flood::padded;
+use crate::ops::measure::SolidMeasures;
 use crate::ops::topology::{components, euler_characteristic};
 use crate::progress::Progress;
 use crate::voxelize::Separability;
@@ -54,14 +57,21 @@ pub fn flood_surface(mesh: &Mesh, t: Transform, progress: &Progress) -> Result<S
     Ok(voxelize_mesh(mesh, t, &options, progress)?.0)
 }
 
-/// A closed mesh's solid: its 26-separating surface flooded by `flood`.
+/// A closed mesh's solid: its 26-separating surface flooded by `flood`, less the enclosed
+/// regions its winding number says are cavities.
 pub fn flooded_mesh(
     mesh: &Mesh,
     t: Transform,
     flood: FloodMethod,
     progress: &Progress,
 ) -> Result<SurfaceAndInside> {
-    SurfaceAndInside::flooded(flood_surface(mesh, t, progress)?, flood, progress)
+    let surface = flood_surface(mesh, t, progress)?;
+    let mut solid = solid_from_surface(&surface, flood, progress)?;
+    if remove_cavities(mesh, &mut solid.inside)? > 0 {
+        let inside = solid.inside.voxel_count();
+        solid.measures = SolidMeasures::of(inside, surface.voxel_count(), t.voxel_size);
+    }
+    Ok(SurfaceAndInside::of(surface, solid))
 }
 
 /// Components (26-connected) and genus (components - Euler characteristic) of a solid.

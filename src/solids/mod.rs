@@ -3,6 +3,7 @@
 //! al.'s beams, CSG trees of shapes, formulas, meshes and grids).
 
 pub mod beam;
+pub mod cavities;
 pub mod csg_leaves;
 #[cfg(feature = "vdb")]
 pub mod csg_tree;
