@@ -589,9 +589,11 @@ fn a_gltf_buffer_is_read_from_the_models_folder_only_and_no_further_than_declare
 fn brick_index(dir: &Path, edit: impl Fn(&mut serde_json::Value)) -> std::path::PathBuf {
     let set = dir.join("set");
     std::fs::create_dir_all(&set).unwrap();
-    let grid = voxelkit::pipeline::Outcome::read_vdb(&sphere_vdb(dir), None)
+    let mut grid = voxelkit::pipeline::Outcome::read_vdb(&sphere_vdb(dir), None)
         .unwrap()
         .grid;
+    // The part of the sphere in brick (0, 0, 0).
+    grid.retain_leaves(|origin| origin.iter().all(|v| (0..64).contains(v)));
     voxelkit::io::vdb::write_vdb(&set.join("b.vdb"), &grid, &[]).unwrap();
     let mut index = serde_json::json!({
         "format": "voxelkit-bricks", "voxel_size": grid.transform.voxel_size,
@@ -629,8 +631,16 @@ fn a_tampered_brick_index_is_refused_alike_by_info_and_read_vdb() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let fine = brick_index(d, |_| {});
-    let o = voxelkit(&["info", fine.to_str().unwrap()]);
+    let o = voxelkit(&["--json", "info", fine.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o));
+    // Both count the voxels the merged grid holds.
+    let merged = voxelkit::pipeline::Outcome::read_vdb(&fine, None)
+        .unwrap()
+        .grid;
+    assert_eq!(
+        json_field(&text(&o), "active_voxels") as u64,
+        merged.voxel_count()
+    );
     std::fs::copy(sphere_vdb(d), d.join("outside.vdb")).unwrap();
     assert!(
         Command::new("mkfifo")
@@ -695,6 +705,16 @@ fn a_tampered_brick_index_is_refused_alike_by_info_and_read_vdb() {
             "voxel size",
             Box::new(|j| j["voxel_size"] = (-1.0).into()),
             "voxel_size -1",
+        ),
+        (
+            "moved brick",
+            Box::new(|j| j["bricks"][0]["brick"] = serde_json::json!([1, 0, 0])),
+            "voxels outside its brick",
+        ),
+        (
+            "other grid",
+            Box::new(|j| j["voxel_size"] = 0.1.into()),
+            "is not the brick set's",
         ),
     ];
     for (name, edit, why) in cases {

@@ -152,6 +152,42 @@ impl BrickSet {
             .collect()
     }
 
+    /// Refuses a brick's file whose voxels (their box `bbox`) leave the brick, or whose grid
+    /// (`transform`) is not the set's: what `merge` and `voxelkit info` both check.
+    pub fn check_part(
+        &self,
+        brick: &BrickFile,
+        file: &Path,
+        bbox: Option<CoordBox>,
+        transform: &Transform,
+    ) -> Result<()> {
+        let refuse = |message: String| {
+            Err(Error::Parse {
+                path: file.to_path_buf(),
+                line: 0,
+                message,
+            })
+        };
+        let voxels = brick_voxels(brick.brick, self.brick_size);
+        if let Some(b) = bbox
+            && !(voxels.contains(b.min) && voxels.contains(b.max))
+        {
+            return refuse(format!("voxels outside its brick {:?}", brick.brick));
+        }
+        let set = self.transform();
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * set.voxel_size.max(a.abs());
+        if !(close(transform.voxel_size, set.voxel_size)
+            && (0..3).all(|a| close(transform.origin[a], set.origin[a])))
+        {
+            return refuse(format!(
+                "its grid (voxel size {}, origin {}) is not the brick set's (voxel size {}, \
+                 origin {})",
+                transform.voxel_size, transform.origin, set.voxel_size, set.origin
+            ));
+        }
+        Ok(())
+    }
+
     pub fn transform(&self) -> Transform {
         Transform::new(DVec3::from_array(self.origin), self.voxel_size)
     }
@@ -162,16 +198,7 @@ impl BrickSet {
         let mut grid = SparseGrid::new(self.transform(), crate::grid::Channels::NONE);
         for (brick, file) in self.bricks.iter().zip(self.files(index)?) {
             let part = read_vdb_grid(&file, None)?;
-            let voxels = brick_voxels(brick.brick, self.brick_size);
-            if let Some(b) = part.bbox()
-                && !(voxels.contains(b.min) && voxels.contains(b.max))
-            {
-                return Err(Error::Parse {
-                    path: file,
-                    line: 0,
-                    message: format!("voxels outside its brick {:?}", brick.brick),
-                });
-            }
+            self.check_part(brick, &file, part.bbox(), &part.transform)?;
             grid.union(&part);
         }
         for &b in &self.full_bricks {

@@ -7,6 +7,7 @@ use clap::{Args, Subcommand};
 use glam::DVec3;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
+use voxelkit::grid::{CoordBox, Transform};
 use voxelkit::io::brick_set::{BrickSet, is_brick_set};
 use voxelkit::io::vdb::{DENSITY_GRID, VOXELS_GRID, read_vdb_info};
 use voxelkit::mesh::{GridFit, generate};
@@ -274,6 +275,14 @@ fn brick_set_info(index: &Path, global: &Global) -> Result<()> {
             .find(|g| g.name == VOXELS_GRID)
             .or_else(|| grids.iter().find(|g| g.name == DENSITY_GRID))
             .or(grids.first());
+        if let Some(g) = main {
+            let bbox = (g.active_voxels > 0).then(|| CoordBox {
+                min: g.bbox_min.map(i64::from),
+                max: g.bbox_max.map(i64::from),
+            });
+            let transform = Transform::new(DVec3::from_array(g.origin), g.voxel_size[0]);
+            set.check_part(brick, &file, bbox, &transform)?;
+        }
         let count = main.map_or(0, |g| g.active_voxels);
         voxels += count;
         rows.push(serde_json::json!({
