@@ -74,9 +74,26 @@ pub fn peak_memory_bytes() -> Option<u64> {
     proc_kib("/proc/self/status", "VmHWM:").map(|k| k * 1024)
 }
 
-/// Refuses `estimated` bytes when more than `limit` (or the available memory) allows.
+/// The limit a front end gives for the whole process (0: none), which every check without a
+/// limit of its own (reading a file, drawing a picture) honours.
+static PROCESS_LIMIT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Sets the process's limit in bytes (`--max-memory`); none: the memory available.
+pub fn set_process_limit(limit: Option<u64>) {
+    PROCESS_LIMIT.store(limit.unwrap_or(0), std::sync::atomic::Ordering::Relaxed);
+}
+
+fn process_limit() -> Option<u64> {
+    Some(PROCESS_LIMIT.load(std::sync::atomic::Ordering::Relaxed)).filter(|&l| l > 0)
+}
+
+/// Refuses `estimated` bytes when more than `limit` (or the process's limit, or the
+/// available memory) allows.
 pub fn check_fits(estimated: u64, limit: Option<u64>, detail: &str) -> Result<()> {
-    let available = limit.or_else(available_memory_bytes).unwrap_or(u64::MAX);
+    let available = limit
+        .or_else(process_limit)
+        .or_else(available_memory_bytes)
+        .unwrap_or(u64::MAX);
     if estimated > available {
         return Err(Error::TooLarge {
             estimated_mib: estimated >> 20,

@@ -931,3 +931,90 @@ fn an_inward_shell_leaves_a_void_that_the_volume_bracket_excludes() {
     let hi = json_field(&text(&o), "volume_with_surface");
     assert!(hi >= 1.0, "the nested cube's inside was taken out: {hi}");
 }
+
+/// A million 8^3 tiles in a checkerboard (no 128^3 node whole), as a `.vdb`.
+fn tile_checkerboard(path: &Path) {
+    use voxelkit::grid::{Channels, SparseGrid, Transform};
+    let mut grid = SparseGrid::new(Transform::new(glam::DVec3::ZERO, 0.01), Channels::NONE);
+    let mut origins = Vec::new();
+    for x in 0..126i64 {
+        for y in 0..126i64 {
+            for z in 0..126i64 {
+                if (x + y + z) % 2 == 0 {
+                    origins.push([8 * x, 8 * y, 8 * z]);
+                }
+            }
+        }
+    }
+    grid.fill_leaf_blocks(origins);
+    assert_eq!(grid.tiles().count(), 1_000_188);
+    voxelkit::io::vdb::write_vdb(path, &grid, &[]).unwrap();
+}
+
+/// Tiles expand where they are read, combined, measured or drawn: each of those is planned
+/// against `--max-memory` (reading and drawing included) and refused under it, and a
+/// resample of grids on one transform costs what the Boolean without it does.
+#[test]
+fn tiles_are_planned_against_the_memory_limit_given() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.vdb"), dir.path().join("b.vdb"));
+    tile_checkerboard(&a);
+    std::fs::copy(&a, &b).unwrap();
+    let p = |f: &Path| f.to_str().unwrap().to_string();
+    let out = p(&dir.path().join("u.vdb"));
+    let png = p(&dir.path().join("u.png"));
+    let cases: [(Vec<String>, &str); 5] = [
+        (
+            vec![
+                "csg".into(),
+                "union".into(),
+                p(&a),
+                p(&b),
+                "-o".into(),
+                out.clone(),
+            ],
+            "50",
+        ),
+        (
+            vec![
+                "csg".into(),
+                "union".into(),
+                "--resample".into(),
+                p(&a),
+                p(&b),
+                "-o".into(),
+                out.clone(),
+            ],
+            "50",
+        ),
+        (vec!["measure".into(), p(&a)], "50"),
+        (vec!["info".into(), p(&a)], "20"),
+        (vec!["render".into(), p(&a), "-o".into(), png.clone()], "20"),
+    ];
+    for (args, limit) in &cases {
+        let mut all: Vec<&str> = vec!["--max-memory", limit];
+        all.extend(args.iter().map(String::as_str));
+        let o = voxelkit(&all);
+        let said = text(&o);
+        assert_eq!(
+            o.status.code(),
+            Some(1),
+            "{args:?} under {limit} MiB: {said}"
+        );
+        assert!(
+            said.contains(&format!("only {limit} MiB")),
+            "{args:?}: {said}"
+        );
+    }
+    // With room, the resample of one transform runs as the plain Boolean does.
+    for resample in [false, true] {
+        let mut all = vec!["--json", "--max-memory", "2000", "csg", "union"];
+        if resample {
+            all.push("--resample");
+        }
+        let (a, b) = (p(&a), p(&b));
+        all.extend([a.as_str(), b.as_str(), "-o", out.as_str()]);
+        let o = voxelkit(&all);
+        assert!(o.status.success(), "resample {resample}: {}", text(&o));
+    }
+}

@@ -34,7 +34,16 @@ pub struct Tiles {
     nodes: FxHashSet<Coord>,
 }
 
+/// Bytes a tile takes in a grid at the peak: its hash-set entry (an origin, its control byte)
+/// at the set's load after growing, and its copy while a grid is read or combined.
+pub const TILE_BYTES: u64 = 64;
+
 impl Tiles {
+    /// The tiles, 8^3 and 128^3.
+    pub fn count(&self) -> u64 {
+        (self.leaves.len() + self.nodes.len()) as u64
+    }
+
     pub fn is_empty(&self) -> bool {
         self.leaves.is_empty() && self.nodes.is_empty()
     }

@@ -102,10 +102,13 @@ struct Nodes {
     internal: [u64; 2],
     /// Every leaf's active voxel count, in the order OpenVDB reads their buffers.
     leaves: Vec<u16>,
+    /// Active tiles of the internal nodes, each a tile voxelkit keeps once read.
+    tiles: u64,
 }
 
 /// Checks a tree's topology (ending by `block`), then its leaf buffers (ending by `end`).
-/// Returns the bytes OpenVDB allocates for the tree as it reads it.
+/// Returns the bytes OpenVDB allocates for the tree as it reads it, and its tiles in
+/// voxelkit's grid.
 pub(super) fn tree(
     r: &mut Reader,
     format: TreeFormat,
@@ -126,11 +129,8 @@ pub(super) fn tree(
         .try_for_each(|&active| leaf_buffer(r, format, compression, active, what));
     r.len = file_len;
     buffers?;
-    Ok(tree_memory(
-        format,
-        nodes.internal,
-        nodes.leaves.len() as u64,
-    ))
+    let tiles = nodes.tiles.saturating_mul(crate::grid::TILE_BYTES);
+    Ok(tree_memory(format, nodes.internal, nodes.leaves.len() as u64).saturating_add(tiles))
 }
 
 /// OpenVDB's memory for a tree of `internal` nodes (by depth) and `leaves` leaves: a slot
@@ -222,6 +222,11 @@ fn internal_node(
     let child_mask = r.vec(mask_bytes, what)?;
     let value_mask = r.vec(mask_bytes, what)?;
     compressed_values(r, format, compression, &value_mask, what)?;
+    nodes.tiles += value_mask
+        .iter()
+        .zip(&child_mask)
+        .map(|(v, c)| (v & !c).count_ones() as u64)
+        .sum::<u64>();
     for _ in 0..ones(&child_mask) {
         if depth + 1 == NODE_LOG2.len() {
             nodes

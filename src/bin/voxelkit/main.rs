@@ -222,6 +222,8 @@ fn main() -> ExitCode {
             half: cli.half,
         },
     };
+    // Reading a file or drawing a picture is planned against the limit given, too.
+    voxelkit::system::set_process_limit(global.limits().max_memory);
     let result = match cli.command {
         Command::Mesh {
             inputs,
