@@ -149,9 +149,9 @@ vk_status vk_mesh_free(vk_mesh *mesh);
 
 /* ---- options ---------------------------------------------------------------------------- */
 
-/* Options with the defaults: resolution 256, 26-separating, Huang's criterion, no normals,
- * separating surface, flood fill by spans, 16 directions of double depth layers, pre-split 8,
- * all cores, no progress callback, no cancel flag. */
+/* Options with the defaults of voxelkit.OPTIONS (resolution 256, 26-separating, Huang's
+ * criterion, no normals, separating surface, the block flood, 16 directions of double depth
+ * layers, pre-split 8, blosc), all cores, no progress callback, no cancel flag. */
 vk_status vk_options_new(vk_options **out);
 vk_status vk_options_free(vk_options *options);
 

@@ -221,6 +221,22 @@ pub enum Directions {
     Given(Vec<[i64; 3]>),
 }
 
+/// As the CLI takes them: `16`, or `0,0,1;1,1,0`.
+impl std::fmt::Display for Directions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Directions::Count(n) => write!(f, "{n}"),
+            Directions::Given(list) => {
+                let each: Vec<String> = list
+                    .iter()
+                    .map(|[x, y, z]| format!("{x},{y},{z}"))
+                    .collect();
+                f.write_str(&each.join(";"))
+            }
+        }
+    }
+}
+
 impl Directions {
     pub fn set(&self) -> Result<DirectionSet> {
         match self {
@@ -236,6 +252,17 @@ impl Directions {
 pub enum Bounds {
     Cube([f64; 2]),
     Box([[f64; 3]; 2]),
+}
+
+/// As the CLI takes them: `lo,hi`, or `x0,y0,z0,x1,y1,z1`.
+impl std::fmt::Display for Bounds {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let numbers: Vec<String> = match self {
+            Bounds::Cube(c) => c.iter().map(f64::to_string).collect(),
+            Bounds::Box(b) => b.iter().flatten().map(f64::to_string).collect(),
+        };
+        f.write_str(&numbers.join(","))
+    }
 }
 
 impl Bounds {

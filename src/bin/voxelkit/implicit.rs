@@ -66,7 +66,7 @@ pub struct ImplicitArgs {
     #[arg(long, default_value_t = ImplicitRequest::default().coords, value_parser = parse_coords)]
     coords: Coordinates,
     /// The box searched: `lo,hi` (a cube) or `x0,y0,z0,x1,y1,z1`.
-    #[arg(long, default_value = "-1,1", allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ImplicitRequest::default().bounds.to_string(), allow_hyphen_values = true)]
     bounds: String,
     /// Voxels along the longest side of the bounds.
     #[arg(short, long, default_value_t = ImplicitRequest::default().resolution)]

@@ -45,7 +45,7 @@ pub struct DepthArgs {
     /// closed meshes but, on open meshes, meeting holes more often); or your own, `x,y,z`
     /// integer vectors separated by `;` (each with a component of 1 or -1, none parallel),
     /// e.g. `0,0,1;1,1,0;2,1,1`.
-    #[arg(long, default_value = "16", value_parser = parse_directions, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = SolidRequest::default().directions, value_parser = parse_directions, allow_hyphen_values = true)]
     pub directions: Directions,
     /// double: two layers per side and a stencil count of crossings (Passalis et al.);
     /// single: one layer per side (Karabassi et al.), which fills concavities no direction
