@@ -2,10 +2,11 @@
 //! over 4π (Van Oosterom and Strackee's formula for a triangle's solid angle). For a closed,
 //! consistently oriented mesh it is the signed count of shells around the point: 1 inside an
 //! outward shell, -1 inside an inward one, 0 outside or in a cavity; for an open mesh it is
-//! the generalized winding number, a fraction near its holes.
+//! the generalized winding number, a fraction near its holes. `winding_number` sums every
+//! triangle exactly; `WindingTree` answers many points fast, within a stated error.
 
 use super::Mesh;
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
 /// The solid angle of triangle `abc` seen from the origin, signed by its orientation.
@@ -24,6 +25,144 @@ pub fn winding_number(mesh: &Mesh, p: DVec3) -> f64 {
         .map(|t| solid_angle(mesh.p(t[0]) - p, mesh.p(t[1]) - p, mesh.p(t[2]) - p))
         .sum();
     total / (4.0 * std::f64::consts::PI)
+}
+
+/// Triangles per leaf of the tree: evaluated exactly.
+const LEAF_TRIANGLES: usize = 8;
+
+/// A node's far-field expansion is used where the point lies farther than this many node
+/// radii from the node's centre: the expansion's error then falls with the cube of
+/// radius / distance.
+const FAR: f64 = 3.0;
+
+/// One node of the tree: a box of triangles `first..last` (in `WindingTree::order`).
+struct Node {
+    /// Area-weighted centroid and the radius of a ball around it holding every corner.
+    centre: DVec3,
+    radius: f64,
+    /// Half the sum of the triangles' edge cross products: their area-weighted normal.
+    area: DVec3,
+    /// The second moment: the sum over triangles of (centroid - centre) times its area vector
+    /// (element i, j: offset i times area j), the expansion's second term.
+    moment: DMat3,
+    first: usize,
+    last: usize,
+    /// The two children, when not a leaf.
+    children: Option<[usize; 2]>,
+}
+
+/// The winding number evaluated hierarchically (Barill et al. 2018, to second order): a tree
+/// of triangle clusters, each far cluster taken as its dipole and moment at its centre, near
+/// ones and leaves exactly. Its error stays under 0.02 of a turn (tested against the exact
+/// sum around closed, holed and overlapping meshes); a point whose answer lies that close to
+/// 1/2 must be decided by the exact `winding_number`.
+pub struct WindingTree {
+    corners: Vec<[DVec3; 3]>,
+    nodes: Vec<Node>,
+}
+
+impl WindingTree {
+    pub fn new(mesh: &Mesh) -> WindingTree {
+        let mut corners: Vec<[DVec3; 3]> = mesh
+            .triangles()
+            .map(|(_, t)| t.map(|v| mesh.p(v)))
+            .collect();
+        let mut tree = WindingTree {
+            corners: Vec::new(),
+            nodes: Vec::new(),
+        };
+        if !corners.is_empty() {
+            let n = corners.len();
+            tree.build(&mut corners, 0, n);
+        }
+        tree.corners = corners;
+        tree
+    }
+
+    /// Builds the node over `corners[first..last]` (reordering them) and returns its index.
+    fn build(&mut self, corners: &mut [[DVec3; 3]], first: usize, last: usize) -> usize {
+        let part = &mut corners[first..last];
+        let mut area = DVec3::ZERO;
+        let mut weighted = DVec3::ZERO;
+        let mut total = 0.0;
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for [a, b, c] in part.iter() {
+            let n = 0.5 * (*b - *a).cross(*c - *a);
+            let weight = n.length();
+            area += n;
+            weighted += weight * (*a + *b + *c) / 3.0;
+            total += weight;
+            lo = lo.min(a.min(*b).min(*c));
+            hi = hi.max(a.max(*b).max(*c));
+        }
+        let centre = if total > 0.0 {
+            weighted / total
+        } else {
+            0.5 * (lo + hi)
+        };
+        let moment = part.iter().fold(DMat3::ZERO, |m, [a, b, c]| {
+            let n = 0.5 * (*b - *a).cross(*c - *a);
+            let offset = (*a + *b + *c) / 3.0 - centre;
+            m + DMat3::from_cols(offset * n.x, offset * n.y, offset * n.z)
+        });
+        let radius = part
+            .iter()
+            .flatten()
+            .map(|p| p.distance(centre))
+            .fold(0.0, f64::max);
+        let index = self.nodes.len();
+        self.nodes.push(Node {
+            centre,
+            radius,
+            area,
+            moment,
+            first,
+            last,
+            children: None,
+        });
+        if last - first > LEAF_TRIANGLES {
+            // Split at the median centroid along the box's longest axis.
+            let axis = (hi - lo).max_position();
+            let key = |t: &[DVec3; 3]| (t[0][axis] + t[1][axis] + t[2][axis]) / 3.0;
+            let middle = (last - first) / 2;
+            part.select_nth_unstable_by(middle, |x, y| key(x).total_cmp(&key(y)));
+            let left = self.build(corners, first, first + middle);
+            let right = self.build(corners, first + middle, last);
+            self.nodes[index].children = Some([left, right]);
+        }
+        index
+    }
+
+    /// The winding number at `p`, within the tree's error.
+    pub fn winding_number(&self, p: DVec3) -> f64 {
+        if self.nodes.is_empty() {
+            return 0.0;
+        }
+        let mut total = 0.0;
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            let node = &self.nodes[i];
+            let to_centre = node.centre - p;
+            let distance = to_centre.length();
+            if distance > FAR * node.radius {
+                // A far patch's solid angle: its area vector against the direction to it,
+                // and the second term, its moment against that direction's gradient.
+                let d3 = distance.powi(3);
+                let trace = node.moment.x_axis.x + node.moment.y_axis.y + node.moment.z_axis.z;
+                let along = to_centre.dot(node.moment * to_centre);
+                total += node.area.dot(to_centre) / d3 + trace / d3
+                    - 3.0 * along / (d3 * distance * distance);
+            } else if let Some(children) = node.children {
+                stack.extend(children);
+            } else {
+                total += self.corners[node.first..node.last]
+                    .iter()
+                    .map(|&[a, b, c]| solid_angle(a - p, b - p, c - p))
+                    .sum::<f64>();
+            }
+        }
+        total / (4.0 * std::f64::consts::PI)
+    }
 }
 
 #[cfg(test)]
@@ -51,5 +190,46 @@ mod tests {
         cube = Mesh::from_polygons(cube.source.clone(), cube.positions.clone(), &keep);
         let w = winding_number(&cube, DVec3::splat(0.5));
         assert!((w - 5.0 / 6.0).abs() < 1e-12, "{w}");
+        assert!((WindingTree::new(&cube).winding_number(DVec3::splat(0.5)) - w).abs() < 1e-12);
+    }
+
+    /// The tree against the exact sum at random points in and around closed, open and
+    /// self-overlapping meshes, close to their surfaces too.
+    #[test]
+    fn the_tree_agrees_with_the_exact_sum_everywhere() {
+        let mut torus = generate::torus(DVec3::ZERO, 1.0, 0.35, 96, 48);
+        let open: Vec<Vec<u32>> = (0..torus.face_count())
+            .filter(|&f| f % 7 != 0)
+            .map(|f| torus.face(f).to_vec())
+            .collect();
+        let holed = Mesh::from_polygons(
+            std::path::PathBuf::from("holed"),
+            torus.positions.clone(),
+            &open,
+        );
+        let overlapping = generate::combine(
+            "two tori",
+            &[
+                torus.clone(),
+                generate::torus(DVec3::new(0.5, 0.2, 0.1), 1.0, 0.35, 64, 32),
+            ],
+        );
+        torus.source = "torus".into();
+        let mut rng = crate::random::SplitMix64(11);
+        for mesh in [torus, holed, overlapping, generate::random_closed(3)] {
+            let tree = WindingTree::new(&mesh);
+            let b = mesh.bbox();
+            let mut worst: f64 = 0.0;
+            for _ in 0..400 {
+                let t = DVec3::new(
+                    rng.range(-0.2, 1.2),
+                    rng.range(-0.2, 1.2),
+                    rng.range(-0.2, 1.2),
+                );
+                let p = b.min + (b.max - b.min) * t;
+                worst = worst.max((tree.winding_number(p) - winding_number(&mesh, p)).abs());
+            }
+            assert!(worst < 0.02, "{}: off by {worst}", mesh.source.display());
+        }
     }
 }

@@ -8,7 +8,7 @@
 use crate::error::Result;
 use crate::grid::{Adjacency, Coord, CoordBox, DenseMask, SparseGrid};
 use crate::mesh::shells::shells;
-use crate::mesh::winding::winding_number;
+use crate::mesh::winding::WindingTree;
 use crate::mesh::{Aabb, Mesh, index_box};
 use crate::ops::flood::flood;
 use glam::DVec3;
@@ -82,12 +82,14 @@ pub fn remove_cavities(mesh: &Mesh, inside: &mut SparseGrid) -> Result<u64> {
         return Ok(0);
     }
     let t = inside.transform;
+    // Seeds lie in regions of integer winding (0 or not): the tree's error cannot blur them.
+    let winding = WindingTree::new(mesh);
     let mut removed = 0;
     for faces in &shells {
         let Some(seed) = seed_behind(mesh, faces, inside) else {
             continue;
         };
-        if winding_number(mesh, t.index_to_world(seed)).abs() >= 0.5 {
+        if winding.winding_number(t.index_to_world(seed)).abs() >= 0.5 {
             continue;
         }
         let Some(region) = index_box(&shell_box(mesh, faces), &t).intersection(
