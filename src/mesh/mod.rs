@@ -248,10 +248,36 @@ impl Mesh {
     /// The volume the faces enclose, signed by their orientation; taken about the centre of
     /// the bounding box, so that a mesh far from the origin loses no precision.
     pub fn signed_volume(&self) -> f64 {
-        let b = self.bbox();
+        self.volume_about(self.bbox(), self.triangles().map(|(_, t)| t))
+    }
+
+    /// The signed volume the faces `faces` enclose (a shell of the mesh).
+    pub fn signed_volume_of(&self, faces: &[u32]) -> f64 {
+        let triangles = faces.iter().flat_map(|&f| self.fan(f as usize));
+        self.volume_about(self.bbox_of(faces), triangles)
+    }
+
+    /// The box of the corners of the faces `faces`.
+    pub fn bbox_of(&self, faces: &[u32]) -> Aabb {
+        let mut b = Aabb {
+            min: DVec3::splat(f64::INFINITY),
+            max: DVec3::splat(f64::NEG_INFINITY),
+        };
+        for &f in faces {
+            for &v in self.face(f as usize) {
+                b.min = b.min.min(self.p(v));
+                b.max = b.max.max(self.p(v));
+            }
+        }
+        b
+    }
+
+    /// The signed volume of `triangles`' cones from the centre of `b` (near the triangles,
+    /// so that far-away meshes keep their digits).
+    fn volume_about(&self, b: Aabb, triangles: impl Iterator<Item = [u32; 3]>) -> f64 {
         let o = 0.5 * (b.min + b.max);
-        self.triangles()
-            .map(|(_, [a, b, c])| (self.p(a) - o).dot((self.p(b) - o).cross(self.p(c) - o)) / 6.0)
+        triangles
+            .map(|[a, b, c]| (self.p(a) - o).dot((self.p(b) - o).cross(self.p(c) - o)) / 6.0)
             .sum()
     }
 

@@ -9,9 +9,8 @@ use crate::error::Result;
 use crate::grid::{Adjacency, Coord, CoordBox, DenseMask, SparseGrid};
 use crate::mesh::shells::shells;
 use crate::mesh::winding::WindingTree;
-use crate::mesh::{Aabb, Mesh, index_box};
+use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::flood;
-use glam::DVec3;
 
 /// Steps (in voxels) from a face's centre to the voxel behind it that seeds its region.
 const SEED_STEPS: [f64; 4] = [0.75, 1.5, 2.5, 3.5];
@@ -23,7 +22,7 @@ pub fn cavity_bytes(mesh: &Mesh, voxel_size: f64) -> f64 {
     let mut volumes: Vec<f64> = shells(mesh)
         .iter()
         .map(|faces| {
-            let b = shell_box(mesh, faces);
+            let b = mesh.bbox_of(faces);
             ((b.max - b.min) / voxel_size + 3.0).element_product()
         })
         .collect();
@@ -31,29 +30,10 @@ pub fn cavity_bytes(mesh: &Mesh, voxel_size: f64) -> f64 {
     volumes.get(1).map_or(0.0, |v| 3.0 * v / 8.0)
 }
 
-fn shell_box(mesh: &Mesh, faces: &[u32]) -> Aabb {
-    let mut b = Aabb {
-        min: DVec3::splat(f64::INFINITY),
-        max: DVec3::splat(f64::NEG_INFINITY),
-    };
-    for &f in faces {
-        for &v in mesh.face(f as usize) {
-            b.min = b.min.min(mesh.p(v));
-            b.max = b.max.max(mesh.p(v));
-        }
-    }
-    b
-}
-
 /// A voxel of `inside` just behind `faces` (against their orientation, so on the side the
 /// shell encloses), from the face of largest area.
 fn seed_behind(mesh: &Mesh, faces: &[u32], inside: &SparseGrid) -> Option<Coord> {
-    let orientation: f64 = faces
-        .iter()
-        .flat_map(|&f| mesh.fan(f as usize))
-        .map(|[a, b, c]| mesh.p(a).dot(mesh.p(b).cross(mesh.p(c))))
-        .sum::<f64>()
-        .signum();
+    let orientation = mesh.signed_volume_of(faces).signum();
     let (area, centre, normal) = faces
         .iter()
         .flat_map(|&f| mesh.fan(f as usize))
@@ -92,12 +72,12 @@ pub fn remove_cavities(mesh: &Mesh, inside: &mut SparseGrid) -> Result<u64> {
         if winding.winding_number(t.index_to_world(seed)).abs() >= 0.5 {
             continue;
         }
-        let Some(region) = index_box(&shell_box(mesh, faces), &t).intersection(
-            &inside.bbox().unwrap_or(CoordBox {
+        let Some(region) =
+            index_box(&mesh.bbox_of(faces), &t).intersection(&inside.bbox().unwrap_or(CoordBox {
                 min: seed,
                 max: seed,
-            }),
-        ) else {
+            }))
+        else {
             continue;
         };
         let enclosed = DenseMask::from_grid(inside, region)?;
