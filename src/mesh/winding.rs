@@ -19,9 +19,9 @@ fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
 
 /// The winding number of `mesh` at `p`.
 pub fn winding_number(mesh: &Mesh, p: DVec3) -> f64 {
-    let triangles: Vec<[u32; 3]> = mesh.triangles().map(|(_, t)| t).collect();
-    let total: f64 = triangles
-        .par_iter()
+    let total: f64 = (0..mesh.face_count())
+        .into_par_iter()
+        .flat_map_iter(|f| mesh.fan(f))
         .map(|t| solid_angle(mesh.p(t[0]) - p, mesh.p(t[1]) - p, mesh.p(t[2]) - p))
         .sum();
     total / (4.0 * std::f64::consts::PI)
@@ -35,7 +35,7 @@ const LEAF_TRIANGLES: usize = 8;
 /// radius / distance.
 const FAR: f64 = 3.0;
 
-/// One node of the tree: a box of triangles `first..last` (in `WindingTree::order`).
+/// One node of the tree: the triangles `first..last` of `WindingTree::corners`.
 struct Node {
     /// Area-weighted centroid and the radius of a ball around it holding every corner.
     centre: DVec3,
