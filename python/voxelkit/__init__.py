@@ -38,6 +38,20 @@ def _default(value):
     return tuple(value) if isinstance(value, list) else value
 
 
+def _option_parameters(fields, kind):
+    """The signature parameters of the table's ``fields``, with their defaults."""
+    return [_inspect.Parameter(f["name"], kind, default=_default(f["default"])) for f in fields]
+
+
+def _option_lines(fields):
+    """A docstring line per field of the table: name = default (choices): doc."""
+    lines = []
+    for f in fields:
+        choices = f" (one of {', '.join(map(str, f['choices']))})" if f["choices"] else ""
+        lines.append(f"{f['name']} = {f['default']!r}{choices}: {f['doc']}")
+    return lines
+
+
 def _from_schema(name, inputs, request, summary):
     """``_voxelkit.<name>`` with the schema's signature and docs: positional inputs, then
     the request's options, the limits and ``progress``."""
@@ -45,7 +59,7 @@ def _from_schema(name, inputs, request, summary):
     fields = (OPTIONS[request]["fields"] if request else []) + OPTIONS["limits"]["fields"]
     kind = _inspect.Parameter.POSITIONAL_OR_KEYWORD
     params = [_inspect.Parameter(i, kind) for i in inputs]
-    params += [_inspect.Parameter(f["name"], kind, default=_default(f["default"])) for f in fields]
+    params += _option_parameters(fields, kind)
     params.append(_inspect.Parameter("progress", kind, default=None))
     signature = _inspect.Signature(params)
 
@@ -56,11 +70,7 @@ def _from_schema(name, inputs, request, summary):
         return native(*positional, **given)
 
     paragraphs = ([OPTIONS[request]["doc"]] if request else []) + [summary]
-    options = []
-    for f in fields:
-        choices = f" (one of {', '.join(map(str, f['choices']))})" if f["choices"] else ""
-        options.append(f"{f['name']} = {f['default']!r}{choices}: {f['doc']}")
-    options.append(_PROGRESS_DOC)
+    options = _option_lines(fields) + [_PROGRESS_DOC]
     call.__name__ = call.__qualname__ = name
     call.__module__ = __name__
     call.__signature__ = signature

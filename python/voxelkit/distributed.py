@@ -33,7 +33,7 @@ import sys
 import threading
 import time
 
-from . import OPTIONS
+from . import OPTIONS, _option_lines, _option_parameters
 from . import _voxelkit as vk
 
 #: The options of a distributed run, their defaults, choices and docs: the library's table.
@@ -301,13 +301,9 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
 def _with_table_options(fn):
     """``fn`` with the table's options in its signature and docs, after its own."""
     own = [p for p in inspect.signature(fn).parameters.values() if p.kind != p.VAR_KEYWORD]
-    table = [
-        inspect.Parameter(f["name"], inspect.Parameter.KEYWORD_ONLY, default=f["default"])
-        for f in _FIELDS
-    ]
+    table = _option_parameters(_FIELDS, inspect.Parameter.KEYWORD_ONLY)
     fn.__signature__ = inspect.Signature(own + table)
-    lines = [f"{f['name']} = {f['default']!r}: {f['doc']}" for f in _FIELDS]
-    fn.__doc__ = fn.__doc__ + "\n" + "\n".join(lines) + "\n"
+    fn.__doc__ = fn.__doc__ + "\n" + "\n".join(_option_lines(_FIELDS)) + "\n"
     return fn
 
 
