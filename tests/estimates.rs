@@ -207,8 +207,15 @@ fn estimates_hold_on_meshes_they_were_not_fitted_on() {
             .display()
             .to_string();
         for command in [&["mesh"][..], &["solid"], &["mesh", "--sdf"]] {
+            // rocker-arm's surface at 1024 peaks at 23-24 MiB, mostly the process itself, where
+            // a MiB of noise moves the ratio by 4%: at 2048 the surface is what is measured.
+            let resolution = if name == "rocker-arm" && command == ["mesh"] {
+                "2048"
+            } else {
+                "1024"
+            };
             let mut case: Vec<String> = command.iter().map(|s| s.to_string()).collect();
-            case.extend([mesh.clone(), "-r".into(), "1024".into()]);
+            case.extend([mesh.clone(), "-r".into(), resolution.into()]);
             cases.push(case);
         }
     }
