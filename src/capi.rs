@@ -143,7 +143,9 @@ impl From<Error> for Failure {
             Error::Parse { .. } | Error::Formula { .. } | Error::UnsupportedFormat { .. } => {
                 VkStatus::Parse
             }
-            Error::BadFace { .. } | Error::EmptyMesh { .. } => VkStatus::BadMesh,
+            Error::BadFace { .. } | Error::EmptyMesh { .. } | Error::BadMesh(_) => {
+                VkStatus::BadMesh
+            }
             Error::TooLarge { .. } => VkStatus::TooLarge,
             Error::Vdb { .. } => VkStatus::Vdb,
             Error::Cancelled => VkStatus::Cancelled,

@@ -33,6 +33,10 @@ pub enum Error {
     UnsupportedFormat { path: PathBuf },
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
+    /// A mesh whose shape rules out what was asked (open where an inside is needed); the
+    /// message names the file and the first offending edge.
+    #[error("{0}")]
+    BadMesh(String),
     #[error(
         "resolution too large: an estimated {} MiB is needed but only {available_mib} MiB is available ({detail})",
         short_number(*estimated_mib)

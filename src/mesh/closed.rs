@@ -58,7 +58,7 @@ impl Mesh {
         let c = self.edge_counts();
         let edge = |e: Option<[u64; 2]>| e.map_or(String::new(), |[a, b]| format!("{a}-{b}"));
         if c.boundary > 0 {
-            return Err(Error::InvalidArgument(format!(
+            return Err(Error::BadMesh(format!(
                 "{}: the mesh is open: {} boundary edge(s), the first between vertices {}; {why}",
                 self.source.display(),
                 c.boundary,
@@ -66,7 +66,7 @@ impl Mesh {
             )));
         }
         if c.non_manifold > 0 {
-            return Err(Error::InvalidArgument(format!(
+            return Err(Error::BadMesh(format!(
                 "{}: {} edge(s) are shared by more than two faces, the first between vertices {}; {why}",
                 self.source.display(),
                 c.non_manifold,

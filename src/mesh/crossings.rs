@@ -53,13 +53,13 @@ fn edge_side(ia: u32, a: DVec2, ib: u32, b: DVec2, p: DVec2) -> f64 {
     flip * s
 }
 
-/// Calls `cross(ray, t)` for every crossing of a triangle of `points` (given as `(a, b, t)`)
-/// with a ray of `window`.
+/// Calls `cross(ray, t, rising)` for every crossing of a triangle of `points` (given as
+/// `(a, b, t)`) with a ray of `window`; `rising` when the triangle's normal points along +t.
 pub fn for_each_crossing(
     points: &[DVec3],
     triangles: impl Iterator<Item = [u32; 3]>,
     window: &RayWindow,
-    mut cross: impl FnMut(usize, f64),
+    mut cross: impl FnMut(usize, f64, bool),
 ) {
     if window.is_empty() {
         return;
@@ -93,7 +93,7 @@ pub fn for_each_crossing(
                 if inside {
                     // The plane through p[0] with normal n, solved for t at (a, b).
                     let depth = p[0].z - (n.x * (c.x - p[0].x) + n.y * (c.y - p[0].y)) / n.z;
-                    cross(window.ray(a, b), depth);
+                    cross(window.ray(a, b), depth, orient > 0.0);
                 }
             }
         }

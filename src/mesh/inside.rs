@@ -9,11 +9,31 @@ use crate::mesh::Mesh;
 use glam::DVec3;
 use rayon::prelude::*;
 
+/// One crossing of a column's ray: the ray's number and whether the surface rises there
+/// (its normal along +z) share one word, `ray << 1 | rising`, so a crossing stays 16 bytes.
+#[derive(Clone, Copy, Debug)]
+pub struct Crossing {
+    key: usize,
+    pub z: f64,
+}
+
+impl Crossing {
+    #[inline]
+    fn ray(&self) -> usize {
+        self.key >> 1
+    }
+
+    /// +1 where the surface faces +z (a ray going up leaves an outward shell), -1 otherwise.
+    #[inline]
+    pub fn direction(&self) -> i32 {
+        if self.key & 1 == 1 { 1 } else { -1 }
+    }
+}
+
 /// The crossings of a mesh with the z rays of a box's columns, sorted by column, then z.
 pub struct ColumnCrossings {
     window: RayWindow,
-    /// (ray, z) of every crossing.
-    crossings: Vec<(usize, f64)>,
+    crossings: Vec<Crossing>,
     /// Where each x row of columns starts in `crossings` (and where the last ends).
     row_starts: Vec<usize>,
     /// Per row, where each of its columns starts, from the row's start (`height + 1` entries
@@ -27,8 +47,18 @@ const TRIANGLE_BATCH: usize = 4096;
 impl ColumnCrossings {
     /// The crossings of the closed `mesh` (world units) with the columns of `bbox`.
     pub fn new(mesh: &Mesh, transform: &Transform, bbox: CoordBox) -> Self {
-        let pos: Vec<DVec3> = mesh
-            .positions
+        let triangles: Vec<[u32; 3]> = mesh.triangles().map(|(_, t)| t).collect();
+        Self::of_triangles(&mesh.positions, &triangles, transform, bbox)
+    }
+
+    /// The crossings of `triangles` over `points` (world units) with the columns of `bbox`.
+    pub fn of_triangles(
+        points: &[DVec3],
+        triangles: &[[u32; 3]],
+        transform: &Transform,
+        bbox: CoordBox,
+    ) -> Self {
+        let pos: Vec<DVec3> = points
             .par_iter()
             .map(|&p| transform.world_to_index(p))
             .collect();
@@ -39,21 +69,23 @@ impl ColumnCrossings {
             width: nx,
             height: ny,
         };
-        let triangles: Vec<[u32; 3]> = mesh.triangles().map(|(_, t)| t).collect();
-        let mut crossings: Vec<(usize, f64)> = triangles
+        let mut crossings: Vec<Crossing> = triangles
             .par_chunks(TRIANGLE_BATCH)
             .flat_map_iter(|batch| {
                 let mut found = Vec::new();
-                for_each_crossing(&pos, batch.iter().copied(), &window, |ray, z| {
-                    found.push((ray, z))
+                for_each_crossing(&pos, batch.iter().copied(), &window, |ray, z, rising| {
+                    found.push(Crossing {
+                        key: ray << 1 | rising as usize,
+                        z,
+                    })
                 });
                 found
             })
             .collect();
-        crossings.par_sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        crossings.par_sort_unstable_by(|a, b| a.ray().cmp(&b.ray()).then(a.z.total_cmp(&b.z)));
         let mut row_starts = vec![0usize; nx + 1];
         for c in &crossings {
-            row_starts[c.0 / ny + 1] += 1;
+            row_starts[c.ray() / ny + 1] += 1;
         }
         for x in 0..nx {
             row_starts[x + 1] += row_starts[x];
@@ -65,7 +97,7 @@ impl ColumnCrossings {
             .for_each(|(x, starts)| {
                 // A row's crossings number far below 2^32: each takes 16 bytes in memory.
                 for c in &crossings[row_starts[x]..row_starts[x + 1]] {
-                    starts[c.0 % ny + 1] += 1;
+                    starts[c.ray() % ny + 1] += 1;
                 }
                 for y in 0..ny {
                     starts[y + 1] += starts[y];
@@ -80,7 +112,7 @@ impl ColumnCrossings {
     }
 
     /// The crossings of columns `(x, y)` for `y` in `ys`, which must lie in the window.
-    fn columns_of(&self, x: i64, ys: std::ops::RangeInclusive<i64>) -> &[(usize, f64)] {
+    fn columns_of(&self, x: i64, ys: std::ops::RangeInclusive<i64>) -> &[Crossing] {
         let row = (x - self.window.a0) as usize;
         let starts = &self.column_starts[row * (self.window.height + 1)..];
         let (first, last) = (
@@ -91,12 +123,21 @@ impl ColumnCrossings {
         &self.crossings[base + starts[first] as usize..base + starts[last + 1] as usize]
     }
 
+    /// The crossings of column `(x, y)`, ascending in z; none outside the box's columns.
+    pub fn column(&self, x: i64, y: i64) -> &[Crossing] {
+        let w = &self.window;
+        if x < w.a0 || x >= w.a0 + w.width as i64 || y < w.b0 || y >= w.b0 + w.height as i64 {
+            return &[];
+        }
+        self.columns_of(x, y..=y)
+    }
+
     /// The inside centres of column `(x, y)` (inside the box's columns) as inclusive z spans,
     /// ascending; some may be empty (`first > last`).
     pub fn spans(&self, x: i64, y: i64) -> impl Iterator<Item = (i64, i64)> + '_ {
         self.columns_of(x, y..=y)
             .chunks_exact(2)
-            .map(|pair| (pair[0].1.ceil() as i64, pair[1].1.floor() as i64))
+            .map(|pair| (pair[0].z.ceil() as i64, pair[1].z.floor() as i64))
     }
 
     /// The spans of inside centres of the `count` columns `(x, y0 + i)`, as `span(i, first z,
@@ -110,10 +151,13 @@ impl ColumnCrossings {
             return;
         }
         let first = self.window.ray(x, ys);
-        for column in self.columns_of(x, ys..=ye).chunk_by(|a, b| a.0 == b.0) {
-            let i = (column[0].0 - first) + (ys - y0) as usize;
+        for column in self
+            .columns_of(x, ys..=ye)
+            .chunk_by(|a, b| a.ray() == b.ray())
+        {
+            let i = (column[0].ray() - first) + (ys - y0) as usize;
             for pair in column.chunks_exact(2) {
-                span(i, pair[0].1.ceil() as i64, pair[1].1.floor() as i64);
+                span(i, pair[0].z.ceil() as i64, pair[1].z.floor() as i64);
             }
         }
     }
@@ -122,15 +166,15 @@ impl ColumnCrossings {
     pub fn all_spans(&self) -> impl Iterator<Item = (i64, i64, i64, i64)> + '_ {
         let height = self.window.height;
         self.crossings
-            .chunk_by(|a, b| a.0 == b.0)
+            .chunk_by(|a, b| a.ray() == b.ray())
             .flat_map(move |column| {
-                let (x, y) = (column[0].0 / height, column[0].0 % height);
+                let (x, y) = (column[0].ray() / height, column[0].ray() % height);
                 column.chunks_exact(2).map(move |pair| {
                     (
                         self.window.a0 + x as i64,
                         self.window.b0 + y as i64,
-                        pair[0].1.ceil() as i64,
-                        pair[1].1.floor() as i64,
+                        pair[0].z.ceil() as i64,
+                        pair[1].z.floor() as i64,
                     )
                 })
             })

@@ -2,6 +2,7 @@
 //! validation,
 //! measurement, fitting to a grid, and the project's own generated fixtures.
 
+pub mod boundary_caps;
 mod closed;
 pub mod crossings;
 mod fit;

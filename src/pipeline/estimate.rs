@@ -454,7 +454,9 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
             let bytes = mesh_surface_bytes(mesh, &t, channels);
             plan_of(t, &mesh.bbox(), bytes, items)
         }
-        Work::DistanceBand { mesh, band, signed } => {
+        Work::DistanceBand {
+            mesh, band, signed, ..
+        } => {
             let (t, _) = mesh_plan(mesh, fit)?;
             // A band 2w+1 voxels thick crosses about that many eighths of each leaf it meets.
             let leaves = surface_leaves(area_in_voxels(mesh, &t)) * (2.0 * band + 1.0) / 4.0;

@@ -14,6 +14,7 @@ use crate::mesh::{Mesh, UpAxis};
 use crate::ops::csg::BooleanOp;
 use crate::solids::csg_tree::{CsgTree, parse_csg_tree, read_csg_tree};
 use crate::solids::exterior_flood::FloodMethod;
+use crate::solids::inside_rule::InsideRule;
 use crate::subd::ControlMesh;
 use crate::voxelize::parametric::ParametricOptions;
 use crate::voxelize::projective::{Coloring, LineSource};
@@ -54,17 +55,20 @@ pub(super) enum Work {
         mesh: Mesh,
         band: f64,
         signed: bool,
+        inside: InsideRule,
     },
     Solid {
         mesh: Mesh,
         fill: Fill,
         density: f64,
         topology: bool,
+        inside: InsideRule,
     },
     MeasureMesh {
         mesh: Mesh,
         flood: FloodMethod,
         density: f64,
+        inside: InsideRule,
     },
     /// A surface grid to fill and weigh.
     MeasureSurface {
@@ -153,31 +157,37 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
             mesh: m,
             band,
             signed,
+            inside,
         } => Work::DistanceBand {
             mesh: mesh(m)?,
             band: *band,
             signed: *signed,
+            inside: *inside,
         },
         Task::Solid {
             mesh: m,
             fill,
             density,
             topology,
+            inside,
         } => Work::Solid {
             mesh: mesh(m)?,
             fill: *fill,
             density: *density,
             topology: *topology,
+            inside: *inside,
         },
         Task::Measure {
             source,
             flood,
             density,
+            inside,
         } => match source {
             MeasureSource::Mesh(m) => Work::MeasureMesh {
                 mesh: mesh(m)?,
                 flood: *flood,
                 density: *density,
+                inside: *inside,
             },
             MeasureSource::Vdb(path) => Work::MeasureSurface {
                 surface: read_surface(path)?,

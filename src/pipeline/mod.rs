@@ -29,6 +29,7 @@ use crate::shapes::{Cylinder, Quadric, Sphere};
 use crate::solids::beam::BeamFill;
 use crate::solids::depth_layers::DepthLayerOptions;
 use crate::solids::exterior_flood::FloodMethod;
+use crate::solids::inside_rule::InsideRule;
 use crate::voxelize::Separability;
 use crate::voxelize::parametric::ParametricOptions;
 use crate::voxelize::projective::{Coloring, LineSource};
@@ -159,18 +160,23 @@ pub enum Task {
         /// Also count components and genus (a pass over the whole solid; `Measure` always
         /// does).
         topology: bool,
+        /// How a flood solid's inside is decided.
+        inside: InsideRule,
     },
     Measure {
         source: MeasureSource,
         flood: FloodMethod,
         density: f64,
+        /// How a mesh's inside is decided.
+        inside: InsideRule,
     },
     /// Exact distances to a mesh on every voxel within `band` voxels: signed (a level set,
-    /// closed meshes only) or unsigned.
+    /// signed by `inside`) or unsigned.
     DistanceBand {
         mesh: MeshSource,
         band: f64,
         signed: bool,
+        inside: InsideRule,
     },
     /// A CSG tree in JSON (see `ops::csg_tree`); the tree sets the grid.
     CsgTree(CsgSource),
@@ -610,20 +616,25 @@ impl PlannedJob {
                 };
                 outcome::implicit(formula, text, *min, *max, &options, progress)
             }
-            Work::DistanceBand { mesh, band, signed } => {
-                solid::distance_band(mesh, t, *band, *signed, fit, progress)
-            }
+            Work::DistanceBand {
+                mesh,
+                band,
+                signed,
+                inside,
+            } => solid::distance_band(mesh, t, *band, *signed, *inside, fit, progress),
             Work::Solid {
                 mesh,
                 fill,
                 density,
                 topology,
-            } => solid::mesh_solid(mesh, t, *fill, *density, *topology, fit, progress),
+                inside,
+            } => solid::mesh_solid(mesh, t, *fill, *density, *topology, *inside, fit, progress),
             Work::MeasureMesh {
                 mesh,
                 flood,
                 density,
-            } => solid::measure_mesh(mesh, t, *flood, *density, progress),
+                inside,
+            } => solid::measure_mesh(mesh, t, *flood, *density, *inside, progress),
             Work::MeasureSurface {
                 surface,
                 flood,

@@ -1,6 +1,7 @@
 //! What a job reports: one serde struct, printed as JSON (`--json`, the Python module's
 //! `report` dict) or as the human summary, so both always say the same.
 
+use crate::solids::winding_inside::AMBIGUOUS;
 use serde::Serialize;
 
 /// The report of one job. Every number is a number; `seconds` is the whole run.
@@ -156,6 +157,12 @@ pub struct DistanceBandDetails {
     /// Band voxels whose centre is inside (negative values).
     pub inside_band_voxels: u64,
     pub background: f64,
+    /// The inside rule that signed the distances, and why (signed only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inside_rule: Option<String>,
+    /// Centres whose winding number lies near 1/2 (written as `ambiguous`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ambiguous_voxels: Option<u64>,
 }
 
 #[derive(Serialize, Debug, Clone, Default)]
@@ -174,6 +181,10 @@ pub struct SolidDetails {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub genus: Option<i64>,
     pub inside_rule: String,
+    /// Centres whose winding number lies near 1/2 (written as `ambiguous`), where the
+    /// winding number decided.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ambiguous_voxels: Option<u64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mesh_signed_volume: Option<f64>,
     /// The surface's area: a mesh's, or a limit surface's by Gauss quadrature.
@@ -344,13 +355,14 @@ impl Report {
             ),
             Details::Solid(s) => solid_summary(place, s, &timing),
             Details::DistanceBand(d) => format!(
-                "{place}: {} {} distances within {} voxels ({} inside), background {:.6}, voxel size {:.6}, {timing}",
+                "{place}: {} {} distances within {} voxels ({} inside), background {:.6}, voxel size {:.6}{}, {timing}",
                 self.voxels,
                 if d.signed { "signed" } else { "unsigned" },
                 d.band,
                 d.inside_band_voxels,
                 d.background,
-                self.voxel_size
+                self.voxel_size,
+                inside_summary(d.inside_rule.as_deref(), d.ambiguous_voxels)
             ),
             Details::DepthLayers(d) => depth_layer_summary(place, &self.method, d, &timing),
             Details::BrickFaces(b) => format!(
@@ -381,6 +393,17 @@ impl Report {
     }
 }
 
+/// `; inside: RULE (N ambiguous voxels)`, or nothing without a rule.
+fn inside_summary(rule: Option<&str>, ambiguous: Option<u64>) -> String {
+    let Some(rule) = rule else {
+        return String::new();
+    };
+    match ambiguous {
+        Some(n) => format!("; inside: {rule}; {n} voxels within {AMBIGUOUS} of winding number 1/2"),
+        None => format!("; inside: {rule}"),
+    }
+}
+
 fn solid_summary(place: &str, s: &SolidDetails, timing: &str) -> String {
     let mesh = match (s.mesh_signed_volume, s.mesh_area, s.limit_volume) {
         (_, Some(a), Some(v)) => {
@@ -402,7 +425,7 @@ fn solid_summary(place: &str, s: &SolidDetails, timing: &str) -> String {
     };
     format!(
         "{place}{mesh}: {} inside + {} surface voxels; volume {:.6} (inside) .. {:.6} (with surface); \
-         mass {:.6} .. {:.6} at density {}; {topology}{}{xyz}; {timing}",
+         mass {:.6} .. {:.6} at density {}; {topology}{}{}{xyz}; {timing}",
         s.inside_voxels,
         s.surface_voxels,
         s.volume_inside,
@@ -410,7 +433,10 @@ fn solid_summary(place: &str, s: &SolidDetails, timing: &str) -> String {
         s.mass_inside,
         s.mass_with_surface,
         s.density,
-        s.inside_rule
+        s.inside_rule,
+        s.ambiguous_voxels.map_or(String::new(), |n| format!(
+            " ({n} voxels within {AMBIGUOUS} of winding number 1/2)"
+        ))
     )
 }
 

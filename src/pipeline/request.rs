@@ -22,6 +22,7 @@ use crate::ops::flood_xyz::DEFAULT_GRAYSTACK;
 use crate::solids::beam::BeamFill;
 use crate::solids::depth_layers::{DepthLayerOptions, DirectionSet, Layers, Unclassified};
 use crate::solids::exterior_flood::FloodMethod;
+use crate::solids::inside_rule::InsideRule;
 use crate::voxelize::Separability;
 use crate::voxelize::parametric::ParametricOptions;
 use crate::voxelize::separating::{Criterion, SeparatingOptions};
@@ -98,6 +99,13 @@ plain_fields!(
     Option<[f32; 3]>
 );
 
+/// The doc of every `inside` field.
+macro_rules! inside_doc {
+    () => {
+        "How the inside is decided: auto (the winding number where the orientation is consistent, ray parity where not), winding (inside where the generalized winding number is at least 1/2: open, overlapping and hollow meshes too) or parity (ray parity and the exterior flood: closed meshes)."
+    };
+}
+
 macro_rules! request {
     // A request on a mesh: the grid fit first, its up axis last.
     ($(#[doc = $sdoc:literal])* $name:ident as $py:literal fitted { $($fields:tt)* }) => {
@@ -117,7 +125,7 @@ macro_rules! request {
         }
     };
     ($(#[doc = $sdoc:literal])* $name:ident as $py:literal {
-        $( $(#[doc = $doc:literal])* $field:ident : $ty:ty = $default:expr ),* $(,)?
+        $( $(#[doc = $doc:expr])* $field:ident : $ty:ty = $default:expr ),* $(,)?
     }) => {
         $(#[doc = $sdoc])*
         #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -316,12 +324,14 @@ request! {
         colors: bool = true,
         /// Projective: one (r, g, b) colour for every voxel instead.
         color: Option<[f32; 3]> = None,
-        /// Exact signed distances (a level set, closed meshes) within `band`.
+        /// Exact signed distances (a level set) within `band`, signed by `inside`.
         sdf: bool = false,
         /// Exact unsigned distances within `band` (open meshes too).
         udf: bool = false,
         /// Half width of the distance band, in voxels.
         band: f64 = BAND,
+        #[doc = inside_doc!()]
+        inside: InsideRule = InsideRule::default(),
     }
 }
 
@@ -355,6 +365,8 @@ request! {
         sdf: bool = false,
         /// Half width of the distance band, in voxels.
         band: f64 = BAND,
+        #[doc = inside_doc!()]
+        inside: InsideRule = InsideRule::default(),
     }
 }
 
@@ -368,6 +380,8 @@ request! {
         graystack: usize = DEFAULT_GRAYSTACK,
         /// Mass per unit volume.
         density: f64 = DENSITY,
+        #[doc = inside_doc!()]
+        inside: InsideRule = InsideRule::default(),
     }
 }
 
@@ -489,9 +503,14 @@ fn color_choice(colors: bool, color: Option<[f32; 3]>) -> ColorChoice {
     }
 }
 
-fn distance_band(mesh: MeshSource, band: f64, signed: bool) -> Result<Task> {
+fn distance_band(mesh: MeshSource, band: f64, signed: bool, inside: InsideRule) -> Result<Task> {
     positive("band", band)?;
-    Ok(Task::DistanceBand { mesh, band, signed })
+    Ok(Task::DistanceBand {
+        mesh,
+        band,
+        signed,
+        inside,
+    })
 }
 
 impl LimitsRequest {
@@ -581,7 +600,7 @@ impl Request for MeshRequest {
             ));
         }
         if self.sdf || self.udf {
-            return distance_band(mesh, self.band, self.sdf);
+            return distance_band(mesh, self.band, self.sdf, self.inside);
         }
         let method = match self.method {
             SurfaceKind::Separating => SurfaceMethod::Separating(self.separating()),
@@ -609,7 +628,7 @@ impl Request for SolidRequest {
 
     fn task(&self, mesh: MeshSource) -> Result<Task> {
         if self.sdf {
-            return distance_band(mesh, self.band, true);
+            return distance_band(mesh, self.band, true, self.inside);
         }
         positive("density", self.density)?;
         let fill = match self.method {
@@ -622,6 +641,7 @@ impl Request for SolidRequest {
             fill,
             density: self.density,
             topology: self.topology,
+            inside: self.inside,
         })
     }
 }
@@ -636,6 +656,7 @@ impl Request for MeasureRequest {
             source,
             flood: self.flood.method(self.graystack),
             density: self.density,
+            inside: self.inside,
         })
     }
 }

@@ -18,8 +18,9 @@ use crate::solids::beam::{BeamFill, beam_solid};
 use crate::solids::csg_tree::CsgTree;
 use crate::solids::depth_layers::{Layers, depth_layer_solid};
 use crate::solids::exterior_flood::{FloodMethod, Solid};
-use crate::solids::flooded_mesh::{self, SurfaceAndInside};
-use crate::solids::level_set::{level_set, unsigned_distance};
+use crate::solids::flooded_mesh::{self, FLOOD_NEEDS_CLOSED, SurfaceAndInside};
+use crate::solids::inside_rule::{Inside, InsideChoice, InsideRule, choose_inside};
+use crate::solids::level_set::{SIGN_NEEDS_CLOSED, level_set, unsigned_distance};
 use crate::subd::ControlMesh;
 use crate::voxelize::parametric::ParametricOptions;
 use rayon::prelude::*;
@@ -28,6 +29,25 @@ use std::time::Instant;
 /// What inside means for the exterior flood.
 const FLOOD_RULE: &str =
     "inside = what the exterior flood (from the box corner, no normals needed) cannot reach";
+
+/// What inside means for the winding number.
+const WINDING_RULE: &str =
+    "inside = the surface and the centres whose winding number is at least 1/2";
+
+/// The report's rule for a flood solid decided by `choice`.
+fn flood_rule(choice: &InsideChoice) -> String {
+    let rule = match choice.inside {
+        Inside::Winding(_) => WINDING_RULE,
+        Inside::Parity => FLOOD_RULE,
+    };
+    format!("{rule} ({})", choice.reason)
+}
+
+/// The metadata naming the inside rule that ran and why.
+fn inside_meta(meta: &mut Vec<(&str, MetaValue)>, choice: &InsideChoice) {
+    meta.push(("inside_rule", choice.name().into()));
+    meta.push(("inside_reason", choice.reason.clone().into()));
+}
 
 /// What inside means for a Catmull-Clark solid.
 const SUBDIVISION_RULE: &str = "inside = what FloodingXYZ reaches from the seeds one voxel against the limit normals (Lai & Cheng)";
@@ -65,6 +85,7 @@ fn solid_details(
         components,
         genus,
         inside_rule: rule.to_string(),
+        ambiguous_voxels: None,
         mesh_signed_volume: mesh.map(Mesh::signed_volume),
         mesh_area: None,
         limit_volume: None,
@@ -87,11 +108,22 @@ fn surface_and_inside(
         surface,
         solid,
         whole,
+        ambiguous,
     } = parts;
-    let details = describe(&whole, &solid)?;
-    Ok(Outcome::new(whole, meta, Details::Solid(details))
+    let mut details = describe(&whole, &solid)?;
+    details.ambiguous_voxels = ambiguous.as_ref().map(SparseGrid::voxel_count);
+    let outcome = Outcome::new(whole, meta, Details::Solid(details))
         .with("shell", surface)
-        .with("interior", solid.inside))
+        .with("interior", solid.inside);
+    Ok(with_ambiguous(outcome, ambiguous))
+}
+
+/// The outcome with its ambiguous centres as a grid `ambiguous`, where there are any.
+fn with_ambiguous(outcome: Outcome, ambiguous: Option<SparseGrid>) -> Outcome {
+    match ambiguous {
+        Some(grid) if !grid.is_empty() => outcome.with("ambiguous", grid),
+        _ => outcome,
+    }
 }
 
 /// A solid classified at voxel centres: `shell` (voxels with a face towards the
@@ -115,6 +147,7 @@ pub(super) fn mesh_solid(
     fill: Fill,
     density: f64,
     topology: bool,
+    inside: InsideRule,
     fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
@@ -123,10 +156,16 @@ pub(super) fn mesh_solid(
     let meta = |method: &str| provenance(method, &source, fit);
     let outcome = match fill {
         Fill::Flood(flood) => {
-            let parts = flooded_mesh::flooded_mesh(mesh, t, flood, progress)?;
-            let method = meta("huang-26-separating-surface+exterior-flood");
+            let choice = choose_inside(inside, mesh, FLOOD_NEEDS_CLOSED)?;
+            let parts = flooded_mesh::flooded_mesh(mesh, t, flood, &choice.inside, progress)?;
+            let mut method = meta(match choice.inside {
+                Inside::Winding(_) => "huang-26-separating-surface+winding-number",
+                Inside::Parity => "huang-26-separating-surface+exterior-flood",
+            });
+            inside_meta(&mut method, &choice);
+            let rule = flood_rule(&choice);
             surface_and_inside(parts, method, |whole, solid| {
-                solid_details(whole, solid, density, FLOOD_RULE, Some(mesh), topology)
+                solid_details(whole, solid, density, &rule, Some(mesh), topology)
             })?
         }
         Fill::Beam(fill) => {
@@ -207,15 +246,23 @@ pub(super) fn distance_band(
     t: Transform,
     band: f64,
     signed: bool,
+    inside: InsideRule,
     fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
-    let (grid, interior) = if signed {
-        let set = level_set(mesh, t, band, progress)?;
-        (set.band, Some(set.interior))
+    let (grid, interior, choice, ambiguous) = if signed {
+        let choice = choose_inside(inside, mesh, SIGN_NEEDS_CLOSED)?;
+        let set = level_set(mesh, t, band, &choice.inside, progress)?;
+        let ambiguous = matches!(choice.inside, Inside::Winding(_)).then_some(set.ambiguous);
+        (set.band, Some(set.interior), Some(choice), ambiguous)
     } else {
-        (unsigned_distance(mesh, t, band, progress)?, None)
+        (
+            unsigned_distance(mesh, t, band, progress)?,
+            None,
+            None,
+            None,
+        )
     };
     let inside_band_voxels = grid
         .leaves()
@@ -233,18 +280,25 @@ pub(super) fn distance_band(
     };
     let mut meta = provenance(method, &mesh.source.display().to_string(), fit);
     meta.push(("band_voxels", band.into()));
+    if let Some(choice) = &choice {
+        inside_meta(&mut meta, choice);
+    }
     let details = DistanceBandDetails {
         band,
         signed,
         inside_band_voxels,
         background,
+        inside_rule: choice
+            .as_ref()
+            .map(|c| format!("{} ({})", c.name(), c.reason)),
+        ambiguous_voxels: ambiguous.as_ref().map(SparseGrid::voxel_count),
     };
     let mut outcome = Outcome::new(grid, meta, Details::DistanceBand(details));
     outcome.distances = Some(Distances {
         background: background as f32,
         interior,
     });
-    Ok(outcome.timed(start))
+    Ok(with_ambiguous(outcome, ambiguous).timed(start))
 }
 
 pub(super) fn measure_mesh(
@@ -252,19 +306,27 @@ pub(super) fn measure_mesh(
     t: Transform,
     flood: FloodMethod,
     density: f64,
+    inside: InsideRule,
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
-    let parts = flooded_mesh::flooded_mesh(mesh, t, flood, progress)?;
-    let meta = vec![
+    let choice = choose_inside(inside, mesh, FLOOD_NEEDS_CLOSED)?;
+    let parts = flooded_mesh::flooded_mesh(mesh, t, flood, &choice.inside, progress)?;
+    let mut meta = vec![
         (
             "method",
-            "huang-26-separating-surface+exterior-flood".into(),
+            match choice.inside {
+                Inside::Winding(_) => "huang-26-separating-surface+winding-number",
+                Inside::Parity => "huang-26-separating-surface+exterior-flood",
+            }
+            .into(),
         ),
         ("source_file", mesh.source.display().to_string().into()),
     ];
+    inside_meta(&mut meta, &choice);
+    let rule = flood_rule(&choice);
     let outcome = surface_and_inside(parts, meta, |whole, solid| {
-        let details = solid_details(whole, solid, density, FLOOD_RULE, Some(mesh), true)?;
+        let details = solid_details(whole, solid, density, &rule, Some(mesh), true)?;
         Ok(SolidDetails {
             mesh_area: Some(mesh.area()),
             ..details

@@ -355,7 +355,7 @@ impl View {
             &ray_points,
             mesh.triangles().map(|(_, t)| t),
             &view.window,
-            |ray, t| {
+            |ray, t, _| {
                 let t = t as f32;
                 count[ray] = count[ray].saturating_add(1);
                 let n = &mut near[ray];

@@ -1,13 +1,16 @@
-//! A closed mesh's solid as Lai & Cheng compose it: the mesh's 26-separating surface (Huang
-//! et al.) and every voxel the exterior flood cannot reach through it but its cavities; and
-//! the measures of
-//! the whole solid's shape, its components and genus.
+//! A mesh's solid as Lai & Cheng compose it: the mesh's 26-separating surface (Huang et al.)
+//! and the voxels inside it, by the mesh's inside rule (`inside_rule`): every voxel the
+//! exterior flood cannot reach through the surface but its cavities (parity, closed meshes),
+//! or every centre whose winding number is at least 1/2 (winding, any mesh); and the measures
+//! of the whole solid's shape, its components and genus.
 
 use super::cavities::remove_cavities;
 use super::exterior_flood::{FloodMethod, Solid, solid_from_surface};
+use super::inside_rule::Inside;
+use super::winding_inside::winding_inside;
 use crate::error::Result;
 use crate::grid::{Adjacency, DenseMask, SparseGrid, Transform};
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
 use crate::ops::measure::SolidMeasures;
 use crate::ops::topology::{components, euler_characteristic};
@@ -17,8 +20,7 @@ use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 
 /// Why the flood needs a closed mesh, for the error that refuses an open one.
 pub const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it and leave the solid hollow \
-     (the depth-layers method, option `method`, reports which voxels an open mesh leaves \
-     undecidable)";
+     (option `inside` winding fills it by the winding number)";
 
 /// A surface, the solid inside it, and the two together.
 pub struct SurfaceAndInside {
@@ -26,6 +28,8 @@ pub struct SurfaceAndInside {
     pub solid: Solid,
     /// Surface and inside: the whole solid.
     pub whole: SparseGrid,
+    /// The centres whose winding number lies near 1/2, where the winding number decided.
+    pub ambiguous: Option<SparseGrid>,
 }
 
 impl SurfaceAndInside {
@@ -37,7 +41,24 @@ impl SurfaceAndInside {
             surface,
             solid,
             whole,
+            ambiguous: None,
         }
+    }
+
+    /// The surface and the centres inside it, the surface's voxels not counted twice.
+    fn with_inside(surface: SparseGrid, mut inside: SparseGrid) -> SurfaceAndInside {
+        inside.difference(&surface);
+        let measures = SolidMeasures::of(
+            inside.voxel_count(),
+            surface.voxel_count(),
+            surface.transform.voxel_size,
+        );
+        let solid = Solid {
+            inside,
+            measures,
+            xyz_stats: None,
+        };
+        SurfaceAndInside::of(surface, solid)
     }
 
     /// The closed `surface` and what `flood` cannot reach from outside.
@@ -47,9 +68,8 @@ impl SurfaceAndInside {
     }
 }
 
-/// The 26-separating surface of a closed mesh, the surface a flood fills.
+/// The 26-separating surface of a mesh, the surface a solid is filled in.
 pub fn flood_surface(mesh: &Mesh, t: Transform, progress: &Progress) -> Result<SparseGrid> {
-    mesh.require_closed(FLOOD_NEEDS_CLOSED)?;
     let options = SeparatingOptions {
         separability: Separability::TwentySix,
         ..Default::default()
@@ -57,14 +77,30 @@ pub fn flood_surface(mesh: &Mesh, t: Transform, progress: &Progress) -> Result<S
     Ok(voxelize_mesh(mesh, t, &options, progress)?.0)
 }
 
-/// A closed mesh's solid: its 26-separating surface flooded by `flood`, less the enclosed
-/// regions its winding number says are cavities.
+/// A mesh's solid: its 26-separating surface and, by winding number, the centres inside it;
+/// by parity, the surface of the closed mesh flooded by `flood`, less the enclosed regions its
+/// winding number says are cavities.
 pub fn flooded_mesh(
     mesh: &Mesh,
     t: Transform,
     flood: FloodMethod,
+    inside: &Inside,
     progress: &Progress,
 ) -> Result<SurfaceAndInside> {
+    if let Inside::Winding(caps) = inside {
+        let region = index_box(&mesh.bbox(), &t);
+        let (surface, centres) = rayon::join(
+            || flood_surface(mesh, t, progress),
+            || winding_inside(mesh, caps, t, region),
+        );
+        let centres = centres?;
+        let parts = SurfaceAndInside::with_inside(surface?, centres.grid(t));
+        return Ok(SurfaceAndInside {
+            ambiguous: Some(centres.ambiguous),
+            ..parts
+        });
+    }
+    mesh.require_closed(FLOOD_NEEDS_CLOSED)?;
     let surface = flood_surface(mesh, t, progress)?;
     let mut solid = solid_from_surface(&surface, flood, progress)?;
     if remove_cavities(mesh, &mut solid.inside)? > 0 {

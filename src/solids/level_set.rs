@@ -1,16 +1,18 @@
-//! Level sets of closed meshes: the narrow band of exact distances (`voxelize::distance_band`)
-//! signed by where each voxel centre lies, inside or outside, by ray parity
-//! (`mesh::inside`), which needs no consistent orientation: inward-facing or mixed normals
-//! give the same level set. Values are in world units, negative inside, as OpenVDB's level
-//! sets are.
+//! Level sets of meshes: the narrow band of exact distances (`voxelize::distance_band`)
+//! signed by where each voxel centre lies, inside or outside, by the mesh's inside rule
+//! (`inside_rule`): its winding number (`winding_inside`: any consistently oriented mesh, open
+//! or not), or ray parity (`mesh::inside`: closed meshes, no consistent orientation needed).
+//! Values are in world units, negative inside, as OpenVDB's level sets are.
 //!
 //! Beside the band, the level set keeps its interior: the inside centres of the band's leaves,
 //! and every 8^3 block wholly inside as a tile (128^3 where whole). A block without band
 //! voxels holds no surface (any surface in it lies within sqrt(3)/2 of a centre, inside the
 //! band), so one centre decides it.
 
+use super::inside_rule::Inside;
+use super::winding_inside::winding_inside;
 use crate::error::Result;
-use crate::grid::{Channels, Coord, Leaf, SparseGrid, Transform};
+use crate::grid::{Block, Channels, Coord, Leaf, SparseGrid, Transform};
 use crate::mesh::inside::ColumnCrossings;
 use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
@@ -18,9 +20,9 @@ use crate::progress::Progress;
 use crate::voxelize::distance_band::distance_band;
 use rayon::prelude::*;
 
-/// Why a signed distance needs a closed mesh, for the error that refuses an open one.
-const SIGN_NEEDS_CLOSED: &str = "a signed distance needs an inside, which an open surface does \
-     not have (option `udf` writes unsigned distances)";
+/// Why a signed distance by parity needs a closed mesh, for the error that refuses an open one.
+pub const SIGN_NEEDS_CLOSED: &str = "ray parity needs a closed mesh to sign distances (option \
+     `inside` winding signs them by the winding number; `udf` writes unsigned distances)";
 
 /// A narrow-band level set and the inside it bounds.
 pub struct LevelSet {
@@ -28,21 +30,83 @@ pub struct LevelSet {
     pub band: SparseGrid,
     /// The inside centres: the band leaves' as leaves, whole inside blocks as tiles.
     pub interior: SparseGrid,
+    /// The centres whose winding number lies near 1/2 (none by parity).
+    pub ambiguous: SparseGrid,
 }
 
 /// Signed distances (world units, negative inside) on every voxel within `band` voxels of
-/// the closed `mesh`, and its interior.
+/// `mesh`, signed by `inside`, and its interior.
 pub fn level_set(
     mesh: &Mesh,
     transform: Transform,
     band: f64,
+    inside: &Inside,
+    progress: &Progress,
+) -> Result<LevelSet> {
+    // The inside covers the band's columns: the mesh's box widened by the band. It is found
+    // beside the band, filling the threads in its serial steps.
+    let reach = band.ceil() as i64;
+    let columns_box = padded(index_box(&mesh.bbox(), &transform), reach);
+    let caps = match inside {
+        Inside::Winding(caps) => caps,
+        Inside::Parity => return parity_level_set(mesh, transform, band, columns_box, progress),
+    };
+    let (grid, inside) = rayon::join(
+        || distance_band(mesh, transform, band, progress),
+        || winding_inside(mesh, caps, transform, columns_box),
+    );
+    let (mut grid, inside) = (grid?, inside?);
+    let h = transform.voxel_size as f32;
+    let centres = inside.grid(transform);
+    grid.leaves_mut().par_iter_mut().for_each(|leaf| {
+        let mask = match centres.block(leaf.origin) {
+            Block::Whole => [u64::MAX; 8],
+            Block::Partial(l) => l.mask,
+            Block::Empty => [0; 8],
+        };
+        sign_leaf(leaf, &mask, h);
+    });
+    // Band leaves stay leaves, even wholly inside: the level set writes its tiles.
+    let (full_band, full_free): (Vec<Coord>, Vec<Coord>) = inside
+        .full_blocks
+        .into_iter()
+        .partition(|&o| grid.leaf(o).is_some());
+    let mut leaves = inside.leaves;
+    leaves.extend(full_band.into_iter().map(|o| {
+        let mut leaf = Leaf::new(o, Channels::NONE);
+        leaf.mask = [u64::MAX; 8];
+        leaf
+    }));
+    let mut interior = SparseGrid::from_distinct_leaves(transform, Channels::NONE, leaves);
+    interior.fill_leaf_blocks(full_free);
+    Ok(LevelSet {
+        band: grid,
+        interior,
+        ambiguous: inside.ambiguous,
+    })
+}
+
+/// Negates the distances of `leaf`'s voxels in `inside` and scales all to world units.
+fn sign_leaf(leaf: &mut Leaf, inside: &[u64; 8], h: f32) {
+    let values = leaf.value.as_mut().expect("distances");
+    for n in crate::grid::bits::ones(&leaf.mask) {
+        values[n] *= if inside[n / 64] >> (n % 64) & 1 == 1 {
+            -h
+        } else {
+            h
+        };
+    }
+}
+
+/// The level set of a closed mesh signed by ray parity.
+fn parity_level_set(
+    mesh: &Mesh,
+    transform: Transform,
+    band: f64,
+    columns_box: crate::grid::CoordBox,
     progress: &Progress,
 ) -> Result<LevelSet> {
     mesh.require_closed(SIGN_NEEDS_CLOSED)?;
-    // The crossings cover the band's columns: the mesh's box widened by the band. They are
-    // found beside the band, filling the threads in its serial steps.
-    let reach = band.ceil() as i64;
-    let columns_box = padded(index_box(&mesh.bbox(), &transform), reach);
     let (grid, columns) = rayon::join(
         || distance_band(mesh, transform, band, progress),
         || ColumnCrossings::new(mesh, &transform, columns_box),
@@ -52,6 +116,7 @@ pub fn level_set(
         return Ok(LevelSet {
             band: grid,
             interior: SparseGrid::new(transform, Channels::NONE),
+            ambiguous: SparseGrid::new(transform, Channels::NONE),
         });
     }
     let h = transform.voxel_size as f32;
@@ -60,15 +125,7 @@ pub fn level_set(
         .par_iter_mut()
         .filter_map(|leaf| {
             let mask = inside_mask(&columns, leaf.origin);
-            let values = leaf.value.as_mut().expect("distances");
-            for n in crate::grid::bits::ones(&leaf.mask) {
-                let sign = if mask[n / 64] >> (n % 64) & 1 == 1 {
-                    -h
-                } else {
-                    h
-                };
-                values[n] *= sign;
-            }
+            sign_leaf(leaf, &mask, h);
             let mut inside = Leaf::new(leaf.origin, Channels::NONE);
             inside.mask = mask;
             (!inside.is_empty()).then_some(inside)
@@ -80,6 +137,7 @@ pub fn level_set(
     Ok(LevelSet {
         band: grid,
         interior,
+        ambiguous: SparseGrid::new(transform, Channels::NONE),
     })
 }
 

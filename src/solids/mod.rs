@@ -10,5 +10,7 @@ pub mod csg_tree;
 pub mod depth_layers;
 pub mod exterior_flood;
 pub mod flooded_mesh;
+pub mod inside_rule;
 pub mod level_set;
 pub mod subdivision;
+pub mod winding_inside;

@@ -94,8 +94,7 @@ pub enum ShapeKind {
 pub struct DistanceArgs {
     /// Write a level set instead: exact signed distances (world units, negative inside) on
     /// every voxel within --band of the mesh, as a FloatGrid of class LEVEL_SET named
-    /// `surface` (Houdini's name) after its fog volume `density`; closed meshes only (the
-    /// sign comes from ray parity, so face orientation does not matter).
+    /// `surface` (Houdini's name) after its fog volume `density`, signed by --inside.
     #[arg(long)]
     pub sdf: bool,
     /// Write unsigned distances within --band (a FloatGrid `distance`); open meshes too.
@@ -104,6 +103,8 @@ pub struct DistanceArgs {
     /// Half width of the distance band, in voxels (the background is band x voxel size).
     #[arg(long, default_value_t = voxelkit::pipeline::request::MeshRequest::default().band, value_name = "W")]
     pub band: f64,
+    #[command(flatten)]
+    pub inside: crate::solids::InsideArgs,
 }
 
 impl SurfaceArgs {
@@ -162,6 +163,7 @@ pub fn mesh(
         sdf: distance.sdf,
         udf: distance.udf,
         band: distance.band,
+        inside: distance.inside.inside,
         ..surface.request()
     };
     batch::run(inputs, out, fit.grid_fit(), global, |mesh| {

@@ -9,6 +9,7 @@ use voxelkit::ops::csg::BooleanOp;
 use voxelkit::pipeline::request::{FillKind, FloodKind, MeasureRequest, Request, SolidRequest};
 use voxelkit::pipeline::{CsgSource, GridSource, Job, MeasureSource, MeshSource, Task};
 use voxelkit::solids::beam::BeamFill;
+use voxelkit::solids::inside_rule::InsideRule;
 
 /// How the exterior is flooded.
 #[derive(Args, Clone, Copy)]
@@ -20,6 +21,21 @@ pub struct FloodArgs {
     /// GRAYSTACK capacity for --flood xyz (entries; when full, sweeps resume the flood).
     #[arg(long, default_value_t = SolidRequest::default().graystack)]
     graystack: usize,
+}
+
+/// Which inside a mesh gets.
+#[derive(Args, Clone, Copy)]
+pub struct InsideArgs {
+    /// How the inside is decided: auto (the generalized winding number wherever the mesh's
+    /// orientation is consistent: open, overlapping, nested and hollow meshes too; ray parity
+    /// where it is not), winding (inside where the winding number is at least 1/2), or parity
+    /// (ray parity and the exterior flood: closed meshes only).
+    #[arg(long, default_value_t = InsideRule::default(), value_parser = parse_inside, value_name = "RULE")]
+    pub inside: InsideRule,
+}
+
+fn parse_inside(s: &str) -> std::result::Result<InsideRule, String> {
+    s.parse()
 }
 
 fn parse_flood(s: &str) -> std::result::Result<FloodKind, String> {
@@ -40,6 +56,8 @@ pub struct FillArgs {
     /// Density (mass per unit volume) for the mass.
     #[arg(long, default_value_t = SolidRequest::default().density)]
     pub density: f64,
+    #[command(flatten)]
+    pub inside: InsideArgs,
 }
 
 fn parse_beam_fill(s: &str) -> std::result::Result<BeamFill, String> {
@@ -48,13 +66,13 @@ fn parse_beam_fill(s: &str) -> std::result::Result<BeamFill, String> {
 
 #[derive(Args)]
 pub struct SolidArgs {
-    /// Closed input meshes (.obj, .stl, .ply, .off, .gltf or .glb; several with --out-dir,
-    /// or one pattern with --frames); their orientation does not matter. With --method
-    /// depth-layers open meshes are accepted and their undecidable voxels reported.
+    /// Input meshes (.obj, .stl, .ply, .off, .gltf or .glb; several with --out-dir, or one
+    /// pattern with --frames): open, overlapping or hollow ones too (see --inside). With
+    /// --method depth-layers their undecidable voxels are reported.
     #[arg(required = true, num_args = 1..)]
     pub inputs: Vec<PathBuf>,
-    /// flood: the 26-separating surface plus everything the exterior flood cannot reach (Lai
-    /// & Cheng); depth-layers: depth buffers with a stencil count (Passalis et al.), exact at
+    /// flood: the 26-separating surface plus its inside (--inside: the centres of winding
+    /// number at least 1/2, or what the exterior flood cannot reach, Lai & Cheng); depth-layers: depth buffers with a stencil count (Passalis et al.), exact at
     /// voxel centres, voxels no direction can decide reported as unclassifiable; beam: the
     /// projective surface plus the beams of voxels between front and back faces along z
     /// (Jegathese et al.), closed meshes only.
@@ -136,7 +154,8 @@ pub struct IntersectArgs {
 
 #[derive(Args)]
 pub struct MeasureArgs {
-    /// A closed mesh (.obj, .stl; voxelized first) or a .vdb whose `surface` grid is closed.
+    /// A mesh (.obj, .stl, ...; voxelized and filled by --inside first) or a .vdb whose
+    /// `surface` grid is closed.
     input: PathBuf,
     #[command(flatten)]
     fill: FillArgs,
@@ -159,6 +178,7 @@ pub fn solid(args: &SolidArgs, global: &Global) -> Result<()> {
         topology: args.topology,
         sdf: args.sdf,
         band: args.band,
+        inside: args.fill.inside.inside,
         ..SolidRequest::default()
     };
     crate::batch::run(
@@ -184,6 +204,7 @@ pub fn measure(args: &MeasureArgs, global: &Global) -> Result<()> {
         flood: args.fill.flood.flood,
         graystack: args.fill.flood.graystack,
         density: args.fill.density,
+        inside: args.fill.inside.inside,
         ..MeasureRequest::default()
     };
     let task = request.task(source)?;
