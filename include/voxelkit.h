@@ -247,7 +247,9 @@ vk_status vk_grid_combine(const vk_grid *a, const vk_grid *b, vk_boolean op, int
 /* ---- grids ------------------------------------------------------------------------------ */
 
 /* Reads grid `name` of a .vdb file (NULL: the voxel set voxelkit writes, `voxels`, else
- * `density`, else the first Bool, Mask or Float grid). */
+ * `density`, else the first Bool, Mask or Float grid) as the voxels it stands for: a level
+ * set's inside (its negative values and tiles, active or not), any other grid's active
+ * voxels. */
 vk_status vk_grid_read_vdb(const char *path, const char *name, vk_grid **out);
 
 /* Writes `density` (a fog volume, whole blocks as tiles) and, when the grid has them,

@@ -12,7 +12,7 @@ use crate::choice::Choice;
 use crate::error::{Error, Result};
 use crate::grid::{LEAF_VOXELS, SparseGrid};
 use crate::implicit::Coordinates;
-use crate::io::vdb::{Compression, MetaValue, read_vdb_grid, write_vdb, write_vdb_as};
+use crate::io::vdb::{Compression, MetaValue, read_vdb_solid, write_vdb, write_vdb_as};
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::BooleanOp;
 use crate::pipeline::request::{
@@ -1062,7 +1062,7 @@ pub extern "C" fn vk_grid_read_vdb(
             Some(c_str(name, "name")?)
         };
         let path = PathBuf::from(c_str(path, "path")?);
-        let grid = read_vdb_grid(&path, name)?;
+        let grid = read_vdb_solid(&path, name)?;
         let metadata = vec![("source_file".to_string(), path.display().to_string().into())];
         hand_out(VkGrid { grid, metadata }, Kind::Grid, out)
     })

@@ -2,8 +2,9 @@
 //! voxel), every voxel within band - 1 of the surface is active, the interior (inactive
 //! voxels and tiles included) is negative, and OpenVDB's own `levelSetVolume` of the file
 //! agrees with the mesh's volume. The sign is checked against the winding number, which is
-//! independent of the ray parity the level set uses. Open meshes: `--sdf` is refused, `--udf`
-//! writes unsigned distances.
+//! independent of the ray parity the level set uses here. Open meshes: `--sdf` signs them by
+//! the winding number (tests/winding_inside.rs), `--inside parity` refuses them, `--udf` writes
+//! unsigned distances.
 #![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 use glam::DVec3;
@@ -16,6 +17,7 @@ use voxelkit::io::vdb::read_vdb_grid;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
 use voxelkit::progress::Progress;
 use voxelkit::random::SplitMix64;
+use voxelkit::solids::inside_rule::Inside;
 use voxelkit::solids::level_set::level_set;
 
 const BAND: f64 = 3.0;
@@ -88,7 +90,9 @@ fn winding(mesh: &Mesh, p: DVec3) -> f64 {
 fn check(name: &str, mesh: &Mesh, resolution: u32) {
     let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
     let h = t.voxel_size;
-    let grid = level_set(mesh, t, BAND, &Progress::none()).unwrap().band;
+    let grid = level_set(mesh, t, BAND, &Inside::Parity, &Progress::none())
+        .unwrap()
+        .band;
     let active: Vec<([i64; 3], f32)> = grid
         .leaves()
         .iter()
@@ -219,7 +223,7 @@ fn openvdb_reads_a_negative_interior_and_measures_the_volume() {
 }
 
 #[test]
-fn open_meshes_get_unsigned_distances_not_a_level_set() {
+fn open_meshes_are_signed_by_winding_refused_by_parity_and_unsigned_by_udf() {
     let dir = tempfile::tempdir().unwrap();
     let open = dir.path().join("open.obj");
     let mut cube = generate::cuboid(DVec3::splat(-1.0), DVec3::splat(1.0));
@@ -227,10 +231,22 @@ fn open_meshes_get_unsigned_distances_not_a_level_set() {
     cube.write_obj(&open).unwrap();
     let out = dir.path().join("open.vdb");
     let (o, v) = (open.to_str().unwrap(), out.to_str().unwrap());
-    let refused = voxelkit(&["mesh", o, "--sdf", "-r", "32", "-o", v]);
+    let refused = voxelkit(&[
+        "mesh", o, "--sdf", "--inside", "parity", "-r", "32", "-o", v,
+    ]);
     let msg = text(&refused);
-    assert!(!refused.status.success() && msg.contains("--udf"), "{msg}");
+    assert!(
+        !refused.status.success() && msg.contains("--udf") && msg.contains("--inside"),
+        "{msg}"
+    );
     assert!(!out.exists());
+    let signed = voxelkit(&["mesh", o, "--sdf", "-r", "32", "-o", v]);
+    let msg = text(&signed);
+    assert!(
+        signed.status.success() && msg.contains("inside: winding"),
+        "{msg}"
+    );
+    std::fs::remove_file(&out).unwrap();
     let unsigned = voxelkit(&["mesh", o, "--udf", "-r", "32", "-o", v]);
     assert!(unsigned.status.success(), "{}", text(&unsigned));
     let grid = read_vdb_grid(Path::new(&out), Some("distance")).unwrap();

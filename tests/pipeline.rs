@@ -123,6 +123,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
                 fill: Fill::Flood(FloodMethod::Spans),
                 density: 1.0,
                 topology: true,
+                inside: Default::default(),
             },
         ),
         (
@@ -132,6 +133,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
                 fill: Fill::DepthLayers(DepthLayerOptions::default()),
                 density: 1.0,
                 topology: true,
+                inside: Default::default(),
             },
         ),
         (
@@ -141,6 +143,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
                 fill: Fill::Beam(Default::default()),
                 density: 1.0,
                 topology: true,
+                inside: Default::default(),
             },
         ),
         (
@@ -149,6 +152,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
                 source: MeasureSource::Mesh(mesh()),
                 flood: FloodMethod::Spans,
                 density: 1.0,
+                inside: Default::default(),
             },
         ),
     ]
@@ -268,6 +272,7 @@ fn the_exterior_flood_stops_when_asked() {
                 source: MeasureSource::Mesh(mesh),
                 flood,
                 density: 1.0,
+                inside: voxelkit::solids::inside_rule::InsideRule::Parity,
             }
         } else {
             Task::Solid {
@@ -275,6 +280,7 @@ fn the_exterior_flood_stops_when_asked() {
                 fill: Fill::Flood(flood),
                 density: 1.0,
                 topology: true,
+                inside: voxelkit::solids::inside_rule::InsideRule::Parity,
             }
         };
         let result = Job::new(task, GridFit::Resolution(256)).run(&StopWhenPolled);

@@ -72,6 +72,7 @@ fn read_mesh(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), TestCaseError> 
                     fill: Fill::DepthLayers(Default::default()),
                     density: 1.0,
                     topology: true,
+                    inside: Default::default(),
                 },
             ] {
                 let _ = Job::new(task, GridFit::Resolution(12)).run(&Unobserved);

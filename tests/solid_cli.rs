@@ -187,8 +187,18 @@ fn depth_layer_solids_report_what_they_cannot_classify() {
         json_field(&boxed, "unclassified_voxels")
     );
 
-    // An open box: the flood refuses it, naming the file and an edge; depth layers report it.
-    let o = voxelkit(&["solid", &p("open.obj"), "-r", "32", "-o", &p("o.vdb")]);
+    // An open box: the flood by parity refuses it, naming the file and an edge; depth layers
+    // report it.
+    let o = voxelkit(&[
+        "solid",
+        &p("open.obj"),
+        "--inside",
+        "parity",
+        "-r",
+        "32",
+        "-o",
+        &p("o.vdb"),
+    ]);
     let msg = text(&o);
     assert!(!o.status.success() && msg.contains("open.obj") && msg.contains("boundary edge"));
     assert!(!dir.path().join("o.vdb").exists());

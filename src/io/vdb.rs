@@ -306,6 +306,18 @@ pub fn read_vdb_info(path: &Path) -> Result<Vec<GridInfo>> {
 /// `normal` and in the colour channel otherwise (`Cd`); tiles stay tiles (their values are
 /// not kept).
 pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
+    read_grid(path, name, false)
+}
+
+/// The solid a grid of a `.vdb` file stands for, as an operand of a Boolean: a level set's
+/// inside (the voxels of negative value, active or not, and its negative tiles: OpenVDB keeps
+/// a level set's interior as inactive tiles at minus the background), any other grid's active
+/// voxels. The grid is chosen as `read_vdb_grid` chooses it.
+pub fn read_vdb_solid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
+    read_grid(path, name, true)
+}
+
+fn read_grid(path: &Path, name: Option<&str>, solid: bool) -> Result<SparseGrid> {
     let file = open(path)?;
     let infos: Vec<GridInfo> = (0..file.grid_count())
         .map(|i| file.grid_info(i).map_err(|e| unreadable(path, e)))
@@ -352,6 +364,27 @@ pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
             info.active_voxels
         ),
     )?;
+    let level_set = solid && info.grid_class == "level set" && info.value_type == "float";
+    let transform = Transform::new(DVec3::from_array(info.origin), info.voxel_size[0]);
+    if level_set {
+        let tree = file.read_negative(index).map_err(|e| unreadable(path, e))?;
+        let leaves = tree
+            .leaves
+            .into_par_iter()
+            .filter_map(|read| {
+                let mut leaf = Leaf::new(read.origin.map(i64::from), Channels::NONE);
+                for (n, v) in read.values.iter().enumerate() {
+                    if *v < 0.0 {
+                        leaf.mask[n / 64] |= 1 << (n % 64);
+                    }
+                }
+                (!leaf.is_empty()).then_some(leaf)
+            })
+            .collect();
+        let mut grid = SparseGrid::from_leaves(transform, Channels::NONE, leaves);
+        fill_tiles(&mut grid, tree.tiles);
+        return Ok(grid);
+    }
     let tree = file.read_tree(index).map_err(|e| unreadable(path, e))?;
     let vectors = info.value_type == "vec3s";
     let channels = Channels {
@@ -376,14 +409,18 @@ pub fn read_vdb_grid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
             leaf
         })
         .collect();
-    let transform = Transform::new(DVec3::from_array(info.origin), info.voxel_size[0]);
     let mut grid = SparseGrid::from_leaves(transform, channels, leaves);
-    for (origin, edge) in tree.tiles {
+    fill_tiles(&mut grid, tree.tiles);
+    Ok(grid)
+}
+
+/// Fills the tiles read (origin, edge 8 or 128) into `grid`.
+fn fill_tiles(grid: &mut SparseGrid, tiles: Vec<([i32; 3], i32)>) {
+    for (origin, edge) in tiles {
         let origin = origin.map(i64::from);
         match edge {
             8 => grid.fill_leaf_block(origin),
             _ => grid.fill_node_block(origin),
         }
     }
-    Ok(grid)
 }

@@ -10,7 +10,6 @@ use super::vdb_format::{
     CHILD_LOG2, COMPRESS_ACTIVE_MASK, NAME_SUFFIX_MARK, NODE_LOG2, ROOT_TILE, VdbFault, value_type,
 };
 use super::vdb_tree_structure::{LeafKind, TreeFormat};
-use crate::grid::LEAF_VOXELS;
 use rayon::prelude::*;
 
 type Parsed<T> = std::result::Result<T, VdbFault>;
@@ -231,6 +230,7 @@ impl VdbFile {
             owner_header.tree,
             format,
             owner_header.compression,
+            false,
         )?;
         let mut active = 0u64;
         let mut tile_count = 0u64;
@@ -292,6 +292,16 @@ impl VdbFile {
     /// The active voxels of grid `index` (bool, mask, float or vec3s): its leaves with
     /// active voxels, with their values for float and vector grids, and its active tiles.
     pub fn read_tree(&self, index: usize) -> Parsed<TreeRead> {
+        self.read_tree_of(index, false)
+    }
+
+    /// A float grid's negative voxels, as a level set's inside: every leaf with its values
+    /// (inactive voxels included), and as tiles the tiles of negative value, active or not.
+    pub fn read_negative(&self, index: usize) -> Parsed<TreeRead> {
+        self.read_tree_of(index, true)
+    }
+
+    fn read_tree_of(&self, index: usize, negative: bool) -> Parsed<TreeRead> {
         let owner = self.tree_owner(index)?;
         let header = self.header(owner)?;
         let format = TreeFormat::of(&owner.type_name).map_err(VdbFault::TreeType)?;
@@ -307,7 +317,14 @@ impl VdbFile {
                 });
             }
         };
-        let topology = read_topology(&self.data, header.tree, format, header.compression)?;
+        let negative = negative && components == 1;
+        let topology = read_topology(
+            &self.data,
+            header.tree,
+            format,
+            header.compression,
+            negative,
+        )?;
         if components == 0 {
             let leaves = topology
                 .leaves
@@ -336,7 +353,7 @@ impl VdbFile {
             .leaves
             .into_par_iter()
             .zip(starts)
-            .filter(|(l, _)| l.mask != [0; 8])
+            .filter(|(l, _)| negative || l.mask != [0; 8])
             .map(|(l, start)| {
                 let mut c = Cursor::at(&self.data, start);
                 let values =
@@ -350,7 +367,11 @@ impl VdbFile {
             .collect::<Parsed<Vec<_>>>()?;
         Ok(TreeRead {
             leaves,
-            tiles: topology.tiles,
+            tiles: if negative {
+                topology.negative_tiles
+            } else {
+                topology.tiles
+            },
         })
     }
 }
@@ -490,10 +511,19 @@ struct Topology {
     /// Leaves in the order of their buffers: root children by origin, below them by position.
     leaves: Vec<LeafTopology>,
     tiles: Vec<([i32; 3], i32)>,
+    /// Tiles, active or not, whose value is negative (float trees read with `tile_values`).
+    negative_tiles: Vec<([i32; 3], i32)>,
 }
 
-/// The root's tiles and children, down to the leaves' masks.
-fn read_topology(data: &[u8], at: usize, format: TreeFormat, compression: u32) -> Parsed<Topology> {
+/// The root's tiles and children, down to the leaves' masks; with `tile_values` (float trees)
+/// the tiles' values are decoded too, for the negative ones.
+fn read_topology(
+    data: &[u8],
+    at: usize,
+    format: TreeFormat,
+    compression: u32,
+    tile_values: bool,
+) -> Parsed<Topology> {
     let mut c = Cursor::at(data, at);
     if c.u32()? != 1 {
         return Err(VdbFault::Buffers);
@@ -501,14 +531,23 @@ fn read_topology(data: &[u8], at: usize, format: TreeFormat, compression: u32) -
     let background = c.take(format.value as usize)?.to_vec();
     let (tile_count, child_count) = (c.u32()?, c.u32()?);
     let mut tiles = Vec::new();
+    let mut negative_tiles = Vec::new();
     for _ in 0..tile_count {
         let origin = [c.i32()?, c.i32()?, c.i32()?];
-        c.take(format.value as usize)?;
-        if c.array::<1>()?[0] != 0 {
-            for x in (0..ROOT_TILE).step_by(128) {
-                for y in (0..ROOT_TILE).step_by(128) {
-                    for z in (0..ROOT_TILE).step_by(128) {
-                        tiles.push(([origin[0] + x, origin[1] + y, origin[2] + z], 128));
+        let value = c.take(format.value as usize)?;
+        let negative = tile_values
+            && value.len() == 4
+            && f32::from_le_bytes(value.try_into().expect("4 bytes")) < 0.0;
+        let active = c.array::<1>()?[0] != 0;
+        for x in (0..ROOT_TILE).step_by(128) {
+            for y in (0..ROOT_TILE).step_by(128) {
+                for z in (0..ROOT_TILE).step_by(128) {
+                    let node = ([origin[0] + x, origin[1] + y, origin[2] + z], 128);
+                    if active {
+                        tiles.push(node);
+                    }
+                    if negative {
+                        negative_tiles.push(node);
                     }
                 }
             }
@@ -518,15 +557,15 @@ fn read_topology(data: &[u8], at: usize, format: TreeFormat, compression: u32) -
     for _ in 0..child_count {
         let origin = [c.i32()?, c.i32()?, c.i32()?];
         let mut leaves = Vec::new();
-        internal_node(
-            &mut c,
+        let mut node = Node {
             format,
             compression,
-            0,
-            origin,
-            &mut leaves,
-            &mut tiles,
-        )?;
+            background: tile_values.then_some(&background[..]),
+            leaves: &mut leaves,
+            tiles: &mut tiles,
+            negative_tiles: &mut negative_tiles,
+        };
+        node.read(&mut c, 0, origin)?;
         children.push((origin, leaves));
     }
     children.sort_by_key(|(origin, _)| *origin);
@@ -534,6 +573,7 @@ fn read_topology(data: &[u8], at: usize, format: TreeFormat, compression: u32) -
         background,
         leaves: children.into_iter().flat_map(|(_, l)| l).collect(),
         tiles,
+        negative_tiles,
     })
 }
 
@@ -545,52 +585,71 @@ fn slot_origin(origin: [i32; 3], depth: usize, n: usize) -> [i32; 3] {
     std::array::from_fn(|a| origin[a] + ((offsets[a] as i32) << CHILD_LOG2[depth]))
 }
 
-fn internal_node(
-    c: &mut Cursor,
+/// What reading the internal nodes collects.
+struct Node<'a> {
     format: TreeFormat,
     compression: u32,
-    depth: usize,
-    origin: [i32; 3],
-    leaves: &mut Vec<LeafTopology>,
-    tiles: &mut Vec<([i32; 3], i32)>,
-) -> Parsed<()> {
-    let words = (1usize << (3 * NODE_LOG2[depth])) / 64;
-    let child_mask = c.mask(words)?;
-    let value_mask = c.mask(words)?;
-    skip_compressed_values(c, format, compression, &value_mask)?;
-    let slots = |mask: &[u64]| -> Vec<usize> {
-        let mut out = Vec::new();
-        for (w, &word) in mask.iter().enumerate() {
-            let mut bits = word;
-            while bits != 0 {
-                out.push(64 * w + bits.trailing_zeros() as usize);
-                bits &= bits - 1;
+    /// The background, where the tiles' values are decoded.
+    background: Option<&'a [u8]>,
+    leaves: &'a mut Vec<LeafTopology>,
+    tiles: &'a mut Vec<([i32; 3], i32)>,
+    negative_tiles: &'a mut Vec<([i32; 3], i32)>,
+}
+
+impl Node<'_> {
+    fn read(&mut self, c: &mut Cursor, depth: usize, origin: [i32; 3]) -> Parsed<()> {
+        let words = (1usize << (3 * NODE_LOG2[depth])) / 64;
+        let child_mask = c.mask(words)?;
+        let value_mask = c.mask(words)?;
+        let tile_edge = 1 << CHILD_LOG2[depth];
+        match self.background {
+            Some(background) => {
+                let values =
+                    node_values(c, self.format, self.compression, 1, background, &value_mask)?;
+                for (n, v) in values.iter().enumerate() {
+                    if *v < 0.0 && child_mask[n / 64] >> (n % 64) & 1 == 0 {
+                        self.negative_tiles
+                            .push((slot_origin(origin, depth, n), tile_edge));
+                    }
+                }
+            }
+            None => skip_compressed_values(c, self.format, self.compression, &value_mask)?,
+        }
+        let tile_slots: Vec<u64> = value_mask
+            .iter()
+            .zip(&child_mask)
+            .map(|(v, ch)| v & !ch)
+            .collect();
+        for n in set_bits(&tile_slots) {
+            self.tiles.push((slot_origin(origin, depth, n), tile_edge));
+        }
+        for n in set_bits(&child_mask) {
+            let child = slot_origin(origin, depth, n);
+            if depth + 1 == NODE_LOG2.len() {
+                let mask: [u64; 8] = c.mask(8)?.try_into().expect("8 words");
+                self.leaves.push(LeafTopology {
+                    origin: child,
+                    mask,
+                });
+            } else {
+                self.read(c, depth + 1, child)?;
             }
         }
-        out
-    };
-    let tile_edge = 1 << CHILD_LOG2[depth];
-    let tile_slots: Vec<u64> = value_mask
-        .iter()
-        .zip(&child_mask)
-        .map(|(v, ch)| v & !ch)
-        .collect();
-    for n in slots(&tile_slots) {
-        tiles.push((slot_origin(origin, depth, n), tile_edge));
+        Ok(())
     }
-    for n in slots(&child_mask) {
-        let child = slot_origin(origin, depth, n);
-        if depth + 1 == NODE_LOG2.len() {
-            let mask: [u64; 8] = c.mask(8)?.try_into().expect("8 words");
-            leaves.push(LeafTopology {
-                origin: child,
-                mask,
-            });
-        } else {
-            internal_node(c, format, compression, depth + 1, child, leaves, tiles)?;
+}
+
+/// The numbers of the set bits of `mask`, ascending.
+fn set_bits(mask: &[u64]) -> Vec<usize> {
+    let mut out = Vec::new();
+    for (w, &word) in mask.iter().enumerate() {
+        let mut bits = word;
+        while bits != 0 {
+            out.push(64 * w + bits.trailing_zeros() as usize);
+            bits &= bits - 1;
         }
     }
-    Ok(())
+    out
 }
 
 /// The flag before a node's values, and what it implies: how many inactive values follow
@@ -664,6 +723,20 @@ fn leaf_values(
     background: &[u8],
 ) -> Parsed<Vec<f32>> {
     let mask = c.mask(8)?;
+    node_values(c, format, compression, components, background, &mask)
+}
+
+/// A node's values, one per bit of its value mask `mask` (`components` floats each), inactive
+/// ones included: OpenVDB writes a leaf's and an internal node's alike.
+fn node_values(
+    c: &mut Cursor,
+    format: TreeFormat,
+    compression: u32,
+    components: usize,
+    background: &[u8],
+    mask: &[u64],
+) -> Parsed<Vec<f32>> {
+    let slots = 64 * mask.len();
     let (flag, inactive, selection) = value_flag(c)?;
     let full = |bytes: &[u8]| -> Vec<f32> {
         bytes
@@ -682,17 +755,22 @@ fn leaf_values(
     if inactive == 2 {
         second = full(c.take(4 * components)?);
     }
-    let selected = if selection { c.mask(8)? } else { vec![0; 8] };
-    let count = stored_count(compression, flag, &mask);
+    let selected = if selection {
+        c.mask(mask.len())?
+    } else {
+        vec![0; mask.len()]
+    };
+    let count = stored_count(compression, flag, mask);
     let stored = if format.half && count == 0 {
         Vec::new()
     } else {
-        let (bytes, _) = read_chunk(
+        let (bytes, used) = read_chunk(
             &c.data[c.pos..],
             count * format.stored as usize,
             compression,
         )
         .map_err(VdbFault::Chunk)?;
+        c.pos += used;
         if format.half {
             bytes
                 .chunks_exact(2)
@@ -702,14 +780,14 @@ fn leaf_values(
             full(&bytes)
         }
     };
-    if count == LEAF_VOXELS {
+    if count == slots {
         return Ok(stored);
     }
     let bit = |m: &[u64], n: usize| m[n >> 6] >> (n & 63) & 1 != 0;
-    let mut values = Vec::with_capacity(LEAF_VOXELS * components);
+    let mut values = Vec::with_capacity(slots * components);
     let mut next = stored.chunks_exact(components);
-    for n in 0..LEAF_VOXELS {
-        let value = if bit(&mask, n) {
+    for n in 0..slots {
+        let value = if bit(mask, n) {
             next.next().ok_or(VdbFault::ShortLeaf)?
         } else if bit(&selected, n) {
             &second[..]

@@ -475,16 +475,26 @@ mod tests {
         );
         let mut rng = crate::random::SplitMix64(3);
         for _ in 0..300 {
-            let p = DVec3::new(rng.range(-1.6, 1.6), rng.range(-1.6, 1.6), rng.range(-0.6, 0.6));
+            let p = DVec3::new(
+                rng.range(-1.6, 1.6),
+                rng.range(-1.6, 1.6),
+                rng.range(-0.6, 0.6),
+            );
             let b = tree.bounds(p);
             let exact = winding_number(&holed, p);
-            assert!(b.low() - 1e-12 <= exact && exact <= b.high() + 1e-12, "{b:?} {exact}");
+            assert!(
+                b.low() - 1e-12 <= exact && exact <= b.high() + 1e-12,
+                "{b:?} {exact}"
+            );
             // The change to a point 0.02 away, where no face passes between them.
             let q = p + DVec3::new(0.02, -0.01, 0.01);
             let jump = winding_number(&holed, q) - exact;
             let bound = 0.03 * rim.gradient(p, 0.03);
             if jump.abs() < 0.5 {
-                assert!(jump.abs() <= bound + 1e-12, "changed {jump} where the rim allows {bound}");
+                assert!(
+                    jump.abs() <= bound + 1e-12,
+                    "changed {jump} where the rim allows {bound}"
+                );
             }
         }
     }

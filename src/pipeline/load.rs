@@ -9,7 +9,7 @@ use super::{
 use crate::error::{Error, Result};
 use crate::grid::SparseGrid;
 use crate::implicit::Formula;
-use crate::io::vdb::read_vdb_grid;
+use crate::io::vdb::{read_vdb_grid, read_vdb_solid};
 use crate::mesh::{Mesh, UpAxis};
 use crate::ops::csg::BooleanOp;
 use crate::solids::csg_tree::{CsgTree, parse_csg_tree, read_csg_tree};
@@ -218,8 +218,11 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
             resample,
             curve,
         } => {
+            // Operands of a Boolean are solids: a level set stands for its inside. The curve of
+            // two surfaces takes their voxels as they are.
             let read = |g: &GridSource| match g {
-                GridSource::File(path) => read_vdb_grid(path, grid.as_deref()),
+                GridSource::File(path) if *curve => read_vdb_grid(path, grid.as_deref()),
+                GridSource::File(path) => read_vdb_solid(path, grid.as_deref()),
                 GridSource::Grid(g) => Ok(g.clone()),
             };
             Work::Combine {

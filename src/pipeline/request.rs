@@ -342,7 +342,8 @@ request! {
     SolidRequest as "solid" fitted {
         /// flood, depth-layers or beam.
         method: FillKind = FillKind::Flood,
-        /// The exterior flood: blocks (fastest), spans, or xyz (Lai & Cheng's FloodingXYZ).
+        /// The exterior flood of inside parity: blocks (fastest), spans, or xyz (Lai & Cheng's
+        /// FloodingXYZ).
         flood: FloodKind = FloodKind::default(),
         /// GRAYSTACK capacity of the xyz flood (entries; when full, sweeps resume the flood).
         graystack: usize = DEFAULT_GRAYSTACK,
@@ -374,7 +375,8 @@ request! {
     /// Volume, mass, area, components and genus of a closed mesh (its flooded 26-separating
     /// surface) or of a closed voxel surface.
     MeasureRequest as "measure" fitted {
-        /// The exterior flood: blocks (fastest), spans, or xyz (Lai & Cheng's FloodingXYZ).
+        /// The exterior flood of inside parity: blocks (fastest), spans, or xyz (Lai & Cheng's
+        /// FloodingXYZ).
         flood: FloodKind = FloodKind::default(),
         /// GRAYSTACK capacity of the xyz flood (entries; when full, sweeps resume the flood).
         graystack: usize = DEFAULT_GRAYSTACK,

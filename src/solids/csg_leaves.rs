@@ -1,7 +1,8 @@
 //! The leaves of a CSG tree as solids over one dense volume, each voxel classified by its
 //! centre: boxes, cylinders and spheres exactly; formulas by the sign of F (inside where
-//! F < 0); closed meshes by depth layers (exact ray parity at the centres); voxel grids from
-//! .vdb files as they are, resampled when their transform differs.
+//! F < 0); meshes by their inside rule (`inside_rule`: the winding number, or for
+//! inconsistently oriented closed meshes depth layers, exact ray parity at the centres); voxel
+//! grids from .vdb files as they are, resampled when their transform differs.
 
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
@@ -12,6 +13,8 @@ use crate::ops::flood_xyz::DEFAULT_GRAYSTACK;
 use crate::progress::Progress;
 use crate::shapes::{Cuboid, Cylinder, Sphere};
 use crate::solids::depth_layers::{DepthLayerOptions, Layers, depth_layer_solid};
+use crate::solids::inside_rule::{Inside, InsideRule, choose_inside};
+use crate::solids::winding_inside::winding_inside;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -127,14 +130,24 @@ pub const ALL_DIRECTIONS: DepthLayerOptions = DepthLayerOptions {
     unclassified: crate::solids::depth_layers::Unclassified::NoDirection,
 };
 
-/// A closed mesh by depth layers; voxels they cannot decide are an error naming the mesh.
+/// A mesh's centres inside it by the automatic inside rule: its winding number, or where its
+/// orientation is inconsistent, depth layers (voxels they cannot decide are an error naming
+/// the mesh).
 pub fn mesh_solid(
     mesh: &Mesh,
     transform: &Transform,
     bbox: CoordBox,
     options: &DepthLayerOptions,
 ) -> Result<DenseMask> {
-    mesh.require_closed("a solid must be closed")?;
+    let choice = choose_inside(InsideRule::Auto, mesh, "a CSG mesh leaf needs an inside")?;
+    if let Inside::Winding(caps) = &choice.inside {
+        let mut inside = DenseMask::new(bbox)?;
+        if let Some(region) = index_box(&mesh.bbox(), transform).intersection(&bbox) {
+            let grid = winding_inside(mesh, caps, *transform, region)?.grid(*transform);
+            inside = DenseMask::from_grid(&grid, bbox)?;
+        }
+        return Ok(inside);
+    }
     let s = depth_layer_solid(mesh, transform, bbox, options, &Progress::none())?;
     if s.stats.unclassified_voxels > 0 {
         return Err(Error::InvalidArgument(format!(

@@ -1,5 +1,6 @@
 //! CSG trees read from a small JSON file (Lai & Cheng §7.3 on whole trees): Booleans over
-//! boxes, cylinders, spheres, formulas, closed meshes, Catmull-Clark solids and .vdb grids,
+//! boxes, cylinders, spheres, formulas, meshes (open ones too: their inside by the winding
+//! number), Catmull-Clark solids and .vdb grids,
 //! evaluated on one grid.
 //!
 //! ```json
@@ -16,7 +17,9 @@
 //!
 //! Every node is an object with one key, its kind (serde's externally tagged enum): `union`,
 //! `intersection` and `difference` hold lists of nodes; `formula` holds the text, or an
-//! object with `text`, `coordinates` and `bounds`; `vdb` a file name, or `file` and `grid`;
+//! object with `text`, `coordinates` and `bounds`; `vdb` a file name, or `file` and `grid`
+//! (a level set stands for its inside, negative values and tiles; other grids for their active
+//! voxels);
 //! `subdiv` a closed Catmull-Clark control mesh, whose solid is its voxelized limit surface
 //! and the inside flooded from seeds (`solids::subdivision`).
 //! `union` and `intersection` take any number of operands, `difference` removes all later
@@ -32,7 +35,7 @@ use super::csg_leaves::{
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
 use crate::implicit::{Coordinates, Formula};
-use crate::io::vdb::read_vdb_grid;
+use crate::io::vdb::read_vdb_solid;
 use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
 use crate::ops::csg::BooleanOp;
 use crate::shapes::{Cuboid, Cylinder, Sphere};
@@ -345,7 +348,7 @@ impl Reader<'_> {
                     VdbSpec::Full { file, grid } => (file, grid),
                 };
                 let source = self.folder.join(file);
-                let grid = read_vdb_grid(&source, name.as_deref())
+                let grid = read_vdb_solid(&source, name.as_deref())
                     .map_err(|e| self.error(&format!("{at}.vdb"), &e.to_string()))?;
                 Ok(CsgNode::Grid { grid, source })
             }

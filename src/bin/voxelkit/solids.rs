@@ -14,8 +14,9 @@ use voxelkit::solids::inside_rule::InsideRule;
 /// How the exterior is flooded.
 #[derive(Args, Clone, Copy)]
 pub struct FloodArgs {
-    /// The exterior flood: blocks (whole empty 8^3 blocks at once, fastest), spans (scanlines
-    /// over a dense bit volume) or xyz (Lai & Cheng's FloodingXYZ with a GRAYSTACK).
+    /// The exterior flood of --inside parity: blocks (whole empty 8^3 blocks at once,
+    /// fastest), spans (scanlines over a dense bit volume) or xyz (Lai & Cheng's FloodingXYZ
+    /// with a GRAYSTACK).
     #[arg(long, default_value_t = SolidRequest::default().flood, value_parser = parse_flood)]
     flood: FloodKind,
     /// GRAYSTACK capacity for --flood xyz (entries; when full, sweeps resume the flood).
