@@ -132,8 +132,18 @@ fn estimates_are_within_30_percent_of_the_peak() {
             .to_string()
     };
     for (command, name, resolution, extra) in [
-        ("solid", "bunny-closed", "1024", &["--flood", "spans"][..]),
-        ("solid", "armadillo", "512", &["--flood", "xyz"][..]),
+        (
+            "solid",
+            "bunny-closed",
+            "1024",
+            &["--inside", "parity", "--flood", "spans"][..],
+        ),
+        (
+            "solid",
+            "armadillo",
+            "512",
+            &["--inside", "parity", "--flood", "xyz"][..],
+        ),
         ("solid", "igea", "1024", &["--method", "beam"][..]),
         ("solid", "horse", "1024", &["--method", "depth-layers"][..]),
         ("lines", "cow", "2048", &[][..]),

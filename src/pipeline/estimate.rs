@@ -22,6 +22,7 @@ use crate::ops::flood::padded;
 use crate::solids::cavities::cavity_bytes;
 use crate::solids::csg_tree::CsgNode;
 use crate::solids::exterior_flood::FloodMethod;
+use crate::solids::inside_rule::InsideRule;
 use crate::subd::ControlMesh;
 use crate::voxelize::projective::{self, Coloring};
 use crate::voxelize::separating;
@@ -549,11 +550,25 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
             let items = crate::voxelize::interval_octree::progress_total(&options);
             plan_of(t, &bbox, bytes, items)
         }
-        Work::Solid { mesh, fill, .. } => solid_plan(mesh, fit, *fill)?,
+        Work::Solid {
+            mesh, fill, inside, ..
+        } => match fill {
+            // The winding number decides without a flood.
+            Fill::Flood(_) if *inside != InsideRule::Parity => {
+                winding_plan(mesh, fit, &BLOCK_FLOOD_COST)?
+            }
+            _ => solid_plan(mesh, fit, *fill)?,
+        },
         // Measuring a mesh fills its flooded surface.
-        Work::MeasureMesh { mesh, flood, .. } => {
-            flood_plan(mesh, fit, flood_cost(*flood, &MEASURE_COST))?
-        }
+        Work::MeasureMesh {
+            mesh,
+            flood,
+            inside,
+            ..
+        } => match inside {
+            InsideRule::Parity => flood_plan(mesh, fit, flood_cost(*flood, &MEASURE_COST))?,
+            _ => winding_plan(mesh, fit, &MEASURE_COST)?,
+        },
         Work::MeasureSurface { surface, .. } => grid_plan(surface, what)?,
         Work::CsgTree(tree) => {
             let (t, bounds) = tree.transform()?;
@@ -599,6 +614,30 @@ fn solid_plan(mesh: &Mesh, fit: GridFit, fill: Fill) -> Result<Plan> {
         }),
         Fill::Beam(_) => fill_plan(mesh, fit, &BEAM_COST, |m, _| m.face_count() as u64),
     }
+}
+
+/// The winding number's inside gathers every crossing of a column's ray with the mesh and its
+/// caps (16 bytes each, gathered in batches that grow as they fill): 36 bytes a crossing at
+/// the peak beside the surface and the solid's grids. Estimate/peak 0.87-1.21 on bunny-closed,
+/// igea, armadillo, skull, horse, spot, scorpion, fandisk and rocker-arm at 1024.
+const WINDING_CROSSING_BYTES: f64 = 36.0;
+
+/// A solid or a measure at `cost` (its grids, no flood) whose inside the winding number
+/// decides: the crossings added.
+fn winding_plan(mesh: &Mesh, fit: GridFit, cost: &FillCost) -> Result<Plan> {
+    let mut plan = fill_plan(mesh, fit, cost, |m, _| separating::work_items(m))?;
+    let h2 = plan.transform.voxel_size.powi(2);
+    // A ray along z crosses a triangle where its projection covers the ray's column.
+    let crossings: f64 = mesh
+        .triangles()
+        .map(|(_, [a, b, c])| {
+            let (a, b, c) = (mesh.p(a), mesh.p(b), mesh.p(c));
+            0.5 * ((b - a).truncate().perp_dot((c - a).truncate())).abs() / h2
+        })
+        .sum();
+    let bytes = crossings * WINDING_CROSSING_BYTES;
+    plan.estimated_bytes = plan.estimated_bytes.saturating_add(bytes as u64);
+    Ok(plan)
 }
 
 /// The cost of a flood: `blocks` for the block flood (writing a solid or measuring it), the
