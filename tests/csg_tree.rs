@@ -121,8 +121,10 @@ fn trees_over_meshes_and_grids_obey_the_boolean_counts() {
 fn bad_trees_are_refused_naming_the_file_and_the_node() {
     let dir = tempfile::tempdir().unwrap();
     let path = |n: &str| dir.path().join(n);
+    // Open, and one face turned against the rest: neither inside rule applies.
     let mut open = generate::cuboid(DVec3::splat(-1.0), DVec3::splat(1.0));
     open.face_starts.pop();
+    open.indices[0..4].reverse();
     open.write_obj(&path("open.obj")).unwrap();
     let cases = [
         ("syntax.json", "{ \"tree\": \n { \"box\": ", "syntax.json:2"),

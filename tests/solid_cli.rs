@@ -26,6 +26,8 @@ fn solid_measure_csg_and_intersect() {
         &p("torus.obj"),
         "-r",
         "96",
+        "--inside",
+        "parity",
         "--flood",
         "xyz",
         "--graystack",

@@ -14,6 +14,7 @@ use voxelkit::pipeline::request::{MeasureRequest, MeshRequest, Request, SolidReq
 use voxelkit::pipeline::{Details, MeasureSource, MeshSource, Outcome};
 use voxelkit::progress::Progress;
 use voxelkit::progress::Unobserved;
+use voxelkit::solids::csg_leaves;
 use voxelkit::solids::exterior_flood::FloodMethod;
 use voxelkit::solids::flooded_mesh::flooded_mesh;
 use voxelkit::solids::inside_rule::{Inside, InsideRule, choose_inside};
@@ -217,6 +218,21 @@ fn solids_level_sets_and_measures_agree_with_the_exact_winding_number() {
             })
         };
         agrees("--sdf", mesh, band, negative, *limit);
+
+        // A CSG tree's mesh leaf: the centres inside, on the solid's grid.
+        let t = solid.grid.transform;
+        let bbox = voxelkit::grid::CoordBox {
+            min: solid.grid.bbox().unwrap().min.map(|v| v - 2),
+            max: solid.grid.bbox().unwrap().max.map(|v| v + 2),
+        };
+        let leaf = csg_leaves::mesh_solid(mesh, &t, bbox, &csg_leaves::ALL_DIRECTIONS).unwrap();
+        agrees(
+            "a CSG mesh leaf",
+            mesh,
+            &solid.grid,
+            |c| Some(leaf.get(c)),
+            *limit,
+        );
 
         let measure = run_measure(mesh, *r);
         let Details::Solid(m) = &measure.report.details else {

@@ -176,6 +176,30 @@ def test_csg_from_a_dict_and_combine(tmp_path):
     assert r["volume_inside"] < 1 / 6 < r["volume_with_surface"]
 
 
+def test_an_openvdb_level_set_operand_means_its_inside(tmp_path, pyopenvdb):
+    """A level set OpenVDB wrote, subtracted from a solid, removes its whole inside: every
+    voxel OpenVDB holds negative, its interior tiles included."""
+    sphere = pyopenvdb.createLevelSetSphere(radius=0.5, center=(0, 0, 0), voxelSize=0.02, halfWidth=3.0)
+    path = tmp_path / "sphere.vdb"
+    pyopenvdb.write(str(path), grids=[sphere])
+    negative = sum(
+        (it.max[0] - it.min[0] + 1) * (it.max[1] - it.min[1] + 1) * (it.max[2] - it.min[2] + 1)
+        for it in sphere.citerAllValues()
+        if it.value < 0
+    )
+    h = sphere.transform.voxelSize()[0]
+    box = voxelkit.csg({"voxel_size": h, "tree": {"box": {"min": [-50.5 * h] * 3, "max": [50.5 * h] * 3}}})
+    cut = voxelkit.combine(box, path, op="difference", resample=True)
+    assert len(box) - len(cut) == negative
+
+
+def test_open_meshes_are_filled_by_their_winding_number(data):
+    scan = voxelkit.solid(data / "meshes" / "stanford-bunny.obj", resolution=64)
+    assert "winding" in scan.report["inside_rule"]
+    with pytest.raises(ValueError, match="open"):
+        voxelkit.solid(data / "meshes" / "stanford-bunny.obj", resolution=64, inside="parity")
+
+
 def test_errors_are_python_exceptions(tmp_path):
     v, f = tetrahedron()
     with pytest.raises(FileNotFoundError, match="nothing.obj"):

@@ -22,7 +22,7 @@ use rayon::prelude::*;
 
 /// Why a signed distance by parity needs a closed mesh, for the error that refuses an open one.
 pub const SIGN_NEEDS_CLOSED: &str = "ray parity needs a closed mesh to sign distances (option \
-     `inside` winding signs them by the winding number; `udf` writes unsigned distances)";
+     `inside` winding signs them by the winding number; option `udf` writes unsigned distances)";
 
 /// A narrow-band level set and the inside it bounds.
 pub struct LevelSet {
