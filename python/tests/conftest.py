@@ -57,13 +57,13 @@ def pyopenvdb():
 
 
 def closed_meshes(data):
-    """The shared meshes a solid can be made of (the flood refuses open ones)."""
+    """The shared meshes the exterior flood can fill (inside="parity": it refuses open ones)."""
     import voxelkit
 
     closed = []
     for path in sorted((data / "meshes").glob("*.obj")):
         try:
-            voxelkit.solid(path, resolution=8)
+            voxelkit.solid(path, resolution=8, inside="parity")
         except ValueError as e:
             assert "open" in str(e) or "boundary" in str(e), e
             continue

@@ -219,7 +219,7 @@ def test_errors_are_python_exceptions(tmp_path):
     with pytest.raises(ValueError, match="separability"):
         voxelkit.mesh((v, f), separability=7)
     with pytest.raises(ValueError, match="open"):
-        voxelkit.solid((v, f[:3]))
+        voxelkit.solid((v, f[:3]), inside="parity")
     with pytest.raises(ValueError, match="not both"):
         voxelkit.mesh((v, f), resolution=8, voxel_size=0.1)
     source = tmp_path / "in.obj"
