@@ -628,7 +628,15 @@ impl PlannedJob {
                 density,
                 topology,
                 inside,
-            } => solid::mesh_solid(mesh, t, *fill, *density, *topology, *inside, fit, progress),
+            } => {
+                let asked = solid::SolidAsked {
+                    fill: *fill,
+                    density: *density,
+                    topology: *topology,
+                    inside: *inside,
+                };
+                solid::mesh_solid(mesh, t, asked, fit, progress)
+            }
             Work::MeasureMesh {
                 mesh,
                 flood,

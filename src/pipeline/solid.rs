@@ -141,16 +141,27 @@ fn centre_solid(
         .with("interior", interior)
 }
 
+/// What a mesh's solid is asked for.
+pub(super) struct SolidAsked {
+    pub fill: Fill,
+    pub density: f64,
+    pub topology: bool,
+    pub inside: InsideRule,
+}
+
 pub(super) fn mesh_solid(
     mesh: &Mesh,
     t: Transform,
-    fill: Fill,
-    density: f64,
-    topology: bool,
-    inside: InsideRule,
+    asked: SolidAsked,
     fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
+    let SolidAsked {
+        fill,
+        density,
+        topology,
+        inside,
+    } = asked;
     let start = Instant::now();
     let source = mesh.source.display().to_string();
     let meta = |method: &str| provenance(method, &source, fit);

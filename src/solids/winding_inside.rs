@@ -108,10 +108,13 @@ pub fn winding_inside(
         .collect();
     // Each cap triangle is (centroid, rim vertex, rim vertex).
     let rim = RimBound::new(corners.iter().map(|&[_, a, b]| [a, b]).collect());
-    let tree =
-        WindingTree::of_triangles(corners.iter().flat_map(|&t| refined(t, CAP_EDGE)).collect());
+    let (tree, fans) = rayon::join(
+        || WindingTree::of_triangles(corners.iter().flat_map(|&t| refined(t, CAP_EDGE)).collect()),
+        || WindingTree::of_triangles(corners.clone()),
+    );
     let caps_winding = Caps {
         tree: &tree,
+        fans: &fans,
         triangles: &corners,
         rim: &rim,
         orientation,
@@ -200,29 +203,20 @@ fn refined(t: [DVec3; 3], longest: f64) -> Vec<[DVec3; 3]> {
 
 /// The caps' winding number, as the blocks are classified by it.
 struct Caps<'a> {
-    /// The caps cut small (`CAP_EDGE`): their tree bounds them and tells where they pass.
+    /// The caps cut small (`CAP_EDGE`): their clusters tell where the caps pass.
     tree: &'a WindingTree,
-    /// The caps as they close the mesh, for the exact sum.
+    /// The caps as they close the mesh, clustered: their winding number with its error.
+    fans: &'a WindingTree,
+    /// The same, for the exact sum where the error cannot tell.
     triangles: &'a [[DVec3; 3]],
     rim: &'a RimBound,
     orientation: i32,
 }
 
-/// Caps of up to this many triangles are summed exactly at every point asked: cheaper than
-/// the tree's query, whose near clusters are summed exactly anyway.
-const EXACT_CAPS: usize = 4096;
-
 impl Caps<'_> {
     /// The caps' winding number at `p` and its error.
     fn bounds(&self, p: DVec3) -> WindingBounds {
-        if self.triangles.len() <= EXACT_CAPS {
-            WindingBounds {
-                value: winding_number_of(self.triangles, p),
-                spread: 0.0,
-            }
-        } else {
-            self.tree.bounds(p)
-        }
+        self.fans.bounds(p)
     }
 
     /// The range of the caps' (oriented) winding number over the ball of radius `reach` around
@@ -280,13 +274,11 @@ fn classify(
     let half = (size - 1) as f64 / 2.0;
     let centre = DVec3::from_array(origin.map(|v| v as f64)) + half;
     let bounds = caps.range(centre, half * 3f64.sqrt());
-    if let Some((low, high)) = bounds {
-        if let Some(m) = threshold(low, high) {
-            if m != DEFAULT_THRESHOLD {
-                for_each_block(origin, size, |b| found.push((b, Block::Threshold(m))));
-            }
-            return;
+    if let Some(m) = bounds.and_then(|(low, high)| threshold(low, high)) {
+        if m != DEFAULT_THRESHOLD {
+            for_each_block(origin, size, |b| found.push((b, Block::Threshold(m))));
         }
+        return;
     }
     if size == 8 {
         let (low, high) = bounds.unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
