@@ -223,8 +223,12 @@ vk_status vk_voxelize_formula(const char *formula, vk_coordinates coordinates,
 
 /* ---- solids, Booleans, measures --------------------------------------------------------- */
 
-/* The solid of the closed `mesh` (surface and inside voxels) by the fill method of
- * `options`; `measures` may be NULL. Depth layers refuse voxels they cannot classify. */
+/* The solid of `mesh` (surface and inside voxels) by the fill method of `options`;
+ * `measures` may be NULL. The flood's inside follows the solid request's `inside` (set by
+ * vk_options_set(options, "solid", "inside", "\"parity\"")): by default the generalized
+ * winding number, so open, overlapping and hollow meshes fill too; VK_ERROR_BAD_MESH where the
+ * rule cannot apply (parity on an open mesh). Depth layers refuse voxels they cannot
+ * classify. */
 vk_status vk_fill_mesh(const vk_mesh *mesh, const vk_options *options, vk_grid **solid,
                        vk_measures *measures);
 
