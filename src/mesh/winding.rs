@@ -48,7 +48,7 @@ const FAR: f64 = 3.0;
 
 /// The far distance, in node radii, of the bounded queries: their error bound (below) falls with
 /// the fourth power of radius / distance and is under a hundredth of a turn per flat node here.
-const BOUNDED_FAR: f64 = 6.0;
+const BOUNDED_FAR: f64 = 4.0;
 
 /// The most the third derivatives of 1/r, times r^4, reach when taken along two equal unit
 /// directions and a third (u, u, n): sqrt(9 - 18a^2 + 45a^4) for a = cos(u, r), at most 6. The
