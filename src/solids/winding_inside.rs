@@ -43,10 +43,6 @@ pub struct WindingInside {
     pub ambiguous: SparseGrid,
     /// Whether the mesh was read reversed (its winding integrates negative).
     pub reversed: bool,
-    /// Centres whose caps' winding number was evaluated one by one, and of those, how many by
-    /// the exact sum.
-    pub evaluated: u64,
-    pub exact: u64,
 }
 
 impl WindingInside {
@@ -153,16 +149,12 @@ pub fn winding_inside(
         full_blocks: Vec::new(),
         ambiguous: SparseGrid::new(transform, Channels::NONE),
         reversed: orientation < 0,
-        evaluated: 0,
-        exact: 0,
     };
     let mut ambiguous = Vec::new();
     for part in parts {
         inside.leaves.extend(part.leaves);
         inside.full_blocks.extend(part.full_blocks);
         ambiguous.extend(part.ambiguous);
-        inside.evaluated += part.evaluated;
-        inside.exact += part.exact;
     }
     inside.ambiguous = SparseGrid::from_distinct_leaves(transform, Channels::NONE, ambiguous);
     Ok(inside)
@@ -316,8 +308,6 @@ struct BlockColumn {
     leaves: Vec<Leaf>,
     full_blocks: Vec<Coord>,
     ambiguous: Vec<Leaf>,
-    evaluated: u64,
-    exact: u64,
 }
 
 /// The stretches of one column between crossings: centres `first ..= last` (rounded inward;
@@ -407,8 +397,6 @@ impl Context<'_> {
                 }
             }
             *masks.entry(bz).or_default() = decided.inside;
-            out.evaluated += decided.evaluated;
-            out.exact += decided.exact;
             if decided.ambiguous.iter().any(|&w| w != 0) {
                 let mut leaf = Leaf::new(origin, Channels::NONE);
                 leaf.mask = decided.ambiguous;
@@ -479,7 +467,7 @@ impl Context<'_> {
                 (kn as f64 > high + 0.5, false)
             } else {
                 let c = crate::grid::offset_coord(block, n);
-                self.evaluate(kn, DVec3::from_array(c.map(|v| v as f64)), decided)
+                self.evaluate(kn, DVec3::from_array(c.map(|v| v as f64)))
             };
             if inside {
                 decided.inside[n / 64] |= 1 << (n % 64);
@@ -493,14 +481,12 @@ impl Context<'_> {
     /// Whether the centre `p` of integer winding `k` is inside, and whether its winding number
     /// lies within `AMBIGUOUS` of 1/2: by the caps' tree, or where its bound cannot tell, by
     /// the exact sum.
-    fn evaluate(&self, k: i32, p: DVec3, decided: &mut Decided) -> (bool, bool) {
-        decided.evaluated += 1;
+    fn evaluate(&self, k: i32, p: DVec3) -> (bool, bool) {
         let o = self.caps.orientation as f64;
         let from_half = |caps: f64| k as f64 - o * caps - 0.5;
         let bounds = self.caps.bounds(p);
         let (d, spread) = (from_half(bounds.value), bounds.spread);
         let d = if d.abs() <= spread || (d.abs() - AMBIGUOUS).abs() <= spread {
-            decided.exact += 1;
             from_half(winding_number_of(self.caps.triangles, p))
         } else {
             d
@@ -514,6 +500,4 @@ impl Context<'_> {
 struct Decided {
     inside: [u64; 8],
     ambiguous: [u64; 8],
-    evaluated: u64,
-    exact: u64,
 }
