@@ -4,6 +4,7 @@
 //! every misuse) built through pkg-config and run under valgrind.
 #![cfg(all(feature = "vdb", feature = "fixtures"))]
 
+mod cli_support;
 mod common;
 
 use std::path::{Path, PathBuf};
@@ -45,6 +46,22 @@ fn prefix() -> &'static Path {
             dir
         })
         .path()
+}
+
+/// `tests/c/NAME.c` built strictly (C11, every warning an error) against the installed
+/// static library, into `dir`.
+fn static_c_program(name: &str, dir: &Path) -> PathBuf {
+    let flags = run(Command::new("pkg-config")
+        .env("PKG_CONFIG_PATH", prefix().join("lib/pkgconfig"))
+        .args(["--cflags", "--libs", "voxelkit-static"]));
+    let exe = dir.join(name);
+    run(Command::new("gcc")
+        .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-pedantic"])
+        .arg(repo().join(format!("tests/c/{name}.c")))
+        .args(String::from_utf8_lossy(&flags.stdout).split_whitespace())
+        .arg("-o")
+        .arg(&exe));
+    exe
 }
 
 /// A closed mesh from the shared data, or a generated one in a clean clone.
@@ -206,16 +223,7 @@ fn the_c_interface_and_the_command_line_give_the_same_voxels_and_metadata() {
     generate::cuboid(glam::DVec3::splat(-1.0), glam::DVec3::ONE)
         .write_obj(&control)
         .unwrap();
-    let flags = run(Command::new("pkg-config")
-        .env("PKG_CONFIG_PATH", prefix().join("lib/pkgconfig"))
-        .args(["--cflags", "--libs", "voxelkit-static"]));
-    let exe = dir.join("equality");
-    run(Command::new("gcc")
-        .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-pedantic"])
-        .arg(repo().join("tests/c/equality.c"))
-        .args(String::from_utf8_lossy(&flags.stdout).split_whitespace())
-        .arg("-o")
-        .arg(&exe));
+    let exe = static_c_program("equality", dir);
     let from_c = dir.join("c");
     std::fs::create_dir(&from_c).unwrap();
     run(Command::new(&exe).arg(&mesh).arg(&control).arg(&from_c));
@@ -413,4 +421,43 @@ fn every_field_of_the_c_options_is_settable_by_name_with_pythons_checks() {
     assert!(read_vdb_grid(&out, Some("density")).is_err());
     let t = voxels.transform;
     assert!((t.voxel_size - 1.0 / 16.0).abs() < 1e-9, "{}", t.voxel_size);
+}
+
+/// A level set OpenVDB wrote (pyopenvdb's level-set sphere), read through `vk_grid_read_vdb`
+/// and subtracted from a solid box with `vk_grid_combine`, removes every voxel OpenVDB holds
+/// negative, its interior tiles included.
+#[test]
+fn a_level_set_read_through_c_stands_for_its_inside() {
+    if !have("pkg-config") || !have("gcc") {
+        return common::skip_or_fail("gcc or pkg-config is missing: the C level-set operand test");
+    }
+    let work = tempfile::tempdir().unwrap();
+    let dir = work.path();
+    let sphere = dir.join("sphere.vdb");
+    let Some(out) =
+        cli_support::run_pyopenvdb(cli_support::OPENVDB_SPHERE, &sphere, "an OpenVDB level set")
+    else {
+        return;
+    };
+    let mut words = out.split_whitespace();
+    let negative: u64 = words.next().unwrap().parse().unwrap();
+    let h: f64 = words.next().unwrap().parse().unwrap();
+    let half = 50.5 * h;
+    generate::cuboid(glam::DVec3::splat(-half), glam::DVec3::splat(half))
+        .write_obj(&dir.join("box.obj"))
+        .unwrap();
+    let boxed = dir.join("box.vdb");
+    run(Command::new(env!("CARGO_BIN_EXE_voxelkit"))
+        .arg("solid")
+        .arg(dir.join("box.obj"))
+        .args(["--voxel-size", &format!("{h:?}"), "-o"])
+        .arg(&boxed));
+    let exe = static_c_program("level_set_operand", dir);
+    let printed = run(Command::new(&exe).arg(&boxed).arg(&sphere));
+    let text = String::from_utf8_lossy(&printed.stdout);
+    let counts: Vec<u64> = text
+        .split_whitespace()
+        .map(|w| w.parse().unwrap())
+        .collect();
+    assert_eq!(counts[0] - counts[1], negative, "{text}");
 }

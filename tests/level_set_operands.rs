@@ -8,31 +8,18 @@
 mod cli_support;
 mod common;
 
-use cli_support::{json_field, run_pyopenvdb, text, voxelkit};
+use cli_support::{OPENVDB_SPHERE, json_field, run_pyopenvdb, text, voxelkit};
 use glam::DVec3;
 use voxelkit::io::vdb::read_vdb_grid;
 use voxelkit::mesh::generate;
-
-/// Writes OpenVDB's level-set sphere (radius 0.5, voxel size 0.02, half width 3) to the file
-/// given and prints its voxels of negative value, counted over every value, tiles included.
-const SPHERE: &str = r#"import sys, pyopenvdb as vdb
-g = vdb.createLevelSetSphere(radius=0.5, center=(0, 0, 0), voxelSize=0.02, halfWidth=3.0)
-g.name = 'sphere'
-vdb.write(sys.argv[1], grids=[g])
-n = 0
-for it in g.citerAllValues():
-    if it.value < 0:
-        (x0, y0, z0), (x1, y1, z1) = it.min, it.max
-        n += (x1 - x0 + 1) * (y1 - y0 + 1) * (z1 - z0 + 1)
-print(n, g.transform.voxelSize()[0])
-"#;
 
 #[test]
 fn an_openvdb_level_set_subtracted_from_a_solid_removes_its_whole_inside() {
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name);
     let p = |name: &str| path(name).to_str().unwrap().to_string();
-    let Some(out) = run_pyopenvdb(SPHERE, &path("sphere.vdb"), "an OpenVDB level set") else {
+    let Some(out) = run_pyopenvdb(OPENVDB_SPHERE, &path("sphere.vdb"), "an OpenVDB level set")
+    else {
         return;
     };
     let mut words = out.split_whitespace();

@@ -65,3 +65,17 @@ pub fn run_pyopenvdb(script: &str, path: &std::path::Path, what: &str) -> Option
     );
     Some(String::from_utf8(out.stdout).unwrap())
 }
+
+/// Writes OpenVDB's level-set sphere (radius 0.5, voxel size 0.02, half width 3) to the file
+/// given and prints its voxels of negative value, counted over every value, tiles included.
+pub const OPENVDB_SPHERE: &str = r#"import sys, pyopenvdb as vdb
+g = vdb.createLevelSetSphere(radius=0.5, center=(0, 0, 0), voxelSize=0.02, halfWidth=3.0)
+g.name = 'sphere'
+vdb.write(sys.argv[1], grids=[g])
+n = 0
+for it in g.citerAllValues():
+    if it.value < 0:
+        (x0, y0, z0), (x1, y1, z1) = it.min, it.max
+        n += (x1 - x0 + 1) * (y1 - y0 + 1) * (z1 - z0 + 1)
+print(n, g.transform.voxelSize()[0])
+"#;
