@@ -19,13 +19,17 @@ fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
     2.0 * numerator.atan2(denominator)
 }
 
-/// The winding number at `p` of the triangles given by their corners, each summed exactly.
-pub fn winding_number_of(corners: &[[DVec3; 3]], p: DVec3) -> f64 {
-    let total: f64 = corners
+/// The signed solid angles the triangles given by their corners subtend at `p`, summed.
+fn solid_angles(corners: &[[DVec3; 3]], p: DVec3) -> f64 {
+    corners
         .iter()
         .map(|&[a, b, c]| solid_angle(a - p, b - p, c - p))
-        .sum();
-    total / (4.0 * std::f64::consts::PI)
+        .sum()
+}
+
+/// The winding number at `p` of the triangles given by their corners, each summed exactly.
+pub fn winding_number_of(corners: &[[DVec3; 3]], p: DVec3) -> f64 {
+    solid_angles(corners, p) / (4.0 * std::f64::consts::PI)
 }
 
 /// The winding number of `mesh` at `p`.
@@ -181,32 +185,18 @@ impl WindingTree {
 
     /// The winding number at `p`, within the tree's error.
     pub fn winding_number(&self, p: DVec3) -> f64 {
-        if self.nodes.is_empty() {
-            return 0.0;
-        }
-        let mut total = 0.0;
-        let mut stack = vec![0usize];
-        while let Some(i) = stack.pop() {
-            let node = &self.nodes[i];
-            let to_centre = node.centre - p;
-            let distance = to_centre.length();
-            if distance > FAR * node.radius {
-                total += node.expansion(to_centre, distance);
-            } else if let Some(children) = node.children {
-                stack.extend(children);
-            } else {
-                total += self.corners[node.first..node.last]
-                    .iter()
-                    .map(|&[a, b, c]| solid_angle(a - p, b - p, c - p))
-                    .sum::<f64>();
-            }
-        }
-        total / (4.0 * std::f64::consts::PI)
+        self.sum(p, FAR).value
     }
 
     /// The winding number at `p` with a proven bound on its error: far clusters by their
     /// expansion, whose remainder is bounded, the rest exactly.
     pub fn bounds(&self, p: DVec3) -> WindingBounds {
+        self.sum(p, BOUNDED_FAR)
+    }
+
+    /// Clusters farther than `far` radii from `p` by their expansion, with the bound on its
+    /// remainder; the rest exactly.
+    fn sum(&self, p: DVec3, far: f64) -> WindingBounds {
         let four_pi = 4.0 * std::f64::consts::PI;
         let mut angle = 0.0;
         let mut spread = 0.0;
@@ -217,7 +207,7 @@ impl WindingTree {
             let node = &self.nodes[i];
             let to_centre = node.centre - p;
             let distance = to_centre.length();
-            if distance > BOUNDED_FAR * node.radius {
+            if distance > far * node.radius {
                 angle += node.expansion(to_centre, distance);
                 let clear = distance - node.radius;
                 spread += 0.5 * KERNEL_THIRD_DERIVATIVE * node.area_sum * node.radius.powi(2)
@@ -225,10 +215,7 @@ impl WindingTree {
             } else if let Some(children) = node.children {
                 stack.extend(children);
             } else {
-                angle += self.corners[node.first..node.last]
-                    .iter()
-                    .map(|&[a, b, c]| solid_angle(a - p, b - p, c - p))
-                    .sum::<f64>();
+                angle += solid_angles(&self.corners[node.first..node.last], p);
             }
         }
         WindingBounds {

@@ -618,7 +618,7 @@ fn solid_plan(mesh: &Mesh, fit: GridFit, fill: Fill) -> Result<Plan> {
 
 /// The winding number's inside gathers every crossing of a column's ray with the mesh and its
 /// caps (16 bytes each, gathered in batches that grow as they fill): 36 bytes a crossing at
-/// the peak beside the surface and the solid's grids. Estimate/peak 0.87-1.21 on bunny-closed,
+/// the peak beside the surface and the solid's grids. Estimate/peak 0.86-1.19 on bunny-closed,
 /// igea, armadillo, skull, horse, spot, scorpion, fandisk and rocker-arm at 1024.
 const WINDING_CROSSING_BYTES: f64 = 36.0;
 

@@ -141,12 +141,13 @@ pub fn mesh_solid(
 ) -> Result<DenseMask> {
     let choice = choose_inside(InsideRule::Auto, mesh, "a CSG mesh leaf needs an inside")?;
     if let Inside::Winding(caps) = &choice.inside {
-        let mut inside = DenseMask::new(bbox)?;
-        if let Some(region) = index_box(&mesh.bbox(), transform).intersection(&bbox) {
-            let grid = winding_inside(mesh, caps, *transform, region)?.grid(*transform);
-            inside = DenseMask::from_grid(&grid, bbox)?;
-        }
-        return Ok(inside);
+        return match index_box(&mesh.bbox(), transform).intersection(&bbox) {
+            Some(region) => {
+                let grid = winding_inside(mesh, caps, *transform, region)?.grid(*transform);
+                DenseMask::from_grid(&grid, bbox)
+            }
+            None => DenseMask::new(bbox),
+        };
     }
     let s = depth_layer_solid(mesh, transform, bbox, options, &Progress::none())?;
     if s.stats.unclassified_voxels > 0 {

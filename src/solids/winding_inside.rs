@@ -20,7 +20,7 @@ use crate::grid::{Channels, Coord, CoordBox, Leaf, SparseGrid, Transform};
 use crate::mesh::Mesh;
 use crate::mesh::boundary_caps::BoundaryCaps;
 use crate::mesh::inside::{ColumnCrossings, Crossing};
-use crate::mesh::winding::{RimBound, WindingBounds, WindingTree, winding_number_of};
+use crate::mesh::winding::{RimBound, WindingTree, winding_number_of};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -206,11 +206,6 @@ struct Caps<'a> {
 }
 
 impl Caps<'_> {
-    /// The caps' winding number at `p` and its error.
-    fn bounds(&self, p: DVec3) -> WindingBounds {
-        self.fans.bounds(p)
-    }
-
     /// The range of the caps' (oriented) winding number over the ball of radius `reach` around
     /// `centre`: its value there, its error, and the most the rim lets it change in the ball;
     /// none where a cap comes within the ball (the number jumps across a cap).
@@ -218,7 +213,7 @@ impl Caps<'_> {
         if self.tree.comes_within(centre, reach) {
             return None;
         }
-        let b = self.bounds(centre);
+        let b = self.fans.bounds(centre);
         let spread = b.spread + reach * self.rim.gradient(centre, reach);
         if !spread.is_finite() {
             return None;
@@ -484,7 +479,7 @@ impl Context<'_> {
     fn evaluate(&self, k: i32, p: DVec3) -> (bool, bool) {
         let o = self.caps.orientation as f64;
         let from_half = |caps: f64| k as f64 - o * caps - 0.5;
-        let bounds = self.caps.bounds(p);
+        let bounds = self.caps.fans.bounds(p);
         let (d, spread) = (from_half(bounds.value), bounds.spread);
         let d = if d.abs() <= spread || (d.abs() - AMBIGUOUS).abs() <= spread {
             from_half(winding_number_of(self.caps.triangles, p))
