@@ -8,23 +8,59 @@
 //! change away from the surface, from its rim alone.
 
 use super::Mesh;
+use super::triangle_distance::{segment_distance, triangle_distance};
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
-/// The solid angle of triangle `abc` seen from the origin, signed by its orientation.
-fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+/// The half solid angle of triangle `abc` seen from the origin, signed by its orientation, as
+/// the argument of the complex number (denominator, numerator).
+fn half_angle_complex(a: DVec3, b: DVec3, c: DVec3) -> (f64, f64) {
     let (la, lb, lc) = (a.length(), b.length(), c.length());
     let numerator = a.dot(b.cross(c));
     let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-    2.0 * numerator.atan2(denominator)
+    (denominator, numerator)
 }
 
-/// The signed solid angles the triangles given by their corners subtend at `p`, summed.
+/// The solid angle of triangle `abc` seen from the origin, signed by its orientation.
+fn solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    let (x, y) = half_angle_complex(a, b, c);
+    2.0 * y.atan2(x)
+}
+
+/// Whether the argument of x + iy lies in (0, pi]: the negative real axis counts as pi.
+fn upper_half(x: f64, y: f64) -> bool {
+    y > 0.0 || (y == 0.0 && x < 0.0)
+}
+
+/// The signed solid angles the triangles given by their corners subtend at `p`, summed. The
+/// half angles are added as arguments, by multiplying their complex numbers (scaled back to
+/// unit size each step) and counting the turns the running argument makes past pi, so that
+/// one atan2 serves the whole sum.
 fn solid_angles(corners: &[[DVec3; 3]], p: DVec3) -> f64 {
-    corners
-        .iter()
-        .map(|&[a, b, c]| solid_angle(a - p, b - p, c - p))
-        .sum()
+    let (mut re, mut im) = (1.0f64, 0.0f64);
+    let mut turns = 0i64;
+    for &[a, b, c] in corners {
+        let (x, y) = half_angle_complex(a - p, b - p, c - p);
+        let (r, i) = (re * x - im * y, re * y + im * x);
+        let scale = r.abs().max(i.abs());
+        if scale == 0.0 || !scale.is_finite() {
+            // A corner at p: the triangle subtends nothing (atan2(0, 0)).
+            continue;
+        }
+        let upper = upper_half(r, i);
+        if upper_half(re, im) && upper_half(x, y) && !upper {
+            turns += 1;
+        } else if im < 0.0 && y < 0.0 && upper {
+            turns -= 1;
+        }
+        (re, im) = (r / scale, i / scale);
+    }
+    let argument = if im == 0.0 && re < 0.0 {
+        std::f64::consts::PI
+    } else {
+        im.atan2(re)
+    };
+    2.0 * (argument + 2.0 * std::f64::consts::PI * turns as f64)
 }
 
 /// The winding number at `p` of the triangles given by their corners, each summed exactly.
@@ -224,8 +260,7 @@ impl WindingTree {
         }
     }
 
-    /// Whether a triangle may come within `reach` of `p` (by the balls around the clusters and
-    /// triangles: a triangle farther than its ball is never missed).
+    /// Whether a triangle comes within `reach` of `p` (clusters skipped by their balls).
     pub fn comes_within(&self, p: DVec3, reach: f64) -> bool {
         let mut stack = vec![0usize];
         while !self.nodes.is_empty()
@@ -240,14 +275,7 @@ impl WindingTree {
                 None => {
                     let near = self.corners[node.first..node.last]
                         .iter()
-                        .any(|&[a, b, c]| {
-                            let centre = (a + b + c) / 3.0;
-                            let radius = a
-                                .distance(centre)
-                                .max(b.distance(centre))
-                                .max(c.distance(centre));
-                            centre.distance(p) <= radius + reach
-                        });
+                        .any(|&t| triangle_distance(p, t) <= reach);
                     if near {
                         return true;
                     }
@@ -356,17 +384,11 @@ impl RimBound {
                 stack.extend(children);
             } else {
                 for &[a, b] in &self.segments[g.first..g.last] {
-                    let d = b - a;
-                    let t = if d.length_squared() > 0.0 {
-                        ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
-                    } else {
-                        0.0
-                    };
-                    let gap = (a + d * t).distance(p) - reach;
+                    let gap = segment_distance(p, a, b) - reach;
                     if gap <= 0.0 {
                         return f64::INFINITY;
                     }
-                    total += d.length() / (gap * gap);
+                    total += a.distance(b) / (gap * gap);
                 }
             }
         }
@@ -400,6 +422,48 @@ mod tests {
         let w = winding_number(&cube, DVec3::splat(0.5));
         assert!((w - 5.0 / 6.0).abs() < 1e-12, "{w}");
         assert!((WindingTree::new(&cube).winding_number(DVec3::splat(0.5)) - w).abs() < 1e-12);
+    }
+
+    /// The one-atan2 sum against the sum of each triangle's atan2, where the total makes
+    /// several whole turns (three nested shells) and where it is a fraction (an open mesh).
+    #[test]
+    fn the_complex_product_sums_the_angles_as_each_atan2_would() {
+        let shells = generate::combine(
+            "three shells",
+            &[0.5, 1.0, 1.5].map(|r| generate::icosphere(DVec3::ZERO, r, 2)),
+        );
+        let holed = Mesh::from_polygons(
+            "holed",
+            shells.positions.clone(),
+            &(0..shells.face_count())
+                .filter(|&f| f % 3 != 0)
+                .map(|f| shells.face(f).to_vec())
+                .collect::<Vec<_>>(),
+        );
+        let mut rng = crate::random::SplitMix64(5);
+        for (mesh, at_centre) in [(shells, Some(3.0)), (holed, None)] {
+            let corners: Vec<[DVec3; 3]> = mesh
+                .triangles()
+                .map(|(_, t)| t.map(|v| mesh.p(v)))
+                .collect();
+            for _ in 0..200 {
+                let p = DVec3::new(
+                    rng.range(-2.0, 2.0),
+                    rng.range(-2.0, 2.0),
+                    rng.range(-2.0, 2.0),
+                );
+                let each: f64 = corners
+                    .iter()
+                    .map(|&[a, b, c]| solid_angle(a - p, b - p, c - p))
+                    .sum();
+                let once = solid_angles(&corners, p);
+                assert!((once - each).abs() < 1e-9, "{once} against {each} at {p}");
+            }
+            if let Some(turns) = at_centre {
+                let w = solid_angles(&corners, DVec3::ZERO) / (4.0 * std::f64::consts::PI);
+                assert!((w - turns).abs() < 1e-9, "{w}");
+            }
+        }
     }
 
     /// The tree against the exact sum at random points in and around closed, open and

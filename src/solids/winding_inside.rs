@@ -104,9 +104,28 @@ pub fn winding_inside(
         .collect();
     // Each cap triangle is (centroid, rim vertex, rim vertex).
     let rim = RimBound::new(corners.iter().map(|&[_, a, b]| [a, b]).collect());
-    let (tree, fans) = rayon::join(
-        || WindingTree::of_triangles(corners.iter().flat_map(|&t| refined(t, CAP_EDGE)).collect()),
-        || WindingTree::of_triangles(corners.clone()),
+    let ((tree, fans), surface) = rayon::join(
+        || {
+            rayon::join(
+                || {
+                    WindingTree::of_triangles(
+                        corners.iter().flat_map(|&t| refined(t, CAP_EDGE)).collect(),
+                    )
+                },
+                || WindingTree::of_triangles(corners.clone()),
+            )
+        },
+        || {
+            // Only where caps exist is the mesh's own surface asked about.
+            let near_caps = if caps.is_empty() {
+                Vec::new()
+            } else {
+                mesh.triangles()
+                    .map(|(_, t)| t.map(|v| index[v as usize]))
+                    .collect()
+            };
+            WindingTree::of_triangles(near_caps)
+        },
     );
     let caps_winding = Caps {
         tree: &tree,
@@ -128,6 +147,7 @@ pub fn winding_inside(
     let context = Context {
         columns: &columns,
         caps: caps_winding,
+        surface: &surface,
         region,
         special: &special,
     };
@@ -293,6 +313,8 @@ fn for_each_block(origin: Coord, size: i64, mut f: impl FnMut(Coord)) {
 struct Context<'a> {
     columns: &'a ColumnCrossings,
     caps: Caps<'a>,
+    /// The mesh's own triangles (index space): the winding number is continuous off them.
+    surface: &'a WindingTree,
     region: CoordBox,
     special: &'a BTreeMap<Coord, Block>,
 }
@@ -439,7 +461,18 @@ impl Context<'_> {
             let k = k as f64;
             k != OUTSIDE_REGION as f64 && k <= high + 0.5 + AMBIGUOUS && k >= low + 0.5 - AMBIGUOUS
         };
-        if size > 1 && offsets().any(|n| open(k[n])) {
+        let undecided = offsets().any(|n| open(k[n]));
+        if undecided && size > 1 && range.is_none() {
+            if let Some(inside) = self.continuous_sign(origin, size, k) {
+                for n in offsets() {
+                    if inside && k[n] != OUTSIDE_REGION {
+                        decided.inside[n / 64] |= 1 << (n % 64);
+                    }
+                }
+                return;
+            }
+        }
+        if size > 1 && undecided {
             let h = size / 2;
             for corner in 0..8 {
                 let child = [0, 1, 2].map(|a| origin[a] + if corner >> a & 1 == 1 { h } else { 0 });
@@ -471,6 +504,28 @@ impl Context<'_> {
                 decided.ambiguous[n / 64] |= 1 << (n % 64);
             }
         }
+    }
+
+    /// Whether every centre of the cube at `origin` of edge `size` (integer windings `k`, by
+    /// offset in its block) is inside, or every one outside, where no centre lies near 1/2:
+    /// none where the mesh passes through the cube or its middle centre cannot tell. The
+    /// winding number is continuous across the caps and changes off the mesh no faster than
+    /// its rim allows, so one centre's value and that rate decide the whole cube.
+    fn continuous_sign(&self, origin: Coord, size: i64, k: &[i32; 512]) -> Option<bool> {
+        let middle = origin.map(|v| v + size / 2);
+        let kq = k[crate::grid::leaf_offset(middle)];
+        if kq == OUTSIDE_REGION {
+            return None;
+        }
+        let q = DVec3::from_array(middle.map(|v| v as f64));
+        let reach = (size / 2) as f64 * 3f64.sqrt();
+        if self.surface.comes_within(q, reach) {
+            return None;
+        }
+        let bounds = self.caps.fans.bounds(q);
+        let d = kq as f64 - self.caps.orientation as f64 * bounds.value - 0.5;
+        let margin = d.abs() - bounds.spread - reach * self.caps.rim.gradient(q, reach);
+        (margin > AMBIGUOUS).then_some(d > 0.0)
     }
 
     /// Whether the centre `p` of integer winding `k` is inside, and whether its winding number
