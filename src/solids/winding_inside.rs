@@ -462,15 +462,17 @@ impl Context<'_> {
             k != OUTSIDE_REGION as f64 && k <= high + 0.5 + AMBIGUOUS && k >= low + 0.5 - AMBIGUOUS
         };
         let undecided = offsets().any(|n| open(k[n]));
-        if undecided && size > 1 && range.is_none() {
-            if let Some(inside) = self.continuous_sign(origin, size, k) {
-                for n in offsets() {
-                    if inside && k[n] != OUTSIDE_REGION {
-                        decided.inside[n / 64] |= 1 << (n % 64);
-                    }
+        if undecided
+            && size > 1
+            && range.is_none()
+            && let Some(inside) = self.continuous_sign(origin, size, k)
+        {
+            for n in offsets() {
+                if inside && k[n] != OUTSIDE_REGION {
+                    decided.inside[n / 64] |= 1 << (n % 64);
                 }
-                return;
             }
+            return;
         }
         if size > 1 && undecided {
             let h = size / 2;
