@@ -2,17 +2,30 @@
 # Every test suite: cargo (the library, the CLI, and the C and C++ interfaces through their
 # integration tests), then the Python module built from this checkout into a virtual
 # environment (target/python-venv) and tested with pytest (the module, the Blender add-on
-# in headless Blender, Dask scale-out).
+# in headless Blender, Dask scale-out). Every suite runs even when one fails; the last line
+# counts passed, failed and skipped tests and what the skipped ones needed.
 #
 # The environment is made from Debian's Python (PYTHON, default /usr/bin/python3) with its
 # site packages, so that pyopenvdb (python3-openvdb) and Blender's Python match the module.
-set -euo pipefail
+# Building it installs maturin, and the module's extras for the tests (pytest, Dask),
+# from PyPI.
+set -uo pipefail
 cd "$(dirname "$0")/.."
-cargo test --release
+# rustup's cargo, where scripts/setup-debian.sh installed it, before an older system one.
+export PATH="$HOME/.cargo/bin:$PATH"
 python="${PYTHON:-/usr/bin/python3}"
+logs=target/test-logs
+mkdir -p "$logs"
+cargo test --release --no-fail-fast 2>&1 | tee "$logs/cargo.log"
+cargo_status=${PIPESTATUS[0]}
 venv=target/python-venv
-if [ ! -x "$venv/bin/python" ]; then
-    "$python" -m venv --system-site-packages "$venv"
-fi
-"$venv/bin/python" -m pip install --quiet ".[distributed,test]"
-"$venv/bin/python" -m pytest -q python/tests
+{
+    if [ ! -x "$venv/bin/python" ]; then
+        "$python" -m venv --system-site-packages "$venv"
+    fi &&
+        "$venv/bin/python" -m pip install --quiet ".[distributed,test]" &&
+        "$venv/bin/python" -m pytest -q -rs python/tests
+} 2>&1 | tee "$logs/pytest.log"
+pytest_status=${PIPESTATUS[0]}
+"$python" scripts/test_summary.py "$logs/cargo.log" "$cargo_status" "$logs/pytest.log" "$pytest_status"
+[ "$cargo_status" -eq 0 ] && [ "$pytest_status" -eq 0 ]

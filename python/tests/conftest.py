@@ -15,9 +15,10 @@ import pytest
 REPO = Path(__file__).resolve().parents[2]
 
 
-def missing(what):
-    """Fails in CI, skips loudly elsewhere."""
-    message = f"MISSING: {what}"
+def missing(need, detail):
+    """Fails in CI, skips loudly elsewhere: `need` names what is missing (the test summary
+    counts skips by it), `detail` what it is wanted for."""
+    message = f"MISSING {need}: {detail}"
     if os.environ.get("CI") == "true":
         pytest.fail(message)
     warnings.warn(message)
@@ -28,7 +29,7 @@ def missing(what):
 def data():
     folder = Path(os.environ.get("VOXELKIT_DATA", REPO.parent / "shared" / "data"))
     if not (folder / "meshes").is_dir():
-        missing(f"the shared test data is not at {folder} (set VOXELKIT_DATA)")
+        missing("the shared test data (VOXELKIT_DATA)", f"not at {folder}")
     return folder
 
 
@@ -37,7 +38,7 @@ def cli():
     """The `voxelkit` command line tool of this checkout (`cargo build --release`)."""
     path = Path(os.environ.get("VOXELKIT_CLI", REPO / "target" / "release" / "voxelkit"))
     if not path.is_file():
-        missing(f"the voxelkit CLI at {path} (run cargo build --release)")
+        missing("the voxelkit CLI (cargo build --release)", f"not at {path}")
 
     def run(*args):
         done = subprocess.run([str(path), *map(str, args)], capture_output=True, text=True)
@@ -52,7 +53,7 @@ def pyopenvdb():
     try:
         import pyopenvdb
     except ImportError:
-        missing("pyopenvdb (Debian's python3-openvdb), the independent .vdb reader")
+        missing("pyopenvdb (python3-openvdb)", "the independent .vdb reader")
     return pyopenvdb
 
 

@@ -19,7 +19,7 @@ SCRIPT = Path(__file__).with_name("blender_addon.py")
 def test_the_add_on_voxelizes_into_volume_objects(data, tmp_path):
     blender = shutil.which("blender")
     if blender is None:
-        missing("blender (Debian's blender package) for the add-on test")
+        missing("blender", "the add-on test")
     package = Path(voxelkit.__file__).resolve().parents[1]
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(package), os.environ.get("PYTHONPATH")])))
     env["TMPDIR"] = str(tmp_path)

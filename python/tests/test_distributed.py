@@ -20,7 +20,7 @@ def dask():
     try:
         import dask.distributed
     except ImportError:
-        missing('Dask (pip install ".[distributed]")')
+        missing('Dask (pip install ".[distributed]")', "scale-out")
     return dask.distributed
 
 

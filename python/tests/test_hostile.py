@@ -1,6 +1,7 @@
 """Hostile input through Python: OpenVDB-made grids voxelkit must read, and writes it must
 refuse rather than get wrong."""
 
+import numpy as np
 import pytest
 
 import voxelkit
@@ -15,8 +16,7 @@ def _grid_with_scale(pyopenvdb, path, diagonal, translation):
     pyopenvdb.write(str(path), [grid])
 
 
-def test_a_uniform_scale_rounded_beside_a_large_translation_is_read(tmp_path):
-    pyopenvdb = pytest.importorskip("pyopenvdb")
+def test_a_uniform_scale_rounded_beside_a_large_translation_is_read(tmp_path, pyopenvdb):
     path = tmp_path / "far.vdb"
     _grid_with_scale(pyopenvdb, path, (0.01, 0.0099999998, 0.010000000009), (5e5, 5e6, 100))
     grid = voxelkit.read_vdb(path)
@@ -39,9 +39,7 @@ def test_half_precision_is_refused_for_distances_beyond_its_range(tmp_path):
     grid.write(tmp_path / "big.vdb")
 
 
-def test_huge_arrays_and_tile_grids_are_memory_errors_not_aborts(tmp_path):
-    np = pytest.importorskip("numpy")
-    pyopenvdb = pytest.importorskip("pyopenvdb")
+def test_huge_arrays_and_tile_grids_are_memory_errors_not_aborts(tmp_path, pyopenvdb):
     # 2^31 vertices as a strided view of three numbers: no memory until copied.
     vertices = np.lib.stride_tricks.as_strided(np.zeros(3), shape=(2**31, 3), strides=(0, 8))
     with pytest.raises(MemoryError):

@@ -6,9 +6,11 @@ import ast
 import inspect
 import pathlib
 
+import numpy as np
 import pytest
 
 import voxelkit
+from voxelkit import distributed
 
 STUBS = pathlib.Path(voxelkit.__file__).with_name("_voxelkit.pyi")
 #: Each function's positional inputs and the table entry of its options.
@@ -78,13 +80,11 @@ def test_zero_threads_and_zero_memory_mean_the_defaults():
 
 
 def test_numpy_numbers_are_options():
-    np = pytest.importorskip("numpy")
     grid = voxelkit.implicit(SPHERE, resolution=np.int64(24), bounds=np.array([-1.0, 1.0]))
     assert grid.same_voxels(voxelkit.implicit(SPHERE, resolution=24))
 
 
 def test_every_dask_option_is_the_tables_in_run_and_on_the_command_line(capsys):
-    distributed = pytest.importorskip("voxelkit.distributed")
     with pytest.raises(SystemExit):
         distributed.main(["mesh", "--help"])
     text = " ".join(capsys.readouterr().out.split())
@@ -104,7 +104,6 @@ def test_every_dask_option_is_the_tables_in_run_and_on_the_command_line(capsys):
 
 
 def test_a_bad_dask_option_gets_the_tables_error_before_any_work(data, tmp_path):
-    distributed = pytest.importorskip("voxelkit.distributed")
     path = data / "meshes" / "bunny-closed.obj"
     with pytest.raises(ValueError, match="separability must be 6 or 26, not `7`"):
         distributed.mesh(path, tmp_path / "b.vdb", separability=7)
@@ -115,8 +114,7 @@ def test_a_bad_dask_option_gets_the_tables_error_before_any_work(data, tmp_path)
     assert not list(tmp_path.iterdir())
 
 
-def test_pyopenvdb_reads_the_fit_and_separability_as_numbers(tmp_path):
-    pyopenvdb = pytest.importorskip("pyopenvdb")
+def test_pyopenvdb_reads_the_fit_and_separability_as_numbers(tmp_path, pyopenvdb):
     voxelkit.implicit(SPHERE, resolution=24).write(tmp_path / "r.vdb")
     grid = voxelkit.mesh((
         [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
@@ -131,7 +129,6 @@ def test_pyopenvdb_reads_the_fit_and_separability_as_numbers(tmp_path):
 
 
 def test_bad_dask_numbers_are_value_errors_naming_the_option(data, tmp_path):
-    distributed = pytest.importorskip("voxelkit.distributed")
     path = data / "meshes" / "bunny-closed.obj"
     with pytest.raises(ValueError, match="brick"):
         distributed.mesh(path, tmp_path / "b.vdb", brick=-8)

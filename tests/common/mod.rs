@@ -18,7 +18,7 @@ pub fn data_dir() -> Option<PathBuf> {
         Some(dir)
     } else {
         skip_or_fail(&format!(
-            "VOXELKIT_DATA: the shared test data is not at {} (set VOXELKIT_DATA to the shared data folder)",
+            "the shared test data (VOXELKIT_DATA): not at {} (set VOXELKIT_DATA to the shared data folder)",
             dir.display()
         ));
         None

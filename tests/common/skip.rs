@@ -1,7 +1,8 @@
 //! What a test does when its data or tool is missing: outside CI it skips with a loud
 //! warning; in CI (`CI=true`) it fails, since CI must run everything.
 
-/// Skips (returns) loudly, or panics under `CI=true`, naming `what` is missing.
+/// Skips (returns) loudly, or panics under `CI=true`, naming `what` is missing: "need: detail",
+/// the summary of `scripts/test-all.sh` counting skips by the need before the colon.
 pub fn skip_or_fail(what: &str) {
     if std::env::var("CI").is_ok_and(|v| v == "true") {
         panic!("CI=true but {what}: the test cannot run");
