@@ -313,4 +313,15 @@ fn mesh_shape_info_and_demo_produce_real_files() {
     for f in ["trefoil.obj", "trefoil-6.vdb", "trefoil-26.vdb"] {
         assert!(demo.join(f).exists(), "{f}");
     }
+    // The grids the README says the demo writes: the surface as `density`, and `normal`.
+    let info = text(&voxelkit(&[
+        "info",
+        demo.join("trefoil-26.vdb").to_str().unwrap(),
+    ]));
+    let grids: Vec<&str> = info
+        .lines()
+        .filter_map(|l| l.strip_prefix("  ")?.split(' ').next())
+        .filter(|name| !name.is_empty())
+        .collect();
+    assert_eq!(grids, ["density", "normal"], "{info}");
 }

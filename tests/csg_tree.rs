@@ -184,3 +184,18 @@ fn bad_trees_are_refused_naming_the_file_and_the_node() {
         assert!(!out.exists());
     }
 }
+
+#[test]
+fn the_summary_prints_the_leaves_numbers_as_typed() {
+    let dir = tempfile::tempdir().unwrap();
+    let example = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/csg/flange.json");
+    let out = dir.path().join("flange.vdb");
+    let o = voxelkit(&["csg", "--tree", example, "-o", out.to_str().unwrap()]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(
+        t.contains("cylinder from (0, 0, -0.1) along (0, 0, 1) radius 0.4 height 1.7"),
+        "{t}"
+    );
+    assert!(!t.contains("99999"), "{t}");
+}

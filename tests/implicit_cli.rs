@@ -155,6 +155,13 @@ fn bad_formulas_and_arguments_are_refused() {
             vec!["column 7", "x^2 + * y\n        ^"],
         ),
         (
+            vec!["implicit", "x^2 + y^^2 + z^2 - 1", "-o", o],
+            vec![
+                "column 10",
+                "a stray `^` where the power after `^` should be",
+            ],
+        ),
+        (
             vec!["implicit", "r - 1", "-o", o],
             vec!["unknown name `r`", "x y z"],
         ),

@@ -87,6 +87,17 @@ fn closed_surfaces_separate_at_every_adjacency() {
                     report.inside_empty > 0,
                     "{name}: nothing inside to leak into"
                 );
+                // Each voxel a tolerance bound touched counts once, and is one of the output's.
+                assert!(
+                    out.stats.guard_voxels <= out.stats.voxels,
+                    "{name}: {} tolerance voxels of {}",
+                    out.stats.guard_voxels,
+                    out.stats.voxels
+                );
+                assert!(
+                    enclose || out.stats.guard_voxels == 0,
+                    "{name} {resolution}"
+                );
                 assert!(
                     report.separates(),
                     "{name} {resolution} N={}: leaked at {:?}",

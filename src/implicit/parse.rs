@@ -278,6 +278,17 @@ impl Parser<'_> {
                 self.at += 1;
                 v as i32
             }
+            Some(&Token::Op(op)) => {
+                let at = self.column();
+                return Err(error(
+                    self.text,
+                    at,
+                    format!(
+                        "a stray `{op}` where the power after `^` should be: write an integer \
+                         from -1024 to 1024, as in y^2"
+                    ),
+                ));
+            }
             _ => {
                 return Err(error(
                     self.text,

@@ -35,19 +35,24 @@ impl Primitive {
         }
     }
 
-    /// A short description for summaries.
+    /// A short description for summaries, its numbers as typed: to 15 significant digits,
+    /// so that a cylinder's base found back from its centre reads -0.1, not -0.09999999999999998.
     pub fn describe(&self) -> String {
-        let v = |p: DVec3| format!("({}, {}, {})", p.x, p.y, p.z);
+        let n = |x: f64| {
+            let typed: f64 = format!("{x:.14e}").parse().unwrap_or(x);
+            format!("{typed}")
+        };
+        let v = |p: DVec3| format!("({}, {}, {})", n(p.x), n(p.y), n(p.z));
         match self {
             Primitive::Cuboid(b) => format!("box {} .. {}", v(b.min), v(b.max)),
             Primitive::Cylinder(c) => format!(
                 "cylinder from {} along {} radius {} height {}",
                 v(c.ends()[0]),
                 v(c.axis),
-                c.radius,
-                c.height
+                n(c.radius),
+                n(c.height)
             ),
-            Primitive::Sphere(s) => format!("sphere {} radius {}", v(s.center), s.radius),
+            Primitive::Sphere(s) => format!("sphere {} radius {}", v(s.center), n(s.radius)),
         }
     }
 

@@ -20,7 +20,7 @@
 //! voxel but its corner voxels; otherwise it is halved until the bound is smaller than
 //! `ENCLOSE_TOLERANCE` voxels, and then every voxel the bound touches is added (counted in
 //! `guard_voxels`; this is where the surface crosses a voxel edge or corner in a sliver no
-//! corner sample lands in). The output is then every voxel the surface touches (eq. 3),
+//! corner sample lands in; each such voxel counted once). The output is then every voxel the surface touches (eq. 3),
 //! whatever N; every output voxel holds an evaluated surface point (eq. 4) or lies within
 //! `ENCLOSE_TOLERANCE` of one. The result blocks 26-paths.
 
@@ -66,8 +66,8 @@ pub struct ParametricStats {
     pub depth_guard_stops: u64,
     /// Sub-patches halved because their bound left their corner voxels (`enclose`).
     pub enclose_splits: u64,
-    /// Voxel insertions from bounds smaller than `ENCLOSE_TOLERANCE` (`enclose`); most land
-    /// in voxels that also hold a sample.
+    /// Voxels a bound smaller than `ENCLOSE_TOLERANCE` touched (`enclose`), each once; many
+    /// also hold a sample.
     pub guard_voxels: u64,
     /// Surface area from the final sub-patch quads, in world units.
     pub area: f64,
@@ -112,7 +112,12 @@ pub fn voxelize_subdivision(
         normal: true,
         ..Channels::NONE
     };
-    let (grid, opposite, mut stats) = (0..surface.patch_count())
+    let Partial {
+        grid,
+        opposite,
+        grazed,
+        mut stats,
+    } = (0..surface.patch_count())
         .into_par_iter()
         .with_min_len(16)
         .fold(
@@ -126,22 +131,13 @@ pub fn voxelize_subdivision(
                 part
             },
         )
-        .map(|p| (p.grid, p.opposite, p.stats))
-        .reduce(
-            || {
-                (
-                    SparseGrid::new(transform, channels),
-                    SparseGrid::new(transform, Channels::NONE),
-                    ParametricStats::default(),
-                )
-            },
-            merge_partials,
-        );
+        .reduce(|| Partial::new(transform, channels), merge_partials);
     progress.check()?;
     stats.area *= transform.voxel_size * transform.voxel_size;
     stats.patches = surface.patch_count() as u64;
     stats.voxels = grid.voxel_count();
     stats.opposite_voxels = opposite.voxel_count();
+    stats.guard_voxels = grazed.voxel_count();
     Ok(ParametricOutput {
         surface: grid,
         opposite,
@@ -153,6 +149,8 @@ pub fn voxelize_subdivision(
 struct Partial {
     grid: SparseGrid,
     opposite: SparseGrid,
+    /// The voxels bounds smaller than `ENCLOSE_TOLERANCE` touched.
+    grazed: SparseGrid,
     stats: ParametricStats,
 }
 
@@ -161,6 +159,7 @@ impl Partial {
         Partial {
             grid: SparseGrid::new(transform, channels),
             opposite: SparseGrid::new(transform, Channels::NONE),
+            grazed: SparseGrid::new(transform, Channels::NONE),
             stats: ParametricStats::default(),
         }
     }
@@ -186,12 +185,19 @@ fn disagree(a: [f32; 3], b: [f32; 3]) -> bool {
     known(a) && known(b) && a[0] * b[0] + a[1] * b[1] + a[2] * b[2] <= 0.0
 }
 
-fn merge_partials(
-    a: (SparseGrid, SparseGrid, ParametricStats),
-    b: (SparseGrid, SparseGrid, ParametricStats),
-) -> (SparseGrid, SparseGrid, ParametricStats) {
-    let (mut grid, mut opposite, mut stats) = a;
-    let (other_grid, other_opposite, s) = b;
+fn merge_partials(a: Partial, b: Partial) -> Partial {
+    let Partial {
+        mut grid,
+        mut opposite,
+        mut grazed,
+        mut stats,
+    } = a;
+    let Partial {
+        grid: other_grid,
+        opposite: other_opposite,
+        grazed: other_grazed,
+        stats: s,
+    } = b;
     let mut crossed = Vec::new();
     grid.merge_with(other_grid, |dst: &mut Leaf, src: &Leaf| {
         let before = dst.mask;
@@ -208,6 +214,7 @@ fn merge_partials(
         }
     });
     opposite.union(&other_opposite);
+    grazed.union(&other_grazed);
     for c in crossed {
         opposite.insert(c);
     }
@@ -216,9 +223,13 @@ fn merge_partials(
     stats.uniform_evaluations += s.uniform_evaluations;
     stats.depth_guard_stops += s.depth_guard_stops;
     stats.enclose_splits += s.enclose_splits;
-    stats.guard_voxels += s.guard_voxels;
     stats.area += s.area;
-    (grid, opposite, stats)
+    Partial {
+        grid,
+        opposite,
+        grazed,
+        stats,
+    }
 }
 
 #[derive(Clone, Copy)]
@@ -297,7 +308,7 @@ impl Run<'_> {
                 true
             } else if (hi_exact - lo_exact).max_element() < ENCLOSE_TOLERANCE {
                 for voxel in box_voxels(lo, hi) {
-                    part.stats.guard_voxels += 1;
+                    part.grazed.insert(voxel);
                     part.add(voxel, c[0].sample.normal);
                 }
                 true

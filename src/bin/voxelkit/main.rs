@@ -34,8 +34,8 @@ use voxelkit::voxelize::separating::Criterion;
         degenerate faces: faces without area, voxelized by their edges (a warning)\n  \
         depth-guard stops (subdiv): sub-patches smaller than the paper's depth guard whose\n    \
         corner voxels were still not adjacent; accepted as they are\n  \
-        tolerance voxels (subdiv --enclose): voxels added where the surface grazes a voxel\n    \
-        edge or corner no sample lands in\n  \
+        tolerance voxels (subdiv --enclose): voxels a sub-patch bound within the tolerance\n    \
+        touched, where the surface grazes a voxel edge or corner (many also hold a sample)\n  \
         inside/surface voxels, volume inside .. with surface (solids): the true volume lies\n    \
         between them; components (26-connected) and genus (components - Euler characteristic;\n    measure, and solid --topology)\n  \
         unclassified voxels (depth layers): voxels no direction decides, written as\n    \
