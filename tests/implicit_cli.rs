@@ -157,7 +157,7 @@ fn bad_formulas_and_arguments_are_refused() {
         (
             vec!["implicit", "x^2 + y^^2 + z^2 - 1", "-o", o],
             vec![
-                "column 10",
+                "column 9",
                 "a stray `^` where the power after `^` should be",
             ],
         ),
