@@ -325,3 +325,54 @@ fn mesh_shape_info_and_demo_produce_real_files() {
         .collect();
     assert_eq!(grids, ["density", "normal"], "{info}");
 }
+
+/// The subcommands `-h` lists for `path` (none for a leaf command).
+fn subcommands(path: &[&str]) -> Vec<String> {
+    let mut args = path.to_vec();
+    args.push("-h");
+    let help = text(&voxelkit(&args));
+    help.lines()
+        .skip_while(|l| *l != "Commands:")
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+        .filter(|name| name != "help")
+        .collect()
+}
+
+#[test]
+fn every_option_and_argument_has_a_short_help() {
+    let mut commands: Vec<Vec<String>> = vec![vec![]];
+    let mut undescribed = Vec::new();
+    let mut seen = 0;
+    while let Some(path) = commands.pop() {
+        let path_str: Vec<&str> = path.iter().map(String::as_str).collect();
+        for sub in subcommands(&path_str) {
+            let mut child = path.clone();
+            child.push(sub);
+            commands.push(child);
+        }
+        let mut args = path_str.clone();
+        args.push("-h");
+        let help = text(&voxelkit(&args));
+        for line in help.lines() {
+            // `  -o, --output <OUTPUT>  Text` or `  <INPUT>  Text`: a name, two spaces, its help.
+            let trimmed = line.trim_start();
+            let is_entry =
+                line.starts_with("  ") && (trimmed.starts_with('-') || trimmed.starts_with('<'));
+            if !is_entry || path.is_empty() && trimmed.starts_with("-V") {
+                continue;
+            }
+            seen += 1;
+            let described = trimmed
+                .split_once("  ")
+                .map(|(_, rest)| rest.trim())
+                .is_some_and(|rest| !rest.is_empty() && !rest.starts_with("[default"));
+            if !described {
+                undescribed.push(format!("voxelkit {} : {trimmed}", path.join(" ")));
+            }
+        }
+    }
+    assert!(seen > 100, "only {seen} options found");
+    assert!(undescribed.is_empty(), "{}", undescribed.join("\n"));
+}

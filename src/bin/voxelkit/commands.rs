@@ -57,8 +57,10 @@ pub struct VoxelizeArgs {
 pub enum ShapeKind {
     /// A sphere.
     Sphere {
+        /// Radius, in world units.
         #[arg(long, default_value_t = 1.0)]
         radius: f64,
+        /// Centre, `x,y,z` in world units.
         #[arg(long, value_parser = parse_vec3, default_value = "0,0,0", allow_hyphen_values = true)]
         center: DVec3,
         #[command(flatten)]
@@ -66,10 +68,13 @@ pub enum ShapeKind {
     },
     /// A closed cylinder (side, caps and sharp rims).
     Cylinder {
+        /// Radius, in world units.
         #[arg(long, default_value_t = 1.0)]
         radius: f64,
+        /// Length along the axis, cap to cap, in world units.
         #[arg(long, default_value_t = 2.0)]
         height: f64,
+        /// Centre (midway between the caps), `x,y,z` in world units.
         #[arg(long, value_parser = parse_vec3, default_value = "0,0,0", allow_hyphen_values = true)]
         center: DVec3,
         /// Axis direction (normalized for you).
@@ -80,8 +85,10 @@ pub enum ShapeKind {
     },
     /// The surface x^2 + k y + k z = 0, clipped to the cube [-extent, extent]^3.
     Quadric {
+        /// The coefficient k of x^2 + k y + k z = 0.
         #[arg(long, default_value_t = 10.0)]
         k: f64,
+        /// Half the edge of the cube the surface is clipped to, in world units.
         #[arg(long, default_value_t = 100.0)]
         extent: f64,
         #[command(flatten)]

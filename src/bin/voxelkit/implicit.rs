@@ -63,6 +63,8 @@ pub struct ImplicitArgs {
     /// A named example instead of a formula: sphere, torus, sinsin, gear, crankshaft.
     #[arg(long)]
     example: Option<String>,
+    /// The formula's variables: cartesian (x y z), spherical (r theta phi) or cylindrical
+    /// (r theta y).
     #[arg(long, default_value_t = ImplicitRequest::default().coords, value_parser = parse_coords)]
     coords: Coordinates,
     /// The box searched: `lo,hi` (a cube) or `x0,y0,z0,x1,y1,z1`.

@@ -158,7 +158,10 @@ enum Command {
     },
     /// Describe the grids of a .vdb file (types, counts, transform, metadata), or the bricks
     /// of a brick set by its index (`index.json`, from `python -m voxelkit.distributed`).
-    Info { file: PathBuf },
+    Info {
+        /// A .vdb file, or a brick set's `index.json`.
+        file: PathBuf,
+    },
     /// Draw the voxels of a .vdb as a PNG picture: each voxel a cube, lit by the file's
     /// `normal` grid when it has one, coloured by its `Cd` grid.
     Render(render::RenderArgs),
@@ -176,19 +179,22 @@ enum Command {
         /// Folder for the example mesh and the .vdb files (created when missing).
         #[arg(short, long, default_value = "voxelkit-demo")]
         output: PathBuf,
+        /// Voxels along the example's longest bounding-box axis.
         #[arg(short, long, default_value_t = voxelkit::mesh::DEFAULT_RESOLUTION)]
         resolution: u32,
     },
-    /// Fill a mesh: by exterior flooding of its 26-separating surface (closed meshes), or by
-    /// depth layers, which report the voxels they cannot classify; prints volumes and mass
-    /// (components and genus with --topology).
+    /// Fill a mesh: its 26-separating surface plus its inside (any mesh, by --inside: the
+    /// winding number, or the exterior flood of a closed one), or by depth layers, which report
+    /// the voxels they cannot classify; prints volumes and mass (components and genus with
+    /// --topology).
     Solid(solids::SolidArgs),
     /// Boolean of two voxel grids (.vdb): union, intersection or difference; or a whole CSG
     /// tree of shapes, formulas, meshes and grids from a JSON file (--tree).
     Csg(solids::CsgArgs),
     /// The intersection curve of two voxel surfaces (.vdb): the voxels they share.
     Intersect(solids::IntersectArgs),
-    /// Volume, mass, components and genus of a closed mesh or a closed .vdb surface.
+    /// Volume, mass, components and genus of a mesh (its inside by --inside) or of a closed
+    /// .vdb surface.
     Measure(solids::MeasureArgs),
     /// Voxelize an implicit surface F = 0 typed as a formula, by interval octree (Stolte &
     /// Kaufman): every level of the octree envelops the surface.

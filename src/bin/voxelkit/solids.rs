@@ -135,6 +135,7 @@ pub struct CsgArgs {
     /// Resample the second grid onto the first's transform when they differ.
     #[arg(long)]
     resample: bool,
+    /// Output .vdb holding the result (`density`; `voxels` with --grids).
     #[arg(short, long)]
     output: PathBuf,
 }
