@@ -376,3 +376,43 @@ fn every_option_and_argument_has_a_short_help() {
     assert!(seen > 100, "only {seen} options found");
     assert!(undescribed.is_empty(), "{}", undescribed.join("\n"));
 }
+
+/// Write options (`--grids`, `--compression`, `--half`, `--preview`) belong to the commands
+/// that write a .vdb, `--up-axis` to those that read meshes (and `render`, where it names the
+/// grid's up axis): elsewhere they are refused, not ignored, and not listed.
+#[test]
+fn options_are_taken_only_where_they_act() {
+    let dir = tempfile::tempdir().unwrap();
+    let vdb = dir.path().join("s.vdb");
+    let v = vdb.to_str().unwrap();
+    let o = voxelkit(&["shape", "sphere", "-r", "16", "--half", "-o", v]);
+    assert!(o.status.success(), "{}", text(&o));
+    let png = dir.path().join("s.png");
+    let p = png.to_str().unwrap();
+    let refused: [(&[&str], &[&str]); 6] = [
+        (&["info", v], &["--up-axis", "y"]),
+        (&["info", v], &["--half"]),
+        (&["render", v, "-o", p], &["--grids", "density"]),
+        (&["render", v, "-o", p], &["--preview"]),
+        (&["measure", v], &["--compression", "none"]),
+        (&["csg", "union", v, v, "-o", p], &["--up-axis", "y"]),
+    ];
+    for (command, option) in refused {
+        let args = [command, option].concat();
+        let o = voxelkit(&args);
+        assert!(
+            !o.status.success() && text(&o).contains("unexpected argument"),
+            "{args:?}: {}",
+            text(&o)
+        );
+        let help = text(&voxelkit(&[command[0], "-h"]));
+        assert!(
+            !help.contains(option[0]),
+            "{} -h lists {}",
+            command[0],
+            option[0]
+        );
+    }
+    let o = voxelkit(&["render", v, "--up-axis", "y", "-o", p]);
+    assert!(o.status.success() && png.exists(), "{}", text(&o));
+}

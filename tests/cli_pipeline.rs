@@ -281,7 +281,7 @@ fn a_y_up_mesh_is_turned_z_up_on_request() {
         .unwrap();
     let centre_and_count = |up: &str| {
         let out = dir.path().join(format!("{up}.vdb"));
-        let o = voxelkit(&["--up-axis", up, "mesh", s(&obj), "-r", "32", "-o", s(&out)]);
+        let o = voxelkit(&["mesh", "--up-axis", up, s(&obj), "-r", "32", "-o", s(&out)]);
         assert!(o.status.success(), "{}", text(&o));
         let grid = voxelkit::io::vdb::read_vdb_grid(&out, None).unwrap();
         let b = grid.bbox().unwrap();

@@ -782,7 +782,7 @@ fn distances_beyond_half_precision_are_refused_not_written_as_infinities() {
     let cube = cube_obj(dir.path(), 4e6);
     let out = dir.path().join("big.vdb");
     let (c, o) = (cube.to_str().unwrap(), out.to_str().unwrap());
-    let refused = voxelkit(&["--half", "mesh", c, "--sdf", "-r", "32", "-o", o]);
+    let refused = voxelkit(&["mesh", "--half", c, "--sdf", "-r", "32", "-o", o]);
     assert!(!refused.status.success(), "{}", text(&refused));
     assert!(
         text(&refused).contains("exceed half precision's range (65504)"),

@@ -9,6 +9,7 @@ mod cli_support;
 use cli_support::{text, voxelkit};
 use voxelkit::grid::{Channels, SparseGrid, Transform};
 use voxelkit::io::preview::{Picture, Scene, View, render};
+use voxelkit::mesh::UpAxis;
 
 /// The pixels that differ from the background's gradient (the background is the same
 /// across a row).
@@ -63,7 +64,29 @@ fn ball(radius: i64, channels: Channels) -> SparseGrid {
 }
 
 fn draw(grid: &SparseGrid, view: View, size: u32) -> Picture {
-    render(&Scene::of(grid), view, size, size, None).unwrap()
+    render(&Scene::of(grid), view, UpAxis::Z, size, size, None).unwrap()
+}
+
+/// A Y-up grid (a post standing along y) drawn with its up axis stands upright: from the
+/// front it is four times as tall as wide; taken as Z-up it lies on its back, seen end on.
+#[test]
+fn a_y_up_grid_stands_upright_when_drawn_with_its_up_axis() {
+    let mut post = SparseGrid::default();
+    for x in 0..16 {
+        for y in 0..64 {
+            for z in 0..16 {
+                post.insert([x, y, z]);
+            }
+        }
+    }
+    let aspect = |up: UpAxis| {
+        let p = render(&Scene::of(&post), View::Y, up, 400, 400, None).unwrap();
+        let ([x0, x1, y0, y1], _) = footprint(&p);
+        (y1 - y0 + 1) as f64 / (x1 - x0 + 1) as f64
+    };
+    let (upright, on_its_back) = (aspect(UpAxis::Y), aspect(UpAxis::Z));
+    assert!((upright - 4.0).abs() < 0.2, "{upright}");
+    assert!((on_its_back - 1.0).abs() < 0.1, "{on_its_back}");
 }
 
 #[test]
@@ -146,8 +169,8 @@ fn the_cli_draws_vdb_files_and_previews_beside_outputs() {
         .unwrap();
     let vdb = dir.path().join("torus.vdb");
     let o = voxelkit(&[
-        "--preview",
         "mesh",
+        "--preview",
         obj.to_str().unwrap(),
         "--normals",
         "-r",

@@ -11,6 +11,7 @@
 use super::atomic::write_atomic;
 use crate::error::{Error, Result};
 use crate::grid::{Coord, Leaf, SparseGrid};
+use crate::mesh::UpAxis;
 use glam::Vec3;
 use rayon::prelude::*;
 use std::path::Path;
@@ -53,14 +54,20 @@ struct Camera {
 }
 
 impl View {
-    fn camera(self) -> Camera {
+    /// The camera over a grid whose up axis is `up`: a Y-up grid is seen as if turned Z-up
+    /// (x, y, z) -> (x, -z, y), the camera turned back the other way.
+    fn camera(self, up: UpAxis) -> Camera {
         let (toward, right) = match self {
             View::Iso => (Vec3::new(1.0, -1.0, 1.0), Vec3::new(1.0, 1.0, 0.0)),
             View::X => (Vec3::X, Vec3::Y),
             View::Y => (Vec3::NEG_Y, Vec3::X),
             View::Z => (Vec3::Z, Vec3::X),
         };
-        let (toward, right) = (toward.normalize(), right.normalize());
+        let into_grid = |v: Vec3| match up {
+            UpAxis::Y => Vec3::new(v.x, v.z, -v.y),
+            UpAxis::Z => v,
+        };
+        let (toward, right) = (into_grid(toward).normalize(), into_grid(right).normalize());
         Camera {
             toward,
             right,
@@ -264,10 +271,11 @@ fn visible_bits(mask: &[u64; 8]) -> [u64; 8] {
     visible
 }
 
-/// Draws `scene` from `view` on a `width` x `height` picture.
+/// Draws `scene` (its up axis `up`) from `view` on a `width` x `height` picture.
 pub fn render(
     scene: &Scene,
     view: View,
+    up: UpAxis,
     width: u32,
     height: u32,
     limit: Option<u64>,
@@ -285,7 +293,7 @@ pub fn render(
     let grid = scene.voxels;
     let mut buffer = Buffer::new(width as usize * height as usize);
     if let Some(b) = grid.bbox() {
-        let camera = view.camera();
+        let camera = view.camera(up);
         let (lo, hi) = (coord_f32(b.min) - 0.5, coord_f32(b.max) + 0.5);
         let middle = 0.5 * (lo + hi);
         // The picture frames what is there: the extent of the leaves and tiles on it.

@@ -5,6 +5,7 @@ use super::keywords::Keywords;
 use super::to_py_err;
 use crate::grid::{SparseGrid, Transform};
 use crate::io::preview::{Scene, View, check_picture_output, render, write_png};
+use crate::mesh::UpAxis;
 use crate::pipeline::Outcome;
 use crate::pipeline::request::WriteRequest;
 use numpy::ndarray::{Array1, Array2, Array3};
@@ -248,7 +249,7 @@ impl Grid {
         let grid = &self.outcome.grid;
         py.detach(|| {
             check_picture_output(&path, &inputs)?;
-            let picture = render(&Scene::of(grid), view, size.0, size.1, None)?;
+            let picture = render(&Scene::of(grid), view, UpAxis::Z, size.0, size.1, None)?;
             write_png(&path, &picture)
         })
         .map_err(to_py_err)

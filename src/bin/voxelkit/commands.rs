@@ -51,6 +51,8 @@ pub struct VoxelizeArgs {
     /// .binvox or .vox (the voxel set alone).
     #[arg(short, long)]
     pub output: PathBuf,
+    #[command(flatten)]
+    pub write: crate::WriteArgs,
 }
 
 #[derive(Subcommand, Clone)]
@@ -94,6 +96,16 @@ pub enum ShapeKind {
         #[command(flatten)]
         common: VoxelizeArgs,
     },
+}
+
+impl ShapeKind {
+    pub fn common(&self) -> &VoxelizeArgs {
+        match self {
+            ShapeKind::Sphere { common, .. }
+            | ShapeKind::Cylinder { common, .. }
+            | ShapeKind::Quadric { common, .. } => common,
+        }
+    }
 }
 
 /// A narrow band of exact distances instead of a voxel set.

@@ -93,6 +93,8 @@ pub struct ImplicitArgs {
     /// alone).
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    pub write: crate::WriteArgs,
 }
 
 fn parse_theta_range(s: &str) -> std::result::Result<ThetaRange, String> {

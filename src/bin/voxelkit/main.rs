@@ -55,27 +55,37 @@ struct Cli {
     /// none: the memory available).
     #[arg(long, global = true, value_name = "MIB")]
     max_memory: Option<u64>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// How a command writes its .vdb: the options of the commands that write one.
+#[derive(Args, Clone)]
+pub struct WriteArgs {
     /// Write only these grids of the .vdb, by name (e.g. `density,voxels`) [default: all but
     /// `voxels`, the boolean copy of `density`'s voxels].
-    #[arg(long, global = true, value_delimiter = ',', value_name = "NAMES")]
-    grids: Vec<String>,
+    #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+    pub grids: Vec<String>,
     /// .vdb compression: blosc (OpenVDB's default), zip or none.
-    #[arg(long, global = true, default_value_t = WriteRequest::default().compression, value_parser = parse_compression)]
-    compression: voxelkit::io::vdb::Compression,
+    #[arg(long, default_value_t = WriteRequest::default().compression, value_parser = parse_compression)]
+    pub compression: voxelkit::io::vdb::Compression,
     /// Write float and vector grids at half precision (16-bit: half the size).
-    #[arg(long, global = true)]
-    half: bool,
+    #[arg(long)]
+    pub half: bool,
+    /// Also draw each result as a picture beside its output (`out.vdb` gives `out.png`;
+    /// `voxelkit render` takes views and sizes).
+    #[arg(long)]
+    pub preview: bool,
+}
+
+/// The up axis of input mesh files: an option of the commands that read meshes.
+#[derive(Args, Clone, Copy)]
+pub struct UpAxisArgs {
     /// The up axis of the input mesh files: `y` turns a Y-up file (most OBJ) to Z-up as
     /// Blender's OBJ importer does, (x, y, z) -> (x, -z, y), so the volume stands where the
     /// imported mesh stands; `z` keeps the coordinates.
-    #[arg(long, global = true, default_value_t = MeshRequest::default().up_axis, value_name = "AXIS")]
-    up_axis: voxelkit::mesh::UpAxis,
-    /// Also draw each result as a picture beside its output (`out.vdb` gives `out.png`;
-    /// `voxelkit render` takes views and sizes).
-    #[arg(long, global = true)]
-    preview: bool,
-    #[command(subcommand)]
-    command: Command,
+    #[arg(long, default_value_t = MeshRequest::default().up_axis, value_name = "AXIS")]
+    pub up_axis: voxelkit::mesh::UpAxis,
 }
 
 #[derive(Args, Clone, Copy)]
@@ -147,6 +157,10 @@ enum Command {
         surface: SurfaceArgs,
         #[command(flatten)]
         out: batch::OutputArgs,
+        #[command(flatten)]
+        write: WriteArgs,
+        #[command(flatten)]
+        up: UpAxisArgs,
     },
     /// Voxelize 3D polylines (OBJ `l`) or the edges of a mesh by marching each segment's
     /// dominant axis (Jegathese et al.), carrying vertex colours into a `Cd` grid.
@@ -173,6 +187,8 @@ enum Command {
         fit: FitArgs,
         #[command(flatten)]
         surface: SurfaceArgs,
+        #[command(flatten)]
+        up: UpAxisArgs,
     },
     /// Voxelize the bundled example (a trefoil-knot tube) and write .vdb files into a folder.
     Demo {
@@ -182,6 +198,8 @@ enum Command {
         /// Voxels along the example's longest bounding-box axis.
         #[arg(short, long, default_value_t = voxelkit::mesh::DEFAULT_RESOLUTION)]
         resolution: u32,
+        #[command(flatten)]
+        write: WriteArgs,
     },
     /// Fill a mesh: its 26-separating surface plus its inside (any mesh, by --inside: the
     /// winding number, or the exterior flood of a closed one), or by depth layers, which report
@@ -204,6 +222,26 @@ enum Command {
     Subdiv(subdiv::SubdivArgs),
 }
 
+impl Command {
+    /// The command's write options and up axis, where it takes them.
+    fn output_options(&self) -> (Option<&WriteArgs>, Option<voxelkit::mesh::UpAxis>) {
+        match self {
+            Command::Mesh { write, up, .. } => (Some(write), Some(up.up_axis)),
+            Command::Lines(a) => (Some(&a.write), Some(a.up.up_axis)),
+            Command::Shape { shape } => (Some(&shape.common().write), None),
+            Command::Check { up, .. } => (None, Some(up.up_axis)),
+            Command::Demo { write, .. } => (Some(write), None),
+            Command::Solid(a) => (Some(&a.write), Some(a.up.up_axis)),
+            Command::Csg(a) => (Some(&a.write), None),
+            Command::Intersect(a) => (Some(&a.write), None),
+            Command::Measure(a) => (None, Some(a.up.up_axis)),
+            Command::Implicit(a) => (Some(&a.write), None),
+            Command::Subdiv(a) => (Some(&a.voxelize.write), None),
+            Command::Info { .. } | Command::Render(_) => (None, None),
+        }
+    }
+}
+
 fn main() -> ExitCode {
     // Like other command-line tools, stop quietly when the reader of stdout goes away
     // (`voxelkit info x.vdb | head`) instead of panicking on the broken pipe.
@@ -214,19 +252,20 @@ fn main() -> ExitCode {
     // An interrupted run leaves no temporary file behind.
     voxelkit::io::atomic::remove_temporaries_on_signals();
     let cli = Cli::parse();
+    let (write, up_axis) = cli.command.output_options();
     let global = run::Global {
         limits: LimitsRequest {
             threads: cli.threads,
             max_memory_mib: cli.max_memory,
         },
-        up_axis: cli.up_axis,
+        up_axis: up_axis.unwrap_or_default(),
         json: cli.json,
-        preview: cli.preview,
-        write: voxelkit::io::vdb::WriteOptions {
-            grids: cli.grids,
-            compression: cli.compression,
-            half: cli.half,
-        },
+        preview: write.is_some_and(|w| w.preview),
+        write: write.map_or_else(Default::default, |w| voxelkit::io::vdb::WriteOptions {
+            grids: w.grids.clone(),
+            compression: w.compression,
+            half: w.half,
+        }),
     };
     // Reading a file or drawing a picture is planned against the limit given, too.
     voxelkit::system::set_process_limit(global.limits().max_memory);
@@ -239,6 +278,7 @@ fn main() -> ExitCode {
             fit,
             surface,
             out,
+            ..
         } => commands::mesh(
             &inputs,
             method == SurfaceKind::Projective,
@@ -257,8 +297,11 @@ fn main() -> ExitCode {
             input,
             fit,
             surface,
+            ..
         } => commands::check(&input, fit, surface, &global),
-        Command::Demo { output, resolution } => commands::demo(&output, resolution, &global),
+        Command::Demo {
+            output, resolution, ..
+        } => commands::demo(&output, resolution, &global),
         Command::Subdiv(args) => subdiv::run(&args, &global),
         Command::Implicit(args) => implicit::run(&args, &global),
         Command::Solid(args) => solids::solid(&args, &global),

@@ -62,6 +62,10 @@ pub struct LinesArgs {
     /// alone).
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    pub write: crate::WriteArgs,
+    #[command(flatten)]
+    pub up: crate::UpAxisArgs,
 }
 
 pub fn lines(args: &LinesArgs, global: &Global) -> Result<()> {

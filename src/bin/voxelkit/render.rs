@@ -8,6 +8,7 @@ use std::time::Instant;
 use voxelkit::grid::SparseGrid;
 use voxelkit::io::preview::{Scene, View, check_picture_output, render, write_png};
 use voxelkit::io::vdb::{COLOR_GRID, NORMAL_GRID, read_vdb_grid, read_vdb_info};
+use voxelkit::mesh::UpAxis;
 use voxelkit::pipeline::on_threads;
 use voxelkit::{Error, Result};
 
@@ -34,6 +35,10 @@ pub struct PictureArgs {
     /// Picture size in pixels.
     #[arg(long, default_value = "800x600", value_parser = parse_size, value_name = "WxH")]
     size: (u32, u32),
+    /// The grid's up axis: `y` stands a grid upright that was voxelized from a Y-up mesh (most
+    /// OBJ, every glTF) without --up-axis y; `z` as Blender shows it.
+    #[arg(long, default_value_t = UpAxis::Z, value_name = "AXIS")]
+    up_axis: UpAxis,
 }
 
 impl Default for PictureArgs {
@@ -41,6 +46,7 @@ impl Default for PictureArgs {
         PictureArgs {
             view: View::Iso,
             size: (800, 600),
+            up_axis: UpAxis::Z,
         }
     }
 }
@@ -67,7 +73,7 @@ pub struct RenderArgs {
 fn draw(scene: &Scene, picture: PictureArgs, output: &Path, limit: Option<u64>) -> Result<String> {
     let start = Instant::now();
     let (w, h) = picture.size;
-    let image = render(scene, picture.view, w, h, limit)?;
+    let image = render(scene, picture.view, picture.up_axis, w, h, limit)?;
     write_png(output, &image)?;
     Ok(format!(
         "{}: {w}x{h} picture of {} voxels, {:.2} s",

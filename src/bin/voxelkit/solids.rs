@@ -110,6 +110,10 @@ pub struct SolidArgs {
     /// --sdf: `density` and the level set `surface`.
     #[command(flatten)]
     pub out: crate::batch::OutputArgs,
+    #[command(flatten)]
+    pub write: crate::WriteArgs,
+    #[command(flatten)]
+    pub up: crate::UpAxisArgs,
 }
 
 #[derive(Args)]
@@ -138,6 +142,8 @@ pub struct CsgArgs {
     /// Output .vdb holding the result (`density`; `voxels` with --grids).
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    pub write: crate::WriteArgs,
 }
 
 #[derive(Args)]
@@ -152,6 +158,8 @@ pub struct IntersectArgs {
     /// Output .vdb holding the voxels common to both surfaces.
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    pub write: crate::WriteArgs,
 }
 
 #[derive(Args)]
@@ -161,6 +169,8 @@ pub struct MeasureArgs {
     input: PathBuf,
     #[command(flatten)]
     fill: FillArgs,
+    #[command(flatten)]
+    pub up: crate::UpAxisArgs,
 }
 
 fn parse_op(s: &str) -> std::result::Result<BooleanOp, String> {

@@ -21,7 +21,7 @@ pub struct SubdivArgs {
     #[arg(required = true)]
     input: Option<PathBuf>,
     #[command(flatten)]
-    voxelize: SubdivVoxelizeArgs,
+    pub voxelize: SubdivVoxelizeArgs,
 }
 
 #[derive(Args)]
@@ -62,6 +62,8 @@ pub struct SubdivVoxelizeArgs {
     /// `density`, `shell`, `interior` and `opposite_normals`), or a .binvox or .vox.
     #[arg(short, long, required = true)]
     output: Option<PathBuf>,
+    #[command(flatten)]
+    pub write: crate::WriteArgs,
 }
 
 #[derive(Subcommand)]
