@@ -7,7 +7,8 @@
 #
 # The environment is made from Debian's Python (PYTHON, default /usr/bin/python3) with its
 # site packages, so that pyopenvdb (python3-openvdb) and Blender's Python match the module.
-# Building it installs maturin, and the module's extras for the tests (pytest, Dask),
+# Building it installs maturin, and the module's extras for the tests (pytest, Dask, trimesh,
+# Open3D: about 1.3 GB),
 # from PyPI.
 set -uo pipefail
 cd "$(dirname "$0")/.."

@@ -57,6 +57,24 @@ def pyopenvdb():
     return pyopenvdb
 
 
+@pytest.fixture(scope="session")
+def trimesh():
+    try:
+        import trimesh
+    except ImportError:
+        missing('trimesh (pip install ".[test]")', "meshes as trimesh users hold them")
+    return trimesh
+
+
+@pytest.fixture(scope="session")
+def open3d():
+    try:
+        import open3d
+    except ImportError:
+        missing('Open3D (pip install ".[test]")', "meshes and voxel grids as Open3D users hold them")
+    return open3d
+
+
 def closed_meshes(data):
     """The shared meshes the exterior flood can fill (inside="parity": it refuses open ones)."""
     import voxelkit

@@ -1,5 +1,8 @@
-//! Meshes from Python: a path to any file the CLI reads, or a `(vertices, faces)` pair of
-//! array-likes (faces: an (m, k) integer array, or a list of polygons of any sizes).
+//! Meshes from Python: a path to any file the CLI reads, a `(vertices, faces)` pair of
+//! array-likes (faces: an (m, k) integer array, or a list of polygons of any sizes), or a mesh
+//! object with `vertices` and `faces` (trimesh's `Trimesh`) or `vertices` and `triangles`
+//! (Open3D's `TriangleMesh`). Faces must hold whole numbers: a float array is taken only where
+//! every value is one.
 
 use crate::mesh::Mesh;
 use crate::pipeline::MeshSource;
@@ -18,14 +21,36 @@ pub fn mesh_source(source: &Bound<'_, PyAny>, limit: Option<u64>) -> PyResult<Me
     if let Ok(path) = source.extract::<PathBuf>() {
         return Ok(MeshSource::File(path));
     }
-    let Ok((vertices, faces)) = source.extract::<(Bound<PyAny>, Bound<PyAny>)>() else {
-        return Err(PyTypeError::new_err(
-            "a mesh is a path or a (vertices, faces) pair of arrays",
-        ));
+    let (vertices, faces) = if let Ok(pair) = source.extract::<(Bound<PyAny>, Bound<PyAny>)>() {
+        pair
+    } else if let Some(arrays) = mesh_object_arrays(source)? {
+        arrays
+    } else {
+        return Err(PyTypeError::new_err(format!(
+            "a mesh is a path, a (vertices, faces) pair of arrays, or an object with `vertices` \
+             and `faces` (trimesh) or `triangles` (Open3D); got {}",
+            source.get_type().name()?
+        )));
     };
     Ok(MeshSource::Mesh(mesh_from_arrays(
         &vertices, &faces, limit,
     )?))
+}
+
+/// The arrays of a mesh object: `vertices` with `faces` (trimesh) or `triangles` (Open3D,
+/// whose vectors numpy reads in place); none when `source` has no such attributes.
+fn mesh_object_arrays<'py>(
+    source: &Bound<'py, PyAny>,
+) -> PyResult<Option<(Bound<'py, PyAny>, Bound<'py, PyAny>)>> {
+    if !source.hasattr("vertices")? {
+        return Ok(None);
+    }
+    for faces in ["faces", "triangles"] {
+        if source.hasattr(faces)? {
+            return Ok(Some((source.getattr("vertices")?, source.getattr(faces)?)));
+        }
+    }
+    Ok(None)
 }
 
 /// Bytes a mesh of `vertices` and `corners` takes while it is built from arrays: the rows
@@ -81,13 +106,26 @@ fn mesh_from_arrays(
     Ok(mesh)
 }
 
-/// Faces as polygons: from a rectangular integer array, else from a sequence of sequences;
-/// `fits(corners)` refuses what would not fit before it is copied.
+/// Faces as polygons: from a rectangular array (floats only where every value is a whole
+/// number), else from a sequence of sequences of integers; `fits(corners)` refuses what would
+/// not fit before it is copied.
 fn polygons(
     faces: &Bound<'_, PyAny>,
     fits: impl Fn(usize) -> PyResult<()>,
 ) -> PyResult<Vec<Vec<i64>>> {
-    if let Ok(array) = faces.extract::<PyArrayLike2<i64, AllowTypeChange>>() {
+    let Some(array) = rectangular(faces)? else {
+        fits(faces.len().unwrap_or(0).saturating_mul(3))?;
+        return faces.extract::<Vec<Vec<i64>>>().map_err(|e| {
+            PyValueError::new_err(format!(
+                "faces: an (m, 3) integer array or a list of polygons ({e})"
+            ))
+        });
+    };
+    let kind: String = array.getattr("dtype")?.getattr("kind")?.extract()?;
+    if kind != "f" {
+        let array: PyArrayLike2<i64, AllowTypeChange> = array
+            .extract()
+            .map_err(|e| PyValueError::new_err(format!("faces: an (m, k) integer array ({e})")))?;
         fits(array.as_array().len())?;
         return Ok(array
             .as_array()
@@ -96,10 +134,42 @@ fn polygons(
             .map(|r| r.to_vec())
             .collect());
     }
-    fits(faces.len().unwrap_or(0).saturating_mul(3))?;
-    faces.extract::<Vec<Vec<i64>>>().map_err(|e| {
-        PyValueError::new_err(format!(
-            "faces: an (m, 3) integer array or a list of polygons ({e})"
-        ))
-    })
+    let array: PyArrayLike2<f64, AllowTypeChange> = array
+        .extract()
+        .map_err(|e| PyValueError::new_err(format!("faces: an (m, k) array ({e})")))?;
+    fits(array.as_array().len())?;
+    let mut out = Vec::with_capacity(array.as_array().nrows());
+    for (f, row) in array.as_array().rows().into_iter().enumerate() {
+        let mut polygon = Vec::with_capacity(row.len());
+        for &i in row {
+            if i.fract() != 0.0 || !i.is_finite() {
+                return Err(PyValueError::new_err(format!(
+                    "faces: face {f} holds {i}, not a vertex index: faces are whole numbers (an \
+                     integer array)"
+                )));
+            }
+            polygon.push(i as i64);
+        }
+        out.push(polygon);
+    }
+    Ok(out)
+}
+
+/// `faces` as a two-dimensional numpy array: itself when it is an array, else as numpy reads
+/// it (a list of equal-length lists, Open3D's vectors); none for ragged polygons.
+fn rectangular<'py>(faces: &Bound<'py, PyAny>) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let array = if faces.hasattr("dtype")? {
+        faces.clone()
+    } else {
+        match faces
+            .py()
+            .import("numpy")?
+            .call_method1("asarray", (faces,))
+        {
+            Ok(array) => array,
+            Err(_) => return Ok(None),
+        }
+    };
+    let dimensions: usize = array.getattr("ndim")?.extract()?;
+    Ok((dimensions == 2).then_some(array))
 }
