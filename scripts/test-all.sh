@@ -8,8 +8,7 @@
 # The environment is made from Debian's Python (PYTHON, default /usr/bin/python3) with its
 # site packages, so that pyopenvdb (python3-openvdb) and Blender's Python match the module.
 # Building it installs maturin, and the module's extras for the tests (pytest, Dask, trimesh,
-# Open3D: about 1.3 GB),
-# from PyPI.
+# Open3D: about 1.3 GB), from PyPI.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 # rustup's cargo, where scripts/setup-debian.sh installed it, before an older system one.

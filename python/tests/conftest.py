@@ -5,6 +5,7 @@ Where it, the CLI, pyopenvdb or Blender is missing, tests fail under CI (`CI=tru
 skipped with a loud warning elsewhere.
 """
 
+import importlib
 import os
 import subprocess
 import warnings
@@ -48,31 +49,27 @@ def cli():
     return run
 
 
+def imported(module, need, detail):
+    """The module named, or `missing(need, detail)` where it is not installed."""
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        missing(need, detail)
+
+
 @pytest.fixture(scope="session")
 def pyopenvdb():
-    try:
-        import pyopenvdb
-    except ImportError:
-        missing("pyopenvdb (python3-openvdb)", "the independent .vdb reader")
-    return pyopenvdb
+    return imported("pyopenvdb", "pyopenvdb (python3-openvdb)", "the independent .vdb reader")
 
 
 @pytest.fixture(scope="session")
 def trimesh():
-    try:
-        import trimesh
-    except ImportError:
-        missing('trimesh (pip install ".[test]")', "meshes as trimesh users hold them")
-    return trimesh
+    return imported("trimesh", 'trimesh (pip install ".[test]")', "meshes as trimesh users hold them")
 
 
 @pytest.fixture(scope="session")
 def open3d():
-    try:
-        import open3d
-    except ImportError:
-        missing('Open3D (pip install ".[test]")', "meshes and voxel grids as Open3D users hold them")
-    return open3d
+    return imported("open3d", 'Open3D (pip install ".[test]")', "meshes and voxel grids as Open3D users hold them")
 
 
 def closed_meshes(data):

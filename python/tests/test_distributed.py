@@ -12,16 +12,12 @@ import pytest
 
 import voxelkit
 import voxelkit.distributed as vd
-from conftest import closed_meshes, missing, voxel_set
+from conftest import closed_meshes, imported, voxel_set
 
 
 @pytest.fixture(scope="module")
 def dask():
-    try:
-        import dask.distributed
-    except ImportError:
-        missing('Dask (pip install ".[distributed]")', "scale-out")
-    return dask.distributed
+    return imported("dask.distributed", 'Dask (pip install ".[distributed]")', "scale-out")
 
 
 @pytest.fixture(scope="module")
