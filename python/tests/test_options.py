@@ -22,6 +22,8 @@ FUNCTIONS = {
     "lines": (["source"], "lines"),
     "measure": (["source"], "measure"),
     "combine": (["a", "b"], "combine"),
+    "signed_distance": (["mesh", "points"], "query"),
+    "contains": (["mesh", "points"], "query"),
     "csg": (["tree"], None),
 }
 SPHERE = "x^2 + y^2 + z^2 - 0.5"

@@ -38,3 +38,89 @@ def test_faces_must_be_whole_numbers():
         voxelkit.mesh((vertices, [[0, 2, 1], [0, 2.5, 3]]), resolution=16)
     with pytest.raises(TypeError, match="trimesh"):
         voxelkit.mesh(object(), resolution=16)
+
+
+def _closest_distances(vertices, faces, points):
+    """The distance from each point to the nearest triangle, brute force over every triangle."""
+    a, b, c = (vertices[faces[:, k]] for k in range(3))
+    out = np.empty(len(points))
+    for n, p in enumerate(points):
+        ab, ac, ap = b - a, c - a, p - a
+        d1, d2 = (ab * ap).sum(1), (ac * ap).sum(1)
+        bp, cp = p - b, p - c
+        d3, d4 = (ab * bp).sum(1), (ac * bp).sum(1)
+        d5, d6 = (ab * cp).sum(1), (ac * cp).sum(1)
+        va, vb, vc = d3 * d6 - d5 * d4, d5 * d2 - d1 * d6, d1 * d4 - d3 * d2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            denom = va + vb + vc
+            v, w = vb / denom, vc / denom
+            closest = a + ab * v[:, None] + ac * w[:, None]
+            # The Voronoi regions of corners and edges (Ericson's order).
+            edge = lambda s, e, t: s + (e - s) * np.clip(t, 0, 1)[:, None]
+            t_ab = d1 / (d1 - d3)
+            t_ac = d2 / (d2 - d6)
+            t_bc = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        regions = [
+            (d1 <= 0) & (d2 <= 0), a,
+            (d3 >= 0) & (d4 <= d3), b,
+            (d6 >= 0) & (d5 <= d6), c,
+            (vc <= 0) & (d1 >= 0) & (d3 <= 0), edge(a, b, t_ab),
+            (vb <= 0) & (d2 >= 0) & (d6 <= 0), edge(a, c, t_ac),
+            (va <= 0) & ((d4 - d3) >= 0) & ((d5 - d6) >= 0), edge(b, c, t_bc),
+        ]
+        chosen = np.zeros(len(a), bool)
+        for mask, point in zip(regions[::2], regions[1::2]):
+            take = mask & ~chosen
+            closest[take] = point[take]
+            chosen |= take
+        out[n] = np.sqrt(((closest - p) ** 2).sum(1)).min()
+    return out
+
+
+def _winding_numbers(vertices, faces, points):
+    """The exact winding number at each point: every triangle's solid angle, summed."""
+    out = np.empty(len(points))
+    for n, p in enumerate(points):
+        a, b, c = (vertices[faces[:, k]] - p for k in range(3))
+        la, lb, lc = (np.sqrt((x * x).sum(1)) for x in (a, b, c))
+        numerator = (a * np.cross(b, c)).sum(1)
+        denominator = la * lb * lc + (a * b).sum(1) * lc + (b * c).sum(1) * la + (c * a).sum(1) * lb
+        out[n] = 2 * np.arctan2(numerator, denominator).sum() / (4 * np.pi)
+    return out
+
+
+def _test_points(vertices, faces, rng):
+    lo, hi = vertices.min(0), vertices.max(0)
+    spread = rng.uniform(lo - 0.3 * (hi - lo), hi + 0.3 * (hi - lo), (300, 3))
+    # Points just off the surface, on both sides.
+    f = rng.integers(0, len(faces), 200)
+    weights = rng.dirichlet([1, 1, 1], 200)
+    on = (vertices[faces[f]] * weights[:, :, None]).sum(1)
+    normals = np.cross(vertices[faces[f, 1]] - vertices[faces[f, 0]], vertices[faces[f, 2]] - vertices[faces[f, 0]])
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    near = on + normals * rng.choice([-1e-3, 1e-3], 200)[:, None]
+    return np.vstack([spread, near])
+
+
+@pytest.mark.parametrize("shape", ["closed", "open", "overlapping"])
+def test_signed_distance_and_contains_agree_with_brute_force(trimesh, shape):
+    rng = np.random.default_rng(7)
+    torus = trimesh.creation.torus(major_radius=1.0, minor_radius=0.35, major_sections=48, minor_sections=24)
+    vertices, faces = np.array(torus.vertices), np.array(torus.faces)
+    if shape == "open":
+        faces = faces[np.arange(len(faces)) % 9 != 0]
+    elif shape == "overlapping":
+        vertices = np.vstack([vertices, vertices + [0.6, 0.2, 0.1]])
+        faces = np.vstack([faces, faces + len(torus.vertices)])
+    points = _test_points(vertices, faces, rng)
+    distance = _closest_distances(vertices, faces, points)
+    winding = _winding_numbers(vertices, faces, points)
+    signed = voxelkit.signed_distance((vertices, faces), points)
+    inside = voxelkit.contains((vertices, faces), points)
+    assert signed.dtype == np.float64 and inside.dtype == np.bool_
+    assert np.abs(np.abs(signed) - distance).max() < 1e-9
+    decided = np.abs(winding - 0.5) > 1e-6
+    assert decided.sum() > 450
+    assert (inside[decided] == (winding[decided] >= 0.5)).all()
+    assert ((signed < 0) == inside).all()
+    assert inside.sum() > 50 and (~inside).sum() > 50

@@ -11,7 +11,10 @@ line tool, with the same options and messages::
     grid.report         # the CLI's JSON report as a dict
     grid.write("bunny.vdb")
 
-A mesh is a path (.obj, .stl, .ply, .off, .gltf, .glb) or a ``(vertices, faces)`` pair of arrays. Every
+A mesh is a path (.obj, .stl, .ply, .off, .gltf, .glb), a ``(vertices, faces)`` pair of arrays
+(faces: whole numbers), or a trimesh ``Trimesh`` or Open3D ``TriangleMesh`` as it is.
+``signed_distance(mesh, points)`` and ``contains(mesh, points)`` answer for any points,
+exactly. Every
 call releases the GIL while it works; Ctrl-C cancels it, and ``progress=f`` calls
 ``f(stage, done, total)`` a few times a second (raising in ``f`` cancels too). Errors are
 ``ValueError`` (bad input), ``MemoryError`` (work that does not fit), ``OSError`` (files).
@@ -78,13 +81,15 @@ def _from_schema(name, inputs, request, summary):
     return call
 
 
-mesh = _from_schema("mesh", ["source"], "mesh", "source: a path (.obj, .stl, .ply, .off, .gltf, .glb) or a (vertices, faces) pair.")
-solid = _from_schema("solid", ["source"], "solid", "source: a closed mesh, as for mesh(); the report holds the volume, mass and area.")
+mesh = _from_schema("mesh", ["source"], "mesh", "source: a path (.obj, .stl, .ply, .off, .gltf, .glb), a (vertices, faces) pair, or a trimesh or Open3D mesh.")
+solid = _from_schema("solid", ["source"], "solid", "source: a mesh, as for mesh() (open ones too: see inside); the report holds the volume, mass and area.")
 subdiv = _from_schema("subdiv", ["source"], "subdiv", "source: a Catmull-Clark control mesh (a path or a (vertices, faces) pair).")
 implicit = _from_schema("implicit", ["formula"], "implicit", "formula: F in the coordinates' variables; the surface is F = 0.")
 lines = _from_schema("lines", ["source"], "lines", "source: a mesh with polylines (OBJ `l`) or faces.")
 measure = _from_schema("measure", ["source"], "measure", "source: a closed mesh, a .vdb path or a Grid holding a surface; the measures are in the returned solid's report.")
 combine = _from_schema("combine", ["a", "b"], "combine", "a, b: Grids, or .vdb paths whose grid `grid` (or voxel set) is read; the result has a's transform.")
+signed_distance = _from_schema("signed_distance", ["mesh", "points"], "query", "mesh: as for mesh(); points: an (n, 3) array. Returns the exact distance (f64) from each point to the nearest triangle, negative inside by the option inside; computed on every thread, the GIL released.")
+contains = _from_schema("contains", ["mesh", "points"], "query", "mesh: as for mesh(); points: an (n, 3) array. Returns whether each point lies inside the mesh (bool), by the option inside: its winding number (at least 1/2, exact where near 1/2) or ray parity.")
 csg = _from_schema("csg", ["tree"], None, "A CSG tree (the CLI's `csg --tree` JSON): a path to the JSON file, or the tree as a dict (its file names are then found from the current directory).")
 
 __all__ = [
@@ -93,12 +98,14 @@ __all__ = [
     "OPTIONS",
     "__version__",
     "combine",
+    "contains",
     "csg",
     "implicit",
     "lines",
     "measure",
     "mesh",
     "read_vdb",
+    "signed_distance",
     "solid",
     "subdiv",
 ]

@@ -160,6 +160,22 @@ def measure(
     max_memory_mib: Optional[int] = None,
     progress: Optional[Progress] = None,
 ) -> Grid: ...
+def signed_distance(
+    mesh: MeshSource,
+    points: npt.ArrayLike,
+    inside: str = "auto",
+    threads: Optional[int] = None,
+    max_memory_mib: Optional[int] = None,
+    progress: Optional[Progress] = None,
+) -> npt.NDArray[np.float64]: ...
+def contains(
+    mesh: MeshSource,
+    points: npt.ArrayLike,
+    inside: str = "auto",
+    threads: Optional[int] = None,
+    max_memory_mib: Optional[int] = None,
+    progress: Optional[Progress] = None,
+) -> npt.NDArray[np.bool_]: ...
 def combine(
     a: Union[Grid, Path],
     b: Union[Grid, Path],

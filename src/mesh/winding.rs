@@ -260,6 +260,47 @@ impl WindingTree {
         }
     }
 
+    /// Calls `leaf` with the triangles of every leaf whose cluster ball, and whose ancestors'
+    /// balls, `keep(centre, radius)` keeps.
+    pub fn visit(
+        &self,
+        mut keep: impl FnMut(DVec3, f64) -> bool,
+        mut leaf: impl FnMut(&[[DVec3; 3]]),
+    ) {
+        let mut stack = vec![0usize];
+        while !self.nodes.is_empty()
+            && let Some(i) = stack.pop()
+        {
+            let node = &self.nodes[i];
+            if !keep(node.centre, node.radius) {
+                continue;
+            }
+            match node.children {
+                Some(children) => stack.extend(children),
+                None => leaf(&self.corners[node.first..node.last]),
+            }
+        }
+    }
+
+    /// The distance from `p` to the nearest triangle, exactly.
+    pub fn distance(&self, p: DVec3) -> f64 {
+        let best = std::cell::Cell::new(f64::INFINITY);
+        self.visit(
+            |centre, radius| centre.distance(p) - radius < best.get(),
+            |triangles| {
+                for &t in triangles {
+                    best.set(best.get().min(triangle_distance(p, t)));
+                }
+            },
+        );
+        best.get()
+    }
+
+    /// The winding number at `p` with every triangle summed exactly.
+    pub fn exact_winding_number(&self, p: DVec3) -> f64 {
+        winding_number_of(&self.corners, p)
+    }
+
     /// Whether a triangle comes within `reach` of `p` (clusters skipped by their balls).
     pub fn comes_within(&self, p: DVec3, reach: f64) -> bool {
         let mut stack = vec![0usize];

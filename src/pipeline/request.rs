@@ -443,6 +443,14 @@ request! {
 }
 
 request! {
+    /// Exact distances from points to a mesh, and whether each point lies inside it.
+    QueryRequest as "query" {
+        #[doc = inside_doc!()]
+        inside: InsideRule = InsideRule::default(),
+    }
+}
+
+request! {
     /// A Boolean of two grids.
     CombineRequest as "combine" {
         /// union, intersection or difference.
@@ -776,6 +784,7 @@ pub fn schema() -> Value {
             entry::<ImplicitRequest>(),
             entry::<LinesRequest>(),
             entry::<CombineRequest>(),
+            entry::<QueryRequest>(),
             entry::<BricksRequest>(),
             entry::<LimitsRequest>(),
             entry::<WriteRequest>(),

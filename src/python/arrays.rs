@@ -67,28 +67,42 @@ fn check_copy_fits(vertices: usize, corners: usize, limit: Option<u64>) -> PyRes
     crate::system::check_fits(bytes, limit, &what).map_err(super::to_py_err)
 }
 
+/// `array` as rows of three numbers (an (n, 3) array-like of floats), named `what` in errors.
+pub fn xyz_rows<'py>(
+    array: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<PyArrayLike2<'py, f64, AllowTypeChange>> {
+    let rows: PyArrayLike2<f64, AllowTypeChange> = array
+        .extract()
+        .map_err(|e| PyValueError::new_err(format!("{what}: an (n, 3) float array ({e})")))?;
+    if rows.as_array().ncols() != 3 {
+        return Err(PyValueError::new_err(format!(
+            "{what}: expected shape (n, 3), got {:?}",
+            rows.as_array().shape()
+        )));
+    }
+    Ok(rows)
+}
+
+/// The rows of an (n, 3) array as points.
+pub fn points_of(rows: &PyArrayLike2<'_, f64, AllowTypeChange>) -> Vec<DVec3> {
+    rows.as_array()
+        .rows()
+        .into_iter()
+        .map(|r| DVec3::new(r[0], r[1], r[2]))
+        .collect()
+}
+
 fn mesh_from_arrays(
     vertices: &Bound<'_, PyAny>,
     faces: &Bound<'_, PyAny>,
     limit: Option<u64>,
 ) -> PyResult<Mesh> {
-    let vertices: PyArrayLike2<f64, AllowTypeChange> = vertices
-        .extract()
-        .map_err(|e| PyValueError::new_err(format!("vertices: an (n, 3) float array ({e})")))?;
-    let v = vertices.as_array();
-    if v.ncols() != 3 {
-        return Err(PyValueError::new_err(format!(
-            "vertices: expected shape (n, 3), got {:?}",
-            v.shape()
-        )));
-    }
+    let vertices = xyz_rows(vertices, "vertices")?;
+    let count = vertices.as_array().nrows();
     // The faces are counted first, so that one check covers every copy before any is made.
-    let polygons = polygons(faces, |corners| check_copy_fits(v.nrows(), corners, limit))?;
-    let positions: Vec<DVec3> = v
-        .rows()
-        .into_iter()
-        .map(|r| DVec3::new(r[0], r[1], r[2]))
-        .collect();
+    let polygons = polygons(faces, |corners| check_copy_fits(count, corners, limit))?;
+    let positions = points_of(&vertices);
     let mut polys = Vec::with_capacity(polygons.len());
     for (f, polygon) in polygons.into_iter().enumerate() {
         let p = polygon

@@ -6,6 +6,7 @@ mod bricks;
 mod grid;
 mod jobs;
 mod keywords;
+mod queries;
 mod watch;
 
 use crate::error::Error;
@@ -39,6 +40,8 @@ fn _voxelkit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(jobs::csg, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::measure, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::combine, m)?)?;
+    m.add_function(wrap_pyfunction!(queries::signed_distance, m)?)?;
+    m.add_function(wrap_pyfunction!(queries::contains, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::read_vdb, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::options, m)?)?;
     bricks::register(m)?;

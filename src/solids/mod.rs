@@ -12,5 +12,6 @@ pub mod exterior_flood;
 pub mod flooded_mesh;
 pub mod inside_rule;
 pub mod level_set;
+pub mod point_queries;
 pub mod subdivision;
 pub mod winding_inside;

@@ -84,11 +84,8 @@ pub fn winding_inside(
     transform: Transform,
     region: CoordBox,
 ) -> Result<WindingInside> {
-    let mut points = mesh.positions.clone();
-    points.extend_from_slice(&caps.points);
-    let mut triangles: Vec<[u32; 3]> = mesh.triangles().map(|(_, t)| t).collect();
-    triangles.extend_from_slice(&caps.triangles);
-    let orientation = if closed_volume(&points, &triangles) < 0.0 {
+    let (points, triangles) = closed_by_caps(mesh, caps);
+    let orientation = if winds_reversed(&points, &triangles) {
         -1
     } else {
         1
@@ -180,18 +177,30 @@ pub fn winding_inside(
     Ok(inside)
 }
 
-/// The signed volume mesh and caps enclose together: the integral of their winding number.
-fn closed_volume(points: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
+/// The mesh closed by its caps: their points and triangles together.
+pub fn closed_by_caps(mesh: &Mesh, caps: &BoundaryCaps) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let mut points = mesh.positions.clone();
+    points.extend_from_slice(&caps.points);
+    let mut triangles: Vec<[u32; 3]> = mesh.triangles().map(|(_, t)| t).collect();
+    triangles.extend_from_slice(&caps.triangles);
+    (points, triangles)
+}
+
+/// Whether mesh and caps together (`points`, `triangles`) enclose a negative volume (the
+/// integral of their winding number): then the mesh faces inward as a whole and is read
+/// reversed.
+pub fn winds_reversed(points: &[DVec3], triangles: &[[u32; 3]]) -> bool {
     let Some(&first) = points.first() else {
-        return 0.0;
+        return false;
     };
-    triangles
+    let volume: f64 = triangles
         .par_iter()
         .map(|t| {
             let [a, b, c] = t.map(|v| points[v as usize] - first);
             a.dot(b.cross(c)) / 6.0
         })
-        .sum()
+        .sum();
+    volume < 0.0
 }
 
 /// `t` cut into n^2 triangles of edges at most `longest` (the same surface, facing the same way).
