@@ -8,7 +8,7 @@
 //! change away from the surface, from its rim alone.
 
 use super::Mesh;
-use super::triangle_distance::{segment_distance, triangle_distance};
+use super::triangle_distance::{segment_distance, triangle_distance, triangle_distance_squared};
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
@@ -118,6 +118,9 @@ struct Node {
     /// Area-weighted centroid and the radius of a ball around it holding every corner.
     centre: DVec3,
     radius: f64,
+    /// The box of the corners.
+    lo: DVec3,
+    hi: DVec3,
     /// Half the sum of the triangles' edge cross products: their area-weighted normal.
     area: DVec3,
     /// The sum of the triangles' areas.
@@ -199,6 +202,8 @@ impl WindingTree {
         self.nodes.push(Node {
             centre,
             radius,
+            lo,
+            hi,
             area,
             area_sum: total,
             moment,
@@ -282,23 +287,45 @@ impl WindingTree {
         }
     }
 
-    /// The distance from `p` to the nearest triangle, exactly.
+    /// The distance from `p` to the nearest triangle, exactly: clusters nearer first, none
+    /// whose box lies farther than the nearest triangle found.
     pub fn distance(&self, p: DVec3) -> f64 {
-        let best = std::cell::Cell::new(f64::INFINITY);
-        self.visit(
-            |centre, radius| centre.distance(p) - radius < best.get(),
-            |triangles| {
-                for &t in triangles {
-                    best.set(best.get().min(triangle_distance(p, t)));
+        // The squared distance to a cluster's box: no triangle of it lies nearer.
+        let lower = |i: usize| {
+            let node = &self.nodes[i];
+            (node.lo - p)
+                .max(p - node.hi)
+                .max(DVec3::ZERO)
+                .length_squared()
+        };
+        let mut best = f64::INFINITY;
+        let mut stack = Vec::with_capacity(64);
+        if !self.nodes.is_empty() {
+            stack.push((0usize, lower(0)));
+        }
+        while let Some((i, bound)) = stack.pop() {
+            if bound >= best {
+                continue;
+            }
+            let node = &self.nodes[i];
+            match node.children {
+                Some([a, b]) => {
+                    let (la, lb) = (lower(a), lower(b));
+                    // The nearer child is popped first.
+                    if la <= lb {
+                        stack.extend([(b, lb), (a, la)]);
+                    } else {
+                        stack.extend([(a, la), (b, lb)]);
+                    }
                 }
-            },
-        );
-        best.get()
-    }
-
-    /// The winding number at `p` with every triangle summed exactly.
-    pub fn exact_winding_number(&self, p: DVec3) -> f64 {
-        winding_number_of(&self.corners, p)
+                None => {
+                    for &t in &self.corners[node.first..node.last] {
+                        best = best.min(triangle_distance_squared(p, t));
+                    }
+                }
+            }
+        }
+        best.sqrt()
     }
 
     /// Whether a triangle comes within `reach` of `p` (clusters skipped by their balls).

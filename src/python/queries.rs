@@ -30,8 +30,9 @@ fn over_points<'py, T: numpy::Element + Send>(
     let source = mesh_source(source, limits.max_memory)?;
     let points = xyz_rows(points, "points")?;
     let count = points.as_array().nrows() as u64;
-    // Each point copied, and its answer.
-    let bytes = count.saturating_mul(24 + std::mem::size_of::<T>() as u64);
+    // Each point copied, its place in the Morton order, and its answer (twice: by place, then
+    // in the points' order).
+    let bytes = count.saturating_mul(24 + 8 + 16 + std::mem::size_of::<T>() as u64);
     crate::system::check_fits(bytes, limits.max_memory, &format!("{count} points"))
         .map_err(to_py_err)?;
     let p = points_of(&points);
@@ -42,7 +43,12 @@ fn over_points<'py, T: numpy::Element + Send>(
                 let mesh = source.load(false, UpAxis::default())?;
                 let choice = choose_inside(rule, &mesh, SIGN_NEEDS_CLOSED)?;
                 let queries = PointQueries::new(&mesh, &choice.inside);
-                Ok(p.par_iter().map(|&q| f(&queries, q)).collect::<Vec<T>>())
+                // Points taken in Morton order walk the tree through the same clusters in turn.
+                let order = morton_order(&p);
+                let mut answers: Vec<(usize, T)> =
+                    order.par_iter().map(|&i| (i, f(&queries, p[i]))).collect();
+                answers.par_sort_unstable_by_key(|a| a.0);
+                Ok(answers.into_iter().map(|a| a.1).collect::<Vec<T>>())
             })
         })
         .map_err(to_py_err)?;
@@ -71,4 +77,33 @@ pub fn contains<'py>(
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
     over_points(py, mesh, points, options, PointQueries::contains)
+}
+
+/// The indices of `points` sorted along a Morton curve over their box (10 bits an axis).
+fn morton_order(points: &[DVec3]) -> Vec<usize> {
+    let (lo, hi) = points.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    let scale = 1023.0 / (hi - lo).max(DVec3::splat(f64::MIN_POSITIVE));
+    let spread = |v: u64| {
+        let mut x = v & 0x3ff;
+        x = (x | x << 16) & 0x0300_00ff;
+        x = (x | x << 8) & 0x0300_f00f;
+        x = (x | x << 4) & 0x030c_30c3;
+        (x | x << 2) & 0x0924_9249
+    };
+    let key = |p: DVec3| {
+        let q = ((p - lo) * scale).max(DVec3::ZERO);
+        spread(q.x as u64) | spread(q.y as u64) << 1 | spread(q.z as u64) << 2
+    };
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.par_sort_unstable_by_key(|&i| {
+        if points[i].is_finite() {
+            key(points[i])
+        } else {
+            u64::MAX
+        }
+    });
+    order
 }
