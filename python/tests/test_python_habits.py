@@ -124,3 +124,30 @@ def test_signed_distance_and_contains_agree_with_brute_force(trimesh, shape):
     assert (inside[decided] == (winding[decided] >= 0.5)).all()
     assert ((signed < 0) == inside).all()
     assert inside.sum() > 50 and (~inside).sum() > 50
+
+
+def test_dense_channels_are_named_and_valued_as_the_file_holds_them(tmp_path, pyopenvdb):
+    grid = voxelkit.mesh(tetrahedron_arrays(), resolution=40, sdf=True)
+    band = grid.values("surface")
+    assert band.shape == (len(grid),)
+    with pytest.raises(KeyError, match="surface"):
+        grid.values("distance")
+    dense, offset = grid.to_dense("surface")
+    assert dense.dtype == np.float32 and dense.shape == grid.to_dense()[0].shape
+    assert np.array_equal(dense[tuple((grid.ijk - offset).T)], band)
+    grid.write(tmp_path / "t.vdb")
+    level_set = pyopenvdb.read(str(tmp_path / "t.vdb"), "surface")
+    theirs = np.zeros(dense.shape, np.float32)
+    level_set.copyToArray(theirs, ijk=tuple(int(o) for o in offset))
+    assert np.array_equal(dense, theirs)
+    assert (dense < 0).any() and (dense == -level_set.background).any() and (dense == level_set.background).any()
+    unsigned = voxelkit.mesh(tetrahedron_arrays(), resolution=40, udf=True)
+    assert unsigned.to_dense("distance")[0].min() >= 0
+    normals = voxelkit.mesh(tetrahedron_arrays(), resolution=40, normals=True)
+    dense_normals, _ = normals.to_dense("normal")
+    assert dense_normals.shape == normals.to_dense()[0].shape + (3,)
+
+
+def tetrahedron_arrays():
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
+    return vertices, np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])

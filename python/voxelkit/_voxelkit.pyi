@@ -25,9 +25,15 @@ class Grid:
     def ijk(self) -> npt.NDArray[np.int64]:
         """The active voxels, (N, 3): leaves first, then whole tiles."""
     def values(self, name: str) -> npt.NDArray[np.float32]:
-        """`distance` (N,), `normal` or `Cd` (N, 3) in the order of `ijk`; NaN on tiles."""
-    def to_dense(self) -> Tuple[npt.NDArray[np.bool_], Tuple[int, int, int]]:
-        """A dense boolean array and the index of its element [0, 0, 0]."""
+        """A channel in the order of `ijk`, named as the file names its grid: `surface` (N,)
+        for a level set, `distance` (N,) for unsigned distances, `normal` or `Cd` (N, 3); NaN
+        on tiles."""
+    def to_dense(
+        self, channel: Optional[str] = None
+    ) -> Tuple[Union[npt.NDArray[np.bool_], npt.NDArray[np.float32]], List[int]]:
+        """A dense array over the voxels' box and the index of its element [0, 0, 0]:
+        booleans, or with `channel` (a name of `values`) float32 (a level set's `surface`
+        minus its background inside and plus it outside the band, as OpenVDB reads it)."""
     @property
     def voxel_size(self) -> float: ...
     @property

@@ -26,6 +26,9 @@ pub const VOXELS_GRID: &str = "voxels";
 /// The level set's name in a `.vdb` (Houdini's VDB from Polygons calls it so).
 pub const LEVEL_SET_GRID: &str = "surface";
 
+/// The grid of unsigned distances (`udf`).
+pub const DISTANCE_GRID: &str = "distance";
+
 /// The fog volume's name, first in every file voxelkit writes.
 pub const DENSITY_GRID: &str = "density";
 
@@ -225,7 +228,7 @@ pub fn write_distance_band(
             ),
         ],
         None => vec![grid_out(
-            "distance",
+            DISTANCE_GRID,
             grid,
             GridValues::Distances { background },
             None,

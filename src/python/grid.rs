@@ -5,11 +5,13 @@ use super::keywords::Keywords;
 use super::to_py_err;
 use crate::grid::{SparseGrid, Transform};
 use crate::io::preview::{Scene, View, check_picture_output, render, write_png};
+use crate::io::vdb::{COLOR_GRID, DISTANCE_GRID, LEVEL_SET_GRID, NORMAL_GRID};
+
 use crate::mesh::UpAxis;
 use crate::pipeline::Outcome;
 use crate::pipeline::request::WriteRequest;
 use numpy::ndarray::{Array1, Array2, Array3};
-use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayLike2};
+use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArrayLike2};
 use pyo3::exceptions::{PyKeyError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -49,6 +51,48 @@ impl Grid {
             .map_err(super::to_py_err)
     }
 
+    /// The value channel's name, as the file names its grid: `surface` for a level set,
+    /// `distance` for unsigned distances and the separating voxelizer's distances.
+    fn value_name(&self) -> &'static str {
+        let level_set = self
+            .outcome
+            .distances
+            .as_ref()
+            .is_some_and(|d| d.interior.is_some());
+        if level_set {
+            LEVEL_SET_GRID
+        } else {
+            DISTANCE_GRID
+        }
+    }
+
+    /// The width of channel `name` (1 or 3), none when the grid has no such channel.
+    fn channel_width(&self, name: &str) -> PyResult<usize> {
+        if !self.channel_names().contains(&name) {
+            return Err(PyKeyError::new_err(format!(
+                "no channel `{name}`: this grid has {:?}",
+                self.channel_names()
+            )));
+        }
+        Ok(if name == self.value_name() { 1 } else { 3 })
+    }
+
+    /// Channel `name` of the voxel at leaf `leaf`, offset `n` (width floats).
+    fn channel_at<'a>(
+        &self,
+        name: &str,
+        leaf: &'a crate::grid::Leaf,
+        n: usize,
+    ) -> Option<&'a [f32]> {
+        if name == self.value_name() {
+            leaf.value.as_ref().map(|v| &v[n..n + 1])
+        } else if name == NORMAL_GRID {
+            leaf.normal.as_ref().map(|v| &v[n][..])
+        } else {
+            leaf.color.as_ref().map(|v| &v[n][..])
+        }
+    }
+
     /// A channel per active voxel, `width` floats each, NaN on whole tiles (which carry
     /// no channels).
     fn channel(
@@ -74,10 +118,14 @@ impl Grid {
     /// The names `values` accepts for this grid.
     fn channel_names(&self) -> Vec<&'static str> {
         let c = self.outcome.grid.channels();
-        [(c.value, "distance"), (c.normal, "normal"), (c.color, "Cd")]
-            .into_iter()
-            .filter_map(|(on, name)| on.then_some(name))
-            .collect()
+        [
+            (c.value, self.value_name()),
+            (c.normal, NORMAL_GRID),
+            (c.color, COLOR_GRID),
+        ]
+        .into_iter()
+        .filter_map(|(on, name)| on.then_some(name))
+        .collect()
     }
 }
 
@@ -94,35 +142,14 @@ impl Grid {
             .into_pyarray(py))
     }
 
-    /// A channel in the order of `ijk`: `"distance"` (N,): world units for `sdf`/`udf` bands,
-    /// voxels for the separating voxelizer's `normals=True`; `"normal"` and `"Cd"` (N, 3).
+    /// A channel in the order of `ijk`, named as the file names its grid: `"surface"` (N,) for
+    /// a level set (`sdf`), `"distance"` (N,) for unsigned distances (`udf`, world units) and
+    /// the separating voxelizer's `normals=True` (voxels); `"normal"` and `"Cd"` (N, 3).
     /// Whole tiles give NaN.
     fn values<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-        let c = self.outcome.grid.channels();
-        if self.channel_names().contains(&name) {
-            let width = if name == "distance" { 1 } else { 3 };
-            self.check_per_voxel(4 * width, &format!("the values `{name}`"))?;
-        }
-        let (width, data) = match name {
-            "distance" if c.value => (
-                1,
-                self.channel(1, |l, n| l.value.as_ref().map(|v| &v[n..n + 1])),
-            ),
-            "normal" if c.normal => (
-                3,
-                self.channel(3, |l, n| l.normal.as_ref().map(|v| &v[n][..])),
-            ),
-            "Cd" if c.color => (
-                3,
-                self.channel(3, |l, n| l.color.as_ref().map(|v| &v[n][..])),
-            ),
-            _ => {
-                return Err(PyKeyError::new_err(format!(
-                    "no channel `{name}`: this grid has {:?}",
-                    self.channel_names()
-                )));
-            }
-        };
+        let width = self.channel_width(name)?;
+        self.check_per_voxel(4 * width as u64, &format!("the values `{name}`"))?;
+        let data = self.channel(width, |l, n| self.channel_at(name, l, n));
         if width == 1 {
             Ok(Array1::from_vec(data).into_pyarray(py).into_any())
         } else {
@@ -134,24 +161,79 @@ impl Grid {
         }
     }
 
-    /// The voxels as a dense boolean array and the index of its element [0, 0, 0]:
-    /// `dense[i - ox, j - oy, k - oz]` is voxel (i, j, k). Refused with MemoryError when the
-    /// array would not fit.
-    fn to_dense<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray3<bool>>, [i64; 3])> {
+    /// The voxels as a dense array over their box, and the index of its element [0, 0, 0]:
+    /// `dense[i - ox, j - oy, k - oz]` is voxel (i, j, k). Without `channel`, booleans (the
+    /// voxel set); with one of `values`' names, float32: a level set's `surface` holds minus
+    /// its background inside and plus it outside away from the band (as OpenVDB reads the
+    /// file), unsigned `distance` the background, other channels NaN (`normal` and `Cd`:
+    /// shape (X, Y, Z, 3)). Refused with MemoryError when the array would not fit.
+    #[pyo3(signature = (channel = None))]
+    fn to_dense<'py>(
+        &self,
+        py: Python<'py>,
+        channel: Option<&str>,
+    ) -> PyResult<(Bound<'py, PyAny>, [i64; 3])> {
         let grid = &self.outcome.grid;
+        let width = channel.map(|c| self.channel_width(c)).transpose()?;
         let Some(b) = grid.bbox() else {
-            return Ok((Array3::from_elem((0, 0, 0), false).into_pyarray(py), [0; 3]));
+            let empty = match width {
+                None => Array3::from_elem((0, 0, 0), false)
+                    .into_pyarray(py)
+                    .into_any(),
+                Some(_) => Array3::from_elem((0, 0, 0), 0f32)
+                    .into_pyarray(py)
+                    .into_any(),
+            };
+            return Ok((empty, [0; 3]));
         };
         let dims = [0, 1, 2].map(|a| (b.max[a] - b.min[a] + 1) as u64);
         let cells = dims.iter().try_fold(1u64, |acc, &d| acc.checked_mul(d));
-        let bytes = cells.unwrap_or(u64::MAX);
+        let per_cell = width.map_or(1, |w| 4 * w as u64);
+        let bytes = cells.map_or(u64::MAX, |c| c.saturating_mul(per_cell));
         crate::system::check_fits(bytes, None, &format!("a dense array of {dims:?} voxels"))
             .map_err(to_py_err)?;
-        let mut dense = Array3::from_elem(dims.map(|d| d as usize), false);
-        for v in grid.voxels() {
-            dense[[0, 1, 2].map(|a| (v[a] - b.min[a]) as usize)] = true;
+        let at = |v: crate::grid::Coord| [0, 1, 2].map(|a| (v[a] - b.min[a]) as usize);
+        let [x, y, z] = dims.map(|d| d as usize);
+        let (Some(name), Some(width)) = (channel, width) else {
+            let mut dense = Array3::from_elem((x, y, z), false);
+            for v in grid.voxels() {
+                dense[at(v)] = true;
+            }
+            return Ok((dense.into_pyarray(py).into_any(), b.min));
+        };
+        let mut dense = numpy::ndarray::Array4::from_elem((x, y, z, width), f32::NAN);
+        if name == self.value_name()
+            && let Some(d) = &self.outcome.distances
+        {
+            dense.fill(d.background);
+            if let Some(interior) = &d.interior {
+                for v in interior.voxels() {
+                    if (0..3).all(|a| b.min[a] <= v[a] && v[a] <= b.max[a]) {
+                        dense[[at(v)[0], at(v)[1], at(v)[2], 0]] = -d.background;
+                    }
+                }
+            }
         }
-        Ok((dense.into_pyarray(py), b.min))
+        for leaf in grid.leaves() {
+            for n in leaf.offsets() {
+                if let Some(values) = self.channel_at(name, leaf, n) {
+                    let [i, j, k] = at(crate::grid::offset_coord(leaf.origin, n));
+                    for (c, &value) in values.iter().enumerate() {
+                        dense[[i, j, k, c]] = value;
+                    }
+                }
+            }
+        }
+        let dense = if width == 1 {
+            dense
+                .into_shape_with_order((x, y, z))
+                .expect("one value per voxel")
+                .into_pyarray(py)
+                .into_any()
+        } else {
+            dense.into_pyarray(py).into_any()
+        };
+        Ok((dense, b.min))
     }
 
     /// Edge length of a voxel in world units.
