@@ -50,6 +50,7 @@ def voxelize(obj, **settings):
         "blender_corners": [list(map(float, c)) for c in corners],
         "voxelkit_corners": grid.index_to_world([lo, hi]).tolist(),
         "mesh_box": [mesh_lo.tolist(), mesh_hi.tolist()],
+        "path": bpy.path.abspath(volume.filepath),
     }))
 
 
@@ -60,6 +61,10 @@ imported = bpy.context.selected_objects[0]
 imported.location = (0.0, 3.0, 0.0)
 voxelize(imported, resolution=96, fill="solid")
 voxelize(imported, resolution=64, fill="sdf")
+# A second solid of the same object, the object stretched, goes to a file of its own: the
+# first volume keeps showing what it showed.
+imported.scale = (1.3, 1.0, 1.0)
+voxelize(imported, resolution=96, fill="solid")
 operator = bpy.ops.object.voxelkit_voxelize.get_rna_type().properties
 print("PROPERTIES " + json.dumps({
     name: {

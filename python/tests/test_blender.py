@@ -30,7 +30,10 @@ def test_the_add_on_voxelizes_into_volume_objects(data, tmp_path):
     )
     assert done.returncode == 0 and "DONE" in done.stdout, done.stdout[-3000:] + done.stderr[-3000:]
     results = [json.loads(l[len("RESULT "):]) for l in done.stdout.splitlines() if l.startswith("RESULT ")]
-    assert [r["object"] for r in results] == ["Suzanne", results[1]["object"], results[1]["object"]]
+    assert [r["object"] for r in results] == ["Suzanne"] + [results[1]["object"]] * 3
+    # The two solids of the same object are two files, the first left as it was.
+    assert results[1]["path"] != results[3]["path"] and results[1]["voxels"] != results[3]["voxels"]
+    assert len(voxelkit.read_vdb(results[1]["path"])) == results[1]["voxels"]
     for r in results:
         assert r["operator"] == ["FINISHED"] and r["loaded"] and r["density_loaded"], r
         assert r["grids"][0] == "density", r["grids"]

@@ -10,6 +10,7 @@ its ``density`` grid. The panel is in Properties > Object > voxelkit.
 """
 
 import os
+import itertools
 import tempfile
 
 import bpy
@@ -105,11 +106,18 @@ def voxelize(vertices, triangles, settings):
 
 
 def output_path(name):
-    """Where the volume's file goes: beside the .blend, or in the temporary folder."""
+    """Where the volume's file goes: beside the .blend, or in the temporary folder; named
+    after `name`, numbered past every file a Volume of this .blend already reads, so that a
+    bake never overwrites what another object shows."""
     folder = bpy.path.abspath("//voxelkit") if bpy.data.filepath else None
     folder = folder or os.path.join(tempfile.gettempdir(), "voxelkit-blender")
     os.makedirs(folder, exist_ok=True)
-    return os.path.join(folder, bpy.path.clean_name(name) + ".vdb")
+    used = {os.path.normpath(bpy.path.abspath(v.filepath)) for v in bpy.data.volumes if v.filepath}
+    base = bpy.path.clean_name(name)
+    for n in itertools.count(1):
+        path = os.path.join(folder, base + (f"-{n}" if n > 1 else "") + ".vdb")
+        if os.path.normpath(path) not in used:
+            return path
 
 
 @_options
