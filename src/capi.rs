@@ -750,7 +750,7 @@ pub extern "C" fn vk_options_set_half(options: *mut VkOptions, half: c_int) -> V
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_resolution(options: *mut VkOptions, resolution: u32) -> VkStatus {
     set(options, |o| {
-        o.fit = grid_fit(Some(resolution), None)?;
+        o.fit = grid_fit(Some(resolution), None, None)?;
         Ok(())
     })
 }
@@ -758,7 +758,7 @@ pub extern "C" fn vk_options_set_resolution(options: *mut VkOptions, resolution:
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_voxel_size(options: *mut VkOptions, voxel_size: f64) -> VkStatus {
     set(options, |o| {
-        o.fit = grid_fit(None, Some(voxel_size))?;
+        o.fit = grid_fit(None, Some(voxel_size), None)?;
         Ok(())
     })
 }

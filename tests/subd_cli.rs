@@ -5,6 +5,7 @@
 
 use std::path::Path;
 mod cli_support;
+mod common;
 
 use cli_support::{text, voxelkit};
 use voxelkit::io::vdb::read_vdb_info;
@@ -254,4 +255,35 @@ fn subdiv_solid_writes_the_filled_limit_surface() {
         text(&o)
     );
     assert!(!refused.exists());
+}
+
+/// `--up-axis y` turns a control mesh as it turns a polygon mesh: (x, y, z) -> (x, -z, y).
+#[test]
+fn the_up_axis_turns_the_control_mesh() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let input = data.join("subd/catmark_car.obj");
+    let extent = |up: &str| {
+        let out = dir.path().join(format!("car-{up}.vdb"));
+        let args = [
+            "subdiv",
+            input.to_str().unwrap(),
+            "-r",
+            "32",
+            "--up-axis",
+            up,
+            "-o",
+        ];
+        let o = voxelkit(&[&args[..], &[out.to_str().unwrap()]].concat());
+        assert!(o.status.success(), "{}", text(&o));
+        let b = voxelkit::io::vdb::read_vdb_grid(&out, None)
+            .unwrap()
+            .bbox()
+            .unwrap();
+        [0, 1, 2].map(|a| b.max[a] - b.min[a])
+    };
+    let (kept, turned) = (extent("z"), extent("y"));
+    assert_eq!([kept[0], kept[2], kept[1]], turned);
 }

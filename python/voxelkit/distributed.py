@@ -335,7 +335,15 @@ def solid(source, output, **options):
 _SHORT = {"resolution": "-r", "separability": "-s"}
 _LONG = {"max_memory_mib": "--max-memory"}
 #: The types of the table's options that are not given by their default.
-_TYPES = {"resolution": int, "voxel_size": float, "max_memory_mib": int}
+def _xyz(text):
+    """Three numbers `x,y,z`."""
+    values = [float(v) for v in text.split(",")]
+    if len(values) != 3:
+        raise ValueError(f"expected x,y,z, got {text!r}")
+    return values
+
+
+_TYPES = {"resolution": int, "voxel_size": float, "max_memory_mib": int, "origin": _xyz}
 
 
 def _add_option(parser, field):

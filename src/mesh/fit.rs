@@ -9,6 +9,7 @@
 use super::Aabb;
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, Transform};
+use glam::DVec3;
 
 /// Voxels along the longest bounding-box axis when neither a resolution nor a voxel size is
 /// given.
@@ -21,8 +22,12 @@ pub enum GridFit {
     Resolution(u32),
     /// Voxel edge length in world units.
     VoxelSize(f64),
+    /// Voxels along the longest bbox axis, with the centre of voxel (0, 0, 0) at a given
+    /// world position.
+    ResolutionAt(u32, DVec3),
     /// A placement decided beforehand (one grid shared by several meshes, e.g. the frames of
-    /// an animation): used as it is, whatever the mesh's box.
+    /// an animation, or a voxel size and origin given): used as it is, whatever the mesh's
+    /// box.
     Placed(Transform),
 }
 
@@ -36,6 +41,17 @@ impl GridFit {
             (None, None) => GridFit::Resolution(DEFAULT_RESOLUTION),
         }
     }
+
+    /// The fit with the centre of voxel (0, 0, 0) at `origin`, when given: the grid then
+    /// lies where the caller's other grids lie (`[0, 0, 0]`: every centre on a multiple of
+    /// the voxel size, as trimesh places them; the mesh's low corner: as Open3D does).
+    pub fn with_origin(self, origin: Option<DVec3>) -> GridFit {
+        match (self, origin) {
+            (GridFit::Resolution(r), Some(o)) => GridFit::ResolutionAt(r, o),
+            (GridFit::VoxelSize(h), Some(o)) => GridFit::Placed(Transform::new(o, h)),
+            (fit, _) => fit,
+        }
+    }
 }
 
 /// The transform that places `bbox` in index space as described in the module docs.
@@ -43,6 +59,15 @@ pub fn fit_transform(bbox: &Aabb, fit: GridFit) -> Result<Transform> {
     let longest = bbox.extent().max_element();
     let voxel_size = match fit {
         GridFit::Placed(t) => return Ok(t),
+        GridFit::ResolutionAt(r, origin) => {
+            let h = fit_transform(bbox, GridFit::Resolution(r))?.voxel_size;
+            if !origin.is_finite() {
+                return Err(Error::InvalidArgument(format!(
+                    "the origin must be three finite numbers, got {origin}"
+                )));
+            }
+            return Ok(Transform::new(origin, h));
+        }
         GridFit::Resolution(0) => {
             return Err(Error::InvalidArgument(
                 "resolution must be at least 1".into(),

@@ -21,13 +21,21 @@ crate::named_choices! {
     "z" => Z,
 }
 
+impl UpAxis {
+    /// `p` with this up axis turned to +z (a rotation: orientation and volume kept).
+    pub fn turn(self, p: DVec3) -> DVec3 {
+        match self {
+            UpAxis::Y => DVec3::new(p.x, -p.z, p.y),
+            UpAxis::Z => p,
+        }
+    }
+}
+
 impl Mesh {
-    /// The mesh with its `up` axis turned to +z (a rotation: orientation and volume kept).
+    /// The mesh with its `up` axis turned to +z.
     pub fn with_up_axis(mut self, up: UpAxis) -> Mesh {
-        if up == UpAxis::Y {
-            for p in &mut self.positions {
-                *p = DVec3::new(p.x, -p.z, p.y);
-            }
+        for p in &mut self.positions {
+            *p = up.turn(*p);
         }
         self
     }

@@ -414,7 +414,7 @@ pub(super) fn octree_resolution(fit: GridFit, min: DVec3, max: DVec3) -> Result<
         other => other,
     };
     match fit {
-        GridFit::Resolution(r) => Ok(r),
+        GridFit::Resolution(r) | GridFit::ResolutionAt(r, _) => Ok(r),
         GridFit::VoxelSize(h) if h.is_finite() && h > 0.0 => {
             let r = ((max - min).max_element() / h).ceil();
             if r > f64::from(1u32 << 16) {

@@ -118,7 +118,11 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
             solid,
         } => Work::Subdivision {
             control: match mesh {
-                MeshSource::File(path) => ControlMesh::load(path)?,
+                MeshSource::File(path) => {
+                    let mut control = ControlMesh::load(path)?;
+                    control.map_points(|p| up.turn(p));
+                    control
+                }
                 MeshSource::Mesh(m) => ControlMesh::from_mesh(m)?,
             },
             options: *options,

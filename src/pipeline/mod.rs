@@ -301,9 +301,10 @@ impl GridFit {
     pub fn describe(&self) -> String {
         match self {
             GridFit::Resolution(r) => r.to_string(),
+            GridFit::ResolutionAt(r, o) => format!("{r}, origin {:?},{:?},{:?}", o.x, o.y, o.z),
             GridFit::VoxelSize(h) => format!("voxel size {h:?}"),
             GridFit::Placed(t) => format!(
-                "voxel size {:?}, origin {:?},{:?},{:?} (shared)",
+                "voxel size {:?}, origin {:?},{:?},{:?} (placed beforehand)",
                 t.voxel_size, t.origin.x, t.origin.y, t.origin.z
             ),
         }

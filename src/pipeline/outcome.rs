@@ -252,14 +252,15 @@ pub(super) fn provenance(
 }
 
 /// How the grid was fitted, typed: `resolution` (an int) or `voxel_size` (a double), and
-/// `grid_placement` `shared` for a grid placed beforehand for several meshes.
+/// `grid_placement` `given` for a grid placed beforehand (shared by several meshes, or a voxel
+/// size and origin given).
 fn fit_metadata(fit: GridFit) -> Vec<(&'static str, MetaValue)> {
     match fit {
-        GridFit::Resolution(r) => vec![("resolution", r.into())],
+        GridFit::Resolution(r) | GridFit::ResolutionAt(r, _) => vec![("resolution", r.into())],
         GridFit::VoxelSize(h) => vec![("voxel_size", h.into())],
         GridFit::Placed(t) => vec![
             ("voxel_size", t.voxel_size.into()),
-            ("grid_placement", "shared".into()),
+            ("grid_placement", "given".into()),
         ],
     }
 }

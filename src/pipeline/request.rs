@@ -96,7 +96,8 @@ plain_fields!(
     Option<u64>,
     Option<f64>,
     Option<String>,
-    Option<[f32; 3]>
+    Option<[f32; 3]>,
+    Option<[f64; 3]>
 );
 
 /// The doc of every `inside` field.
@@ -117,6 +118,11 @@ macro_rules! request {
                 resolution: Option<u32> = None,
                 /// Voxel edge length in world units (instead of resolution).
                 voxel_size: Option<f64> = None,
+                /// The world position of the centre of voxel (0, 0, 0) (none: half a voxel
+                /// inside the low corner of the mesh's box): [0, 0, 0] puts every centre on a
+                /// multiple of the voxel size, as trimesh does; the mesh's low corner gives
+                /// Open3D's VoxelGrid centres.
+                origin: Option<[f64; 3]> = None,
                 $($fields)*
                 /// The up axis of a mesh file: y turns a Y-up file to Z-up as Blender's
                 /// importer does.
@@ -477,7 +483,11 @@ request! {
 }
 
 /// The grid fit of `resolution` or `voxel_size` (not both), checked.
-pub fn grid_fit(resolution: Option<u32>, voxel_size: Option<f64>) -> Result<GridFit> {
+pub fn grid_fit(
+    resolution: Option<u32>,
+    voxel_size: Option<f64>,
+    origin: Option<[f64; 3]>,
+) -> Result<GridFit> {
     if resolution.is_some() && voxel_size.is_some() {
         return Err(Error::InvalidArgument(
             "give resolution or voxel_size, not both".into(),
@@ -491,7 +501,14 @@ pub fn grid_fit(resolution: Option<u32>, voxel_size: Option<f64>) -> Result<Grid
     if let Some(h) = voxel_size {
         positive("voxel_size", h)?;
     }
-    Ok(GridFit::from_options(resolution, voxel_size))
+    if let Some(o) = origin
+        && !o.iter().all(|v| v.is_finite())
+    {
+        return Err(Error::InvalidArgument(format!(
+            "origin must be three finite numbers, got {o:?}"
+        )));
+    }
+    Ok(GridFit::from_options(resolution, voxel_size).with_origin(origin.map(DVec3::from_array)))
 }
 
 /// Refuses a value that is not a positive, finite number, naming the option.
@@ -580,7 +597,7 @@ pub trait Request: Schema {
 macro_rules! fitted {
     () => {
         fn fit(&self) -> Result<GridFit> {
-            grid_fit(self.resolution, self.voxel_size)
+            grid_fit(self.resolution, self.voxel_size, self.origin)
         }
 
         fn up_axis(&self) -> UpAxis {
@@ -708,7 +725,7 @@ impl Request for ImplicitRequest {
     type Input = String;
 
     fn fit(&self) -> Result<GridFit> {
-        grid_fit(Some(self.resolution), None)
+        grid_fit(Some(self.resolution), None, None)
     }
 
     fn task(&self, formula: String) -> Result<Task> {
@@ -756,7 +773,7 @@ impl Request for CombineRequest {
 
 impl BricksRequest {
     pub fn fit(&self) -> Result<GridFit> {
-        grid_fit(self.resolution, self.voxel_size)
+        grid_fit(self.resolution, self.voxel_size, self.origin)
     }
 }
 

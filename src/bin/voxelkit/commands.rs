@@ -21,11 +21,11 @@ use voxelkit::{Error, Result};
 
 impl FitArgs {
     pub fn grid_fit(&self) -> GridFit {
-        GridFit::from_options(self.resolution, self.voxel_size)
+        GridFit::from_options(self.resolution, self.voxel_size).with_origin(self.origin)
     }
 }
 
-fn parse_vec3(s: &str) -> std::result::Result<DVec3, String> {
+pub fn parse_vec3(s: &str) -> std::result::Result<DVec3, String> {
     let v: Vec<f64> = s
         .split(',')
         .map(|p| {
@@ -455,6 +455,7 @@ pub fn demo(folder: &Path, resolution: u32, global: &Global) -> Result<()> {
         let fit = FitArgs {
             resolution: Some(resolution),
             voxel_size: None,
+            origin: None,
         };
         let out = folder.join(format!("trefoil-{}.vdb", sep.adjacency()));
         let job = surface_job(MeshSource::Mesh(mesh.clone()), fit, surface);

@@ -96,6 +96,11 @@ pub struct FitArgs {
     /// Voxel edge length in world units (instead of --resolution).
     #[arg(long)]
     voxel_size: Option<f64>,
+    /// World position `x,y,z` of the centre of voxel (0,0,0) [default: half a voxel inside the
+    /// low corner of the mesh's box]: 0,0,0 puts every centre on a multiple of the voxel size
+    /// (as trimesh does), the mesh's low corner gives Open3D's VoxelGrid centres.
+    #[arg(long, value_parser = commands::parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z")]
+    origin: Option<glam::DVec3>,
 }
 
 #[derive(Args, Clone, Copy)]
@@ -236,7 +241,7 @@ impl Command {
             Command::Intersect(a) => (Some(&a.write), None),
             Command::Measure(a) => (None, Some(a.up.up_axis)),
             Command::Implicit(a) => (Some(&a.write), None),
-            Command::Subdiv(a) => (Some(&a.voxelize.write), None),
+            Command::Subdiv(a) => (Some(&a.voxelize.write), Some(a.voxelize.up.up_axis)),
             Command::Info { .. } | Command::Render(_) => (None, None),
         }
     }

@@ -64,6 +64,8 @@ pub struct SubdivVoxelizeArgs {
     output: Option<PathBuf>,
     #[command(flatten)]
     pub write: crate::WriteArgs,
+    #[command(flatten)]
+    pub up: crate::UpAxisArgs,
 }
 
 #[derive(Subcommand)]
