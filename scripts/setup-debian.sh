@@ -4,7 +4,8 @@
 #   .vdb files); OpenVDB, Boost headers, TBB and OpenSubdiv (the C++ side, the tests'
 #   independent reader and the benchmarks' reference); pyopenvdb; CMake and valgrind (the C
 #   and C++ interface tests); Blender (opens the .vdb files headless in a test); Python's venv
-#   and pip (scripts/test-all.sh builds the Python module into a virtual environment).
+#   and pip (scripts/test-all.sh builds the Python module into a virtual environment); EGL
+#   (Open3D, which the Python tests compare against, loads it).
 #   On a fresh Debian 12 that is about 410 packages with their dependencies: 430 MB to
 #   download, 1.8 GB installed, a few minutes.
 # - Rust, when cargo is missing or older than Cargo.toml's rust-version (Debian 12's own cargo
@@ -22,6 +23,7 @@ packages=(
     libopenvdb-dev libboost-dev libtbb-dev libosd-dev python3-openvdb
     blender
     python3-venv python3-pip python3-numpy
+    libegl1
 )
 
 command -v apt-get >/dev/null && command -v dpkg-query >/dev/null ||

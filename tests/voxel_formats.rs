@@ -65,9 +65,9 @@ fn same_voxels_as_the_vdb(command: &str) {
     let (binvox, vdb) = (dir.path().join("t.binvox"), dir.path().join("t.vdb"));
     for (out, grids) in [(&binvox, "density"), (&vdb, "voxels")] {
         let o = voxelkit(&[
+            command,
             "--grids",
             grids,
-            command,
             obj.to_str().unwrap(),
             "-r",
             "40",
@@ -149,9 +149,9 @@ fn a_coloured_surface_as_vox_holds_the_voxels_and_colours_of_its_vdb() {
     let (vox, vdb) = (dir.path().join("t.vox"), dir.path().join("t.vdb"));
     for out in [&vox, &vdb] {
         let o = voxelkit(&[
+            "mesh",
             "--grids",
             "voxels,Cd",
-            "mesh",
             obj.to_str().unwrap(),
             "--method",
             "projective",
@@ -201,9 +201,9 @@ fn a_set_past_256_voxels_is_split_into_models_and_past_2048_refused() {
     let (vox, vdb) = (dir.path().join("big.vox"), dir.path().join("big.vdb"));
     for out in [&vox, &vdb] {
         let o = voxelkit(&[
+            "mesh",
             "--grids",
             "voxels",
-            "mesh",
             obj.to_str().unwrap(),
             "-r",
             "600",

@@ -8,12 +8,14 @@ mod leaf;
 mod sparse;
 mod tiles;
 mod transform;
+mod up_axis;
 
 pub use coord::{Coord, CoordBox, LEAF_VOXELS, leaf_offset, leaf_origin, offset_coord};
 pub use leaf::{Channels, Leaf};
 pub use sparse::{Accessor, Block, SparseGrid};
 pub use tiles::{NODE_DIM, TILE_BYTES, Tiles, node_origin};
 pub use transform::Transform;
+pub use up_axis::UpAxis;
 
 mod adjacency;
 mod dense;

@@ -10,8 +10,8 @@
 
 use super::atomic::write_atomic;
 use crate::error::{Error, Result};
+use crate::grid::UpAxis;
 use crate::grid::{Coord, Leaf, SparseGrid};
-use crate::mesh::UpAxis;
 use glam::Vec3;
 use rayon::prelude::*;
 use std::path::Path;
