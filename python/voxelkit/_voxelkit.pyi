@@ -34,6 +34,9 @@ class Grid:
         """A dense array over the voxels' box and the index of its element [0, 0, 0]:
         booleans, or with `channel` (a name of `values`) float32 (a level set's `surface`
         minus its background inside and plus it outside the band, as OpenVDB reads it)."""
+    def sample(self, points: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """The value at each world point, trilinear between voxel centres as OpenVDB's box
+        sampler reads the file (a level set: minus the background inside, plus it outside)."""
     @property
     def voxel_size(self) -> float: ...
     @property

@@ -236,6 +236,68 @@ impl Grid {
         Ok((dense, b.min))
     }
 
+    /// The grid's value at each of an (n, 3) array of world points, trilinear between voxel
+    /// centres, as OpenVDB's box sampler reads the file: a level set's band values, minus its
+    /// background inside and plus it outside the band; unsigned distances with the background
+    /// beyond; a voxel set 1 on its voxels and 0 elsewhere.
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
+        let rows = super::arrays::xyz_rows(points, "points")?;
+        let count = rows.as_array().nrows() as u64;
+        crate::system::check_fits(count.saturating_mul(32), None, &format!("{count} points"))
+            .map_err(to_py_err)?;
+        let points = super::arrays::points_of(&rows);
+        let grid = &self.outcome.grid;
+        let distances = self.outcome.distances.as_ref();
+        let value = |c: crate::grid::Coord| -> f64 {
+            let n = crate::grid::leaf_offset(c);
+            let band = grid
+                .leaf(crate::grid::leaf_origin(c))
+                .filter(|l| l.is_on(n))
+                .and_then(|l| l.value.as_ref().map(|v| f64::from(v[n])));
+            match (distances, band) {
+                (Some(_), Some(v)) => v,
+                (Some(d), None) => {
+                    let inside = d.interior.as_ref().is_some_and(|i| i.contains(c));
+                    f64::from(if inside { -d.background } else { d.background })
+                }
+                (None, _) => f64::from(u8::from(grid.contains(c))),
+            }
+        };
+        let transform = self.transform();
+        let values: Vec<f64> = py.detach(|| {
+            use rayon::prelude::*;
+            points
+                .par_iter()
+                .map(|&p| {
+                    if !p.is_finite() {
+                        return f64::NAN;
+                    }
+                    let q = transform.world_to_index(p);
+                    let base = q.floor();
+                    let t = q - base;
+                    let b = [base.x as i64, base.y as i64, base.z as i64];
+                    let mut sum = 0.0;
+                    for corner in 0..8 {
+                        let d = [0, 1, 2].map(|a| (corner >> a) & 1);
+                        let weight = [0, 1, 2]
+                            .map(|a| if d[a] == 1 { t[a] } else { 1.0 - t[a] })
+                            .iter()
+                            .product::<f64>();
+                        if weight > 0.0 {
+                            sum += weight * value([0, 1, 2].map(|a| b[a] + d[a] as i64));
+                        }
+                    }
+                    sum
+                })
+                .collect()
+        });
+        Ok(values.into_pyarray(py))
+    }
+
     /// Edge length of a voxel in world units.
     #[getter]
     fn voxel_size(&self) -> f64 {
