@@ -54,41 +54,43 @@ impl GridFit {
     }
 }
 
-/// The transform that places `bbox` in index space as described in the module docs.
+/// The transform that places `bbox` in index space as described in the module docs. Every
+/// fit's voxel size and origin are checked here, whichever front end gave them.
 pub fn fit_transform(bbox: &Aabb, fit: GridFit) -> Result<Transform> {
-    let longest = bbox.extent().max_element();
-    let voxel_size = match fit {
-        GridFit::Placed(t) => return Ok(t),
-        GridFit::ResolutionAt(r, origin) => {
-            let h = fit_transform(bbox, GridFit::Resolution(r))?.voxel_size;
-            if !origin.is_finite() {
-                return Err(Error::InvalidArgument(format!(
-                    "the origin must be three finite numbers, got {origin}"
-                )));
-            }
-            return Ok(Transform::new(origin, h));
-        }
-        GridFit::Resolution(0) => {
-            return Err(Error::InvalidArgument(
-                "resolution must be at least 1".into(),
-            ));
-        }
-        GridFit::Resolution(r) if longest > 0.0 => longest / r as f64,
-        GridFit::Resolution(_) => {
-            return Err(Error::InvalidArgument(
-                "the mesh has zero extent; give a voxel size (option `voxel_size`) instead of a resolution"
-                    .into(),
-            ));
-        }
-        // Volumes and masses need h^3: refuse sizes whose cube overflows.
-        GridFit::VoxelSize(h) if h > 0.0 && h.powi(3).is_finite() => h,
-        GridFit::VoxelSize(h) => {
-            return Err(Error::InvalidArgument(format!(
-                "voxel size must be a positive number whose cube is finite, got {h:?}"
-            )));
-        }
+    let h = voxel_size(bbox, fit)?;
+    let origin = match fit {
+        GridFit::Placed(t) => t.origin,
+        GridFit::ResolutionAt(_, origin) => origin,
+        GridFit::Resolution(_) | GridFit::VoxelSize(_) => bbox.min + 0.5 * h,
     };
-    Ok(Transform::new(bbox.min + 0.5 * voxel_size, voxel_size))
+    if !origin.is_finite() {
+        return Err(Error::InvalidArgument(format!(
+            "the origin must be three finite numbers, got {origin}"
+        )));
+    }
+    Ok(Transform::new(origin, h))
+}
+
+/// The voxel size `fit` gives `bbox`.
+fn voxel_size(bbox: &Aabb, fit: GridFit) -> Result<f64> {
+    let longest = bbox.extent().max_element();
+    match fit {
+        GridFit::Placed(t) => voxel_size(bbox, GridFit::VoxelSize(t.voxel_size)),
+        GridFit::ResolutionAt(r, _) => voxel_size(bbox, GridFit::Resolution(r)),
+        GridFit::Resolution(0) => Err(Error::InvalidArgument(
+            "resolution must be at least 1".into(),
+        )),
+        GridFit::Resolution(r) if longest > 0.0 => Ok(longest / r as f64),
+        GridFit::Resolution(_) => Err(Error::InvalidArgument(
+            "the mesh has zero extent; give a voxel size (option `voxel_size`) instead of a resolution"
+                .into(),
+        )),
+        // Volumes and masses need h^3: refuse sizes whose cube overflows.
+        GridFit::VoxelSize(h) if h > 0.0 && h.powi(3).is_finite() => Ok(h),
+        GridFit::VoxelSize(h) => Err(Error::InvalidArgument(format!(
+            "voxel size must be a positive number whose cube is finite, got {h:?}"
+        ))),
+    }
 }
 
 /// The voxels covering `bbox` on `transform`, one more on every side: a dense volume in which

@@ -501,13 +501,6 @@ pub fn grid_fit(
     if let Some(h) = voxel_size {
         positive("voxel_size", h)?;
     }
-    if let Some(o) = origin
-        && !o.iter().all(|v| v.is_finite())
-    {
-        return Err(Error::InvalidArgument(format!(
-            "origin must be three finite numbers, got {o:?}"
-        )));
-    }
     Ok(GridFit::from_options(resolution, voxel_size).with_origin(origin.map(DVec3::from_array)))
 }
 
