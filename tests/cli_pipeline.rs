@@ -298,3 +298,54 @@ fn a_y_up_mesh_is_turned_z_up_on_request() {
     );
     assert_eq!(n_kept, n_turned);
 }
+
+#[test]
+fn bounds_place_the_grid_and_leave_out_every_voxel_beyond_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("torus.obj");
+    voxelkit::mesh::generate::torus(glam::DVec3::ZERO, 1.0, 0.3, 48, 16)
+        .write_obj(&obj)
+        .unwrap();
+    let (lo, hi) = (
+        glam::DVec3::new(-1.5, -1.5, -0.2),
+        glam::DVec3::new(0.0, 1.5, 0.4),
+    );
+    for command in ["mesh", "solid"] {
+        let out = dir.path().join(format!("{command}.vdb"));
+        let bounds = "-1.5,-1.5,-0.2,0,1.5,0.4";
+        let o = voxelkit(&[
+            command,
+            s(&obj),
+            "-r",
+            "60",
+            "--bounds",
+            bounds,
+            "-o",
+            s(&out),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        assert!(text(&o).contains("outside left out"), "{}", text(&o));
+        let grid = voxelkit::io::vdb::read_vdb_grid(&out, None).unwrap();
+        let t = grid.transform;
+        // 60 voxels along the bounds' longest side (y, 3 units), the first centre half a
+        // voxel inside their low corner.
+        assert!((t.voxel_size - 0.05).abs() < 1e-12, "{}", t.voxel_size);
+        assert!((t.origin - (lo + 0.025)).length() < 1e-12, "{}", t.origin);
+        assert!(grid.voxel_count() > 500);
+        for v in grid.voxels() {
+            let c = t.index_to_world(v);
+            assert!(
+                c.cmpge(lo).all() && c.cmple(hi).all(),
+                "{command}: {v:?} at {c}"
+            );
+        }
+    }
+    let out = dir.path().join("bad.vdb");
+    let o = voxelkit(&["mesh", s(&obj), "--bounds", "1,0,0,0,1,1", "-o", s(&out)]);
+    assert!(
+        !o.status.success() && text(&o).contains("bounds"),
+        "{}",
+        text(&o)
+    );
+    assert!(!out.exists());
+}

@@ -12,6 +12,11 @@ import pytest
 import voxelkit
 from voxelkit import distributed
 
+from conftest import REPO
+
+#: The package's stubs as the repository holds them (written by `python -m voxelkit._stubs`).
+PACKAGE_STUBS = REPO / "python" / "voxelkit" / "__init__.pyi"
+#: The extension's own stubs (the Grid class), written by hand.
 STUBS = pathlib.Path(voxelkit.__file__).with_name("_voxelkit.pyi")
 #: Each function's positional inputs and the table entry of its options.
 FUNCTIONS = {
@@ -39,8 +44,14 @@ def plain(value):
     return list(value) if isinstance(value, tuple) else value
 
 
-def test_stubs_declare_the_tables_options_and_defaults():
-    tree = ast.parse(STUBS.read_text())
+def test_the_stubs_are_written_from_the_table():
+    from voxelkit import _stubs
+
+    assert PACKAGE_STUBS.read_text() == _stubs.stubs(), "run `python -m voxelkit._stubs python/voxelkit/__init__.pyi`"
+
+
+def test_stubs_declare_the_tables_options_defaults_and_help():
+    tree = ast.parse(PACKAGE_STUBS.read_text())
     stubs = {n.name: n for n in tree.body if isinstance(n, ast.FunctionDef)}
     for name, (inputs, request) in FUNCTIONS.items():
         args = stubs[name].args
@@ -48,6 +59,12 @@ def test_stubs_declare_the_tables_options_and_defaults():
         assert names[: len(inputs)] == inputs, name
         defaults = [plain(ast.literal_eval(d)) for d in args.defaults]
         assert list(zip(names[len(inputs):], defaults)) == expected(request), name
+        assert all(a.annotation is not None for a in args.args), name
+        assert ast.get_docstring(stubs[name]) == inspect.cleandoc(getattr(voxelkit, name).__doc__), name
+    # Everything the package exports is declared.
+    declared = set(stubs) | {a.asname for n in tree.body if isinstance(n, ast.ImportFrom) for a in n.names}
+    declared |= {n.target.id for n in tree.body if isinstance(n, ast.AnnAssign)}
+    assert set(voxelkit.__all__) <= declared
 
 
 def test_signatures_and_help_document_every_option():

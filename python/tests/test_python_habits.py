@@ -183,6 +183,50 @@ def test_origin_places_voxel_centres_where_open3d_and_trimesh_put_them(trimesh, 
     assert iou_trimesh > 0.5
 
 
+def test_bounds_place_and_cut_the_grid_as_open3d_does_within_bounds(trimesh, open3d):
+    mesh = trimesh.creation.torus(major_radius=1.0, minor_radius=0.35, major_sections=64, minor_sections=32)
+    h, low, high = 0.05, np.array([-1.5, -0.4, -0.5]), np.array([0.3, 1.5, 0.5])
+    o3d_mesh = open3d.geometry.TriangleMesh(
+        open3d.utility.Vector3dVector(mesh.vertices), open3d.utility.Vector3iVector(mesh.faces)
+    )
+    o3d_grid = open3d.geometry.VoxelGrid.create_from_triangle_mesh_within_bounds(o3d_mesh, h, low, high)
+    # Open3D places its grid in the bounds but keeps the voxels beyond them: compare inside.
+    dims = np.floor((high - low) / h - 0.5).astype(int) + 1  # centres within the bounds
+    theirs = {tuple(v.grid_index) for v in o3d_grid.get_voxels() if np.all((0 <= v.grid_index) & (v.grid_index < dims))}
+    ours_grid = voxelkit.mesh(mesh, voxel_size=h, bounds=[low, high])
+    assert np.allclose(ours_grid.origin, low + h / 2)
+    ours = voxel_set(ours_grid.ijk)
+    iou = len(ours & theirs) / len(ours | theirs)
+    print(f"IoU with Open3D's VoxelGrid within bounds at voxel size {h}: {iou:.3f} ({len(ours)} and {len(theirs)} voxels)")
+    assert iou > 0.7
+    centres = ours_grid.index_to_world(ours_grid.ijk)
+    assert np.all(centres >= low) and np.all(centres <= high)
+    # The dense array spans the bounds, whatever the mesh holds there.
+    dense, corner = ours_grid.to_dense()
+    assert dense.shape == tuple(dims) and tuple(corner) == (0, 0, 0)
+    assert dense.sum() == len(ours_grid)
+
+
+def test_bounds_keep_the_same_solid_voxels_and_measure_what_is_kept(trimesh):
+    mesh = trimesh.creation.icosphere(subdivisions=4, radius=1.0)
+    h, origin = 0.04, (0.0, 0.0, 0.0)
+    full = voxelkit.solid(mesh, voxel_size=h, origin=origin)
+    bounds = [[-2.0, -2.0, 0.0], [2.0, 2.0, 2.0]]
+    upper = voxelkit.solid(mesh, voxel_size=h, origin=origin, bounds=bounds)
+    centres = full.index_to_world(full.ijk)
+    expected = voxel_set(full.ijk[centres[:, 2] >= 0.0])
+    assert voxel_set(upper.ijk) == expected
+    report = upper.report
+    assert report["voxels"] == len(expected)
+    assert report["voxels_outside_bounds"] == len(full) - len(expected)
+    assert report["inside_voxels"] + report["surface_voxels"] == len(expected)
+    assert report["volume_with_surface"] == pytest.approx(len(expected) * h**3)
+    # Half the sphere's volume lies between the kept solid's inside and whole.
+    assert report["volume_inside"] <= mesh.volume / 2 <= report["volume_with_surface"] * 1.02
+    with pytest.raises(ValueError, match="bounds"):
+        voxelkit.solid(mesh, bounds=[[1.0, 0.0, 0.0], [0.0, 1.0, 1.0]])
+
+
 def test_sample_reads_a_level_set_as_openvdb_does():
     vertices, faces = tetrahedron_arrays()
     grid = voxelkit.mesh((vertices, faces), resolution=40, sdf=True)

@@ -55,11 +55,64 @@ def _option_lines(fields):
     return lines
 
 
-def _from_schema(name, inputs, request, summary):
-    """``_voxelkit.<name>`` with the schema's signature and docs: positional inputs, then
+#: Each function made from the table: its positional inputs with their types (annotations
+#: for the generated stubs), the table entry of its options, what it returns, and what it
+#: takes. ``python -m voxelkit._stubs`` writes ``__init__.pyi`` from these and the table.
+_FUNCTIONS = {
+    "mesh": (
+        {"source": "MeshSource"}, "mesh", "Grid",
+        "source: a path (.obj, .stl, .ply, .off, .gltf, .glb), a (vertices, faces) pair, or a trimesh or Open3D mesh.",
+    ),
+    "solid": (
+        {"source": "MeshSource"}, "solid", "Grid",
+        "source: a mesh, as for mesh() (open ones too: see inside); the report holds the volume, mass and area.",
+    ),
+    "subdiv": (
+        {"source": "MeshSource"}, "subdiv", "Grid",
+        "source: a Catmull-Clark control mesh (a path or a (vertices, faces) pair).",
+    ),
+    "implicit": (
+        {"formula": "str"}, "implicit", "Grid",
+        "formula: F in the coordinates' variables; the surface is F = 0.",
+    ),
+    "lines": (
+        {"source": "MeshSource"}, "lines", "Grid",
+        "source: a mesh with polylines (OBJ `l`) or faces.",
+    ),
+    "measure": (
+        {"source": "Union[MeshSource, Grid]"}, "measure", "Grid",
+        "source: a closed mesh, a .vdb path or a Grid holding a surface; the measures are in the returned solid's report.",
+    ),
+    "combine": (
+        {"a": "Union[Grid, Path]", "b": "Union[Grid, Path]"}, "combine", "Grid",
+        "a, b: Grids, or .vdb paths whose grid `grid` (or voxel set) is read; the result has a's transform.",
+    ),
+    "signed_distance": (
+        {"mesh": "MeshSource", "points": "npt.ArrayLike"}, "query", "npt.NDArray[np.float64]",
+        "mesh: as for mesh(); points: an (n, 3) array. Returns the exact distance (f64) from each point to the nearest triangle, negative inside by the option inside; computed on every thread, the GIL released.",
+    ),
+    "contains": (
+        {"mesh": "MeshSource", "points": "npt.ArrayLike"}, "query", "npt.NDArray[np.bool_]",
+        "mesh: as for mesh(); points: an (n, 3) array. Returns whether each point lies inside the mesh (bool), by the option inside: its winding number (at least 1/2, exact where near 1/2) or ray parity.",
+    ),
+    "csg": (
+        {"tree": "Union[Path, Dict[str, Any]]"}, None, "Grid",
+        "A CSG tree (the CLI's `csg --tree` JSON): a path to the JSON file, or the tree as a dict (its file names are then found from the current directory).",
+    ),
+}
+
+
+def _option_fields(request):
+    """The table's fields of a function's options: its request's, then the limits."""
+    return (OPTIONS[request]["fields"] if request else []) + OPTIONS["limits"]["fields"]
+
+
+def _from_schema(name):
+    """``_voxelkit.<name>`` with the table's signature and docs: positional inputs, then
     the request's options, the limits and ``progress``."""
+    inputs, request, _, summary = _FUNCTIONS[name]
     native = getattr(_voxelkit, name)
-    fields = (OPTIONS[request]["fields"] if request else []) + OPTIONS["limits"]["fields"]
+    fields = _option_fields(request)
     kind = _inspect.Parameter.POSITIONAL_OR_KEYWORD
     params = [_inspect.Parameter(i, kind) for i in inputs]
     params += _option_parameters(fields, kind)
@@ -81,16 +134,16 @@ def _from_schema(name, inputs, request, summary):
     return call
 
 
-mesh = _from_schema("mesh", ["source"], "mesh", "source: a path (.obj, .stl, .ply, .off, .gltf, .glb), a (vertices, faces) pair, or a trimesh or Open3D mesh.")
-solid = _from_schema("solid", ["source"], "solid", "source: a mesh, as for mesh() (open ones too: see inside); the report holds the volume, mass and area.")
-subdiv = _from_schema("subdiv", ["source"], "subdiv", "source: a Catmull-Clark control mesh (a path or a (vertices, faces) pair).")
-implicit = _from_schema("implicit", ["formula"], "implicit", "formula: F in the coordinates' variables; the surface is F = 0.")
-lines = _from_schema("lines", ["source"], "lines", "source: a mesh with polylines (OBJ `l`) or faces.")
-measure = _from_schema("measure", ["source"], "measure", "source: a closed mesh, a .vdb path or a Grid holding a surface; the measures are in the returned solid's report.")
-combine = _from_schema("combine", ["a", "b"], "combine", "a, b: Grids, or .vdb paths whose grid `grid` (or voxel set) is read; the result has a's transform.")
-signed_distance = _from_schema("signed_distance", ["mesh", "points"], "query", "mesh: as for mesh(); points: an (n, 3) array. Returns the exact distance (f64) from each point to the nearest triangle, negative inside by the option inside; computed on every thread, the GIL released.")
-contains = _from_schema("contains", ["mesh", "points"], "query", "mesh: as for mesh(); points: an (n, 3) array. Returns whether each point lies inside the mesh (bool), by the option inside: its winding number (at least 1/2, exact where near 1/2) or ray parity.")
-csg = _from_schema("csg", ["tree"], None, "A CSG tree (the CLI's `csg --tree` JSON): a path to the JSON file, or the tree as a dict (its file names are then found from the current directory).")
+mesh = _from_schema("mesh")
+solid = _from_schema("solid")
+subdiv = _from_schema("subdiv")
+implicit = _from_schema("implicit")
+lines = _from_schema("lines")
+measure = _from_schema("measure")
+combine = _from_schema("combine")
+signed_distance = _from_schema("signed_distance")
+contains = _from_schema("contains")
+csg = _from_schema("csg")
 
 __all__ = [
     "DEFAULT_RESOLUTION",

@@ -15,7 +15,9 @@ def options() -> str:
 Path = Union[str, PathLike]
 MeshSource = Union[Path, Tuple[npt.ArrayLike, Union[npt.ArrayLike, Sequence[Sequence[int]]]]]
 Progress = Callable[[str, int, int], Any]
-Vec3 = Tuple[float, float, float]
+#: What comes back as three numbers: a list.
+Vec3 = List[float]
+#: A brick's index (a dict key): a tuple.
 Index = Tuple[int, int, int]
 
 class Grid:
@@ -31,7 +33,7 @@ class Grid:
     def to_dense(
         self, channel: Optional[str] = None
     ) -> Tuple[Union[npt.NDArray[np.bool_], npt.NDArray[np.float32]], List[int]]:
-        """A dense array over the voxels' box and the index of its element [0, 0, 0]:
+        """A dense array over the voxels' box (the bounds' voxels, given bounds) and the index of its element [0, 0, 0]:
         booleans, or with `channel` (a name of `values`) float32 (a level set's `surface`
         minus its background inside and plus it outside the band, as OpenVDB reads it)."""
     def sample(self, points: npt.ArrayLike) -> npt.NDArray[np.float64]:
@@ -44,7 +46,8 @@ class Grid:
         """World position of the centre of voxel (0, 0, 0)."""
     def index_to_world(self, ijk: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
     @property
-    def bbox(self) -> Optional[Tuple[Index, Index]]: ...
+    def bbox(self) -> Optional[Tuple[List[int], List[int]]]:
+        """The active voxels' index box, both corners inclusive (None when empty)."""
     @property
     def report(self) -> Dict[str, Any]:
         """The CLI's JSON report."""
@@ -75,137 +78,18 @@ class Grid:
         """Whether both hold exactly the same voxel indices."""
     def __len__(self) -> int: ...
 
-def mesh(
-    source: MeshSource,
-    resolution: Optional[int] = None,
-    voxel_size: Optional[float] = None,
-    origin: Optional[Sequence[float]] = None,
-    separability: int = 26,
-    method: str = "separating",
-    criterion: str = "huang",
-    normals: bool = False,
-    colors: bool = True,
-    color: Optional[Vec3] = None,
-    sdf: bool = False,
-    udf: bool = False,
-    band: float = 3.0,
-    inside: str = "auto",
-    up_axis: str = "z",
-    threads: Optional[int] = None,
-    max_memory_mib: Optional[int] = None,
-    progress: Optional[Progress] = None,
-) -> Grid: ...
-def solid(
-    source: MeshSource,
-    resolution: Optional[int] = None,
-    voxel_size: Optional[float] = None,
-    origin: Optional[Sequence[float]] = None,
-    method: str = "flood",
-    flood: str = "blocks",
-    graystack: int = 1048576,
-    directions: Union[int, Sequence[Index]] = 16,
-    layers: str = "double",
-    unclassified: str = "no-direction",
-    fill: str = "parity",
-    density: float = 1.0,
-    topology: bool = False,
-    sdf: bool = False,
-    band: float = 3.0,
-    inside: str = "auto",
-    up_axis: str = "z",
-    threads: Optional[int] = None,
-    max_memory_mib: Optional[int] = None,
-    progress: Optional[Progress] = None,
-) -> Grid: ...
-def subdiv(
-    source: MeshSource,
-    resolution: Optional[int] = None,
-    voxel_size: Optional[float] = None,
-    origin: Optional[Sequence[float]] = None,
-    adjacency: int = 26,
-    enclose: bool = False,
-    presplit: int = 8,
-    solid: bool = False,
-    graystack: int = 1048576,
-    density: float = 1.0,
-    topology: bool = False,
-    up_axis: str = "z",
-    threads: Optional[int] = None,
-    max_memory_mib: Optional[int] = None,
-    progress: Optional[Progress] = None,
-) -> Grid: ...
-def implicit(
-    formula: str,
-    coords: str = "cartesian",
-    bounds: Union[Tuple[float, float], Tuple[Vec3, Vec3]] = (-1.0, 1.0),
-    resolution: Optional[int] = 256,
-    levels: bool = False,
-    negative_r: bool = False,
-    theta_range: str = "positive",
-    squared: bool = False,
-    threads: Optional[int] = None,
-    max_memory_mib: Optional[int] = None,
-    progress: Optional[Progress] = None,
-) -> Grid: ...
-def lines(
-    source: MeshSource,
-    resolution: Optional[int] = None,
-    voxel_size: Optional[float] = None,
-    origin: Optional[Sequence[float]] = None,
-    edges: bool = False,
-    colors: bool = True,
-    color: Optional[Vec3] = None,
-    up_axis: str = "z",
-    threads: Optional[int] = None,
-    max_memory_mib: Optional[int] = None,
-    progress: Optional[Progress] = None,
-) -> Grid: ...
-def measure(
-    source: Union[MeshSource, Grid],
-    resolution: Optional[int] = None,
-    voxel_size: Optional[float] = None,
-    origin: Optional[Sequence[float]] = None,
-    flood: str = "blocks",
-    graystack: int = 1048576,
-    density: float = 1.0,
-    inside: str = "auto",
-    up_axis: str = "z",
-    threads: Optional[int] = None,
-    max_memory_mib: Optional[int] = None,
-    progress: Optional[Progress] = None,
-) -> Grid: ...
-def signed_distance(
-    mesh: MeshSource,
-    points: npt.ArrayLike,
-    inside: str = "auto",
-    threads: Optional[int] = None,
-    max_memory_mib: Optional[int] = None,
-    progress: Optional[Progress] = None,
-) -> npt.NDArray[np.float64]: ...
-def contains(
-    mesh: MeshSource,
-    points: npt.ArrayLike,
-    inside: str = "auto",
-    threads: Optional[int] = None,
-    max_memory_mib: Optional[int] = None,
-    progress: Optional[Progress] = None,
-) -> npt.NDArray[np.bool_]: ...
-def combine(
-    a: Union[Grid, Path],
-    b: Union[Grid, Path],
-    op: str = "union",
-    grid: Optional[str] = None,
-    resample: bool = False,
-    threads: Optional[int] = None,
-    max_memory_mib: Optional[int] = None,
-    progress: Optional[Progress] = None,
-) -> Grid: ...
-def csg(
-    tree: Union[Path, Dict[str, Any]],
-    threads: Optional[int] = None,
-    max_memory_mib: Optional[int] = None,
-    progress: Optional[Progress] = None,
-) -> Grid: ...
+# The jobs (mesh, solid, ...) take their options by keyword; their typed signatures are in
+# the package's stubs, written from the table of options.
+def mesh(source: Any, **options: Any) -> Grid: ...
+def solid(source: Any, **options: Any) -> Grid: ...
+def subdiv(source: Any, **options: Any) -> Grid: ...
+def implicit(formula: str, **options: Any) -> Grid: ...
+def lines(source: Any, **options: Any) -> Grid: ...
+def measure(source: Any, **options: Any) -> Grid: ...
+def combine(a: Any, b: Any, **options: Any) -> Grid: ...
+def signed_distance(mesh: Any, points: npt.ArrayLike, **options: Any) -> npt.NDArray[np.float64]: ...
+def contains(mesh: Any, points: npt.ArrayLike, **options: Any) -> npt.NDArray[np.bool_]: ...
+def csg(tree: Any, **options: Any) -> Grid: ...
 def read_vdb(path: Path, grid: Optional[str] = None) -> Grid:
     """A .vdb grid, or a brick set's index (.json) merged."""
 
@@ -241,7 +125,7 @@ def brick_surface_file(
     positions: npt.NDArray[np.float64],
     indices: npt.NDArray[np.uint32],
     starts: npt.NDArray[np.uint32],
-    origin: Vec3,
+    origin: Sequence[float],
     voxel_size: float,
     brick: Index,
     size: int,
@@ -253,7 +137,7 @@ def brick_faces(
     positions: npt.NDArray[np.float64],
     indices: npt.NDArray[np.uint32],
     starts: npt.NDArray[np.uint32],
-    origin: Vec3,
+    origin: Sequence[float],
     voxel_size: float,
     brick: Index,
     size: int,
@@ -263,7 +147,7 @@ def brick_solid_file(
     positions: npt.NDArray[np.float64],
     indices: npt.NDArray[np.uint32],
     starts: npt.NDArray[np.uint32],
-    origin: Vec3,
+    origin: Sequence[float],
     voxel_size: float,
     brick: Index,
     size: int,

@@ -4,7 +4,7 @@
 
 use super::coord::{Coord, CoordBox, leaf_offset, leaf_origin, offset_coord};
 use super::leaf::{Channels, Leaf};
-use super::tiles::{NODE_LEAVES, Tiles, node_leaf_origins, node_origin};
+use super::tiles::{NODE_DIM, NODE_LEAVES, Tiles, node_leaf_origins, node_origin};
 use super::transform::Transform;
 use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -420,6 +420,36 @@ impl SparseGrid {
         self.compact();
     }
 
+    /// Keeps only the voxels inside `keep`; tiles it cuts become leaves.
+    pub fn clip(&mut self, keep: CoordBox) {
+        for leaf in &mut self.leaves {
+            let inside = block_mask(leaf.origin, &keep);
+            (0..8).for_each(|w| leaf.mask[w] &= inside[w]);
+        }
+        let mut blocks: Vec<Coord> = self.tiles.leaf_tiles().collect();
+        for node in self.tiles.node_tiles().collect::<Vec<_>>() {
+            let last = node.map(|v| v + NODE_DIM - 1);
+            if !(keep.contains(node) && keep.contains(last)) {
+                self.tiles.remove_node(node);
+                blocks.extend(node_leaf_origins(node));
+            }
+        }
+        for o in blocks {
+            match block_mask(o, &keep) {
+                FULL => self.tiles.insert_leaf(o),
+                [0, 0, 0, 0, 0, 0, 0, 0] => {
+                    self.tiles.remove_leaf(o);
+                }
+                inside => {
+                    self.tiles.remove_leaf(o);
+                    self.leaf_mut_or_insert(o).mask = inside;
+                }
+            }
+        }
+        self.prune();
+        self.compact();
+    }
+
     /// Origins of the blocks `self` holds anything in, inside the 128^3 node at `node`.
     fn blocks_in_node(&self, node: Coord) -> Vec<Coord> {
         self.leaves
@@ -473,6 +503,27 @@ impl SparseGrid {
         }
         self.tiles.promote();
     }
+}
+
+/// The voxels of the 8^3 block at `origin` that lie in `keep`, as a leaf mask.
+fn block_mask(origin: Coord, keep: &CoordBox) -> [u64; 8] {
+    let range = |a: usize| {
+        [
+            (keep.min[a] - origin[a]).max(0),
+            (keep.max[a] - origin[a]).min(7),
+        ]
+    };
+    let ([x0, x1], [y0, y1], [z0, z1]) = (range(0), range(1), range(2));
+    let mut mask = [0u64; 8];
+    if x0 > x1 || y0 > y1 || z0 > z1 {
+        return mask;
+    }
+    let row = ((1u64 << (z1 - z0 + 1)) - 1) << z0;
+    let word = (y0..=y1).fold(0u64, |w, y| w | row << (y * 8));
+    for x in x0..=x1 {
+        mask[x as usize] = word;
+    }
+    mask
 }
 
 /// ORs `src` into `dst`, taking `src`'s channels only where `dst` was empty.
@@ -554,6 +605,44 @@ mod tests {
                 expected.expand(p);
             }
             assert_eq!(g.bbox(), Some(expected), "{pts:?}");
+        }
+    }
+
+    #[test]
+    fn clip_keeps_exactly_the_voxels_in_the_box() {
+        // A whole 128^3 node, a whole 8^3 block and scattered voxels, cut by boxes.
+        let mut rng = crate::random::SplitMix64(11);
+        let scattered: Vec<Coord> = (0..300)
+            .map(|_| [0, 1, 2].map(|_| rng.range(-20.0, 150.0).floor() as i64))
+            .collect();
+        let mut g = grid(&scattered);
+        g.fill_node_block([0, 0, 0]);
+        g.fill_leaf_block([-16, 0, 8]);
+        g.compact();
+        let all: Vec<Coord> = g.voxels().collect();
+        for keep in [
+            CoordBox {
+                min: [3, -5, 10],
+                max: [60, 130, 127],
+            },
+            CoordBox {
+                min: [-20, -20, -20],
+                max: [200, 200, 200],
+            },
+            CoordBox {
+                min: [-13, 2, 9],
+                max: [-9, 6, 14],
+            },
+            CoordBox {
+                min: [500, 0, 0],
+                max: [501, 1, 1],
+            },
+        ] {
+            let mut clipped = g.clone();
+            clipped.clip(keep);
+            let expected = all.iter().filter(|&&c| keep.contains(c)).count() as u64;
+            assert_eq!(clipped.voxel_count(), expected, "{keep:?}");
+            assert!(clipped.voxels().all(|c| keep.contains(c)), "{keep:?}");
         }
     }
 

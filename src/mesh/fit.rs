@@ -29,6 +29,9 @@ pub enum GridFit {
     /// an animation, or a voxel size and origin given): used as it is, whatever the mesh's
     /// box.
     Placed(Transform),
+    /// A world box the grid covers, placed in it as the other fits place a mesh's box:
+    /// only the voxels whose centres lie in the box are kept.
+    Within(Transform, Aabb),
 }
 
 impl GridFit {
@@ -52,6 +55,33 @@ impl GridFit {
             (fit, _) => fit,
         }
     }
+
+    /// The fit placed in the world box `bounds`, when given, instead of the mesh's box; the
+    /// job then keeps only the voxels whose centres lie in it.
+    pub fn within(self, bounds: Option<Aabb>) -> Result<GridFit> {
+        let Some(b) = bounds else {
+            return Ok(self);
+        };
+        if !(b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()) {
+            return Err(Error::InvalidArgument(format!(
+                "bounds must be two finite corners, low then high, got {} and {}",
+                b.min, b.max
+            )));
+        }
+        Ok(GridFit::Within(fit_transform(&b, self)?, b))
+    }
+
+    /// The voxels whose centres lie in the box the fit keeps (`Within`), on its transform.
+    pub fn kept_voxels(&self) -> Option<CoordBox> {
+        let GridFit::Within(t, b) = self else {
+            return None;
+        };
+        let (lo, hi) = (t.world_to_index(b.min), t.world_to_index(b.max));
+        Some(CoordBox {
+            min: lo.to_array().map(|v| v.ceil() as i64),
+            max: hi.to_array().map(|v| v.floor() as i64),
+        })
+    }
 }
 
 /// The transform that places `bbox` in index space as described in the module docs. Every
@@ -59,7 +89,7 @@ impl GridFit {
 pub fn fit_transform(bbox: &Aabb, fit: GridFit) -> Result<Transform> {
     let h = voxel_size(bbox, fit)?;
     let origin = match fit {
-        GridFit::Placed(t) => t.origin,
+        GridFit::Placed(t) | GridFit::Within(t, _) => t.origin,
         GridFit::ResolutionAt(_, origin) => origin,
         GridFit::Resolution(_) | GridFit::VoxelSize(_) => bbox.min + 0.5 * h,
     };
@@ -75,7 +105,9 @@ pub fn fit_transform(bbox: &Aabb, fit: GridFit) -> Result<Transform> {
 fn voxel_size(bbox: &Aabb, fit: GridFit) -> Result<f64> {
     let longest = bbox.extent().max_element();
     match fit {
-        GridFit::Placed(t) => voxel_size(bbox, GridFit::VoxelSize(t.voxel_size)),
+        GridFit::Placed(t) | GridFit::Within(t, _) => {
+            voxel_size(bbox, GridFit::VoxelSize(t.voxel_size))
+        }
         GridFit::ResolutionAt(r, _) => voxel_size(bbox, GridFit::Resolution(r)),
         GridFit::Resolution(0) => Err(Error::InvalidArgument(
             "resolution must be at least 1".into(),

@@ -165,7 +165,11 @@ impl FromStr for FrameRange {
 /// union, or a voxel size) on the union of the files' bounding boxes, the lower corner on a
 /// voxel's lower face as for one file. Files that cannot be read are left out here (they
 /// fail again, and are reported, when their job runs); an error only when none can be read.
+/// A fit within bounds is shared as it is.
 pub fn shared_placement(files: &[PathBuf], fit: GridFit, up: UpAxis) -> Result<GridFit> {
+    if let GridFit::Within(..) = fit {
+        return Ok(fit);
+    }
     let boxes: Vec<Result<Aabb>> = files
         .par_iter()
         .map(|f| Mesh::load(f).map(|m| m.with_up_axis(up).bbox()))

@@ -410,7 +410,7 @@ fn implicit_leaves(
 /// The octree's resolution: voxels along the longest side of the bounds.
 pub(super) fn octree_resolution(fit: GridFit, min: DVec3, max: DVec3) -> Result<u32> {
     let fit = match fit {
-        GridFit::Placed(t) => GridFit::VoxelSize(t.voxel_size),
+        GridFit::Placed(t) | GridFit::Within(t, _) => GridFit::VoxelSize(t.voxel_size),
         other => other,
     };
     match fit {
@@ -425,9 +425,11 @@ pub(super) fn octree_resolution(fit: GridFit, min: DVec3, max: DVec3) -> Result<
                 Ok(r.max(1.0) as u32)
             }
         }
-        GridFit::VoxelSize(h) | GridFit::Placed(Transform { voxel_size: h, .. }) => Err(
-            Error::InvalidArgument(format!("voxel size must be a positive number, got {h:?}")),
-        ),
+        GridFit::VoxelSize(h)
+        | GridFit::Placed(Transform { voxel_size: h, .. })
+        | GridFit::Within(Transform { voxel_size: h, .. }, _) => Err(Error::InvalidArgument(
+            format!("voxel size must be a positive number, got {h:?}"),
+        )),
     }
 }
 

@@ -307,6 +307,10 @@ impl GridFit {
                 "voxel size {:?}, origin {:?},{:?},{:?} (placed beforehand)",
                 t.voxel_size, t.origin.x, t.origin.y, t.origin.z
             ),
+            GridFit::Within(t, b) => format!(
+                "voxel size {:?} within bounds {},{}",
+                t.voxel_size, b.min, b.max
+            ),
         }
     }
 }
@@ -551,6 +555,9 @@ impl PlannedJob {
         progress.stage(self.stage_name(), self.plan.work_items);
         let mut outcome = on_threads(self.job.limits.threads, || self.run_here(&progress))?;
         progress.check()?;
+        if let Some(keep) = self.job.fit.kept_voxels() {
+            on_threads(self.job.limits.threads, || outcome.clip(keep))?;
+        }
         outcome.threads = self.job.limits.threads;
         outcome.report.warnings.splice(0..0, self.warnings);
         outcome.report.input = self.job.describe_input();

@@ -7,7 +7,7 @@ use super::report::{
 };
 use super::{ShapeTask, SurfaceMethod, on_threads};
 use crate::error::{Error, Result};
-use crate::grid::{SparseGrid, Transform};
+use crate::grid::{CoordBox, SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::io::atomic::check_output;
 use crate::io::binvox::write_binvox;
@@ -16,6 +16,7 @@ use crate::io::vdb::{MetaValue, WriteOptions, read_vdb_grid, write_distance_band
 use crate::io::vox::write_vox;
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::{BooleanOp, combine as combine_grids};
+use crate::ops::measure::SolidMeasures;
 use crate::ops::minimality::simple_voxel_count;
 use crate::ops::separability::check_mesh_separation;
 use crate::progress::Progress;
@@ -121,6 +122,60 @@ impl Outcome {
             distances: None,
             threads: None,
         }
+    }
+
+    /// Keeps the voxels inside `keep` in every grid (a fit within bounds); the report counts
+    /// what is kept: the voxels, and a solid's or a band's measures.
+    pub(super) fn clip(&mut self, keep: CoordBox) -> Result<()> {
+        let before = self.grid.voxel_count();
+        self.grid.clip(keep);
+        self.extra.iter_mut().for_each(|(_, g)| g.clip(keep));
+        if let Some(interior) = self.distances.as_mut().and_then(|d| d.interior.as_mut()) {
+            interior.clip(keep);
+        }
+        let count = |name: &str| {
+            self.extra
+                .iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, g)| g.voxel_count())
+        };
+        let h = self.grid.transform.voxel_size;
+        let cell = h.powi(3);
+        match &mut self.report.details {
+            Details::Solid(d) => {
+                let m = SolidMeasures::of(
+                    count("interior").unwrap_or(0),
+                    count("shell").unwrap_or(0),
+                    h,
+                );
+                (d.mass_inside, d.mass_with_surface) = m.mass(d.density);
+                (d.inside_voxels, d.surface_voxels) = (m.inside_voxels, m.surface_voxels);
+                (d.volume_inside, d.volume_with_surface) = (m.volume_inside, m.volume_with_surface);
+                d.ambiguous_voxels = d.ambiguous_voxels.map(|_| count("ambiguous").unwrap_or(0));
+                if d.components.is_some() {
+                    let (components, genus) = crate::solids::flooded_mesh::topology(&self.grid)?;
+                    (d.components, d.genus) = (Some(components), Some(genus));
+                }
+            }
+            Details::DepthLayers(d) => {
+                d.inside_voxels = self.grid.voxel_count();
+                d.unclassified_voxels = count("unclassified").unwrap_or(0);
+                d.volume = d.inside_voxels as f64 * cell;
+                d.volume_with_unclassified =
+                    (d.inside_voxels + d.unclassified_voxels) as f64 * cell;
+                d.mass = d.volume * d.density;
+            }
+            Details::DistanceBand(d) => {
+                d.inside_band_voxels = super::solid::inside_band_voxels(&self.grid);
+                d.ambiguous_voxels = d.ambiguous_voxels.map(|_| count("ambiguous").unwrap_or(0));
+            }
+            _ => {}
+        }
+        self.report.voxels = self.grid.voxel_count();
+        self.report.leaves = self.grid.leaf_count() as u64;
+        self.report.bounds_voxels = Some([keep.min, keep.max]);
+        self.report.voxels_outside_bounds = Some(before - self.report.voxels);
+        Ok(())
     }
 
     /// A grid of a `.vdb` file (its grid `name`, else the voxel set voxelkit writes), as an
@@ -253,7 +308,7 @@ pub(super) fn provenance(
 
 /// How the grid was fitted, typed: `resolution` (an int) or `voxel_size` (a double), and
 /// `grid_placement` `given` for a grid placed beforehand (shared by several meshes, or a voxel
-/// size and origin given).
+/// size and origin given), or the bounds it was clipped to.
 fn fit_metadata(fit: GridFit) -> Vec<(&'static str, MetaValue)> {
     match fit {
         GridFit::Resolution(r) | GridFit::ResolutionAt(r, _) => vec![("resolution", r.into())],
@@ -261,6 +316,13 @@ fn fit_metadata(fit: GridFit) -> Vec<(&'static str, MetaValue)> {
         GridFit::Placed(t) => vec![
             ("voxel_size", t.voxel_size.into()),
             ("grid_placement", "given".into()),
+        ],
+        GridFit::Within(t, b) => vec![
+            ("voxel_size", t.voxel_size.into()),
+            (
+                "grid_placement",
+                format!("within bounds {},{}", b.min, b.max).into(),
+            ),
         ],
     }
 }

@@ -24,6 +24,13 @@ pub struct Report {
     pub voxel_size: f64,
     /// World position of the centre of voxel (0,0,0).
     pub origin: [f64; 3],
+    /// Within bounds: the index box of the voxels kept (both corners inclusive), and the
+    /// voxels left out; the details other than a solid's or a band's measures count the
+    /// work before the cut.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bounds_voxels: Option<[[i64; 3]; 2]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub voxels_outside_bounds: Option<u64>,
     #[serde(flatten)]
     pub details: Details,
     /// What the user should know although the job succeeded.
@@ -385,6 +392,11 @@ impl Report {
         };
         if let Some(p) = &self.preview {
             text.push_str(&format!("\npreview: {p}"));
+        }
+        if let (Some([lo, hi]), Some(out)) = (self.bounds_voxels, self.voxels_outside_bounds) {
+            text.push_str(&format!(
+                "\nwithin bounds: voxels {lo:?} to {hi:?} kept, {out} outside left out"
+            ));
         }
         for w in &self.warnings {
             text.push_str(&format!("\nwarning: {w}"));

@@ -16,7 +16,7 @@ use crate::error::{Error, Result};
 use crate::grid::Adjacency;
 use crate::implicit::{Coordinates, ThetaRange};
 use crate::io::vdb::{Compression, WriteOptions};
-use crate::mesh::{DEFAULT_RESOLUTION, GridFit, UpAxis};
+use crate::mesh::{Aabb, DEFAULT_RESOLUTION, GridFit, UpAxis};
 use crate::ops::csg::BooleanOp;
 use crate::ops::flood_xyz::DEFAULT_GRAYSTACK;
 use crate::solids::beam::BeamFill;
@@ -43,6 +43,8 @@ pub struct FieldSchema {
     pub default: Value,
     /// The names it takes, for a choice; empty otherwise.
     pub choices: Vec<&'static str>,
+    /// Its type as a Python annotation (for the generated stubs).
+    pub python_type: String,
 }
 
 /// A request's fields, defaults and docs, for the front ends that fill it by name.
@@ -67,37 +69,63 @@ pub trait Schema: Default + Serialize + for<'de> Deserialize<'de> {
     }
 }
 
-/// The choices a field's type offers (none but for `Choice` enums).
-pub trait FieldChoices {
+/// What the table tells of a field's type: the names a choice takes, the Python annotation.
+pub trait FieldType {
     fn choices() -> Vec<&'static str> {
         Vec::new()
     }
+    fn python_type() -> String;
 }
 
-impl<T: Choice> FieldChoices for T {
+impl<T: Choice> FieldType for T {
     fn choices() -> Vec<&'static str> {
         T::names()
     }
+
+    /// `Literal[...]` of the names; numbers (separability) unquoted, as Python passes them.
+    fn python_type() -> String {
+        let names: Vec<String> = T::names()
+            .iter()
+            .map(|n| {
+                if n.parse::<i64>().is_ok() {
+                    n.to_string()
+                } else {
+                    format!("{n:?}")
+                }
+            })
+            .collect();
+        format!("Literal[{}]", names.join(", "))
+    }
 }
 
-/// Field types that are not choices.
+impl<T: FieldType> FieldType for Option<T> {
+    fn python_type() -> String {
+        format!("Optional[{}]", T::python_type())
+    }
+}
+
+/// Field types that are not choices, with their Python annotations.
 macro_rules! plain_fields {
-    ($($t:ty),*) => {$(impl FieldChoices for $t {})*};
+    ($($t:ty => $python:literal),* $(,)?) => {$(
+        impl FieldType for $t {
+            fn python_type() -> String {
+                $python.into()
+            }
+        }
+    )*};
 }
 plain_fields!(
-    bool,
-    f64,
-    u32,
-    usize,
-    Vec<String>,
-    Directions,
-    Bounds,
-    Option<u32>,
-    Option<u64>,
-    Option<f64>,
-    Option<String>,
-    Option<[f32; 3]>,
-    Option<[f64; 3]>
+    bool => "bool",
+    f64 => "float",
+    u32 => "int",
+    u64 => "int",
+    usize => "int",
+    String => "str",
+    Vec<String> => "Sequence[str]",
+    Directions => "Union[int, Sequence[Sequence[int]]]",
+    Bounds => "Union[Sequence[float], Sequence[Sequence[float]]]",
+    [f32; 3] => "Sequence[float]",
+    [f64; 3] => "Sequence[float]",
 );
 
 /// The doc of every `inside` field.
@@ -108,8 +136,23 @@ macro_rules! inside_doc {
 }
 
 macro_rules! request {
-    // A request on a mesh: the grid fit first, its up axis last.
+    // A request on a mesh whose grid may be given a world box to cover.
     ($(#[doc = $sdoc:literal])* $name:ident as $py:literal fitted { $($fields:tt)* }) => {
+        request! {
+            $(#[doc = $sdoc])*
+            $name as $py placed {
+                /// The world box the grid covers, `[lo, hi]` (a cube) or `[[x0, y0, z0], [x1,
+                /// y1, z1]]` (none: the mesh's box): resolution counts voxels along its
+                /// longest side and, unless origin is given, the first centre lies half a
+                /// voxel inside its low corner (Open3D's within_bounds grid); only voxels whose
+                /// centres lie in it are kept, and dense arrays span it.
+                bounds: Option<Bounds> = None,
+                $($fields)*
+            }
+        }
+    };
+    // A request on a mesh: the grid's placement first, its up axis last.
+    ($(#[doc = $sdoc:literal])* $name:ident as $py:literal placed { $($fields:tt)* }) => {
         request! {
             $(#[doc = $sdoc])*
             $name as $py {
@@ -155,7 +198,8 @@ macro_rules! request {
                     name: stringify!($field),
                     doc: [$($doc),*].map(str::trim).join(" "),
                     default: serde_json::to_value(&d.$field).unwrap_or(Value::Null),
-                    choices: <$ty as FieldChoices>::choices(),
+                    choices: <$ty as FieldType>::choices(),
+                    python_type: <$ty as FieldType>::python_type(),
                 }),*]
             }
         }
@@ -261,7 +305,7 @@ impl Directions {
 }
 
 /// A formula's box: `[lo, hi]` for a cube, or `[[x0, y0, z0], [x1, y1, z1]]`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum Bounds {
     Cube([f64; 2]),
@@ -279,12 +323,35 @@ impl std::fmt::Display for Bounds {
     }
 }
 
+/// The inverse of `Display`: `lo,hi` or `x0,y0,z0,x1,y1,z1`.
+impl std::str::FromStr for Bounds {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Bounds, String> {
+        let v: Vec<f64> = s
+            .split(',')
+            .map(|p| p.trim().parse::<f64>())
+            .collect::<std::result::Result<_, _>>()
+            .map_err(|_| format!("`{s}`: expected numbers separated by commas"))?;
+        match v[..] {
+            [lo, hi] => Ok(Bounds::Cube([lo, hi])),
+            [x0, y0, z0, x1, y1, z1] => Ok(Bounds::Box([[x0, y0, z0], [x1, y1, z1]])),
+            _ => Err(format!("`{s}`: give `lo,hi` or `x0,y0,z0,x1,y1,z1`")),
+        }
+    }
+}
+
 impl Bounds {
     pub fn corners(&self) -> (DVec3, DVec3) {
         match self {
             Bounds::Cube([lo, hi]) => (DVec3::splat(*lo), DVec3::splat(*hi)),
             Bounds::Box([lo, hi]) => (DVec3::from_array(*lo), DVec3::from_array(*hi)),
         }
+    }
+
+    pub fn aabb(&self) -> Aabb {
+        let (min, max) = self.corners();
+        Aabb { min, max }
     }
 }
 
@@ -472,7 +539,7 @@ request! {
 request! {
     /// The separating surface (or solid) of a mesh cut into bricks and voxelized by Dask
     /// workers, merged into one .vdb.
-    BricksRequest as "distributed" fitted {
+    BricksRequest as "distributed" placed {
         /// Voxels along a brick's edge, a multiple of 8.
         brick: u32 = 1024,
         /// 6 or 26 (the surface; a solid is always 26).
@@ -586,11 +653,12 @@ pub trait Request: Schema {
     }
 }
 
-/// `fit` and `up_axis` of a request with `resolution`, `voxel_size` and `up_axis` fields.
+/// `fit` and `up_axis` of a `fitted` request.
 macro_rules! fitted {
     () => {
         fn fit(&self) -> Result<GridFit> {
-            grid_fit(self.resolution, self.voxel_size, self.origin)
+            grid_fit(self.resolution, self.voxel_size, self.origin)?
+                .within(self.bounds.as_ref().map(Bounds::aabb))
         }
 
         fn up_axis(&self) -> UpAxis {

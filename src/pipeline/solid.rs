@@ -275,14 +275,7 @@ pub(super) fn distance_band(
             None,
         )
     };
-    let inside_band_voxels = grid
-        .leaves()
-        .par_iter()
-        .map(|l| {
-            let values = l.value.as_ref().expect("distances");
-            l.offsets().filter(|&n| values[n] < 0.0).count() as u64
-        })
-        .sum();
+    let inside_band_voxels = inside_band_voxels(&grid);
     let background = band * t.voxel_size;
     let method = if signed {
         "exact-signed-distance-band"
@@ -310,6 +303,17 @@ pub(super) fn distance_band(
         interior,
     });
     Ok(with_ambiguous(outcome, ambiguous).timed(start))
+}
+
+/// Band voxels whose centre is inside (negative distances).
+pub(super) fn inside_band_voxels(band: &SparseGrid) -> u64 {
+    band.leaves()
+        .par_iter()
+        .map(|l| {
+            let values = l.value.as_ref().expect("distances");
+            l.offsets().filter(|&n| values[n] < 0.0).count() as u64
+        })
+        .sum()
 }
 
 pub(super) fn measure_mesh(

@@ -161,7 +161,8 @@ impl Grid {
         }
     }
 
-    /// The voxels as a dense array over their box, and the index of its element [0, 0, 0]:
+    /// The voxels as a dense array over their box (the bounds' voxels, for a job given
+    /// bounds: the same shape whatever the mesh), and the index of its element [0, 0, 0]:
     /// `dense[i - ox, j - oy, k - oz]` is voxel (i, j, k). Without `channel`, booleans (the
     /// voxel set); with one of `values`' names, float32: a level set's `surface` holds minus
     /// its background inside and plus it outside away from the band (as OpenVDB reads the
@@ -175,7 +176,9 @@ impl Grid {
     ) -> PyResult<(Bound<'py, PyAny>, [i64; 3])> {
         let grid = &self.outcome.grid;
         let width = channel.map(|c| self.channel_width(c)).transpose()?;
-        let Some(b) = grid.bbox() else {
+        let bounds = (self.outcome.report.bounds_voxels)
+            .map(|[min, max]| crate::grid::CoordBox { min, max });
+        let Some(b) = bounds.or_else(|| grid.bbox()) else {
             let empty = match width {
                 None => Array3::from_elem((0, 0, 0), false)
                     .into_pyarray(py)
@@ -186,7 +189,7 @@ impl Grid {
             };
             return Ok((empty, [0; 3]));
         };
-        let dims = [0, 1, 2].map(|a| (b.max[a] - b.min[a] + 1) as u64);
+        let dims = [0, 1, 2].map(|a| (b.max[a] - b.min[a] + 1).max(0) as u64);
         let cells = dims.iter().try_fold(1u64, |acc, &d| acc.checked_mul(d));
         let per_cell = width.map_or(1, |w| 4 * w as u64);
         let bytes = cells.map_or(u64::MAX, |c| c.saturating_mul(per_cell));

@@ -12,7 +12,7 @@ use voxelkit::io::brick_set::{BrickSet, is_brick_set};
 use voxelkit::io::vdb::{DENSITY_GRID, VOXELS_GRID, read_vdb_info};
 use voxelkit::mesh::{GridFit, generate};
 use voxelkit::ops::separability::check_mesh_separation;
-use voxelkit::pipeline::request::{MeshRequest, Request, SurfaceKind};
+use voxelkit::pipeline::request::{Bounds, MeshRequest, Request, SurfaceKind};
 use voxelkit::pipeline::{Details, Job, MeshSource, Shape, ShapeTask, SurfaceMethod, Task};
 use voxelkit::shapes::{Cylinder, Quadric, Sphere};
 use voxelkit::voxelize::Separability;
@@ -20,8 +20,10 @@ use voxelkit::voxelize::separating::{Criterion, SeparatingOptions};
 use voxelkit::{Error, Result};
 
 impl FitArgs {
-    pub fn grid_fit(&self) -> GridFit {
-        GridFit::from_options(self.resolution, self.voxel_size).with_origin(self.origin)
+    pub fn grid_fit(&self) -> Result<GridFit> {
+        GridFit::from_options(self.resolution, self.voxel_size)
+            .with_origin(self.origin)
+            .within(self.bounds.as_ref().map(Bounds::aabb))
     }
 }
 
@@ -143,14 +145,14 @@ impl SurfaceArgs {
 }
 
 /// The separating surface of a mesh.
-fn surface_job(mesh: MeshSource, fit: FitArgs, surface: SurfaceArgs) -> Job {
-    Job::new(
+fn surface_job(mesh: MeshSource, fit: FitArgs, surface: SurfaceArgs) -> Result<Job> {
+    Ok(Job::new(
         Task::MeshSurface {
             mesh,
             method: SurfaceMethod::Separating(surface.separating()),
         },
-        fit.grid_fit(),
-    )
+        fit.grid_fit()?,
+    ))
 }
 
 /// `voxelkit mesh`: a separating or projective surface, or a distance band, of each input.
@@ -185,7 +187,7 @@ pub fn mesh(
         inside: distance.inside.inside,
         ..surface.request()
     };
-    batch::run(inputs, out, fit.grid_fit(), global, |mesh| {
+    batch::run(inputs, out, fit.grid_fit()?, global, |mesh| {
         request.task(mesh)
     })
 }
@@ -250,7 +252,7 @@ pub fn shape(kind: &ShapeKind, global: &Global) -> Result<()> {
         curvature_margin: !common.surface.no_curvature_margin,
     });
     run_and_report(
-        Job::new(task, common.fit.grid_fit()),
+        Job::new(task, common.fit.grid_fit()?),
         &common.output,
         global,
     )
@@ -410,7 +412,7 @@ pub fn check(input: &Path, fit: FitArgs, surface: SurfaceArgs, global: &Global) 
         mesh: MeshSource::File(input.to_path_buf()),
         options: surface.separating(),
     };
-    let outcome = run_job(Job::new(task, fit.grid_fit()), None, global)?;
+    let outcome = run_job(Job::new(task, fit.grid_fit()?), None, global)?;
     let report = &outcome.report;
     println!(
         "{}",
@@ -456,9 +458,10 @@ pub fn demo(folder: &Path, resolution: u32, global: &Global) -> Result<()> {
             resolution: Some(resolution),
             voxel_size: None,
             origin: None,
+            bounds: None,
         };
         let out = folder.join(format!("trefoil-{}.vdb", sep.adjacency()));
-        let job = surface_job(MeshSource::Mesh(mesh.clone()), fit, surface);
+        let job = surface_job(MeshSource::Mesh(mesh.clone()), fit, surface)?;
         let outcome = run_job(job, Some(&out), global)?;
         let found = check_mesh_separation(&outcome.grid, &mesh, sep.flood_adjacency())?;
         let verdict = if found.separates() {

@@ -2,11 +2,10 @@
 
 use crate::run::{Global, run_and_report};
 use clap::Args;
-use glam::DVec3;
 use std::path::PathBuf;
 use voxelkit::implicit::{Coordinates, ThetaRange};
 use voxelkit::mesh::GridFit;
-use voxelkit::pipeline::request::ImplicitRequest;
+use voxelkit::pipeline::request::{Bounds, ImplicitRequest};
 use voxelkit::pipeline::{Job, Task};
 use voxelkit::{Error, Result};
 
@@ -68,8 +67,8 @@ pub struct ImplicitArgs {
     #[arg(long, default_value_t = ImplicitRequest::default().coords, value_parser = parse_coords)]
     coords: Coordinates,
     /// The box searched: `lo,hi` (a cube) or `x0,y0,z0,x1,y1,z1`.
-    #[arg(long, default_value_t = ImplicitRequest::default().bounds.to_string(), allow_hyphen_values = true)]
-    bounds: String,
+    #[arg(long, default_value_t = ImplicitRequest::default().bounds, value_parser = parse_bounds, allow_hyphen_values = true, value_name = "LO,HI")]
+    bounds: Bounds,
     /// Voxels along the longest side of the bounds.
     #[arg(short, long, default_value_t = ImplicitRequest::default().resolution)]
     resolution: u32,
@@ -105,23 +104,9 @@ fn parse_coords(s: &str) -> std::result::Result<Coordinates, String> {
     s.parse()
 }
 
-fn parse_bounds(s: &str) -> Result<(DVec3, DVec3)> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|p| p.trim().parse::<f64>())
-        .collect::<std::result::Result<_, _>>()
-        .map_err(|_| {
-            Error::InvalidArgument(format!(
-                "--bounds `{s}`: expected numbers separated by commas"
-            ))
-        })?;
-    match v[..] {
-        [lo, hi] => Ok((DVec3::splat(lo), DVec3::splat(hi))),
-        [x0, y0, z0, x1, y1, z1] => Ok((DVec3::new(x0, y0, z0), DVec3::new(x1, y1, z1))),
-        _ => Err(Error::InvalidArgument(format!(
-            "--bounds `{s}`: give `lo,hi` or `x0,y0,z0,x1,y1,z1`"
-        ))),
-    }
+/// `--bounds` as the request takes it.
+pub fn parse_bounds(s: &str) -> std::result::Result<Bounds, String> {
+    s.parse()
 }
 
 pub fn run(args: &ImplicitArgs, global: &Global) -> Result<()> {
@@ -141,7 +126,7 @@ pub fn run(args: &ImplicitArgs, global: &Global) -> Result<()> {
             args.coords,
         ),
     };
-    let (min, max) = parse_bounds(&args.bounds)?;
+    let (min, max) = args.bounds.corners();
     let task = Task::Implicit {
         formula: text,
         coordinates,

@@ -101,6 +101,11 @@ pub struct FitArgs {
     /// (as trimesh does), the mesh's low corner gives Open3D's VoxelGrid centres.
     #[arg(long, value_parser = commands::parse_vec3, allow_hyphen_values = true, value_name = "X,Y,Z")]
     origin: Option<glam::DVec3>,
+    /// The world box the grid covers, `lo,hi` (a cube) or `x0,y0,z0,x1,y1,z1` [default: the
+    /// mesh's box]: --resolution counts voxels along its longest side and voxels whose
+    /// centres lie outside it are left out.
+    #[arg(long, value_parser = implicit::parse_bounds, allow_hyphen_values = true, value_name = "LO,HI")]
+    bounds: Option<voxelkit::pipeline::request::Bounds>,
 }
 
 #[derive(Args, Clone, Copy)]

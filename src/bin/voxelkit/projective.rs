@@ -77,5 +77,5 @@ pub fn lines(args: &LinesArgs, global: &Global) -> Result<()> {
         ..LinesRequest::default()
     };
     let task = request.task(MeshSource::File(args.input.clone()))?;
-    run_and_report(Job::new(task, args.fit.grid_fit()), &args.output, global)
+    run_and_report(Job::new(task, args.fit.grid_fit()?), &args.output, global)
 }

@@ -196,7 +196,7 @@ pub fn solid(args: &SolidArgs, global: &Global) -> Result<()> {
     crate::batch::run(
         &args.inputs,
         &args.out,
-        args.fill.fit.grid_fit(),
+        args.fill.fit.grid_fit()?,
         global,
         |mesh| request.task(mesh),
     )
@@ -220,7 +220,7 @@ pub fn measure(args: &MeasureArgs, global: &Global) -> Result<()> {
         ..MeasureRequest::default()
     };
     let task = request.task(source)?;
-    let outcome = run_job(Job::new(task, args.fill.fit.grid_fit()), None, global)?;
+    let outcome = run_job(Job::new(task, args.fill.fit.grid_fit()?), None, global)?;
     if global.json {
         println!("{}", outcome.report.to_json());
     } else {

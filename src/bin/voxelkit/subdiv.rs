@@ -130,7 +130,7 @@ fn voxelize(input: &Path, args: &SubdivVoxelizeArgs, global: &Global) -> Result<
             topology: args.topology,
         }),
     };
-    run_and_report(Job::new(task, args.fit.grid_fit()), output, global)
+    run_and_report(Job::new(task, args.fit.grid_fit()?), output, global)
 }
 
 #[cfg(feature = "osd")]
