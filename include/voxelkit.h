@@ -195,8 +195,11 @@ vk_status vk_options_set_half(vk_options *options, int half);
  * Any option by name: field `field` of request `request` (mesh, solid, subdiv, lines, limits
  * or write: the tables of Python's voxelkit.OPTIONS) set to `value`, a JSON text such as
  * "2.5", "\"projective\"", "true", "null" or "[\"shell\"]". Checked and refused with the same
- * message as Python's keyword. A `resolution` or `voxel_size` of any request sets the grid
- * every call shares, as vk_options_set_resolution does.
+ * message as Python's keyword. The placement of mesh, solid, subdiv and lines (`resolution`,
+ * `voxel_size`, `origin`, `bounds`) sets the grid every call shares: `resolution` as
+ * vk_options_set_resolution does, `origin` "[0, 0, 0]" puts every voxel centre on a multiple
+ * of the voxel size, `bounds` "[[x0, y0, z0], [x1, y1, z1]]" fits the grid to that box and
+ * keeps only the voxels whose centres lie in it.
  */
 vk_status vk_options_set(vk_options *options, const char *request, const char *field,
                          const char *value);

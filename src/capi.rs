@@ -17,8 +17,8 @@ use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::BooleanOp;
 use crate::pipeline::request::{
     CombineRequest, Directions, FillKind, FloodKind, ImplicitRequest, LimitsRequest, LinesRequest,
-    MeasureRequest, MeshRequest, Request, Schema, SolidRequest, SubdivRequest, SurfaceKind,
-    WriteRequest, grid_fit,
+    MeasureRequest, MeshRequest, Placement, Request, Schema, SolidRequest, SubdivRequest,
+    SurfaceKind, WriteRequest,
 };
 use crate::pipeline::{Details, GridSource, Job, MeasureSource, MeshSource, Outcome, Task};
 use crate::progress::Observer;
@@ -94,6 +94,8 @@ unsafe impl Send for Options {}
 /// options' defaults) and the grid they share.
 #[derive(Clone)]
 struct Options {
+    /// The grid every call shares, and its fit.
+    placement: Placement,
     fit: GridFit,
     mesh: MeshRequest,
     solid: SolidRequest,
@@ -108,6 +110,7 @@ struct Options {
 impl Default for Options {
     fn default() -> Self {
         Options {
+            placement: Placement::default(),
             fit: GridFit::from_options(None, None),
             mesh: MeshRequest::default(),
             solid: SolidRequest::default(),
@@ -674,26 +677,46 @@ fn changed<R: Schema>(request: &R, changes: Vec<(&str, Value)>) -> Result<R> {
     R::from_json(values)
 }
 
-/// Sets `field` of a request that places the grid; `resolution` and `voxel_size` set the
-/// grid every call shares, each replacing the other.
+/// Sets `field` of a request on a mesh. A placement field (`resolution`, `voxel_size`,
+/// `origin`, `bounds`) sets the grid every call shares instead: `resolution` and `voxel_size`
+/// each replacing the other.
 fn set_field<R: Request>(
     request: &mut R,
+    placement: &mut Placement,
     fit: &mut GridFit,
     field: &str,
     value: Value,
 ) -> Result<()> {
-    if !matches!(field, "resolution" | "voxel_size") {
-        *request = changed(request, vec![(field, value)])?;
+    let new = changed(request, vec![(field, value.clone())])?;
+    if !Placement::FIELDS.contains(&field) {
+        *request = new;
         return Ok(());
     }
-    let grid = vec![
-        ("resolution", Value::Null),
-        ("voxel_size", Value::Null),
-        (field, value),
-    ];
-    let new = changed(request, grid)?;
-    *fit = new.fit()?;
-    *request = new;
+    let json = serde_json::to_value(&new).map_err(|e| Error::InvalidArgument(e.to_string()))?;
+    let given: Placement =
+        serde_json::from_value(json).map_err(|e| Error::InvalidArgument(e.to_string()))?;
+    let place = match field {
+        "resolution" => Placement {
+            resolution: given.resolution,
+            voxel_size: None,
+            ..*placement
+        },
+        "voxel_size" => Placement {
+            resolution: None,
+            voxel_size: given.voxel_size,
+            ..*placement
+        },
+        "origin" => Placement {
+            origin: given.origin,
+            ..*placement
+        },
+        _ => Placement {
+            bounds: given.bounds,
+            ..*placement
+        },
+    };
+    *fit = place.fit()?;
+    *placement = place;
     Ok(())
 }
 
@@ -711,10 +734,16 @@ pub extern "C" fn vk_options_set(
         let value: Value = serde_json::from_str(text)
             .map_err(|e| invalid(format!("{field}: {text:?} is not a JSON value ({e})")))?;
         match request {
-            "mesh" => set_field(&mut o.mesh, &mut o.fit, field, value)?,
-            "solid" => set_field(&mut o.solid, &mut o.fit, field, value)?,
-            "subdiv" => set_field(&mut o.subdivision, &mut o.fit, field, value)?,
-            "lines" => set_field(&mut o.lines, &mut o.fit, field, value)?,
+            "mesh" => set_field(&mut o.mesh, &mut o.placement, &mut o.fit, field, value)?,
+            "solid" => set_field(&mut o.solid, &mut o.placement, &mut o.fit, field, value)?,
+            "subdiv" => set_field(
+                &mut o.subdivision,
+                &mut o.placement,
+                &mut o.fit,
+                field,
+                value,
+            )?,
+            "lines" => set_field(&mut o.lines, &mut o.placement, &mut o.fit, field, value)?,
             "limits" => o.limits = changed(&o.limits, vec![(field, value)])?,
             "write" => o.write = changed(&o.write, vec![(field, value)])?,
             other => {
@@ -750,7 +779,13 @@ pub extern "C" fn vk_options_set_half(options: *mut VkOptions, half: c_int) -> V
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_resolution(options: *mut VkOptions, resolution: u32) -> VkStatus {
     set(options, |o| {
-        o.fit = grid_fit(Some(resolution), None, None)?;
+        let place = Placement {
+            resolution: Some(resolution),
+            voxel_size: None,
+            ..o.placement
+        };
+        o.fit = place.fit()?;
+        o.placement = place;
         Ok(())
     })
 }
@@ -758,7 +793,13 @@ pub extern "C" fn vk_options_set_resolution(options: *mut VkOptions, resolution:
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_voxel_size(options: *mut VkOptions, voxel_size: f64) -> VkStatus {
     set(options, |o| {
-        o.fit = grid_fit(None, Some(voxel_size), None)?;
+        let place = Placement {
+            resolution: None,
+            voxel_size: Some(voxel_size),
+            ..o.placement
+        };
+        o.fit = place.fit()?;
+        o.placement = place;
         Ok(())
     })
 }

@@ -369,8 +369,10 @@ fn every_field_of_the_c_options_is_settable_by_name_with_pythons_checks() {
     }
     for (request, field, value) in [
         ("mesh", "resolution", "16"),
-        // Another field of the request keeps the grid.
+        // Another field of the request keeps the grid; another request's placement changes it.
         ("mesh", "band", "2.0"),
+        ("solid", "origin", "[0, 0, 0]"),
+        ("mesh", "bounds", "[[0, 0, 0], [0.5, 1, 1]]"),
         ("limits", "max_memory_mib", "0"),
         ("limits", "threads", "0"),
         ("write", "grids", r#"["voxels"]"#),
@@ -415,12 +417,16 @@ fn every_field_of_the_c_options_is_settable_by_name_with_pythons_checks() {
         assert_eq!(got, want, "{line}");
     }
     assert_eq!(said.len(), expected.len());
-    // The write options reached the file: only `voxels`, at 16 voxels across.
+    // The write options reached the file: only `voxels`, at 16 voxels across the bounds'
+    // longest side, centres on multiples of the voxel size, none beyond x = 0.5.
     let voxels = read_vdb_grid(&out, Some("voxels")).unwrap();
     assert!(voxels.voxel_count() > 0);
     assert!(read_vdb_grid(&out, Some("density")).is_err());
     let t = voxels.transform;
     assert!((t.voxel_size - 1.0 / 16.0).abs() < 1e-9, "{}", t.voxel_size);
+    assert_eq!(t.origin, glam::DVec3::ZERO);
+    let b = voxels.bbox().unwrap();
+    assert!(b.min[0] >= 0 && b.max[0] == 8, "{b:?}");
 }
 
 /// A level set OpenVDB wrote (pyopenvdb's level-set sphere), read through `vk_grid_read_vdb`

@@ -653,12 +653,38 @@ pub trait Request: Schema {
     }
 }
 
+/// Where a mesh's grid lies: the placement fields of a `fitted` request, which the C
+/// interface also sets on their own (one grid shared by every call).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Placement {
+    pub resolution: Option<u32>,
+    pub voxel_size: Option<f64>,
+    pub origin: Option<[f64; 3]>,
+    pub bounds: Option<Bounds>,
+}
+
+impl Placement {
+    /// The names of its fields, as the requests name them.
+    pub const FIELDS: [&str; 4] = ["resolution", "voxel_size", "origin", "bounds"];
+
+    /// The grid fit, checked.
+    pub fn fit(&self) -> Result<GridFit> {
+        grid_fit(self.resolution, self.voxel_size, self.origin)?
+            .within(self.bounds.as_ref().map(Bounds::aabb))
+    }
+}
+
 /// `fit` and `up_axis` of a `fitted` request.
 macro_rules! fitted {
     () => {
         fn fit(&self) -> Result<GridFit> {
-            grid_fit(self.resolution, self.voxel_size, self.origin)?
-                .within(self.bounds.as_ref().map(Bounds::aabb))
+            Placement {
+                resolution: self.resolution,
+                voxel_size: self.voxel_size,
+                origin: self.origin,
+                bounds: self.bounds,
+            }
+            .fit()
         }
 
         fn up_axis(&self) -> UpAxis {
