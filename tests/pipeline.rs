@@ -91,18 +91,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
                 solid: None,
             },
         ),
-        (
-            "subdivision solid",
-            Task::Subdivision {
-                mesh: MeshSource::File(cube.to_path_buf()),
-                options: ParametricOptions::default(),
-                solid: Some(voxelkit::pipeline::SubdivisionFill {
-                    graystack: 1 << 10,
-                    density: 1.0,
-                    topology: true,
-                }),
-            },
-        ),
+        ("subdivision solid", subdivision_solid(cube)),
         (
             "implicit",
             Task::Implicit {
@@ -156,6 +145,19 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
             },
         ),
     ]
+}
+
+/// The solid of the cube control mesh's limit surface.
+fn subdivision_solid(cube: &Path) -> Task {
+    Task::Subdivision {
+        mesh: MeshSource::File(cube.to_path_buf()),
+        options: ParametricOptions::default(),
+        solid: Some(voxelkit::pipeline::SubdivisionFill {
+            graystack: 1 << 10,
+            density: 1.0,
+            topology: true,
+        }),
+    }
 }
 
 #[test]
@@ -288,5 +290,78 @@ fn the_exterior_flood_stops_when_asked() {
             matches!(result, Err(Error::Cancelled)),
             "measure: {measure}, {flood:?}"
         );
+    }
+}
+
+/// Hears every stage: its name, its total and the items counted in it.
+#[derive(Default)]
+struct Recording(std::sync::Mutex<Vec<(String, u64, u64)>>);
+
+impl Observer for Recording {
+    fn stage(&self, name: &str, total: u64) {
+        let mut heard = self.0.lock().unwrap();
+        heard.push((name.to_string(), total, 0));
+    }
+    fn advance(&self, n: u64) -> ControlFlow<()> {
+        if let Some(last) = self.0.lock().unwrap().last_mut() {
+            last.2 += n;
+        }
+        ControlFlow::Continue(())
+    }
+}
+
+#[test]
+fn every_stage_of_a_fill_is_heard_and_counted_to_its_total() {
+    use voxelkit::solids::inside_rule::InsideRule;
+    let dir = tempfile::tempdir().unwrap();
+    let (torus, cube, _) = fixtures(dir.path());
+    let mesh = || MeshSource::File(torus.clone());
+    let solid = |fill, inside| Task::Solid {
+        mesh: mesh(),
+        fill,
+        density: 1.0,
+        topology: false,
+        inside,
+    };
+    let cases = [
+        (
+            solid(Fill::Flood(FloodMethod::Blocks), InsideRule::Winding),
+            vec!["surface and inside"],
+        ),
+        (
+            solid(Fill::Flood(FloodMethod::Blocks), InsideRule::Parity),
+            vec!["surface", "filling"],
+        ),
+        (
+            solid(
+                Fill::DepthLayers(DepthLayerOptions::default()),
+                InsideRule::Auto,
+            ),
+            vec!["depth buffers", "classifying"],
+        ),
+        (
+            Task::DistanceBand {
+                mesh: mesh(),
+                band: 3.0,
+                signed: true,
+                inside: InsideRule::Winding,
+            },
+            vec!["distances and inside"],
+        ),
+        (subdivision_solid(&cube), vec!["voxelizing", "filling"]),
+    ];
+    for (task, stages) in cases {
+        let heard = Recording::default();
+        Job::new(task, GridFit::Resolution(128))
+            .run(&heard)
+            .unwrap();
+        let heard = heard.0.into_inner().unwrap();
+        // The stages the work itself begins: each counted to its total, none silent.
+        let worked: Vec<&(String, u64, u64)> = heard.iter().filter(|s| s.2 > 0).collect();
+        let names: Vec<&str> = worked.iter().map(|s| s.0.as_str()).collect();
+        assert_eq!(names, stages, "{heard:?}");
+        for (name, total, done) in worked {
+            assert!(*total > 0 && done == total, "{name}: {done} of {total}");
+        }
     }
 }

@@ -255,3 +255,18 @@ def test_sample_reads_a_level_set_as_openvdb_does():
     far = np.abs(got) > 2 * grid.voxel_size
     assert ((got[far] < 0) == voxelkit.contains((vertices, faces), points[far])).all()
     assert np.isnan(grid.sample([[np.nan, 0, 0]])[0])
+
+
+def test_progress_is_heard_from_the_fill_stage_to_its_end(trimesh):
+    mesh = trimesh.creation.torus(major_radius=1.0, minor_radius=0.35)
+    for options, last in [
+        (dict(inside="winding"), "surface and inside"),
+        (dict(inside="parity"), "filling"),
+        (dict(method="depth-layers"), "classifying"),
+        (dict(sdf=True), "distances and inside"),
+    ]:
+        heard = []
+        voxelkit.solid(mesh, resolution=128, progress=lambda *told: heard.append(told), **options)
+        stage, done, total = heard[-1]
+        assert (stage, done) == (last, total) and total > 0, (options, heard[-1])
+        assert all(told[0] and told[1] <= told[2] for told in heard), options

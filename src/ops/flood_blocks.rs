@@ -149,6 +149,10 @@ pub fn inside_by_blocks(surface: &SparseGrid, progress: &Progress) -> Result<Spa
         return Ok(inside);
     };
     let blocks = Blocks::new(surface, bbox)?;
+    let total = blocks.slot.len() as u64;
+    progress.stage("filling", total);
+    // Blocks first reached, told in batches: the flood reaches most blocks once.
+    let (mut reached_blocks, mut told) = (1u64, 0u64);
     // Empty blocks: reached or not; surface blocks: their reached voxels.
     let mut exterior = vec![false; blocks.slot.len()];
     let mut reached = vec![[0u64; 8]; blocks.free.len()];
@@ -158,8 +162,12 @@ pub fn inside_by_blocks(surface: &SparseGrid, progress: &Progress) -> Result<Spa
     let mut popped = 0u64;
     while let Some(i) = stack.pop() {
         popped += 1;
-        if popped.is_multiple_of(4096) && progress.stopped() {
-            return Err(Error::Cancelled);
+        if popped.is_multiple_of(4096) {
+            progress.advance(reached_blocks - told);
+            told = reached_blocks;
+            if progress.stopped() {
+                return Err(Error::Cancelled);
+            }
         }
         let slot = blocks.slot[i] as usize;
         let from = if slot == 0 {
@@ -180,17 +188,20 @@ pub fn inside_by_blocks(surface: &SparseGrid, progress: &Progress) -> Result<Spa
                 0 => {
                     if !exterior[j] && face.iter().any(|&w| w != 0) {
                         exterior[j] = true;
+                        reached_blocks += 1;
                         stack.push(j);
                     }
                 }
                 s => {
                     let s = s - 1;
+                    let first = reached[s] == [0; 8];
                     let mut grew = false;
                     for x in 0..8 {
                         let new = face[x] & blocks.free[s][x] & !reached[s][x];
                         grew |= new != 0;
                         reached[s][x] |= new;
                     }
+                    reached_blocks += u64::from(grew && first);
                     if grew && !queued[s] {
                         queued[s] = true;
                         stack.push(j);
@@ -199,7 +210,8 @@ pub fn inside_by_blocks(surface: &SparseGrid, progress: &Progress) -> Result<Spa
             }
         }
     }
-    progress.advance(1);
+    // The blocks never reached are inside: done too.
+    progress.advance(total.saturating_sub(told));
     let whole: Vec<Coord> = (0..blocks.slot.len())
         .into_par_iter()
         .filter(|&i| blocks.slot[i] == 0 && !exterior[i])

@@ -49,6 +49,10 @@ impl Watch {
         py.check_signals()?;
         if let Some(callback) = progress {
             let (stage, total) = self.stage.lock().unwrap_or_else(|e| e.into_inner()).clone();
+            // Nothing to tell before the first stage begins.
+            if stage.is_empty() {
+                return Ok(());
+            }
             let done = if finished {
                 total
             } else {

@@ -473,7 +473,7 @@ fn push_voxel(runs: &mut Vec<(usize, usize)>, index: usize) {
 
 /// The solid of `mesh` on `transform` over `bbox`: depth buffers along `options.directions`,
 /// classified with single or double layers; `progress` counts the directions
-/// rendered, then the x slabs classified.
+/// rendered, then the x slabs classified (two stages).
 pub fn depth_layer_solid(
     mesh: &Mesh,
     transform: &Transform,
@@ -490,9 +490,9 @@ pub fn depth_layer_solid(
         .iter()
         .map(|&p| transform.world_to_index(p) - origin)
         .collect();
-    let views = options
-        .directions
-        .to_vec()
+    let directions = options.directions.to_vec();
+    progress.stage("depth buffers", directions.len() as u64);
+    let views = directions
         .par_iter()
         .map(|&d| {
             let view = View::render(d, dims, &points, mesh);
@@ -505,6 +505,7 @@ pub fn depth_layer_solid(
     let open_input = per_direction.iter().any(|c| c.odd > 0);
     let [_, ny, nz] = dims;
     let z_view = &views[0];
+    progress.stage("classifying", dims[0] as u64);
     let slabs: Vec<SlabRuns> = (0..dims[0])
         .into_par_iter()
         .map(|x| {

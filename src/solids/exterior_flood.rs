@@ -62,6 +62,8 @@ pub fn solid_from_surface(
     let bbox = padded(bbox, 2);
     let blocked = DenseMask::from_grid(surface, bbox)?;
     let seed = [bbox.min];
+    // These floods cannot tell how far they have come: one item, done at the end.
+    progress.stage("filling", 1);
     let (exterior, xyz_stats) = match method {
         FloodMethod::Blocks | FloodMethod::Spans => (flood_spans(&blocked, &seed, progress)?, None),
         FloodMethod::Xyz { capacity } => {
@@ -69,6 +71,7 @@ pub fn solid_from_surface(
             (reached, Some(stats))
         }
     };
+    progress.advance(1);
     let inside_mask = DenseMask::neither(&blocked, &exterior);
     let inside = inside_mask.to_grid(surface.transform);
     let measures = SolidMeasures::of(

@@ -7,7 +7,7 @@
 use super::cavities::remove_cavities;
 use super::exterior_flood::{FloodMethod, Solid, solid_from_surface};
 use super::inside_rule::Inside;
-use super::winding_inside::winding_inside;
+use super::winding_inside::{block_columns, winding_inside};
 use crate::error::Result;
 use crate::grid::{Adjacency, DenseMask, SparseGrid, Transform};
 use crate::mesh::{Mesh, index_box};
@@ -16,7 +16,7 @@ use crate::ops::measure::SolidMeasures;
 use crate::ops::topology::{components, euler_characteristic};
 use crate::progress::Progress;
 use crate::voxelize::Separability;
-use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
+use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh, work_items};
 
 /// Why the flood needs a closed mesh, for the error that refuses an open one.
 pub const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it and leave the solid hollow \
@@ -89,9 +89,11 @@ pub fn flooded_mesh(
 ) -> Result<SurfaceAndInside> {
     if let Inside::Winding(caps) = inside {
         let region = index_box(&mesh.bbox(), &t);
+        let columns = block_columns(region).len() as u64;
+        progress.stage("surface and inside", work_items(mesh) + columns);
         let (surface, centres) = rayon::join(
             || flood_surface(mesh, t, progress),
-            || winding_inside(mesh, caps, t, region),
+            || winding_inside(mesh, caps, t, region, progress),
         );
         let centres = centres?;
         let parts = SurfaceAndInside::with_inside(surface?, centres.grid(t));

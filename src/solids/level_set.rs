@@ -10,7 +10,7 @@
 //! band), so one centre decides it.
 
 use super::inside_rule::Inside;
-use super::winding_inside::winding_inside;
+use super::winding_inside::{block_columns, winding_inside};
 use crate::error::Result;
 use crate::grid::{Block, Channels, Coord, Leaf, SparseGrid, Transform};
 use crate::mesh::inside::ColumnCrossings;
@@ -18,6 +18,7 @@ use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
 use crate::progress::Progress;
 use crate::voxelize::distance_band::distance_band;
+use crate::voxelize::separating::work_items;
 use rayon::prelude::*;
 
 /// Why a signed distance by parity needs a closed mesh, for the error that refuses an open one.
@@ -51,9 +52,11 @@ pub fn level_set(
         Inside::Winding(caps) => caps,
         Inside::Parity => return parity_level_set(mesh, transform, band, columns_box, progress),
     };
+    let columns = block_columns(columns_box).len() as u64;
+    progress.stage("distances and inside", work_items(mesh) + columns);
     let (grid, inside) = rayon::join(
         || distance_band(mesh, transform, band, progress),
-        || winding_inside(mesh, caps, transform, columns_box),
+        || winding_inside(mesh, caps, transform, columns_box, progress),
     );
     let (mut grid, inside) = (grid?, inside?);
     let h = transform.voxel_size as f32;

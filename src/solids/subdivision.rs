@@ -89,7 +89,9 @@ pub fn subdivision_solid(
     let mut outside = DenseMask::new(bbox)?;
     let mut stats = FloodXyzStats::default();
     let mut outside_seeds = 0u64;
+    progress.stage("filling", seeds.len() as u64);
     for &seed in &seeds {
+        progress.advance(1);
         if inside.get(seed) || outside.get(seed) {
             continue;
         }

@@ -21,6 +21,7 @@ use crate::mesh::Mesh;
 use crate::mesh::boundary_caps::BoundaryCaps;
 use crate::mesh::inside::{ColumnCrossings, Crossing};
 use crate::mesh::winding::{RimBound, WindingTree, winding_number_of};
+use crate::progress::Progress;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -77,12 +78,27 @@ fn threshold(low: f64, high: f64) -> Option<i32> {
     (first > high + 0.5 + AMBIGUOUS).then_some(first as i32)
 }
 
-/// The inside centres of `mesh` (closed by `caps`) over `region`, with `transform`.
+/// The columns of 8^3 blocks `winding_inside` decides over `region`: the items it counts.
+pub fn block_columns(region: CoordBox) -> Vec<(i64, i64)> {
+    let aligned = |lo: i64| lo & !7;
+    (aligned(region.min[0])..=region.max[0])
+        .step_by(8)
+        .flat_map(|x| {
+            (aligned(region.min[1])..=region.max[1])
+                .step_by(8)
+                .map(move |y| (x, y))
+        })
+        .collect()
+}
+
+/// The inside centres of `mesh` (closed by `caps`) over `region`, with `transform`;
+/// `progress` counts the block columns decided.
 pub fn winding_inside(
     mesh: &Mesh,
     caps: &BoundaryCaps,
     transform: Transform,
     region: CoordBox,
+    progress: &Progress,
 ) -> Result<WindingInside> {
     let (points, triangles) = closed_by_caps(mesh, caps);
     let orientation = if winds_reversed(&points, &triangles) {
@@ -148,19 +164,19 @@ pub fn winding_inside(
         region,
         special: &special,
     };
-    let aligned = |lo: i64| lo & !7;
-    let block_columns: Vec<(i64, i64)> = (aligned(region.min[0])..=region.max[0])
-        .step_by(8)
-        .flat_map(|x| {
-            (aligned(region.min[1])..=region.max[1])
-                .step_by(8)
-                .map(move |y| (x, y))
+    // Once cancelled, the remaining columns are skipped (the call then fails).
+    let parts: Vec<Option<BlockColumn>> = block_columns(region)
+        .par_iter()
+        .map(|&(x, y)| {
+            if progress.stopped() {
+                return None;
+            }
+            let column = context.block_column(x, y);
+            progress.advance(1);
+            Some(column)
         })
         .collect();
-    let parts: Vec<BlockColumn> = block_columns
-        .par_iter()
-        .map(|&(x, y)| context.block_column(x, y))
-        .collect();
+    progress.check()?;
     let mut inside = WindingInside {
         leaves: Vec::new(),
         full_blocks: Vec::new(),
@@ -168,7 +184,7 @@ pub fn winding_inside(
         reversed: orientation < 0,
     };
     let mut ambiguous = Vec::new();
-    for part in parts {
+    for part in parts.into_iter().flatten() {
         inside.leaves.extend(part.leaves);
         inside.full_blocks.extend(part.full_blocks);
         ambiguous.extend(part.ambiguous);
