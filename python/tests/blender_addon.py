@@ -65,6 +65,39 @@ voxelize(imported, resolution=64, fill="sdf")
 # first volume keeps showing what it showed.
 imported.scale = (1.3, 1.0, 1.0)
 voxelize(imported, resolution=96, fill="solid")
+# An animated ball, moving along x and growing from frame 1 to 3, baked frame by frame into
+# one sequence; each frame's file read back as Blender plays it.
+bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=3, radius=0.5, location=(0.0, 0.0, 0.0))
+ball = bpy.context.active_object
+for frame, x, size in [(1, 0.0, 1.0), (3, 4.0, 1.5)]:
+    ball.location.x, ball.scale = x, (size, size, size)
+    ball.keyframe_insert("location", frame=frame)
+    ball.keyframe_insert("scale", frame=frame)
+scene = bpy.context.scene
+scene.frame_start, scene.frame_end = 1, 3
+before = set(bpy.data.objects.keys())
+baked = bpy.ops.object.voxelkit_bake_frames(resolution=32, fill="solid")
+[name] = set(bpy.data.objects.keys()) - before
+sequence = bpy.data.objects[name].data
+played = []
+for frame in (1, 2, 3):
+    scene.frame_set(frame)
+    loaded = sequence.grids.load()
+    path = bpy.path.abspath(sequence.grids.frame_filepath)
+    grid = voxelkit.read_vdb(path)
+    lo, hi = grid.index_to_world(list(grid.bbox))
+    played.append({
+        "frame": frame,
+        "grid_frame": sequence.grids.frame,
+        "loaded": loaded,
+        "path": path,
+        "voxel_size": grid.voxel_size,
+        "origin": list(grid.origin),
+        "centre": ((lo + hi) / 2).tolist(),
+        "width": float(hi[0] - lo[0]),
+        "location": list(ball.matrix_world.translation),
+    })
+print("FRAMES " + json.dumps({"operator": list(baked), "is_sequence": sequence.is_sequence, "played": played}))
 operator = bpy.ops.object.voxelkit_voxelize.get_rna_type().properties
 print("PROPERTIES " + json.dumps({
     name: {

@@ -56,3 +56,15 @@ def test_the_add_on_voxelizes_into_volume_objects(data, tmp_path):
     band = next(f["default"] for f in voxelkit.OPTIONS["solid"]["fields"] if f["name"] == "band")
     assert f"within {band:g} voxels" in shown["fill"]["description"][2]
     assert "PANEL True True" in done.stdout and "UNREGISTERED False" in done.stdout
+    # The frame bake: one file per frame, on one grid, each played at its frame where the
+    # animated ball stands then, growing as it grows.
+    [baked] = [json.loads(l[len("FRAMES "):]) for l in done.stdout.splitlines() if l.startswith("FRAMES ")]
+    assert baked["operator"] == ["FINISHED"] and baked["is_sequence"], baked
+    played = baked["played"]
+    assert len({p["path"] for p in played}) == 3 and all(Path(p["path"]).is_file() for p in played)
+    assert {results[i]["path"] for i in range(4)}.isdisjoint(p["path"] for p in played)
+    for p in played:
+        assert p["loaded"] and p["grid_frame"] == p["frame"], p
+        assert p["voxel_size"] == played[0]["voxel_size"] and p["origin"] == played[0]["origin"], p
+        assert np.allclose(p["centre"], p["location"], atol=p["voxel_size"]), p
+    assert played[0]["width"] < played[1]["width"] < played[2]["width"]

@@ -6,11 +6,16 @@ in ``__init__``; the compiled module must match Blender's Python, 3.11 for Blend
 (modifiers applied) in its world transform and Blender's axes, voxelizes it (a surface, a
 solid, or a level set), writes a ``.vdb`` beside the ``.blend`` file (or in the temporary
 folder for an unsaved file) and adds a Volume object placed exactly over the mesh, showing
-its ``density`` grid. The panel is in Properties > Object > voxelkit.
+its ``density`` grid. ``object.voxelkit_bake_frames`` does the same for every frame of a
+range (the mesh as animated: armature, shape keys, modifiers, its own motion) on one grid
+fitted to all frames, into a numbered ``.vdb`` sequence that the Volume object plays. Each
+bake writes files of its own, never over a file another object reads. The panel is in
+Properties > Object > voxelkit.
 """
 
-import os
 import itertools
+import os
+import shutil
 import tempfile
 
 import bpy
@@ -46,8 +51,10 @@ FILL = [
 
 
 def _options(owner):
-    """The settings shared by the operator and the panel's property group."""
+    """The settings shared by the operators and the panel's property group, beside the
+    owner's own."""
     owner.__annotations__ = {
+        **owner.__dict__.get("__annotations__", {}),
         "resolution": IntProperty(
             name="Resolution",
             description="Voxels along the longest side of the mesh's box",
@@ -88,9 +95,10 @@ def world_mesh(obj, depsgraph):
     return vertices, tris.reshape(-1, 3)
 
 
-def voxelize(vertices, triangles, settings):
-    """The voxelkit call the settings ask for."""
-    fit = (
+def voxelize(vertices, triangles, settings, fit=None):
+    """The voxelkit call the settings ask for; ``fit`` (voxel_size and origin) places the
+    grid instead of the settings' resolution or voxel size."""
+    fit = fit or (
         {"voxel_size": settings.voxel_size}
         if settings.voxel_size > 0
         else {"resolution": settings.resolution}
@@ -105,13 +113,19 @@ def voxelize(vertices, triangles, settings):
     )
 
 
-def output_path(name):
-    """Where the volume's file goes: beside the .blend, or in the temporary folder; named
-    after `name`, numbered past every file a Volume of this .blend already reads, so that a
-    bake never overwrites what another object shows."""
+def output_folder():
+    """Where bakes go: beside the .blend, or in the temporary folder for an unsaved file."""
     folder = bpy.path.abspath("//voxelkit") if bpy.data.filepath else None
     folder = folder or os.path.join(tempfile.gettempdir(), "voxelkit-blender")
     os.makedirs(folder, exist_ok=True)
+    return folder
+
+
+def output_path(name):
+    """Where the volume's file goes: in the output folder, named after `name`, numbered past
+    every file a Volume of this .blend already reads, so that a bake never overwrites what
+    another object shows."""
+    folder = output_folder()
     used = {os.path.normpath(bpy.path.abspath(v.filepath)) for v in bpy.data.volumes if v.filepath}
     base = bpy.path.clean_name(name)
     for n in itertools.count(1):
@@ -158,6 +172,98 @@ class VOXELKIT_OT_voxelize(bpy.types.Operator):
         return {"FINISHED"}
 
 
+def new_sequence_folder(name):
+    """A folder of its own for a frame sequence, made now: `name`, numbered past every one
+    that exists."""
+    base = os.path.join(output_folder(), bpy.path.clean_name(name))
+    for n in itertools.count(1):
+        folder = base + (f"-{n}" if n > 1 else "")
+        try:
+            os.makedirs(folder)
+            return folder
+        except FileExistsError:
+            continue
+
+
+def shared_fit(frames, settings):
+    """One grid for every frame: the voxel size the settings give the union of the frames'
+    boxes, and voxel (0, 0, 0) half a voxel inside its low corner (as one frame is placed)."""
+    low = np.min([v.min(axis=0) for v, _ in frames], axis=0)
+    high = np.max([v.max(axis=0) for v, _ in frames], axis=0)
+    h = settings.voxel_size if settings.voxel_size > 0 else float((high - low).max()) / settings.resolution
+    return {"voxel_size": h, "origin": (low + h / 2).tolist()}
+
+
+@_options
+class VOXELKIT_OT_bake_frames(bpy.types.Operator):
+    """Voxelize the active mesh object at every frame of a range into a Volume object that
+    plays the sequence"""
+
+    bl_idname = "object.voxelkit_bake_frames"
+    bl_label = "Bake frames with voxelkit"
+    bl_options = {"REGISTER", "UNDO"}
+
+    frame_start: IntProperty(name="First frame", description="The first frame baked (default: the scene's)", default=-1)
+    frame_end: IntProperty(name="Last frame", description="The last frame baked (default: the scene's)", default=-1)
+
+    @classmethod
+    def poll(cls, context):
+        return VOXELKIT_OT_voxelize.poll(context)
+
+    def execute(self, context):
+        scene, obj = context.scene, context.active_object
+        first = self.frame_start if self.frame_start >= 0 else scene.frame_start
+        last = self.frame_end if self.frame_end >= 0 else scene.frame_end
+        if last < first:
+            self.report({"ERROR"}, f"the last frame ({last}) comes before the first ({first})")
+            return {"CANCELLED"}
+        shown = scene.frame_current
+        frames = []
+        try:
+            for frame in range(first, last + 1):
+                scene.frame_set(frame)
+                frames.append(world_mesh(obj, context.evaluated_depsgraph_get()))
+        finally:
+            scene.frame_set(shown)
+        if any(len(t) == 0 for _, t in frames):
+            self.report({"ERROR"}, f"{obj.name} has no faces to voxelize at some frame")
+            return {"CANCELLED"}
+        folder = new_sequence_folder(f"{obj.name}-{self.fill}-frames")
+        fit = shared_fit(frames, self)
+        paths, voxels = [], 0
+        window_manager = context.window_manager
+        window_manager.progress_begin(0, len(frames))
+        try:
+            for i, (frame, (vertices, triangles)) in enumerate(zip(range(first, last + 1), frames)):
+                grid = voxelize(vertices, triangles, self, fit)
+                # Blender reads the number at the end of the name as the frame.
+                paths.append(os.path.join(folder, f"{bpy.path.clean_name(obj.name)}_{frame:04d}.vdb"))
+                grid.write(paths[-1])
+                voxels += len(grid)
+                window_manager.progress_update(i + 1)
+        except (ValueError, MemoryError, OSError) as e:
+            shutil.rmtree(folder, ignore_errors=True)
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        finally:
+            window_manager.progress_end()
+        volume = bpy.data.volumes.new(f"{obj.name} voxels {first}-{last}")
+        volume.filepath = paths[0]
+        volume.is_sequence = True
+        volume.frame_start = first
+        volume.frame_duration = len(paths)
+        # File number n plays at frame frame_start + n - 1 - offset: the files are numbered by frame.
+        volume.frame_offset = first - 1
+        volume.sequence_mode = "CLIP"
+        volume_object = bpy.data.objects.new(volume.name, volume)
+        context.collection.objects.link(volume_object)
+        self.report(
+            {"INFO"},
+            f"{len(paths)} frames, {voxels} voxels of size {fit['voxel_size']:.4g} in {folder}",
+        )
+        return {"FINISHED"}
+
+
 @_options
 class VoxelkitSettings(bpy.types.PropertyGroup):
     """The panel's settings, kept with the scene."""
@@ -178,12 +284,13 @@ class VOXELKIT_PT_panel(bpy.types.Panel):
         layout = self.layout
         for name in ("resolution", "voxel_size", "separability", "method", "fill"):
             layout.prop(settings, name)
-        op = layout.operator(VOXELKIT_OT_voxelize.bl_idname)
-        for name in ("resolution", "voxel_size", "separability", "method", "fill"):
-            setattr(op, name, getattr(settings, name))
+        for operator in (VOXELKIT_OT_voxelize, VOXELKIT_OT_bake_frames):
+            op = layout.operator(operator.bl_idname)
+            for name in ("resolution", "voxel_size", "separability", "method", "fill"):
+                setattr(op, name, getattr(settings, name))
 
 
-CLASSES = (VoxelkitSettings, VOXELKIT_OT_voxelize, VOXELKIT_PT_panel)
+CLASSES = (VoxelkitSettings, VOXELKIT_OT_voxelize, VOXELKIT_OT_bake_frames, VOXELKIT_PT_panel)
 
 
 def register():
