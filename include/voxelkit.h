@@ -131,7 +131,9 @@ const char *vk_last_error(void);
 
 /* ---- meshes ---------------------------------------------------------------------------- */
 
-/* Loads an .obj (polygons, `l` polylines, `v x y z r g b` colours) or .stl file. */
+/* Loads a mesh file by its extension: .obj (polygons, `l` polylines, `v x y z r g b`
+ * colours), .stl (binary or ASCII), .ply, .off, .gltf or .glb (its buffers read only from
+ * its own folder). */
 vk_status vk_mesh_load(const char *path, vk_mesh **out);
 
 /*
@@ -188,6 +190,16 @@ vk_status vk_options_set_progress(vk_options *options, vk_progress_fn callback, 
  * NULL to remove. It must stay valid while calls with these options run.
  */
 vk_status vk_options_set_cancel_flag(vk_options *options, const int32_t *flag);
+/*
+ * Distances instead of voxel sets: with a positive `band` (half width in voxels),
+ * vk_voxelize_mesh and vk_fill_mesh make a level set, exact signed distances in world units
+ * (negative inside, by the solid request's `inside` rule) on every voxel within `band`
+ * voxels of the surface; vk_options_set_udf makes vk_voxelize_mesh give unsigned distances
+ * (open meshes too). 0 turns them off; each turns the other off. Read the values with
+ * vk_grid_copy_values; vk_grid_write_vdb writes the level set as the CLI's --sdf does.
+ */
+vk_status vk_options_set_sdf(vk_options *options, double band);
+vk_status vk_options_set_udf(vk_options *options, double band);
 /* Compression and half-precision floats of vk_grid_write_vdb_with (default blosc, full). */
 vk_status vk_options_set_compression(vk_options *options, vk_compression compression);
 vk_status vk_options_set_half(vk_options *options, int half);
@@ -259,8 +271,13 @@ vk_status vk_grid_combine(const vk_grid *a, const vk_grid *b, vk_boolean op, int
  * voxels. */
 vk_status vk_grid_read_vdb(const char *path, const char *name, vk_grid **out);
 
-/* Writes `density` (a fog volume, whole blocks as tiles) and, when the grid has them,
- * `normal` and `Cd` grids (written to a temporary file, then renamed). */
+/*
+ * Writes every grid the CLI writes for the same job, with its metadata: `density` (a fog
+ * volume, whole blocks as tiles), `normal` and `Cd` when the grid has them, a solid's
+ * `shell` and `interior`, a level set as `surface` (LEVEL_SET class, its inside as inactive
+ * -background tiles), unsigned distances as `distance` (written to a temporary file, then
+ * renamed). A .binvox or .vox path writes the voxel set alone.
+ */
 vk_status vk_grid_write_vdb(const vk_grid *grid, const char *path);
 /* vk_grid_write_vdb with the write options of `options`: the grids named (write.grids),
  * the compression and half precision. */
@@ -305,6 +322,38 @@ vk_status vk_grid_copy_colors(const vk_grid *grid, size_t first, size_t count, f
  */
 vk_status vk_grid_copy_voxels(const vk_grid *grid, int64_t *coords, size_t capacity,
                               size_t *written);
+
+/* What a grid holds: voxels (a surface or a solid), a level set (vk_options_set_sdf) or
+ * unsigned distances (vk_options_set_udf); `background` receives the distance grids'
+ * background, band x voxel size (0 for voxels). */
+typedef enum vk_grid_class {
+    VK_GRID_VOXELS = 0,
+    VK_GRID_LEVEL_SET = 1,
+    VK_GRID_UNSIGNED_DISTANCE = 2
+} vk_grid_class;
+vk_status vk_grid_get_class(const vk_grid *grid, vk_grid_class *grid_class, float *background);
+
+/*
+ * Copies the distances of leaves first .. first + count of a distance grid: 512 floats per
+ * leaf in voxel order n, the distance (world units) at active voxels and what OpenVDB reads
+ * at inactive ones: -background inside a level set, +background elsewhere (so that
+ * openvdb::tools::signedFloodFill gives the tiles beyond the band their sign).
+ * VK_ERROR_INVALID_ARGUMENT for a voxel grid.
+ */
+vk_status vk_grid_copy_values(const vk_grid *grid, size_t first, size_t count, float *values);
+
+/*
+ * A voxel grid from the caller's own leaves and tiles, in the layout vk_grid_copy_leaves and
+ * vk_grid_copy_tiles give: `leaf_origins` 3 * leaf_count int32 (multiples of 8), `masks`
+ * 8 * leaf_count uint64, `tile_origins` 3 * tile_count int32 and `tile_edges` tile_count
+ * int32 (8 or 128, origins multiples of the edge); world = origin + voxel_size * index.
+ * Leaves at the same origin are OR-ed. The grid enters vk_grid_combine, vk_measure_surface
+ * and the writers as any other.
+ */
+vk_status vk_grid_from_leaves(double voxel_size, const double origin[3], size_t leaf_count,
+                              const int32_t *leaf_origins, const uint64_t *masks,
+                              size_t tile_count, const int32_t *tile_origins,
+                              const int32_t *tile_edges, vk_grid **out);
 
 vk_status vk_grid_free(vk_grid *grid);
 

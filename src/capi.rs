@@ -10,9 +10,9 @@
 
 use crate::choice::Choice;
 use crate::error::{Error, Result};
-use crate::grid::{LEAF_VOXELS, SparseGrid};
+use crate::grid::{Block, Channels, Coord, LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use crate::implicit::Coordinates;
-use crate::io::vdb::{Compression, MetaValue, read_vdb_solid, write_vdb, write_vdb_as};
+use crate::io::vdb::{Compression, read_vdb_solid};
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::BooleanOp;
 use crate::pipeline::request::{
@@ -71,16 +71,14 @@ pub type VkProgressFn = extern "C" fn(done: u64, total: u64, user_data: *mut c_v
 pub struct VkMesh(Mesh);
 /// `vk_grid`: a grid and the `.vdb` metadata of the job that made it.
 pub struct VkGrid {
-    grid: SparseGrid,
-    metadata: Vec<(String, MetaValue)>,
+    /// Every grid of the job that made it (a level set's interior, a solid's shell ...),
+    /// its metadata and report: what the CLI would write.
+    outcome: Outcome,
 }
 
 impl From<Outcome> for VkGrid {
     fn from(outcome: Outcome) -> Self {
-        VkGrid {
-            grid: outcome.grid,
-            metadata: outcome.metadata,
-        }
+        VkGrid { outcome }
     }
 }
 /// `vk_options`: changed by the setters, copied by each call.
@@ -776,6 +774,41 @@ pub extern "C" fn vk_options_set_half(options: *mut VkOptions, half: c_int) -> V
     })
 }
 
+/// The band of `vk_options_set_sdf` and `_udf`: on (true) for a positive half width, off for 0.
+fn distance_band_option(band: f64) -> std::result::Result<bool, Failure> {
+    if band == 0.0 {
+        return Ok(false);
+    }
+    crate::pipeline::request::positive("band", band)?;
+    Ok(true)
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_sdf(options: *mut VkOptions, band: f64) -> VkStatus {
+    set(options, |o| {
+        let on = distance_band_option(band)?;
+        (o.mesh.sdf, o.solid.sdf) = (on, on);
+        o.mesh.udf &= !on;
+        if on {
+            (o.mesh.band, o.solid.band) = (band, band);
+        }
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_options_set_udf(options: *mut VkOptions, band: f64) -> VkStatus {
+    set(options, |o| {
+        let on = distance_band_option(band)?;
+        o.mesh.udf = on;
+        o.mesh.sdf &= !on;
+        if on {
+            o.mesh.band = band;
+        }
+        Ok(())
+    })
+}
+
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_options_set_resolution(options: *mut VkOptions, resolution: u32) -> VkStatus {
     set(options, |o| {
@@ -1031,6 +1064,17 @@ pub extern "C" fn vk_fill_mesh(
             volume_inside: d.volume,
             volume_with_surface: d.volume,
         }),
+        // A level set: the centres inside it.
+        Details::DistanceBand(_) => {
+            let inside = outcome.solid_voxels().voxel_count();
+            let volume = inside as f64 * outcome.grid.transform.voxel_size.powi(3);
+            Ok(VkMeasures {
+                inside_voxels: inside,
+                surface_voxels: 0,
+                volume_inside: volume,
+                volume_with_surface: volume,
+            })
+        }
         _ => solid_measures(outcome),
     };
     solid_from_job(options, solid, measures, task, measures_of)
@@ -1059,7 +1103,7 @@ pub extern "C" fn vk_measure_surface(
     measures: *mut VkMeasures,
 ) -> VkStatus {
     guard(|| {
-        let g = &borrow(surface, Kind::Grid)?.grid;
+        let g = &borrow(surface, Kind::Grid)?.outcome.grid;
         non_null_out(measures)?;
         let task = MeasureRequest::default().task(MeasureSource::Grid(g.clone()))?;
         let outcome = run_job(&Options::default(), task)?;
@@ -1076,14 +1120,17 @@ pub extern "C" fn vk_grid_combine(
     out: *mut *mut VkGrid,
 ) -> VkStatus {
     guard(|| {
-        let (a, b) = (&borrow(a, Kind::Grid)?.grid, &borrow(b, Kind::Grid)?.grid);
+        let (a, b) = (
+            borrow(a, Kind::Grid)?.outcome.solid_voxels(),
+            borrow(b, Kind::Grid)?.outcome.solid_voxels(),
+        );
         non_null_out(out)?;
         let request = CombineRequest {
             op: BooleanOp::from_code(i64::from(op)).map_err(invalid)?,
             resample: resample != 0,
             ..CombineRequest::default()
         };
-        let task = request.task((GridSource::Grid(a.clone()), GridSource::Grid(b.clone())))?;
+        let task = request.task((GridSource::Grid(a), GridSource::Grid(b)))?;
         let outcome = run_job(&Options::default(), task)?;
         hand_out(VkGrid::from(outcome), Kind::Grid, out)
     })
@@ -1104,8 +1151,9 @@ pub extern "C" fn vk_grid_read_vdb(
         };
         let path = PathBuf::from(c_str(path, "path")?);
         let grid = read_vdb_solid(&path, name)?;
-        let metadata = vec![("source_file".to_string(), path.display().to_string().into())];
-        hand_out(VkGrid { grid, metadata }, Kind::Grid, out)
+        let mut outcome = Outcome::from_voxels(grid, &path.display().to_string());
+        outcome.metadata = vec![("source_file".to_string(), path.display().to_string().into())];
+        hand_out(VkGrid::from(outcome), Kind::Grid, out)
     })
 }
 
@@ -1114,12 +1162,8 @@ pub extern "C" fn vk_grid_write_vdb(grid: *const VkGrid, path: *const c_char) ->
     guard(|| {
         let g = borrow(grid, Kind::Grid)?;
         let path = PathBuf::from(c_str(path, "path")?);
-        let meta: Vec<(&str, MetaValue)> = g
-            .metadata
-            .iter()
-            .map(|(k, v)| (k.as_str(), v.clone()))
-            .collect();
-        Ok(write_vdb(&path, &g.grid, &meta)?)
+        Ok(g.outcome
+            .write_files(&path, &[], &WriteRequest::default().options())?)
     })
 }
 
@@ -1133,19 +1177,14 @@ pub extern "C" fn vk_grid_write_vdb_with(
         let g = borrow(grid, Kind::Grid)?;
         let path = PathBuf::from(c_str(path, "path")?);
         let write = options_of(options)?.write.options();
-        let meta: Vec<(&str, MetaValue)> = g
-            .metadata
-            .iter()
-            .map(|(k, v)| (k.as_str(), v.clone()))
-            .collect();
-        Ok(write_vdb_as(&path, &g.grid, &[], &meta, &write)?)
+        Ok(g.outcome.write_files(&path, &[], &write)?)
     })
 }
 
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_grid_voxel_count(grid: *const VkGrid, count: *mut u64) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.grid;
+        let g = &borrow(grid, Kind::Grid)?.outcome.grid;
         put(count, g.voxel_count())
     })
 }
@@ -1153,7 +1192,7 @@ pub extern "C" fn vk_grid_voxel_count(grid: *const VkGrid, count: *mut u64) -> V
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_grid_leaf_count(grid: *const VkGrid, count: *mut usize) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.grid;
+        let g = &borrow(grid, Kind::Grid)?.outcome.grid;
         put(count, g.leaf_count())
     })
 }
@@ -1165,7 +1204,7 @@ pub extern "C" fn vk_grid_transform(
     origin: *mut f64,
 ) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.grid;
+        let g = &borrow(grid, Kind::Grid)?.outcome.grid;
         non_null_out(voxel_size)?;
         let o = slice_mut(origin, 3, "origin")?;
         o.copy_from_slice(&g.transform.origin.to_array());
@@ -1197,7 +1236,7 @@ pub extern "C" fn vk_grid_copy_leaves(
     masks: *mut u64,
 ) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.grid;
+        let g = &borrow(grid, Kind::Grid)?.outcome.grid;
         let leaves = leaf_range(g, first, count)?;
         let origins = slice_mut(origins, 3 * count, "origins")?;
         let masks = slice_mut(masks, 8 * count, "masks")?;
@@ -1223,7 +1262,7 @@ pub extern "C" fn vk_grid_copy_leaves(
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_grid_tile_count(grid: *const VkGrid, count: *mut usize) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.grid;
+        let g = &borrow(grid, Kind::Grid)?.outcome.grid;
         put(count, g.tiles().with_edges().count())
     })
 }
@@ -1237,7 +1276,7 @@ pub extern "C" fn vk_grid_copy_tiles(
     edges: *mut i32,
 ) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.grid;
+        let g = &borrow(grid, Kind::Grid)?.outcome.grid;
         let tiles: Vec<_> = g.tiles().with_edges().collect();
         let n = tiles.len();
         let chosen = match first.checked_add(count) {
@@ -1275,7 +1314,7 @@ fn copy_channel(
     channel: fn(&crate::grid::Leaf) -> Option<&[[f32; 3]; LEAF_VOXELS]>,
 ) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.grid;
+        let g = &borrow(grid, Kind::Grid)?.outcome.grid;
         let leaves = leaf_range(g, first, count)?;
         let out = slice_mut(out, 3 * LEAF_VOXELS * count, name)?;
         for (k, leaf) in leaves.iter().enumerate() {
@@ -1321,7 +1360,7 @@ pub extern "C" fn vk_grid_copy_voxels(
     written: *mut usize,
 ) -> VkStatus {
     guard(|| {
-        let g = &borrow(grid, Kind::Grid)?.grid;
+        let g = &borrow(grid, Kind::Grid)?.outcome.grid;
         non_null_out(written)?;
         let n = g.voxel_count() as usize;
         put(written, n)?;
@@ -1336,6 +1375,141 @@ pub extern "C" fn vk_grid_copy_voxels(
             out[3 * k..3 * k + 3].copy_from_slice(&c);
         }
         Ok(())
+    })
+}
+
+/// `vk_grid_class`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VkGridClass {
+    Voxels = 0,
+    LevelSet = 1,
+    UnsignedDistance = 2,
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_get_class(
+    grid: *const VkGrid,
+    kind: *mut VkGridClass,
+    background: *mut f32,
+) -> VkStatus {
+    guard(|| {
+        let g = &borrow(grid, Kind::Grid)?.outcome;
+        non_null_out(kind)?;
+        non_null_out(background)?;
+        let (k, b) = match &g.distances {
+            None => (VkGridClass::Voxels, 0.0),
+            Some(d) if d.interior.is_some() => (VkGridClass::LevelSet, d.background),
+            Some(d) => (VkGridClass::UnsignedDistance, d.background),
+        };
+        put(kind, k)?;
+        put(background, b)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_copy_values(
+    grid: *const VkGrid,
+    first: usize,
+    count: usize,
+    values: *mut f32,
+) -> VkStatus {
+    guard(|| {
+        let g = &borrow(grid, Kind::Grid)?.outcome;
+        let Some(d) = &g.distances else {
+            return Err(invalid(
+                "the grid holds voxels, not distances: it has no values to copy",
+            ));
+        };
+        let leaves = leaf_range(&g.grid, first, count)?;
+        let out = slice_mut(values, LEAF_VOXELS * count, "values")?;
+        for (k, leaf) in leaves.iter().enumerate() {
+            let dst = &mut out[LEAF_VOXELS * k..LEAF_VOXELS * (k + 1)];
+            // What OpenVDB reads at inactive voxels: minus the background inside.
+            let inside = match d.interior.as_ref().map(|i| i.block(leaf.origin)) {
+                Some(Block::Whole) => [u64::MAX; 8],
+                Some(Block::Partial(l)) => l.mask,
+                _ => [0; 8],
+            };
+            for (n, v) in dst.iter_mut().enumerate() {
+                *v = if inside[n / 64] >> (n % 64) & 1 == 1 {
+                    -d.background
+                } else {
+                    d.background
+                };
+            }
+            let own = leaf.value.as_ref().expect("distances");
+            for n in leaf.offsets() {
+                dst[n] = own[n];
+            }
+        }
+        Ok(())
+    })
+}
+
+/// The first coordinate of `v` as a block origin: a multiple of `edge`, or an error.
+fn block_origin(v: &[i32], edge: i64, what: &str) -> std::result::Result<Coord, Failure> {
+    let origin = [0, 1, 2].map(|a| i64::from(v[a]));
+    if origin.iter().any(|c| c.rem_euclid(edge) != 0) {
+        return Err(invalid(format!(
+            "{what} at {origin:?} is not on a multiple of {edge}"
+        )));
+    }
+    Ok(origin)
+}
+
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub extern "C" fn vk_grid_from_leaves(
+    voxel_size: f64,
+    origin: *const f64,
+    leaf_count: usize,
+    leaf_origins: *const i32,
+    masks: *const u64,
+    tile_count: usize,
+    tile_origins: *const i32,
+    tile_edges: *const i32,
+    out: *mut *mut VkGrid,
+) -> VkStatus {
+    guard(|| {
+        non_null_out(out)?;
+        crate::pipeline::request::positive("voxel_size", voxel_size)?;
+        let o = slice(origin, 3, "origin")?;
+        if !o.iter().all(|v| v.is_finite()) {
+            return Err(invalid(format!("the origin {o:?} must be finite numbers")));
+        }
+        let leaf_origins = slice(leaf_origins, 3 * leaf_count, "leaf_origins")?;
+        let masks = slice(masks, 8 * leaf_count, "masks")?;
+        let tile_origins = slice(tile_origins, 3 * tile_count, "tile_origins")?;
+        let tile_edges = slice(tile_edges, tile_count, "tile_edges")?;
+        let bytes = (leaf_count as u64).saturating_mul(std::mem::size_of::<Leaf>() as u64 * 2);
+        crate::system::check_fits(bytes, None, &format!("a grid of {leaf_count} leaves"))?;
+        let transform = Transform::new(DVec3::new(o[0], o[1], o[2]), voxel_size);
+        let mut leaves = Vec::with_capacity(leaf_count);
+        for k in 0..leaf_count {
+            let mut leaf = Leaf::new(
+                block_origin(&leaf_origins[3 * k..], 8, "leaf")?,
+                Channels::NONE,
+            );
+            leaf.mask.copy_from_slice(&masks[8 * k..8 * k + 8]);
+            leaves.push(leaf);
+        }
+        let mut grid = SparseGrid::from_leaves(transform, Channels::NONE, leaves);
+        for k in 0..tile_count {
+            match tile_edges[k] {
+                8 => grid.fill_leaf_block(block_origin(&tile_origins[3 * k..], 8, "tile")?),
+                128 => grid.fill_node_block(block_origin(&tile_origins[3 * k..], 128, "tile")?),
+                e => {
+                    return Err(invalid(format!(
+                        "tile {k} has edge {e}: tiles are 8 or 128"
+                    )));
+                }
+            }
+        }
+        grid.prune();
+        grid.compact();
+        let outcome = Outcome::from_voxels(grid, "the caller's leaves");
+        hand_out(VkGrid::from(outcome), Kind::Grid, out)
     })
 }
 

@@ -467,3 +467,67 @@ fn a_level_set_read_through_c_stands_for_its_inside() {
         .collect();
     assert_eq!(counts[0] - counts[1], negative, "{text}");
 }
+
+/// A level set made and read in memory through C (values against the exact distance of a
+/// box, measures, a Boolean operand) and a grid rebuilt from its leaves: `in_memory.c`, under
+/// valgrind; its level set file holds what the CLI's `--sdf` file holds.
+#[test]
+fn a_level_set_in_memory_through_c_is_the_clis_and_grids_rebuild_from_leaves() {
+    if !have("pkg-config") || !have("gcc") {
+        return common::skip_or_fail("gcc or pkg-config is missing: the C in-memory test");
+    }
+    let work = tempfile::tempdir().unwrap();
+    let dir = work.path();
+    let flags = run(Command::new("pkg-config")
+        .env("PKG_CONFIG_PATH", prefix().join("lib/pkgconfig"))
+        .args(["--cflags", "--libs", "voxelkit"]));
+    let exe = dir.join("in_memory");
+    run(Command::new("gcc")
+        .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-pedantic"])
+        .arg(repo().join("tests/c/in_memory.c"))
+        .args(String::from_utf8_lossy(&flags.stdout).split_whitespace())
+        .arg("-lm")
+        .arg("-o")
+        .arg(&exe));
+    let from_c = dir.join("c.vdb");
+    let out = run(Command::new(&exe).arg(&from_c));
+    assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "ok");
+    if have("valgrind") {
+        let out = run(Command::new("valgrind")
+            .args(["--leak-check=full", "--errors-for-leak-kinds=definite"])
+            .args(["--show-leak-kinds=definite", "--error-exitcode=99"])
+            .arg(&exe)
+            .arg(dir.join("valgrind.vdb")));
+        let report = String::from_utf8_lossy(&out.stderr);
+        assert!(report.contains("ERROR SUMMARY: 0 errors"), "{report}");
+    } else {
+        common::skip_or_fail("valgrind is not installed: the leak and invalid-read check");
+    }
+    // The same box through the CLI.
+    let obj = dir.join("box.obj");
+    generate::cuboid(glam::DVec3::ZERO, glam::DVec3::new(1.0, 1.0, 2.0))
+        .write_obj(&obj)
+        .unwrap();
+    let from_cli = dir.join("cli.vdb");
+    run(Command::new(env!("CARGO_BIN_EXE_voxelkit"))
+        .args(["mesh", "--sdf", "-r", "40", "-o"])
+        .arg(&from_cli)
+        .arg(&obj));
+    let (c, cli) = (
+        read_vdb_grid(&from_c, Some("surface")).unwrap(),
+        read_vdb_grid(&from_cli, Some("surface")).unwrap(),
+    );
+    assert_eq!(c.transform, cli.transform);
+    assert_eq!(c.voxel_count(), cli.voxel_count());
+    for leaf in cli.leaves() {
+        let other = c.leaf(leaf.origin).expect("the same leaves");
+        assert_eq!(other.mask, leaf.mask);
+        let (a, b) = (other.value.as_ref().unwrap(), leaf.value.as_ref().unwrap());
+        assert!(leaf.offsets().all(|n| a[n] == b[n]), "{:?}", leaf.origin);
+    }
+    let (c_inside, cli_inside) = (
+        voxelkit::io::vdb::read_vdb_solid(&from_c, Some("surface")).unwrap(),
+        voxelkit::io::vdb::read_vdb_solid(&from_cli, Some("surface")).unwrap(),
+    );
+    assert!(c_inside.voxel_count() > 0 && c_inside.voxel_count() == cli_inside.voxel_count());
+}

@@ -7,7 +7,7 @@ use super::report::{
 };
 use super::{ShapeTask, SurfaceMethod, on_threads};
 use crate::error::{Error, Result};
-use crate::grid::{CoordBox, SparseGrid, Transform};
+use crate::grid::{Channels, CoordBox, Leaf, SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::io::atomic::check_output;
 use crate::io::binvox::write_binvox;
@@ -199,6 +199,14 @@ impl Outcome {
         Ok(outcome)
     }
 
+    /// A voxel set made elsewhere (read from a file, built from a caller's leaves) as an
+    /// outcome: `source` says where it came from.
+    pub fn from_voxels(grid: SparseGrid, source: &str) -> Outcome {
+        let mut outcome = Outcome::new(grid, Vec::new(), Details::None);
+        outcome.report.input = source.to_string();
+        outcome
+    }
+
     /// One of `parent`'s grids as an outcome of its own, with `parent`'s metadata.
     pub fn from_grid(grid: SparseGrid, parent: &Outcome) -> Outcome {
         let mut report = parent.report.clone();
@@ -226,10 +234,43 @@ impl Outcome {
         self
     }
 
+    /// What the outcome stands for as an operand of a Boolean or a measure: a level set's
+    /// inside (its negative band voxels and its interior), any other grid's voxels.
+    pub fn solid_voxels(&self) -> SparseGrid {
+        let Some(interior) = self.distances.as_ref().and_then(|d| d.interior.as_ref()) else {
+            return self.grid.clone();
+        };
+        let negative = self
+            .grid
+            .leaves()
+            .iter()
+            .map(|l| {
+                let values = l.value.as_ref().expect("distances");
+                let mut leaf = Leaf::new(l.origin, Channels::NONE);
+                l.offsets()
+                    .filter(|&n| values[n] < 0.0)
+                    .for_each(|n| leaf.set_on(n));
+                leaf
+            })
+            .filter(|l| !l.is_empty())
+            .collect();
+        let mut inside =
+            SparseGrid::from_distinct_leaves(self.grid.transform, Channels::NONE, negative);
+        inside.union(interior);
+        inside
+    }
+
     /// Writes the grids to `path` (`.vdb`; `-` for standard output) as `options` say, or the
     /// voxel set alone to a `.binvox` or `.vox`, atomically, refusing to replace any of `inputs`;
     /// records the output in the report.
     pub fn write(&mut self, path: &Path, inputs: &[&Path], options: &WriteOptions) -> Result<()> {
+        self.write_files(path, inputs, options)?;
+        self.report.output = Some(path.display().to_string());
+        Ok(())
+    }
+
+    /// `write` without recording the output: the files alone.
+    pub fn write_files(&self, path: &Path, inputs: &[&Path], options: &WriteOptions) -> Result<()> {
         check_output_path(path, inputs)?;
         if let Some(format) = voxel_file(path) {
             if self.distances.is_some() {
@@ -243,7 +284,6 @@ impl Outcome {
                 VoxelFile::Binvox => write_binvox(path, &self.grid)?,
                 VoxelFile::Vox => write_vox(path, &self.grid)?,
             }
-            self.report.output = Some(path.display().to_string());
             return Ok(());
         }
         let meta: Vec<(&str, MetaValue)> = self
@@ -271,9 +311,7 @@ impl Outcome {
             } else {
                 write(path)
             }
-        })?;
-        self.report.output = Some(path.display().to_string());
-        Ok(())
+        })
     }
 }
 

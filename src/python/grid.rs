@@ -3,7 +3,7 @@
 
 use super::keywords::Keywords;
 use super::to_py_err;
-use crate::grid::{SparseGrid, Transform};
+use crate::grid::Transform;
 use crate::io::preview::{Scene, View, check_picture_output, render, write_png};
 use crate::io::vdb::{COLOR_GRID, DISTANCE_GRID, LEVEL_SET_GRID, NORMAL_GRID};
 
@@ -34,8 +34,8 @@ impl Grid {
         Grid { outcome, inputs }
     }
 
-    pub fn sparse(&self) -> &SparseGrid {
-        &self.outcome.grid
+    pub fn outcome(&self) -> &Outcome {
+        &self.outcome
     }
 
     fn transform(&self) -> Transform {

@@ -134,7 +134,7 @@ pub fn measure(
 ) -> PyResult<Grid> {
     let call = Keywords::<MeasureRequest>::new(options)?;
     let source = if let Ok(grid) = source.cast::<Grid>() {
-        MeasureSource::Grid(grid.borrow().sparse().clone())
+        MeasureSource::Grid(grid.borrow().outcome().grid.clone())
     } else if let Ok(path) = source.extract::<PathBuf>()
         && path
             .extension()
@@ -158,7 +158,7 @@ pub fn combine(
 ) -> PyResult<Grid> {
     let source = |g: &Bound<'_, PyAny>| -> PyResult<GridSource> {
         match g.cast::<Grid>() {
-            Ok(grid) => Ok(GridSource::Grid(grid.borrow().sparse().clone())),
+            Ok(grid) => Ok(GridSource::Grid(grid.borrow().outcome().solid_voxels())),
             Err(_) => Ok(GridSource::File(g.extract::<PathBuf>()?)),
         }
     };
