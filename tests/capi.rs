@@ -531,3 +531,37 @@ fn a_level_set_in_memory_through_c_is_the_clis_and_grids_rebuild_from_leaves() {
     );
     assert!(c_inside.voxel_count() > 0 && c_inside.voxel_count() == cli_inside.voxel_count());
 }
+
+/// The installed shared library exports the header's functions and nothing else, without
+/// debug information (kept beside it).
+#[test]
+fn the_installed_library_exports_exactly_the_headers_functions_stripped() {
+    if !have("nm") {
+        return common::skip_or_fail("nm is missing: the exported-symbol check");
+    }
+    let lib = prefix().join("lib/libvoxelkit.so");
+    let out = run(Command::new("nm").args(["-D", "--defined-only"]).arg(&lib));
+    let mut exported: Vec<String> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|l| l.split_whitespace().nth(2).map(str::to_string))
+        .collect();
+    exported.sort();
+    let header = std::fs::read_to_string(repo().join("include/voxelkit.h")).unwrap();
+    let mut declared: Vec<String> = header
+        .split(|c: char| !(c.is_alphanumeric() || c == '_'))
+        .filter(|w| w.starts_with("vk_"))
+        .filter(|w| header.contains(&format!("{w}(")))
+        .map(str::to_string)
+        .collect();
+    declared.sort();
+    declared.dedup();
+    assert_eq!(exported, declared);
+    let size = std::fs::metadata(&lib).unwrap().len();
+    assert!(prefix().join("lib/libvoxelkit.so.debug").is_file());
+    let sections = run(Command::new("objdump").arg("-h").arg(&lib));
+    assert!(!String::from_utf8_lossy(&sections.stdout).contains(".debug_info"));
+    eprintln!(
+        "libvoxelkit.so: {size} bytes, {} exported symbols",
+        exported.len()
+    );
+}
