@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs the C interface of voxelkit into PREFIX (default /usr/local): the static and shared
 # libraries (stripped; the shared one's debug information in libvoxelkit.so.debug beside it),
-# include/voxelkit.h, pkg-config files (voxelkit, voxelkit-static) and a CMake
-# package (find_package(voxelkit): targets voxelkit::voxelkit and voxelkit::voxelkit_static).
+# include/voxelkit.h and include/voxelkit/openvdb.hpp (the C++ bridge to OpenVDB), pkg-config
+# files (voxelkit, voxelkit-static) and a CMake package (find_package(voxelkit): targets
+# voxelkit::voxelkit and voxelkit::voxelkit_static).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 prefix="${1:-/usr/local}"
@@ -10,7 +11,9 @@ cargo build --release --lib --quiet
 version="$(sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -1)"
 target="${CARGO_TARGET_DIR:-target}/release"
 mkdir -p "$prefix/lib/pkgconfig" "$prefix/lib/cmake/voxelkit" "$prefix/include"
+mkdir -p "$prefix/include/voxelkit"
 install -m 644 include/voxelkit.h "$prefix/include/"
+install -m 644 include/voxelkit/openvdb.hpp "$prefix/include/voxelkit/"
 # What the static library needs besides itself (rustc --print native-static-libs).
 private="-lblosc -lz -losdCPU -lstdc++ -lgcc_s -lutil -lrt -lpthread -lm -ldl"
 install -m 644 "$target/libvoxelkit.a" "$prefix/lib/"

@@ -78,9 +78,10 @@ fn test_mesh(dir: &Path) -> PathBuf {
     }
 }
 
-fn field(text: &str, key: &str) -> u64 {
+/// The number after `key` on a line of a program's output.
+fn field<T: std::str::FromStr>(text: &str, key: &str) -> T {
     text.lines()
-        .find_map(|l| l.strip_prefix(key)?.trim().parse().ok())
+        .find_map(|l| l.strip_prefix(&format!("{key} "))?.trim().parse().ok())
         .unwrap_or_else(|| panic!("{key} missing from {text}"))
 }
 
@@ -130,9 +131,9 @@ fn the_cpp_example_builds_with_werror_static_and_shared_and_matches_the_rust_api
             .arg(resolution.to_string())
             .arg(&vdb));
         let text = String::from_utf8_lossy(&out.stdout);
-        assert_eq!(field(&text, "voxelkit_voxels"), expected, "{name}: {text}");
-        assert_eq!(field(&text, "openvdb_voxels"), expected, "{name}: {text}");
-        assert!(field(&text, "mesh_quads") > 0, "{name}: {text}");
+        assert_eq!(field::<u64>(&text, "voxelkit_voxels"), expected, "{name}: {text}");
+        assert_eq!(field::<u64>(&text, "openvdb_voxels"), expected, "{name}: {text}");
+        assert!(field::<u64>(&text, "mesh_quads") > 0, "{name}: {text}");
         let written = read_vdb_grid(&vdb, Some("density")).unwrap();
         assert_eq!(written.voxel_count(), expected);
         assert_eq!(written.transform, t);
@@ -564,4 +565,66 @@ fn the_installed_library_exports_exactly_the_headers_functions_stripped() {
         "libvoxelkit.so: {size} bytes, {} exported symbols",
         exported.len()
     );
+}
+
+/// The C++ bridge (`voxelkit/openvdb.hpp`) as a user builds it with CMake against the
+/// installed package: a mesh's level set handed to OpenVDB measures the mesh's volume and
+/// meshes; an OpenVDB sphere taken into voxelkit removes its whole inside from a box. Both
+/// valgrind-clean.
+#[test]
+fn the_openvdb_bridge_hands_level_sets_over_both_ways() {
+    if !have("cmake") {
+        return common::skip_or_fail("cmake is not installed: the OpenVDB bridge test");
+    }
+    let work = tempfile::tempdir().unwrap();
+    let build = work.path().join("build");
+    run(Command::new("cmake")
+        .arg("-S")
+        .arg(repo().join("tests/cpp"))
+        .arg("-B")
+        .arg(&build)
+        .arg(format!("-DCMAKE_PREFIX_PATH={}", prefix().display())));
+    run(Command::new("cmake").arg("--build").arg(&build));
+    let mesh_path = test_mesh(work.path());
+    let exact = Mesh::load(&mesh_path).unwrap().signed_volume();
+    let volume_exe = build.join("level_set_volume");
+    let out = run(Command::new(&volume_exe).arg(&mesh_path).arg("256"));
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    let number = |key: &str| -> f64 { field(&text, key) };
+    let volume = number("volume");
+    assert!(
+        (volume - exact).abs() <= 1e-3 * exact,
+        "OpenVDB measured {volume}, the mesh holds {exact}"
+    );
+    assert!(number("quads") > 1000.0, "{text}");
+    let sphere_exe = build.join("openvdb_sphere_difference");
+    let out = run(&mut Command::new(&sphere_exe));
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    let number = |key: &str| -> f64 { field(&text, key) };
+    assert_eq!(number("left_inside"), 0.0, "{text}");
+    assert!(
+        (number("sphere_voxels") / number("sphere_expected") - 1.0).abs() < 0.01,
+        "{text}"
+    );
+    assert!(number("carved_voxels") < number("box_voxels"), "{text}");
+    eprintln!("OpenVDB levelSetVolume {volume} of a mesh holding {exact}; sphere: {text}");
+    if !have("valgrind") {
+        return common::skip_or_fail("valgrind is not installed: the bridge's leak check");
+    }
+    for args in [
+        vec![
+            volume_exe.clone().into_os_string(),
+            mesh_path.clone().into_os_string(),
+            "64".into(),
+        ],
+        vec![sphere_exe.into_os_string()],
+    ] {
+        let out = run(Command::new("valgrind")
+            .args(["--leak-check=full", "--errors-for-leak-kinds=definite"])
+            .args(["--show-leak-kinds=definite", "--error-exitcode=99"])
+            .args(&args));
+        let report = String::from_utf8_lossy(&out.stderr);
+        assert!(report.contains("ERROR SUMMARY: 0 errors"), "{report}");
+        assert!(report.contains("definitely lost: 0 bytes"), "{report}");
+    }
 }
