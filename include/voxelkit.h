@@ -323,6 +323,22 @@ vk_status vk_grid_copy_colors(const vk_grid *grid, size_t first, size_t count, f
 vk_status vk_grid_copy_voxels(const vk_grid *grid, int64_t *coords, size_t capacity,
                               size_t *written);
 
+/*
+ * The metadata items every grid of the job's .vdb file carries (`method`, `source_file`,
+ * `resolution` or `voxel_size`, ..., `voxelkit_version`): their count, then item `index`: its
+ * key, its type, its value as text (every type), and as a number in `integer` (VK_META_INT) or
+ * `real` (VK_META_REAL). No pointer may be NULL; the strings live as long as the grid.
+ */
+typedef enum vk_meta_type {
+    VK_META_TEXT = 0,
+    VK_META_INT = 1,
+    VK_META_REAL = 2
+} vk_meta_type;
+vk_status vk_grid_metadata_count(const vk_grid *grid, size_t *count);
+vk_status vk_grid_metadata_item(const vk_grid *grid, size_t index, const char **key,
+                                vk_meta_type *type, const char **text, int64_t *integer,
+                                double *real);
+
 /* What a grid holds: voxels (a surface or a solid), a level set (vk_options_set_sdf) or
  * unsigned distances (vk_options_set_udf); `background` receives the distance grids'
  * background, band x voxel size (0 for voxels). */

@@ -12,7 +12,7 @@ use crate::choice::Choice;
 use crate::error::{Error, Result};
 use crate::grid::{Block, Channels, Coord, LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use crate::implicit::Coordinates;
-use crate::io::vdb::{Compression, read_vdb_solid};
+use crate::io::vdb::{Compression, MetaValue, meta_entries, read_vdb_solid};
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::BooleanOp;
 use crate::pipeline::request::{
@@ -74,11 +74,26 @@ pub struct VkGrid {
     /// Every grid of the job that made it (a level set's interior, a solid's shell ...),
     /// its metadata and report: what the CLI would write.
     outcome: Outcome,
+    /// The metadata every written grid carries, as C strings that live as long as the grid.
+    metadata: Vec<(CString, MetaValue, CString)>,
 }
 
 impl From<Outcome> for VkGrid {
     fn from(outcome: Outcome) -> Self {
-        VkGrid { outcome }
+        let given: Vec<(&str, MetaValue)> = outcome
+            .metadata
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.clone()))
+            .collect();
+        let c = |s: String| CString::new(s.replace('\0', "")).unwrap_or_default();
+        let metadata = meta_entries(&given)
+            .into_iter()
+            .map(|(k, v)| {
+                let text = c(v.to_string());
+                (c(k), v, text)
+            })
+            .collect();
+        VkGrid { outcome, metadata }
     }
 }
 /// `vk_options`: changed by the setters, copied by each call.
@@ -1375,6 +1390,54 @@ pub extern "C" fn vk_grid_copy_voxels(
             out[3 * k..3 * k + 3].copy_from_slice(&c);
         }
         Ok(())
+    })
+}
+
+/// `vk_meta_type`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VkMetaType {
+    Text = 0,
+    Int = 1,
+    Real = 2,
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_metadata_count(grid: *const VkGrid, count: *mut usize) -> VkStatus {
+    guard(|| put(count, borrow(grid, Kind::Grid)?.metadata.len()))
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_metadata_item(
+    grid: *const VkGrid,
+    index: usize,
+    key: *mut *const c_char,
+    meta_type: *mut VkMetaType,
+    text: *mut *const c_char,
+    integer: *mut i64,
+    real: *mut f64,
+) -> VkStatus {
+    guard(|| {
+        let g = borrow(grid, Kind::Grid)?;
+        let n = g.metadata.len();
+        let (k, value, as_text) = g.metadata.get(index).ok_or_else(|| {
+            invalid(format!(
+                "metadata item {index} is out of range: the grid has {n}"
+            ))
+        })?;
+        put(key, k.as_ptr())?;
+        put(text, as_text.as_ptr())?;
+        match value {
+            MetaValue::Text(_) => put(meta_type, VkMetaType::Text),
+            MetaValue::Int(v) => {
+                put(integer, *v)?;
+                put(meta_type, VkMetaType::Int)
+            }
+            MetaValue::Real(v) => {
+                put(real, *v)?;
+                put(meta_type, VkMetaType::Real)
+            }
+        }
     })
 }
 

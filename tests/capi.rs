@@ -131,12 +131,40 @@ fn the_cpp_example_builds_with_werror_static_and_shared_and_matches_the_rust_api
             .arg(resolution.to_string())
             .arg(&vdb));
         let text = String::from_utf8_lossy(&out.stdout);
-        assert_eq!(field::<u64>(&text, "voxelkit_voxels"), expected, "{name}: {text}");
-        assert_eq!(field::<u64>(&text, "openvdb_voxels"), expected, "{name}: {text}");
+        assert_eq!(
+            field::<u64>(&text, "voxelkit_voxels"),
+            expected,
+            "{name}: {text}"
+        );
+        assert_eq!(
+            field::<u64>(&text, "openvdb_voxels"),
+            expected,
+            "{name}: {text}"
+        );
         assert!(field::<u64>(&text, "mesh_quads") > 0, "{name}: {text}");
         let written = read_vdb_grid(&vdb, Some("density")).unwrap();
         assert_eq!(written.voxel_count(), expected);
         assert_eq!(written.transform, t);
+        // vk::to_openvdb gives the grid the metadata and class the CLI's file gives it.
+        let cli = work.path().join(format!("{name}-cli.vdb"));
+        run(Command::new(env!("CARGO_BIN_EXE_voxelkit"))
+            .arg("mesh")
+            .arg(&mesh_path)
+            .args(["-r", &resolution.to_string(), "-o"])
+            .arg(&cli));
+        let density = |path: &Path| {
+            let infos = voxelkit::io::vdb::read_vdb_info(path).unwrap();
+            let info = infos.into_iter().find(|i| i.name == "density").unwrap();
+            // Less the writer's bookkeeping, which OpenVDB writes only when set.
+            let items: Vec<String> = info
+                .metadata
+                .iter()
+                .filter(|m| m.key != "is_saved_as_half_float")
+                .map(|m| format!("{m:?}"))
+                .collect();
+            (info.grid_class, items)
+        };
+        assert_eq!(density(&vdb), density(&cli), "{name}");
         eprintln!("C++ example ({name}): {expected} voxels, as the Rust API; {text}");
     }
 }

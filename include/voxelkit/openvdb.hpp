@@ -78,10 +78,11 @@ typename GridT::Ptr from_leaves(const Leaves& leaves, typename GridT::ValueType 
     return out;
 }
 
-// A vec3 channel (`normal` or `Cd`) of every leaf, when the grid has one.
+// A vec3 channel (`normal` or `Cd`) of every leaf, when the grid has one: normals transform
+// covariantly, colours are plain triples.
 inline openvdb::GridBase::Ptr vector_grid(const vk_grid* grid, const Leaves& leaves,
                                           vk_status (*copy)(const vk_grid*, size_t, size_t, float*),
-                                          const char* name) {
+                                          const char* name, openvdb::VecType vector_type) {
     std::vector<float> values(3 * 512 * leaves.count);
     if (leaves.count == 0 || copy(grid, 0, leaves.count, values.data()) != VK_OK) return nullptr;
     auto out = from_leaves<openvdb::Vec3SGrid>(leaves, openvdb::Vec3s(0.0f), [&](size_t i, openvdb::Index n) {
@@ -89,6 +90,7 @@ inline openvdb::GridBase::Ptr vector_grid(const vk_grid* grid, const Leaves& lea
         return openvdb::Vec3s(v[0], v[1], v[2]);
     });
     out->setName(name);
+    out->setVectorType(vector_type);
     return out;
 }
 
@@ -148,9 +150,30 @@ vk_grid* voxels_of(const TreeT& tree, const openvdb::math::Transform& xform, Ins
     return out;
 }
 
+// The metadata voxelkit's file gives every grid: text, int64 and double items.
+inline void add_metadata(const vk_grid* grid, openvdb::GridBase& out) {
+    size_t count = 0;
+    check(vk_grid_metadata_count(grid, &count), "vk_grid_metadata_count");
+    for (size_t i = 0; i < count; ++i) {
+        const char *key = nullptr, *text = nullptr;
+        vk_meta_type type = VK_META_TEXT;
+        int64_t integer = 0;
+        double real = 0.0;
+        check(vk_grid_metadata_item(grid, i, &key, &type, &text, &integer, &real), "vk_grid_metadata_item");
+        if (type == VK_META_INT) {
+            out.insertMeta(key, openvdb::Int64Metadata(integer));
+        } else if (type == VK_META_REAL) {
+            out.insertMeta(key, openvdb::DoubleMetadata(real));
+        } else {
+            out.insertMeta(key, openvdb::StringMetadata(text));
+        }
+    }
+}
+
 }  // namespace detail
 
-// A voxelkit grid as the grids voxelkit's .vdb file of it holds, on its transform: a voxel
+// A voxelkit grid as the grids voxelkit's .vdb file of it holds, on its transform, with its
+// metadata: a voxel
 // set as the FOG_VOLUME `density` (1 on every voxel, whole blocks as tiles), a level set as
 // the LEVEL_SET `surface` (signed distances in world units, its inside -background beyond
 // the band), unsigned distances as `distance`; then `normal` and `Cd` where the grid has them.
@@ -182,15 +205,13 @@ inline openvdb::GridPtrVec to_openvdb(const vk_grid* grid) {
         }
         out.push_back(distances);
     }
-    for (auto& g : out) g->setTransform(detail::transform_of(grid));
-    const auto xform = detail::transform_of(grid);
-    if (auto normal = detail::vector_grid(grid, leaves, vk_grid_copy_normals, "normal")) {
-        normal->setTransform(xform);
+    if (auto normal = detail::vector_grid(grid, leaves, vk_grid_copy_normals, "normal", openvdb::VEC_COVARIANT_NORMALIZE))
         out.push_back(normal);
-    }
-    if (auto color = detail::vector_grid(grid, leaves, vk_grid_copy_colors, "Cd")) {
-        color->setTransform(xform);
+    if (auto color = detail::vector_grid(grid, leaves, vk_grid_copy_colors, "Cd", openvdb::VEC_INVARIANT))
         out.push_back(color);
+    for (auto& g : out) {
+        g->setTransform(detail::transform_of(grid));
+        detail::add_metadata(grid, *g);
     }
     return out;
 }

@@ -167,7 +167,7 @@ impl WriteOptions {
 }
 
 /// The metadata entries of every grid: the caller's plus `voxelkit_version`.
-fn meta_entries(metadata: &[(&str, MetaValue)]) -> Vec<(String, MetaValue)> {
+pub fn meta_entries(metadata: &[(&str, MetaValue)]) -> Vec<(String, MetaValue)> {
     let mut meta: Vec<(String, MetaValue)> = metadata
         .iter()
         .map(|(k, v)| (k.to_string(), v.clone()))
