@@ -359,7 +359,6 @@ pub(super) fn measure_surface(
 ) -> Result<Outcome> {
     let start = Instant::now();
     let parts = SurfaceAndInside::flooded(surface.clone(), flood, progress)?;
-    progress.advance(1);
     let meta = vec![
         ("method", "exterior-flood".into()),
         ("source_file", source.into()),
