@@ -3,8 +3,11 @@
 //! return `Error::Cancelled`.
 
 use crate::error::{Error, Result};
+use serde::Serialize;
 use std::ops::ControlFlow;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
 
 /// Watches a job: the CLI draws progress bars, the C API calls the caller's callback.
 pub trait Observer: Sync {
@@ -32,10 +35,52 @@ impl<F: Fn(u64) -> ControlFlow<()> + Sync> Observer for Counting<F> {
     }
 }
 
+/// Where a run's time went: one stage, its wall-clock seconds and the threads busy in it on
+/// average (CPU seconds of the whole process over wall-clock seconds).
+#[derive(Clone, Debug, Serialize)]
+pub struct StageTime {
+    pub stage: String,
+    pub seconds: f64,
+    pub threads_busy: f64,
+}
+
+impl StageTime {
+    /// The stage `name` between two moments, each with the process's CPU seconds then.
+    fn between(
+        name: &str,
+        (start, cpu): (Instant, f64),
+        (end, cpu_end): (Instant, f64),
+    ) -> StageTime {
+        let seconds = end.duration_since(start).as_secs_f64();
+        StageTime {
+            stage: name.to_string(),
+            seconds,
+            threads_busy: if seconds > 0.0 {
+                (cpu_end - cpu) / seconds
+            } else {
+                0.0
+            },
+        }
+    }
+
+    /// The stage `name` from `start` (the moment and the CPU seconds then, `StageTime::now`)
+    /// until now.
+    pub fn since(name: &str, start: (Instant, f64)) -> StageTime {
+        StageTime::between(name, start, StageTime::now())
+    }
+
+    /// This moment and the process's CPU seconds.
+    pub fn now() -> (Instant, f64) {
+        (Instant::now(), crate::system::cpu_seconds())
+    }
+}
+
 /// The algorithms' side: count finished items and learn whether to stop.
 pub struct Progress<'a> {
     observer: &'a dyn Observer,
     stopped: AtomicBool,
+    /// Each stage begun: its name, when, and the process's CPU seconds then.
+    begun: Mutex<Vec<(String, Instant, f64)>>,
 }
 
 impl<'a> Progress<'a> {
@@ -43,6 +88,7 @@ impl<'a> Progress<'a> {
         Progress {
             observer,
             stopped: AtomicBool::new(false),
+            begun: Mutex::new(Vec::new()),
         }
     }
 
@@ -53,7 +99,27 @@ impl<'a> Progress<'a> {
 
     /// Starts a stage of `total` items.
     pub fn stage(&self, name: &str, total: u64) {
+        let (at, cpu) = StageTime::now();
+        self.begun
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push((name.to_string(), at, cpu));
         self.observer.stage(name, total);
+    }
+
+    /// The time of every stage begun, each until the next began, the last until now.
+    pub fn profile(&self) -> Vec<StageTime> {
+        let begun = self.begun.lock().unwrap_or_else(|e| e.into_inner());
+        let ends = begun
+            .iter()
+            .skip(1)
+            .map(|(_, at, cpu)| (*at, *cpu))
+            .chain([StageTime::now()]);
+        begun
+            .iter()
+            .zip(ends)
+            .map(|((name, at, cpu), end)| StageTime::between(name, (*at, *cpu), end))
+            .collect()
     }
 
     /// `n` more items are done; remembers a request to stop.

@@ -365,3 +365,41 @@ fn every_stage_of_a_fill_is_heard_and_counted_to_its_total() {
         }
     }
 }
+
+#[test]
+fn the_report_says_where_the_time_went_stage_by_stage() {
+    let dir = tempfile::tempdir().unwrap();
+    let (torus, _, _) = fixtures(dir.path());
+    let task = Task::Solid {
+        mesh: MeshSource::File(torus),
+        fill: Fill::Flood(FloodMethod::Blocks),
+        density: 1.0,
+        topology: false,
+        inside: voxelkit::solids::inside_rule::InsideRule::Parity,
+    };
+    let mut outcome = Job::new(task, GridFit::Resolution(256))
+        .run(&voxelkit::progress::Unobserved)
+        .unwrap();
+    let out = dir.path().join("solid.vdb");
+    outcome
+        .write(&out, &[], &voxelkit::io::vdb::WriteOptions::default())
+        .unwrap();
+    let report = &outcome.report;
+    let names: Vec<&str> = report.stages.iter().map(|s| s.stage.as_str()).collect();
+    assert_eq!(names, ["read and plan", "surface", "filling", "write"]);
+    // The stages before the write cover the run, one after another.
+    let run: f64 = report.stages[..3].iter().map(|s| s.seconds).sum();
+    assert!(
+        run <= report.seconds && run >= 0.9 * report.seconds - 0.005,
+        "{run} of {}",
+        report.seconds
+    );
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
+    for s in &report.stages {
+        assert!(
+            s.seconds >= 0.0 && (0.0..=cores + 0.5).contains(&s.threads_busy),
+            "{s:?}"
+        );
+    }
+    assert!(report.summary().contains("stages: read and plan"));
+}

@@ -24,7 +24,7 @@ use crate::grid::{SparseGrid, Transform};
 use crate::implicit::{Coordinates, ThetaRange};
 use crate::mesh::{GridFit, Mesh, UpAxis};
 use crate::ops::csg::BooleanOp;
-use crate::progress::{Observer, Progress};
+use crate::progress::{Observer, Progress, StageTime};
 use crate::shapes::{Cylinder, Quadric, Sphere};
 use crate::solids::beam::BeamFill;
 use crate::solids::depth_layers::DepthLayerOptions;
@@ -294,6 +294,8 @@ pub struct PlannedJob {
     plan: Plan,
     warnings: Vec<String>,
     start: Instant,
+    /// Reading the inputs and planning, timed.
+    planning: StageTime,
 }
 
 impl GridFit {
@@ -438,7 +440,8 @@ impl Job {
     /// Reads the inputs, places the grid, estimates memory and work; refuses work that does
     /// not fit in `limits.max_memory` (or the memory available) with the estimate.
     pub fn plan(self) -> Result<PlannedJob> {
-        let start = Instant::now();
+        let begun = StageTime::now();
+        let start = begun.0;
         let mut warnings = Vec::new();
         if let Some(n) = self.limits.threads {
             if n == 0 {
@@ -472,6 +475,7 @@ impl Job {
             plan,
             warnings,
             start,
+            planning: StageTime::since("read and plan", begun),
         })
     }
 
@@ -558,6 +562,10 @@ impl PlannedJob {
         if let Some(keep) = self.job.fit.kept_voxels() {
             on_threads(self.job.limits.threads, || outcome.clip(keep))?;
         }
+        outcome.report.stages = [self.planning]
+            .into_iter()
+            .chain(progress.profile())
+            .collect();
         outcome.threads = self.job.limits.threads;
         outcome.report.warnings.splice(0..0, self.warnings);
         outcome.report.input = self.job.describe_input();

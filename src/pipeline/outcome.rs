@@ -19,7 +19,7 @@ use crate::ops::csg::{BooleanOp, combine as combine_grids};
 use crate::ops::measure::SolidMeasures;
 use crate::ops::minimality::simple_voxel_count;
 use crate::ops::separability::check_mesh_separation;
-use crate::progress::Progress;
+use crate::progress::{Progress, StageTime};
 use crate::subd::ControlMesh;
 use crate::voxelize::interval_octree::{OctreeOptions, voxelize_implicit};
 use crate::voxelize::parametric::{ParametricOptions, voxelize_subdivision};
@@ -264,7 +264,9 @@ impl Outcome {
     /// voxel set alone to a `.binvox` or `.vox`, atomically, refusing to replace any of `inputs`;
     /// records the output in the report.
     pub fn write(&mut self, path: &Path, inputs: &[&Path], options: &WriteOptions) -> Result<()> {
+        let begun = StageTime::now();
         self.write_files(path, inputs, options)?;
+        self.report.stages.push(StageTime::since("write", begun));
         self.report.output = Some(path.display().to_string());
         Ok(())
     }

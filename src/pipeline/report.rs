@@ -1,6 +1,7 @@
 //! What a job reports: one serde struct, printed as JSON (`--json`, the Python module's
 //! `report` dict) or as the human summary, so both always say the same.
 
+use crate::progress::StageTime;
 use crate::solids::winding_inside::AMBIGUOUS;
 use serde::Serialize;
 
@@ -36,6 +37,9 @@ pub struct Report {
     /// What the user should know although the job succeeded.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// Where the time went: reading and planning, each stage of the work, writing.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub stages: Vec<StageTime>,
     /// Time in the voxelization (or classification) itself.
     pub voxelize_seconds: f64,
     /// The whole run: reading, planning, voxelizing, measuring and writing.
@@ -392,6 +396,19 @@ impl Report {
         };
         if let Some(p) = &self.preview {
             text.push_str(&format!("\npreview: {p}"));
+        }
+        if !self.stages.is_empty() {
+            let each: Vec<String> = self
+                .stages
+                .iter()
+                .map(|s| {
+                    format!(
+                        "{} {:.2} s ({:.1} threads busy)",
+                        s.stage, s.seconds, s.threads_busy
+                    )
+                })
+                .collect();
+            text.push_str(&format!("\nstages: {}", each.join(", ")));
         }
         if let (Some([lo, hi]), Some(out)) = (self.bounds_voxels, self.voxels_outside_bounds) {
             text.push_str(&format!(
