@@ -69,17 +69,6 @@ fn address_space_headroom() -> Option<u64> {
     Some(limit.rlim_cur.saturating_sub(used))
 }
 
-/// CPU time this process has used so far, user and system, in seconds (every thread).
-pub fn cpu_seconds() -> f64 {
-    // SAFETY: getrusage writes the struct it is given.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } != 0 {
-        return 0.0;
-    }
-    let seconds = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
-    seconds(usage.ru_utime) + seconds(usage.ru_stime)
-}
-
 /// Peak resident memory of this process so far, in bytes.
 pub fn peak_memory_bytes() -> Option<u64> {
     proc_kib("/proc/self/status", "VmHWM:").map(|k| k * 1024)
