@@ -294,8 +294,8 @@ pub struct PlannedJob {
     plan: Plan,
     warnings: Vec<String>,
     start: Instant,
-    /// Reading the inputs and planning, timed.
-    planning: StageTime,
+    /// Reading the inputs, then planning, timed.
+    planning: [StageTime; 2],
 }
 
 impl GridFit {
@@ -454,6 +454,8 @@ impl Job {
             }
         }
         let work = load::load(&self.task, self.up_axis)?;
+        let reading = StageTime::since("read", begun);
+        let planning_begun = StageTime::now();
         let plan = estimate::price(&work, self.fit, &self.describe_input())?;
         let limit = self.limits.max_memory;
         crate::system::check_fits(
@@ -475,7 +477,7 @@ impl Job {
             plan,
             warnings,
             start,
-            planning: StageTime::since("read and plan", begun),
+            planning: [reading, StageTime::since("plan", planning_begun)],
         })
     }
 
@@ -562,7 +564,8 @@ impl PlannedJob {
         if let Some(keep) = self.job.fit.kept_voxels() {
             on_threads(self.job.limits.threads, || outcome.clip(keep))?;
         }
-        outcome.report.stages = [self.planning]
+        outcome.report.stages = self
+            .planning
             .into_iter()
             .chain(progress.profile())
             .collect();
