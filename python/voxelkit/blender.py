@@ -95,14 +95,17 @@ def world_mesh(obj, depsgraph):
     return vertices, tris.reshape(-1, 3)
 
 
+def settings_fit(settings):
+    """The grid the settings ask for: a voxel size when given, else the resolution."""
+    if settings.voxel_size > 0:
+        return {"voxel_size": settings.voxel_size}
+    return {"resolution": settings.resolution}
+
+
 def voxelize(vertices, triangles, settings, fit=None):
     """The voxelkit call the settings ask for; ``fit`` (voxel_size and origin) places the
     grid instead of the settings' resolution or voxel size."""
-    fit = fit or (
-        {"voxel_size": settings.voxel_size}
-        if settings.voxel_size > 0
-        else {"resolution": settings.resolution}
-    )
+    fit = fit or settings_fit(settings)
     source = (vertices, triangles)
     if settings.fill == "solid":
         return voxelkit.solid(source, **fit)
@@ -186,12 +189,13 @@ def new_sequence_folder(name):
 
 
 def shared_fit(frames, settings):
-    """One grid for every frame: the voxel size the settings give the union of the frames'
-    boxes, and voxel (0, 0, 0) half a voxel inside its low corner (as one frame is placed)."""
-    low = np.min([v.min(axis=0) for v, _ in frames], axis=0)
-    high = np.max([v.max(axis=0) for v, _ in frames], axis=0)
-    h = settings.voxel_size if settings.voxel_size > 0 else float((high - low).max()) / settings.resolution
-    return {"voxel_size": h, "origin": (low + h / 2).tolist()}
+    """One grid for every frame: where the library places the settings' grid for all frames'
+    meshes taken as one."""
+    offsets = np.cumsum([0] + [len(v) for v, _ in frames[:-1]])
+    vertices = np.vstack([v for v, _ in frames])
+    triangles = np.vstack([t + o for (_, t), o in zip(frames, offsets)])
+    voxel_size, origin = voxelkit._voxelkit.placement((vertices, triangles), **settings_fit(settings))
+    return {"voxel_size": voxel_size, "origin": origin}
 
 
 @_options

@@ -166,6 +166,28 @@ pub fn combine(
     run(py, call, (source(a)?, source(b)?))
 }
 
+/// Where the grid of a mesh job lies, as the job would place it: its voxel size and the
+/// world position of voxel (0, 0, 0), from the mesh options' placement (`resolution`,
+/// `voxel_size`, `origin`, `bounds`, `up_axis`). Several meshes given as one share it.
+#[pyfunction]
+#[pyo3(signature = (source, **options))]
+pub fn placement(
+    py: Python<'_>,
+    source: &Bound<'_, PyAny>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<(f64, [f64; 3])> {
+    let call = Keywords::<MeshRequest>::new(options)?;
+    let source = mesh_source(source, call.limits.limits().max_memory)?;
+    let fit = call.request.fit().map_err(to_py_err)?;
+    let up = call.request.up_axis();
+    py.detach(|| {
+        let mesh = source.load(false, up)?;
+        crate::mesh::fit_transform(&mesh.bbox(), fit)
+    })
+    .map(|t| (t.voxel_size, t.origin.to_array()))
+    .map_err(to_py_err)
+}
+
 /// A grid of a `.vdb` file: the one named `grid`, else the voxel set voxelkit writes
 /// (`voxels`, else `density`), else the first bool, mask or float grid.
 #[pyfunction]

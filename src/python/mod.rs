@@ -43,6 +43,7 @@ fn _voxelkit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(queries::signed_distance, m)?)?;
     m.add_function(wrap_pyfunction!(queries::contains, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::read_vdb, m)?)?;
+    m.add_function(wrap_pyfunction!(jobs::placement, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::options, m)?)?;
     bricks::register(m)?;
     Ok(())
