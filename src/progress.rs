@@ -52,11 +52,14 @@ impl StageTime {
         (end, cpu_end): (Instant, f64),
     ) -> StageTime {
         let seconds = end.duration_since(start).as_secs_f64();
+        // The kernel brings other running threads' CPU time up to date only at its ticks, so a
+        // stage shorter than a tick can seem to use more threads than the process may run on.
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
         StageTime {
             stage: name.to_string(),
             seconds,
             threads_busy: if seconds > 0.0 {
-                (cpu_end - cpu) / seconds
+                ((cpu_end - cpu) / seconds).clamp(0.0, cores)
             } else {
                 0.0
             },
@@ -75,15 +78,18 @@ impl StageTime {
     }
 }
 
-/// CPU time this process has used so far, user and system, in seconds (every thread).
+/// CPU time this process has used so far, every thread, in seconds (the scheduler's own
+/// nanosecond count rather than getrusage's tick-sampled split into user and system).
 fn cpu_seconds() -> f64 {
-    // SAFETY: getrusage writes the struct it is given.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } != 0 {
+    let mut t = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: clock_gettime writes the timespec it is given.
+    if unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut t) } != 0 {
         return 0.0;
     }
-    let seconds = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
-    seconds(usage.ru_utime) + seconds(usage.ru_stime)
+    t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
 }
 
 /// The algorithms' side: count finished items and learn whether to stop.
