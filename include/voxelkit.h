@@ -276,7 +276,8 @@ vk_status vk_grid_read_vdb(const char *path, const char *name, vk_grid **out);
  * volume, whole blocks as tiles), `normal` and `Cd` when the grid has them, a solid's
  * `shell` and `interior`, a level set as `surface` (LEVEL_SET class, its inside as inactive
  * -background tiles), unsigned distances as `distance` (written to a temporary file, then
- * renamed). A .binvox or .vox path writes the voxel set alone.
+ * renamed). A .nvdb path writes the same grids in NanoVDB's layout (uncompressed, names,
+ * transforms and classes but no other metadata); a .binvox or .vox path the voxel set alone.
  */
 vk_status vk_grid_write_vdb(const vk_grid *grid, const char *path);
 /* vk_grid_write_vdb with the write options of `options`: the grids named (write.grids),

@@ -2,8 +2,9 @@
 # Installs what voxelkit needs on Debian 12, saying what it does as it goes:
 # - Debian packages: a C/C++ tool chain and pkg-config; blosc and zlib (build.rs links them for
 #   .vdb files); OpenVDB, Boost headers, TBB and OpenSubdiv (the C++ side, the tests'
-#   independent reader and the benchmarks' reference); pyopenvdb; CMake and valgrind (the C
-#   and C++ interface tests); Blender (opens the .vdb files headless in a test); Python's venv
+#   independent reader and the benchmarks' reference); pyopenvdb; NanoVDB's headers and tools
+#   (the .nvdb files are checked by them); CMake and valgrind (the C and C++ interface
+#   tests); Blender (opens the .vdb files headless in a test); Python's venv
 #   and pip (scripts/test-all.sh builds the Python module into a virtual environment); EGL
 #   (Open3D, which the Python tests compare against, loads it).
 #   On a fresh Debian 12 that is about 410 packages with their dependencies: 430 MB to
@@ -21,6 +22,7 @@ packages=(
     build-essential pkg-config cmake valgrind curl ca-certificates
     libblosc-dev zlib1g-dev
     libopenvdb-dev libboost-dev libtbb-dev libosd-dev python3-openvdb
+    libnanovdb-dev libnanovdb-tools
     blender
     python3-venv python3-pip python3-numpy
     libegl1

@@ -499,7 +499,8 @@ fn a_level_set_read_through_c_stands_for_its_inside() {
 
 /// A level set made and read in memory through C (values against the exact distance of a
 /// box, measures, a Boolean operand) and a grid rebuilt from its leaves: `in_memory.c`, under
-/// valgrind; its level set file holds what the CLI's `--sdf` file holds.
+/// valgrind; its level set file holds what the CLI's `--sdf` file holds, and its `.nvdb`
+/// passes NanoVDB's validation.
 #[test]
 fn a_level_set_in_memory_through_c_is_the_clis_and_grids_rebuild_from_leaves() {
     if !have("pkg-config") || !have("gcc") {
@@ -519,8 +520,18 @@ fn a_level_set_in_memory_through_c_is_the_clis_and_grids_rebuild_from_leaves() {
         .arg("-o")
         .arg(&exe));
     let from_c = dir.join("c.vdb");
-    let out = run(Command::new(&exe).arg(&from_c));
+    let nvdb = dir.join("c.nvdb");
+    let out = run(Command::new(&exe).arg(&from_c).arg(&nvdb));
     assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "ok");
+    // The same level set for NanoVDB, by extension.
+    assert_eq!(&std::fs::read(&nvdb).unwrap()[..8], b"NanoVDB0");
+    if have("nanovdb_validate") {
+        let out = run(Command::new("nanovdb_validate").arg("-v").arg(&nvdb));
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("Grid named \"surface\": passed"), "{text}");
+    } else {
+        common::skip_or_fail("nanovdb_validate is missing (libnanovdb-tools): the C .nvdb check");
+    }
     if have("valgrind") {
         let out = run(Command::new("valgrind")
             .args(["--leak-check=full", "--errors-for-leak-kinds=definite"])

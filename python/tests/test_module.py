@@ -156,6 +156,30 @@ def test_write_is_read_by_openvdb(tmp_path, pyopenvdb):
     assert (tmp_path / "tet.binvox").stat().st_size > 0
 
 
+def test_write_nvdb_is_read_by_nanovdb(tmp_path):
+    import shutil
+    import subprocess
+
+    from conftest import missing
+
+    tools = ["nanovdb_validate", "nanovdb_print"]
+    if not all(shutil.which(t) for t in tools):
+        missing("NanoVDB's tools (libnanovdb-tools)", "reading the .nvdb back")
+    grid = voxelkit.solid(tetrahedron(), resolution=48)
+    out = tmp_path / "tet.nvdb"
+    grid.write(out)
+    assert grid.report["output"] == str(out)
+    validated = subprocess.run(["nanovdb_validate", "-v", str(out)], capture_output=True, text=True)
+    assert validated.returncode == 0 and 'Grid named "density": passed' in validated.stdout
+    printed = subprocess.run(["nanovdb_print", str(out)], capture_output=True, text=True).stdout
+    rows = {line.split()[1]: line.split() for line in printed.splitlines() if line[:1].isdigit()}
+    assert sorted(rows) == ["density", "interior", "shell"]
+    assert str(len(grid)) in rows["density"]
+    with pytest.raises(ValueError, match="half"):
+        grid.write(tmp_path / "half.nvdb", half=True)
+    assert not (tmp_path / "half.nvdb").exists()
+
+
 def ball(radius):
     return {"sphere": {"radius": radius, "center": [0, 0, 0]}}
 

@@ -62,7 +62,7 @@ class Grid:
         compression: str = "blosc",
         half: bool = False,
     ) -> None:
-        """Writes .vdb, .binvox or .vox by extension, atomically, never over an input."""
+        """Writes .vdb, .nvdb (NanoVDB), .binvox or .vox by extension, atomically, never over an input."""
     def render(
         self, path: Path, view: str = "iso", size: Tuple[int, int] = (800, 600)
     ) -> None:

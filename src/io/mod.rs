@@ -3,6 +3,10 @@ pub mod atomic;
 pub mod binvox;
 #[cfg(feature = "vdb")]
 pub mod brick_set;
+#[cfg(feature = "vdb")]
+mod grid_out;
+#[cfg(feature = "vdb")]
+mod nvdb_writer;
 pub mod preview;
 pub mod references;
 #[cfg(feature = "vdb")]

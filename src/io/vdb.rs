@@ -4,13 +4,15 @@
 //! covariant-normalize) when the grid carries normals, `Cd` (Vec3s, the Houdini name for
 //! colour) when it carries colours, and on request `voxels` (the same set as a BoolGrid);
 //! whole blocks are written as active tiles. A level set is `surface`, Houdini's name. Any
-//! Bool, Mask or Float grid reads back, tiles as tiles. Writes are atomic (temporary file,
-//! then rename).
+//! Bool, Mask or Float grid reads back, tiles as tiles. The same grids go to a `.nvdb` in
+//! NanoVDB's layout (`nvdb_writer`). Writes are atomic (temporary file, then rename).
 
 use super::atomic::write_atomic;
+use super::grid_out::{GridOut, GridValues};
+use super::nvdb_writer::write_nvdb_grids;
 use super::vdb_format::{COVARIANT_NORMALIZE, FOG_VOLUME, LEVEL_SET};
 pub use super::vdb_format::{Compression, MetaValue};
-use super::vdb_writer::{Encoding, GridOut, GridValues, compression_flags, write_grids};
+use super::vdb_writer::{Encoding, compression_flags, write_grids};
 use crate::error::{Error, Result};
 use crate::grid::{Channels, LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use glam::DVec3;
@@ -119,8 +121,8 @@ pub fn write_vdb_as(
     write_chosen(path, candidates, options)
 }
 
-/// Writes the grids of `candidates` that `options` asks for to `path`, atomically; a grid
-/// asked for that is not among them is an error naming those there are.
+/// Writes the grids of `candidates` that `options` asks for to `path` (`.vdb`, or `.nvdb`),
+/// atomically; a grid asked for that is not among them is an error naming those there are.
 fn write_chosen(path: &Path, mut candidates: Vec<GridOut>, options: &WriteOptions) -> Result<()> {
     if let Some(missing) = options
         .grids
@@ -137,11 +139,27 @@ fn write_chosen(path: &Path, mut candidates: Vec<GridOut>, options: &WriteOption
         ));
     }
     candidates.retain(|g| options.wants(g.name));
+    if is_nvdb(path) {
+        if options.half {
+            return Err(Error::InvalidArgument(format!(
+                "{}: half precision is written to .vdb only; a .nvdb holds 32-bit floats",
+                path.display()
+            )));
+        }
+        return write_atomic(path, |tmp| write_nvdb_grids(tmp, path, &candidates));
+    }
     let encoding = Encoding {
         compression: compression_flags(options.compression),
         half: options.half,
     };
     write_atomic(path, |tmp| write_grids(tmp, path, &candidates, encoding))
+}
+
+/// Whether `path` names a NanoVDB file (`.nvdb`): the same grids in NanoVDB's layout,
+/// uncompressed, without the `.vdb` metadata (NanoVDB keeps names, transforms and classes).
+pub fn is_nvdb(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("nvdb"))
 }
 
 /// How a `.vdb` is written: which grids, compressed how, floats at what precision.

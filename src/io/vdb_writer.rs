@@ -7,14 +7,15 @@
 //! blocks) in coordinate order, each with its 128^3 children and 128^3 tiles, those with
 //! their leaves and 8^3 tiles; then every leaf's buffer in the same order.
 
+use super::grid_out::{Entry, GridOut, GridValues, Key, ValueType, tree_entries};
 use super::vdb_chunks::{compression_name, push_chunk};
 use super::vdb_format::{
-    CHILD_LOG2, COMPRESS_ACTIVE_MASK, COMPRESS_BLOSC, COMPRESS_ZIP, FILE_VERSION, LIBRARY_VERSION,
-    MAGIC, NODE_LOG2, ROOT_TILE, tree_type,
+    COMPRESS_ACTIVE_MASK, COMPRESS_BLOSC, COMPRESS_ZIP, FILE_VERSION, LIBRARY_VERSION, MAGIC,
+    tree_type,
 };
 use super::vdb_tree_structure::{TreeFormat, tree_memory};
 use crate::error::{Error, Result};
-use crate::grid::{LEAF_VOXELS, Leaf, SparseGrid, Transform};
+use crate::grid::{LEAF_VOXELS, Leaf, Transform};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -24,124 +25,33 @@ use std::sync::OnceLock;
 /// Leaves per parallel batch of leaf buffers.
 const BATCH: usize = 2048;
 
-/// What a grid's voxels hold.
-#[derive(Clone, Copy)]
-pub(super) enum GridValues<'g> {
-    /// A BoolGrid, true on every active voxel and tile.
-    Bool,
-    /// A FloatGrid holding this value on every active voxel and tile (a fog volume's 1).
-    Constant(f32),
-    /// A Vec3SGrid of every leaf's normals (tiles carry none).
-    Normals,
-    /// A Vec3SGrid of every leaf's colours.
-    Colors,
-    /// A FloatGrid of every leaf's values with `background` elsewhere (an unsigned band).
-    Distances { background: f32 },
-    /// A level set: every leaf's signed values; its inactive voxels and tiles `-background`
-    /// where `interior` holds them (its tiles are written, inactive), `background` elsewhere.
-    LevelSet {
-        background: f32,
-        interior: &'g SparseGrid,
-    },
-    /// The fog volume of a level set (written from its interior): 1 on whole blocks and
-    /// inside voxels off the band, `-d / background` on the band's inside voxels.
-    Fog {
-        band: &'g SparseGrid,
-        background: f32,
-    },
+/// The standard tree's type name of a grid.
+fn tree_type_of(values: GridValues) -> String {
+    tree_type(match values.value_type() {
+        ValueType::Bool => "bool",
+        ValueType::Vec3 => "vec3s",
+        ValueType::Float => "float",
+    })
 }
 
-impl GridValues<'_> {
-    fn tree_type(self) -> String {
-        tree_type(match self {
-            GridValues::Bool => "bool",
-            GridValues::Normals | GridValues::Colors => "vec3s",
-            _ => "float",
-        })
+/// The value of an active tile, as stored (half precision when `half`).
+fn push_tile_value(out: &mut Vec<u8>, values: GridValues, half: bool) {
+    match values.value_type() {
+        ValueType::Bool => out.push(1),
+        _ => push_reals(out, &[values.tile_value()], half),
     }
+}
 
-    fn is_real(self) -> bool {
-        !matches!(self, GridValues::Bool)
-    }
-
-    /// The value of voxels and slots outside the tree.
-    fn background(self) -> f32 {
-        match self {
-            GridValues::Distances { background } | GridValues::LevelSet { background, .. } => {
-                background
-            }
-            _ => 0.0,
-        }
-    }
-
-    /// Whether the grid's tiles are active (a level set's interior tiles are not).
-    fn active_tiles(self) -> bool {
-        !matches!(self, GridValues::LevelSet { .. })
-    }
-
-    /// The value of a tile, as stored (half precision when `half`).
-    fn push_tile_value(self, out: &mut Vec<u8>, half: bool) {
-        match self {
-            GridValues::Bool => out.push(1),
-            GridValues::Constant(v) => push_reals(out, &[v], half),
-            GridValues::Fog { .. } => push_reals(out, &[1.0], half),
-            _ => unreachable!("only voxel sets and fog volumes have active tiles"),
-        }
-    }
-
-    /// The active values of `leaf`, in offset order, as stored.
-    fn push_leaf_values(self, out: &mut Vec<u8>, leaf: &Leaf, half: bool) {
-        // Gathered first, then stored in one pass at one precision.
-        let mut reals = [0f32; 3 * LEAF_VOXELS];
-        let mut len = 0;
-        let mut put = |v: f32| {
-            reals[len] = v;
-            len += 1;
-        };
-        match self {
-            GridValues::Bool => unreachable!("bool leaves store a mask"),
-            GridValues::Constant(v) => leaf.offsets().for_each(|_| put(v)),
-            GridValues::Distances { .. } | GridValues::LevelSet { .. } => {
-                let d = leaf
-                    .value
-                    .as_deref()
-                    .expect("a distance grid's leaves carry values");
-                leaf.offsets().for_each(|n| put(d[n]));
-            }
-            GridValues::Fog { band, background } => {
-                let on_band = band.leaf(leaf.origin);
-                leaf.offsets().for_each(|n| {
-                    put(match on_band {
-                        Some(b) if b.is_on(n) => {
-                            let d = b.value.as_deref().expect("distances")[n];
-                            (-d / background).clamp(0.0, 1.0)
-                        }
-                        _ => 1.0,
-                    })
-                });
-            }
-            GridValues::Normals | GridValues::Colors => {
-                let vectors = match self {
-                    GridValues::Normals => leaf.normal.as_deref(),
-                    _ => leaf.color.as_deref(),
-                };
-                let vectors = vectors.expect("a vector grid's leaves carry its channel");
-                leaf.offsets()
-                    .for_each(|n| vectors[n].iter().for_each(|&c| put(c)));
-            }
-        }
-        push_reals(out, &reals[..len], half);
-    }
-
-    /// The inside voxels of a level set's leaf at `origin` (the others are outside).
-    fn inside(self, origin: [i64; 3]) -> [u64; 8] {
-        match self {
-            GridValues::LevelSet { interior, .. } => {
-                interior.leaf(origin).map_or([0; 8], |l| l.mask)
-            }
-            _ => [0; 8],
-        }
-    }
+/// The active values of `leaf`, in offset order, as stored.
+fn push_leaf_values(out: &mut Vec<u8>, leaf: &Leaf, values: GridValues, half: bool) {
+    // Gathered first, then stored in one pass at one precision.
+    let mut reals = [0f32; 3 * LEAF_VOXELS];
+    let mut len = 0;
+    values.for_each_active(leaf, |v| {
+        reals[len] = v;
+        len += 1;
+    });
+    push_reals(out, &reals[..len], half);
 }
 
 /// `values` as stored: little-endian f32, or f16 when `half`.
@@ -158,18 +68,6 @@ fn push_reals(out: &mut Vec<u8>, values: &[f32], half: bool) {
             bytes.copy_from_slice(&v.to_le_bytes());
         }
     }
-}
-
-/// One grid to write.
-pub(super) struct GridOut<'g> {
-    pub name: &'g str,
-    pub grid: &'g SparseGrid,
-    pub values: GridValues<'g>,
-    /// OpenVDB's grid class (`fog volume`), when it has one.
-    pub class: Option<&'static str>,
-    /// OpenVDB's vector type of a Vec3 grid (`covariant normalize`, `invariant`).
-    pub vector_type: Option<&'static str>,
-    pub metadata: &'g [(String, super::vdb_format::MetaValue)],
 }
 
 /// How the file is written.
@@ -199,8 +97,8 @@ pub(super) fn write_grids(
         let encoded = encode_grid(path, g, encoding)?;
         let mut descriptor = Vec::new();
         push_string(&mut descriptor, g.name);
-        let mut tree_type = g.values.tree_type();
-        if encoding.half && g.values.is_real() {
+        let mut tree_type = tree_type_of(g.values);
+        if encoding.half && (g.values.value_type() != ValueType::Bool) {
             tree_type.push_str("_HalfFloat");
         }
         push_string(&mut descriptor, &tree_type);
@@ -276,87 +174,10 @@ struct EncodedGrid {
     buffers: Vec<Vec<u8>>,
 }
 
-/// Something held by a 128^3 or an 8^3 slot of an internal node.
-#[derive(Clone, Copy)]
-enum Entry<'g> {
-    NodeTile,
-    LeafTile,
-    Leaf(&'g Leaf),
-}
-
-/// Where an entry sits: its root child's origin, its slot in that child (32^3 slots of
-/// 128^3), its slot in the 128^3 node (16^3 slots of 8^3). Sorting by key gives OpenVDB's
-/// order.
-type Key = ([i32; 3], u16, u16);
-
-fn key(path: &Path, origin: [i64; 3]) -> Result<Key> {
-    let mut c = [0i32; 3];
-    for (o, &v) in c.iter_mut().zip(&origin) {
-        *o = i32::try_from(v)
-            .ok()
-            .filter(|v| v.checked_add(127).is_some())
-            .ok_or_else(|| Error::Vdb {
-                path: path.to_path_buf(),
-                message: format!("block {origin:?} is outside OpenVDB's 32-bit index range"),
-            })?;
-    }
-    let slot = |shift: u32, bits: u32| {
-        let mask = (1 << bits) - 1;
-        c.iter()
-            .fold(0u16, |s, &v| (s << bits) | ((v >> shift) & mask) as u16)
-    };
-    Ok((
-        c.map(|v| v & !(ROOT_TILE - 1)),
-        slot(CHILD_LOG2[0], NODE_LOG2[0]),
-        slot(CHILD_LOG2[1], NODE_LOG2[1]),
-    ))
-}
-
 fn encode_grid(path: &Path, g: &GridOut, encoding: Encoding) -> Result<EncodedGrid> {
     let grid = g.grid;
-    let mut entries: Vec<(Key, Entry)> = grid
-        .leaves()
-        .iter()
-        .filter(|l| !l.is_empty())
-        .map(|l| Ok((key(path, l.origin)?, Entry::Leaf(l))))
-        .collect::<Result<_>>()?;
-    let tiles_of = match g.values {
-        GridValues::LevelSet { interior, .. } => interior,
-        _ => grid,
-    };
-    for (origin, edge) in tiles_of.tiles().with_edges() {
-        let entry = if edge == 8 {
-            Entry::LeafTile
-        } else {
-            Entry::NodeTile
-        };
-        entries.push((key(path, origin)?, entry));
-    }
-    if matches!(g.values, GridValues::Normals | GridValues::Colors)
-        && entries.iter().any(|e| !matches!(e.1, Entry::Leaf(_)))
-    {
-        return Err(Error::Vdb {
-            path: path.to_path_buf(),
-            message: format!("grid {}: tiles carry no vectors", g.name),
-        });
-    }
-    entries.par_sort_unstable_by_key(|e| e.0);
-    // A block is a leaf or a tile, and a 128^3 tile holds nothing else.
-    let clash = entries.windows(2).find(|w| {
-        w[0].0 == w[1].0
-            || (w[0].0.0 == w[1].0.0 && w[0].0.1 == w[1].0.1 && matches!(w[0].1, Entry::NodeTile))
-    });
-    if let Some(w) = clash {
-        return Err(Error::Vdb {
-            path: path.to_path_buf(),
-            message: format!(
-                "grid {}: a tile and another node in one place (root child {:?}, slot {})",
-                g.name, w[0].0.0, w[0].0.1
-            ),
-        });
-    }
-
-    let half = encoding.half && g.values.is_real();
+    let entries = tree_entries(path, g)?;
+    let half = encoding.half && (g.values.value_type() != ValueType::Bool);
     let compression = encoding.compression | COMPRESS_ACTIVE_MASK;
     // Each root child's topology on its own thread, with its leaves in buffer order.
     let roots: Vec<&[(Key, Entry)]> = entries.chunk_by(|a, b| a.0.0 == b.0.0).collect();
@@ -489,7 +310,7 @@ fn push_internal_values(
     push_inactive(out, inside, &outside);
     let count: u32 = active.iter().map(|w| w.count_ones()).sum();
     let mut data = Vec::new();
-    (0..count).for_each(|_| values.push_tile_value(&mut data, half));
+    (0..count).for_each(|_| push_tile_value(&mut data, values, half));
     push_values(out, &data, values, compression, half);
 }
 
@@ -540,7 +361,7 @@ fn leaf_buffer(
         // compressed once.
         let chunk = constant_chunks[leaf.count() as usize].get_or_init(|| {
             let mut data = Vec::new();
-            values.push_leaf_values(&mut data, leaf, half);
+            push_leaf_values(&mut data, leaf, values, half);
             let mut chunk = Vec::new();
             push_values(&mut chunk, &data, values, compression, half);
             chunk
@@ -549,7 +370,7 @@ fn leaf_buffer(
         return;
     }
     scratch.clear();
-    values.push_leaf_values(scratch, leaf, half);
+    push_leaf_values(scratch, leaf, values, half);
     push_values(out, scratch, values, compression, half);
 }
 
@@ -610,7 +431,7 @@ fn push_metadata(
         "file_compression",
         Meta::Str(compression_name(encoding.compression).to_string()),
     );
-    let format = TreeFormat::of(&g.values.tree_type()).expect("a standard tree");
+    let format = TreeFormat::of(&tree_type_of(g.values)).expect("a standard tree");
     map.insert(
         "file_mem_bytes",
         Meta::Int64(tree_memory(format, internal, leaves) as i64),
@@ -618,7 +439,7 @@ fn push_metadata(
     map.insert("file_voxel_count", Meta::Int64(g.grid.voxel_count() as i64));
     map.insert(
         "is_saved_as_half_float",
-        Meta::Bool(encoding.half && g.values.is_real()),
+        Meta::Bool(encoding.half && (g.values.value_type() != ValueType::Bool)),
     );
     out.extend_from_slice(&(map.len() as u32).to_le_bytes());
     for (name, value) in map {

@@ -12,7 +12,9 @@ use crate::implicit::Formula;
 use crate::io::atomic::check_output;
 use crate::io::binvox::write_binvox;
 use crate::io::brick_set::{BrickSet, is_brick_set};
-use crate::io::vdb::{MetaValue, WriteOptions, read_vdb_grid, write_distance_band, write_vdb_as};
+use crate::io::vdb::{
+    MetaValue, WriteOptions, is_nvdb, read_vdb_grid, write_distance_band, write_vdb_as,
+};
 use crate::io::vox::write_vox;
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::{BooleanOp, combine as combine_grids};
@@ -55,7 +57,7 @@ pub struct Distances {
 }
 
 /// Output formats by extension; `-` is standard output (as `.vdb`).
-const FORMATS: &str = ".vdb (or - for standard output), .binvox and .vox";
+const FORMATS: &str = ".vdb (or - for standard output), .nvdb (NanoVDB), .binvox and .vox";
 
 /// The voxel-set formats besides `.vdb`, by extension.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -82,7 +84,7 @@ pub fn check_output_path(path: &Path, inputs: &[&Path]) -> Result<()> {
     let vdb = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("vdb"));
-    if !vdb && voxel_file(path).is_none() {
+    if !vdb && !is_nvdb(path) && voxel_file(path).is_none() {
         return Err(Error::InvalidArgument(format!(
             "{}: voxelkit cannot write this format; it writes {FORMATS}",
             path.display()
@@ -260,9 +262,9 @@ impl Outcome {
         inside
     }
 
-    /// Writes the grids to `path` (`.vdb`; `-` for standard output) as `options` say, or the
-    /// voxel set alone to a `.binvox` or `.vox`, atomically, refusing to replace any of `inputs`;
-    /// records the output in the report.
+    /// Writes the grids to `path` (`.vdb` or `.nvdb`; `-` for standard output, as `.vdb`) as
+    /// `options` say, or the voxel set alone to a `.binvox` or `.vox`, atomically, refusing to
+    /// replace any of `inputs`; records the output in the report.
     pub fn write(&mut self, path: &Path, inputs: &[&Path], options: &WriteOptions) -> Result<()> {
         let begun = StageTime::now();
         self.write_files(path, inputs, options)?;
@@ -278,7 +280,7 @@ impl Outcome {
             if self.distances.is_some() {
                 return Err(Error::InvalidArgument(format!(
                     "{}: .binvox and .vox hold voxel sets, not distances; write the level set \
-                     as .vdb",
+                     as .vdb or .nvdb",
                     path.display()
                 )));
             }

@@ -369,8 +369,8 @@ impl Grid {
     }
 
     /// Writes the grid as the CLI does, by extension: `.vdb` (all grids, or those `grids`
-    /// names: `density`, `voxels`, `normal`, `Cd`, `shell`, ...), `.binvox` or `.vox`;
-    /// atomically, never over an input of the job. The keywords are `OPTIONS["write"]`'s:
+    /// names: `density`, `voxels`, `normal`, `Cd`, `shell`, ...), `.nvdb` (the same grids
+    /// for NanoVDB), `.binvox` or `.vox`; atomically, never over an input of the job. The keywords are `OPTIONS["write"]`'s:
     /// `grids`, `compression` (blosc, zip or none) and `half`.
     #[pyo3(signature = (path, **options))]
     fn write(

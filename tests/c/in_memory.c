@@ -116,8 +116,8 @@ static void check_rebuilt(const vk_grid *solid) {
 }
 
 int main(int argc, char **argv) {
-    if (argc != 2) {
-        fprintf(stderr, "usage: in_memory LEVEL_SET.vdb\n");
+    if (argc != 2 && argc != 3) {
+        fprintf(stderr, "usage: in_memory LEVEL_SET.vdb [LEVEL_SET.nvdb]\n");
         return 2;
     }
     vk_mesh *m = box();
@@ -130,6 +130,9 @@ int main(int argc, char **argv) {
     OK(vk_voxelize_mesh(m, opts, &sdf));
     check_level_set(sdf);
     OK(vk_grid_write_vdb(sdf, argv[1]));
+    if (argc == 3) {
+        OK(vk_grid_write_vdb(sdf, argv[2]));
+    }
     /* The level set as a fill: its measures count the centres inside, volume 2. */
     vk_measures measures;
     OK(vk_fill_mesh(m, opts, &filled, &measures));

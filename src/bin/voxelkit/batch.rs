@@ -18,6 +18,8 @@ use voxelkit::{Error, Result};
 #[derive(clap::ValueEnum, Clone, Copy)]
 pub enum OutputFormat {
     Vdb,
+    /// NanoVDB
+    Nvdb,
     Binvox,
     Vox,
 }
@@ -26,6 +28,7 @@ impl OutputFormat {
     fn extension(self) -> &'static str {
         match self {
             OutputFormat::Vdb => "vdb",
+            OutputFormat::Nvdb => "nvdb",
             OutputFormat::Binvox => "binvox",
             OutputFormat::Vox => "vox",
         }
@@ -35,7 +38,7 @@ impl OutputFormat {
 /// Where the results go, for one input or many.
 #[derive(Args)]
 pub struct OutputArgs {
-    /// Output file: .vdb, .binvox or .vox, chosen by extension (`-`: a .vdb on standard
+    /// Output file: .vdb, .nvdb (NanoVDB), .binvox or .vox, chosen by extension (`-`: a .vdb on standard
     /// output). Under --frames, a pattern with `#` for the frame number
     /// (`out/f_####.vdb`).
     #[arg(short, long, required_unless_present = "out_dir")]

@@ -49,8 +49,8 @@ pub struct VoxelizeArgs {
     pub fit: FitArgs,
     #[command(flatten)]
     pub surface: SurfaceArgs,
-    /// Output: a .vdb (`density`, `normal` with --normals; `voxels` with --grids), or a
-    /// .binvox or .vox (the voxel set alone).
+    /// Output: a .vdb (`density`, `normal` with --normals; `voxels` with --grids), a .nvdb
+    /// (the same grids for NanoVDB), or a .binvox or .vox (the voxel set alone).
     #[arg(short, long)]
     pub output: PathBuf,
     #[command(flatten)]

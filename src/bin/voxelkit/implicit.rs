@@ -88,8 +88,8 @@ pub struct ImplicitArgs {
     /// (lobes where G < 0 included) instead of r = G as typed.
     #[arg(long)]
     squared: bool,
-    /// Output: a .vdb (`density`, `normal`, and the levels), or a .binvox or .vox (the voxels
-    /// alone).
+    /// Output: a .vdb (`density`, `normal`, and the levels), a .nvdb (the same grids for
+    /// NanoVDB), or a .binvox or .vox (the voxels alone).
     #[arg(short, long)]
     output: PathBuf,
     #[command(flatten)]

@@ -58,8 +58,8 @@ pub struct LinesArgs {
     fit: FitArgs,
     #[command(flatten)]
     color: ColorArgs,
-    /// Output: a .vdb (`density` and, with colours, `Cd`), or a .binvox or .vox (the voxels
-    /// alone).
+    /// Output: a .vdb (`density` and, with colours, `Cd`), a .nvdb (the same grids for
+    /// NanoVDB), or a .binvox or .vox (the voxels alone).
     #[arg(short, long)]
     output: PathBuf,
     #[command(flatten)]

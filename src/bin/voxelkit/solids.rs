@@ -107,7 +107,7 @@ pub struct SolidArgs {
     /// Output: a .binvox or .vox (the whole solid), or a .vdb: `density` (1 on the whole
     /// solid, whole blocks as tiles), `shell` (its outer voxels) and `interior`; depth layers
     /// add `unclassified`; `voxels` (the whole solid as booleans) when --grids names it. With
-    /// --sdf: `density` and the level set `surface`.
+    /// --sdf: `density` and the level set `surface`. A .nvdb holds the same grids for NanoVDB.
     #[command(flatten)]
     pub out: crate::batch::OutputArgs,
     #[command(flatten)]

@@ -59,7 +59,8 @@ pub struct SubdivVoxelizeArgs {
     #[arg(long, requires = "solid")]
     topology: bool,
     /// Output: a .vdb (`density`, `normal` and `opposite_normals` grids; with --solid,
-    /// `density`, `shell`, `interior` and `opposite_normals`), or a .binvox or .vox.
+    /// `density`, `shell`, `interior` and `opposite_normals`), a .nvdb (the same grids for
+    /// NanoVDB), or a .binvox or .vox.
     #[arg(short, long, required = true)]
     output: Option<PathBuf>,
     #[command(flatten)]

@@ -1,0 +1,224 @@
+//! A grid to write, as both writers see it (`.vdb` by `vdb_writer`, `.nvdb` by
+//! `nvdb_writer`): what its voxels and tiles hold, and its leaves and tiles sorted into the
+//! order of OpenVDB's standard 5-4-3 tree (root children of 4096^3, internal nodes of 128^3,
+//! leaves of 8^3), which NanoVDB shares.
+
+use super::vdb_format::{CHILD_LOG2, NODE_LOG2, ROOT_TILE};
+use crate::error::{Error, Result};
+use crate::grid::{Leaf, SparseGrid};
+use rayon::prelude::*;
+use std::path::Path;
+
+/// What a grid's voxels hold.
+#[derive(Clone, Copy)]
+pub(super) enum GridValues<'g> {
+    /// A BoolGrid, true on every active voxel and tile.
+    Bool,
+    /// A FloatGrid holding this value on every active voxel and tile (a fog volume's 1).
+    Constant(f32),
+    /// A Vec3SGrid of every leaf's normals (tiles carry none).
+    Normals,
+    /// A Vec3SGrid of every leaf's colours.
+    Colors,
+    /// A FloatGrid of every leaf's values with `background` elsewhere (an unsigned band).
+    Distances { background: f32 },
+    /// A level set: every leaf's signed values; its inactive voxels and tiles `-background`
+    /// where `interior` holds them (its tiles are written, inactive), `background` elsewhere.
+    LevelSet {
+        background: f32,
+        interior: &'g SparseGrid,
+    },
+    /// The fog volume of a level set (written from its interior): 1 on whole blocks and
+    /// inside voxels off the band, `-d / background` on the band's inside voxels.
+    Fog {
+        band: &'g SparseGrid,
+        background: f32,
+    },
+}
+
+/// The type of a grid's values.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum ValueType {
+    Bool,
+    Float,
+    Vec3,
+}
+
+impl GridValues<'_> {
+    pub(super) fn value_type(self) -> ValueType {
+        match self {
+            GridValues::Bool => ValueType::Bool,
+            GridValues::Normals | GridValues::Colors => ValueType::Vec3,
+            _ => ValueType::Float,
+        }
+    }
+
+    /// The value of voxels and slots outside the tree.
+    pub(super) fn background(self) -> f32 {
+        match self {
+            GridValues::Distances { background } | GridValues::LevelSet { background, .. } => {
+                background
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Whether the grid's tiles are active (a level set's interior tiles are not).
+    pub(super) fn active_tiles(self) -> bool {
+        !matches!(self, GridValues::LevelSet { .. })
+    }
+
+    /// The value of a tile: an active tile's (true is 1), or a level set's interior one.
+    pub(super) fn tile_value(self) -> f32 {
+        match self {
+            GridValues::Bool | GridValues::Fog { .. } => 1.0,
+            GridValues::Constant(v) => v,
+            GridValues::LevelSet { background, .. } => -background,
+            _ => unreachable!("only voxel sets, fog volumes and level sets have tiles"),
+        }
+    }
+
+    /// Hands `put` the active values of `leaf` in offset order, a vector's three components
+    /// one after another; a bool grid's leaves store no values.
+    pub(super) fn for_each_active(self, leaf: &Leaf, mut put: impl FnMut(f32)) {
+        match self {
+            GridValues::Bool => unreachable!("bool leaves store a mask"),
+            GridValues::Constant(v) => leaf.offsets().for_each(|_| put(v)),
+            GridValues::Distances { .. } | GridValues::LevelSet { .. } => {
+                let d = leaf
+                    .value
+                    .as_deref()
+                    .expect("a distance grid's leaves carry values");
+                leaf.offsets().for_each(|n| put(d[n]));
+            }
+            GridValues::Fog { band, background } => {
+                let on_band = band.leaf(leaf.origin);
+                leaf.offsets().for_each(|n| {
+                    put(match on_band {
+                        Some(b) if b.is_on(n) => {
+                            let d = b.value.as_deref().expect("distances")[n];
+                            (-d / background).clamp(0.0, 1.0)
+                        }
+                        _ => 1.0,
+                    })
+                });
+            }
+            GridValues::Normals | GridValues::Colors => {
+                let vectors = match self {
+                    GridValues::Normals => leaf.normal.as_deref(),
+                    _ => leaf.color.as_deref(),
+                };
+                let vectors = vectors.expect("a vector grid's leaves carry its channel");
+                leaf.offsets()
+                    .for_each(|n| vectors[n].iter().for_each(|&c| put(c)));
+            }
+        }
+    }
+
+    /// The inside voxels of a level set's leaf at `origin` (the others are outside).
+    pub(super) fn inside(self, origin: [i64; 3]) -> [u64; 8] {
+        match self {
+            GridValues::LevelSet { interior, .. } => {
+                interior.leaf(origin).map_or([0; 8], |l| l.mask)
+            }
+            _ => [0; 8],
+        }
+    }
+}
+
+/// One grid to write.
+pub(super) struct GridOut<'g> {
+    pub name: &'g str,
+    pub grid: &'g SparseGrid,
+    pub values: GridValues<'g>,
+    /// OpenVDB's grid class (`fog volume`), when it has one.
+    pub class: Option<&'static str>,
+    /// OpenVDB's vector type of a Vec3 grid (`covariant normalize`, `invariant`).
+    pub vector_type: Option<&'static str>,
+    pub metadata: &'g [(String, super::vdb_format::MetaValue)],
+}
+
+/// Something held by a 128^3 or an 8^3 slot of an internal node.
+#[derive(Clone, Copy)]
+pub(super) enum Entry<'g> {
+    NodeTile,
+    LeafTile,
+    Leaf(&'g Leaf),
+}
+
+/// Where an entry sits: its root child's origin, its slot in that child (32^3 slots of
+/// 128^3), its slot in the 128^3 node (16^3 slots of 8^3). Sorting by key gives OpenVDB's
+/// order.
+pub(super) type Key = ([i32; 3], u16, u16);
+
+fn key(path: &Path, origin: [i64; 3]) -> Result<Key> {
+    let mut c = [0i32; 3];
+    for (o, &v) in c.iter_mut().zip(&origin) {
+        *o = i32::try_from(v)
+            .ok()
+            .filter(|v| v.checked_add(127).is_some())
+            .ok_or_else(|| Error::Vdb {
+                path: path.to_path_buf(),
+                message: format!("block {origin:?} is outside OpenVDB's 32-bit index range"),
+            })?;
+    }
+    let slot = |shift: u32, bits: u32| {
+        let mask = (1 << bits) - 1;
+        c.iter()
+            .fold(0u16, |s, &v| (s << bits) | ((v >> shift) & mask) as u16)
+    };
+    Ok((
+        c.map(|v| v & !(ROOT_TILE - 1)),
+        slot(CHILD_LOG2[0], NODE_LOG2[0]),
+        slot(CHILD_LOG2[1], NODE_LOG2[1]),
+    ))
+}
+
+/// The grid's non-empty leaves and its tiles (a level set's: its interior's) in tree order;
+/// refuses vectors on tiles and a tile sharing its place with another node. Errors name
+/// `path`.
+pub(super) fn tree_entries<'g>(path: &Path, g: &GridOut<'g>) -> Result<Vec<(Key, Entry<'g>)>> {
+    let mut entries: Vec<(Key, Entry)> = g
+        .grid
+        .leaves()
+        .iter()
+        .filter(|l| !l.is_empty())
+        .map(|l| Ok((key(path, l.origin)?, Entry::Leaf(l))))
+        .collect::<Result<_>>()?;
+    let tiles_of = match g.values {
+        GridValues::LevelSet { interior, .. } => interior,
+        _ => g.grid,
+    };
+    for (origin, edge) in tiles_of.tiles().with_edges() {
+        let entry = if edge == 8 {
+            Entry::LeafTile
+        } else {
+            Entry::NodeTile
+        };
+        entries.push((key(path, origin)?, entry));
+    }
+    if g.values.value_type() == ValueType::Vec3
+        && entries.iter().any(|e| !matches!(e.1, Entry::Leaf(_)))
+    {
+        return Err(Error::Vdb {
+            path: path.to_path_buf(),
+            message: format!("grid {}: tiles carry no vectors", g.name),
+        });
+    }
+    entries.par_sort_unstable_by_key(|e| e.0);
+    // A block is a leaf or a tile, and a 128^3 tile holds nothing else.
+    let clash = entries.windows(2).find(|w| {
+        w[0].0 == w[1].0
+            || (w[0].0.0 == w[1].0.0 && w[0].0.1 == w[1].0.1 && matches!(w[0].1, Entry::NodeTile))
+    });
+    if let Some(w) = clash {
+        return Err(Error::Vdb {
+            path: path.to_path_buf(),
+            message: format!(
+                "grid {}: a tile and another node in one place (root child {:?}, slot {})",
+                g.name, w[0].0.0, w[0].0.1
+            ),
+        });
+    }
+    Ok(entries)
+}
