@@ -18,7 +18,6 @@ use voxelkit::{Error, Result};
 #[derive(clap::ValueEnum, Clone, Copy)]
 pub enum OutputFormat {
     Vdb,
-    /// NanoVDB
     Nvdb,
     Binvox,
     Vox,
