@@ -285,6 +285,46 @@ vk_status vk_grid_write_vdb(const vk_grid *grid, const char *path);
 vk_status vk_grid_write_vdb_with(const vk_grid *grid, const char *path,
                                  const vk_options *options);
 
+/*
+ * The grids vk_grid_write_vdb_with(grid, path, options) writes (options NULL: those
+ * vk_grid_write_vdb writes), as arrays to build one's own grids from (voxelkit/openvdb.hpp
+ * builds OpenVDB grids of them): how many, each one described, and its arrays:
+ * `leaf_origins` 3 * leaf_count int32, `masks` 8 * leaf_count uint64 (OpenVDB's mask words),
+ * `values` every voxel's value of every leaf in OpenVDB's voxel order (512 * leaf_count floats,
+ * 3 * 512 * leaf_count for VK_VALUE_VEC3S, none for VK_VALUE_BOOL; inactive voxels hold the
+ * background, or minus it inside a level set), `tiles` 4 * tile_count int32 (origin, edge 8 or
+ * 128), every tile holding `tile_value`, active when `tiles_active` (a level set's interior
+ * tiles are not). Each call makes the grid asked for anew.
+ */
+typedef enum vk_value_type { VK_VALUE_BOOL = 0, VK_VALUE_FLOAT = 1, VK_VALUE_VEC3S = 2 } vk_value_type;
+typedef enum vk_export_class {
+    VK_CLASS_NONE = 0,
+    VK_CLASS_FOG_VOLUME = 1,
+    VK_CLASS_LEVEL_SET = 2
+} vk_export_class;
+typedef enum vk_vector_type {
+    VK_VECTOR_NONE = 0,
+    VK_VECTOR_COVARIANT_NORMALIZE = 1,
+    VK_VECTOR_INVARIANT = 2
+} vk_vector_type;
+typedef struct vk_export_info {
+    char name[256];
+    int value_type;  /* vk_value_type */
+    int grid_class;  /* vk_export_class */
+    int vector_type; /* vk_vector_type */
+    size_t leaf_count;
+    size_t tile_count;
+    float background;
+    int tiles_active;
+    float tile_value;
+} vk_export_info;
+vk_status vk_grid_export_count(const vk_grid *grid, const vk_options *options, size_t *count);
+vk_status vk_grid_export_info(const vk_grid *grid, const vk_options *options, size_t index,
+                              vk_export_info *info);
+vk_status vk_grid_export_arrays(const vk_grid *grid, const vk_options *options, size_t index,
+                                int32_t *leaf_origins, uint64_t *masks, float *values,
+                                int32_t *tiles);
+
 vk_status vk_grid_voxel_count(const vk_grid *grid, uint64_t *count);
 vk_status vk_grid_leaf_count(const vk_grid *grid, size_t *count);
 vk_status vk_grid_transform(const vk_grid *grid, double *voxel_size, double origin[3]);

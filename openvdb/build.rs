@@ -30,6 +30,7 @@ fn main() {
     build
         .file("cpp/vdb_bridge.cc")
         .include("../cpp")
+        .include("../include")
         .std("c++17")
         .flag_if_supported("-Wno-deprecated-declarations")
         .opt_level(2);
@@ -50,6 +51,8 @@ fn main() {
         "cpp/vdb_bridge.cc",
         "cpp/vdb_bridge.h",
         "../cpp/trycatch.h",
+        "../include/voxelkit/openvdb.hpp",
+        "../include/voxelkit.h",
         "src/bridge.rs",
     ] {
         println!("cargo:rerun-if-changed={f}");

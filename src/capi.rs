@@ -12,7 +12,8 @@ use crate::choice::Choice;
 use crate::error::{Error, Result};
 use crate::grid::{Block, Channels, Coord, LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use crate::implicit::Coordinates;
-use crate::io::vdb::{Compression, MetaValue, meta_entries, read_vdb_solid};
+use crate::io::grid_export::ExportedGrid;
+use crate::io::vdb::{Compression, MetaValue, WriteOptions, meta_entries, read_vdb_solid};
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::BooleanOp;
 use crate::pipeline::request::{
@@ -1448,6 +1449,117 @@ pub enum VkGridClass {
     Voxels = 0,
     LevelSet = 1,
     UnsignedDistance = 2,
+}
+
+/// `vk_export_info`: one grid of a write, described.
+#[repr(C)]
+pub struct VkExportInfo {
+    pub name: [c_char; 256],
+    /// 0 bool, 1 float, 2 vec3s.
+    pub value_type: c_int,
+    /// 0 none, 1 fog volume, 2 level set.
+    pub grid_class: c_int,
+    /// 0 none, 1 covariant normalize, 2 invariant.
+    pub vector_type: c_int,
+    pub leaf_count: usize,
+    pub tile_count: usize,
+    pub background: f32,
+    pub tiles_active: c_int,
+    pub tile_value: f32,
+}
+
+/// The write options of `options`, or the defaults when it is NULL.
+fn write_options_of(options: *const VkOptions) -> std::result::Result<WriteOptions, Failure> {
+    if options.is_null() {
+        return Ok(WriteRequest::default().options());
+    }
+    Ok(options_of(options)?.write.options())
+}
+
+/// The grid `index` of the write of `grid` as `options` choose its grids.
+fn exported(
+    grid: *const VkGrid,
+    options: *const VkOptions,
+    index: usize,
+) -> std::result::Result<ExportedGrid, Failure> {
+    let g = &borrow(grid, Kind::Grid)?.outcome;
+    let mut one = g.export_grids(&write_options_of(options)?, Some(index))?;
+    Ok(one.pop().expect("the grid asked for"))
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_export_count(
+    grid: *const VkGrid,
+    options: *const VkOptions,
+    count: *mut usize,
+) -> VkStatus {
+    guard(|| {
+        let g = &borrow(grid, Kind::Grid)?.outcome;
+        put(count, g.export_grid_count(&write_options_of(options)?)?)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_export_info(
+    grid: *const VkGrid,
+    options: *const VkOptions,
+    index: usize,
+    info: *mut VkExportInfo,
+) -> VkStatus {
+    guard(|| {
+        non_null_out(info)?;
+        let e = exported(grid, options, index)?;
+        let mut name = [0 as c_char; 256];
+        for (d, b) in name.iter_mut().zip(e.name.bytes().take(255)) {
+            *d = b as c_char;
+        }
+        let code = |v: Option<&str>, names: [&str; 2]| {
+            v.and_then(|v| names.iter().position(|n| *n == v))
+                .map_or(0, |i| i as c_int + 1)
+        };
+        put(
+            info,
+            VkExportInfo {
+                name,
+                value_type: ["bool", "float", "vec3s"]
+                    .iter()
+                    .position(|t| *t == e.value_type)
+                    .unwrap_or(0) as c_int,
+                grid_class: code(e.class, ["fog volume", "level set"]),
+                vector_type: code(e.vector_type, ["covariant normalize", "invariant"]),
+                leaf_count: e.leaf_origins.len() / 3,
+                tile_count: e.tiles.len() / 4,
+                background: e.background,
+                tiles_active: c_int::from(e.tiles_active),
+                tile_value: e.tile_value,
+            },
+        )
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_export_arrays(
+    grid: *const VkGrid,
+    options: *const VkOptions,
+    index: usize,
+    leaf_origins: *mut i32,
+    masks: *mut u64,
+    values: *mut f32,
+    tiles: *mut i32,
+) -> VkStatus {
+    guard(|| {
+        let e = exported(grid, options, index)?;
+        fn copy<T: Copy>(dst: *mut T, src: &[T], what: &str) -> Status {
+            if !src.is_empty() {
+                slice_mut(dst, src.len(), what)?.copy_from_slice(src);
+            }
+            Ok(())
+        }
+        copy(leaf_origins, &e.leaf_origins, "leaf_origins")?;
+        copy(masks, &e.masks, "masks")?;
+        copy(values, &e.values, "values")?;
+        copy(tiles, &e.tiles, "tiles")
+    })
 }
 
 #[unsafe(no_mangle)]

@@ -11,11 +11,11 @@
 #include <voxelkit.h>
 
 #include <openvdb/openvdb.h>
-#include <openvdb/tools/SignedFloodFill.h>
 
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace vk {
@@ -40,71 +40,54 @@ inline openvdb::math::Transform::Ptr transform_of(const vk_grid* grid) {
     return xform;
 }
 
-// The leaves of a voxelkit grid: origins (3 per leaf) and OpenVDB's mask words (8 per leaf).
-struct Leaves {
-    size_t count = 0;
-    std::vector<int32_t> origins;
-    std::vector<uint64_t> masks;
-    explicit Leaves(const vk_grid* grid) {
-        check(vk_grid_leaf_count(grid, &count), "vk_grid_leaf_count");
-        origins.resize(3 * count);
-        masks.resize(8 * count);
-        check(vk_grid_copy_leaves(grid, 0, count, origins.data(), masks.data()), "vk_grid_copy_leaves");
-    }
-    openvdb::Coord origin(size_t i) const {
-        return openvdb::Coord(origins[3 * i], origins[3 * i + 1], origins[3 * i + 2]);
-    }
-    bool on(size_t i, openvdb::Index n) const { return masks[8 * i + n / 64] >> (n % 64) & 1; }
-};
-
-// A grid of `leaves` whose voxel n of leaf i takes value(i, n), active where the mask says.
-template <typename GridT, typename Value>
-typename GridT::Ptr from_leaves(const Leaves& leaves, typename GridT::ValueType background,
-                                Value value) {
-    using LeafT = typename GridT::TreeType::LeafNodeType;
-    auto out = GridT::create(background);
-    auto accessor = out->getAccessor();
-    for (size_t i = 0; i < leaves.count; ++i) {
-        auto* leaf = new LeafT(leaves.origin(i), background);
-        for (openvdb::Index n = 0; n < LeafT::SIZE; ++n) {
-            if (leaves.on(i, n)) {
-                leaf->setValueOn(n, value(i, n));
+// A grid of GridT from voxelkit's arrays, in the layout vk_grid_export_arrays gives: per leaf
+// its origin (3 int32), mask words (8 uint64, OpenVDB's) and every value (512 floats, 3 x 512
+// for Vec3s, none for bool: true where active); per tile its origin and edge (8 or 128), each
+// holding `tile_value`, active or not. Also used by voxelkit's Rust bridge to OpenVDB.
+template <typename GridT>
+typename GridT::Ptr grid_from_arrays(float background, size_t leaf_count, const int32_t* origins,
+                                     const uint64_t* masks, const float* values, size_t tile_count,
+                                     const int32_t* tiles, bool tiles_active, float tile_value) {
+    using ValueT = typename GridT::ValueType;
+    constexpr bool vector = std::is_same_v<ValueT, openvdb::Vec3s>;
+    constexpr bool boolean = std::is_same_v<ValueT, bool>;
+    auto grid = GridT::create(ValueT(background));
+    auto& tree = grid->tree();
+    for (size_t i = 0; i < leaf_count; ++i) {
+        auto* leaf = tree.touchLeaf(openvdb::Coord(origins[3 * i], origins[3 * i + 1], origins[3 * i + 2]));
+        typename GridT::TreeType::LeafNodeType::NodeMaskType mask;
+        for (openvdb::Index w = 0; w < 8; ++w) mask.template getWord<openvdb::Index64>(w) = masks[8 * i + w];
+        for (openvdb::Index n = 0; n < 512; ++n) {
+            if constexpr (boolean) {
+                leaf->setValueOnly(n, mask.isOn(n));
+            } else if constexpr (vector) {
+                const float* v = values + 3 * (512 * i + n);
+                leaf->setValueOnly(n, ValueT(v[0], v[1], v[2]));
             } else {
-                leaf->setValueOff(n, value(i, n));
+                leaf->setValueOnly(n, values[512 * i + n]);
             }
         }
-        accessor.addLeaf(leaf);
+        leaf->setValueMask(mask);
     }
-    return out;
+    for (size_t i = 0; i < tile_count; ++i) {
+        const int32_t* t = tiles + 4 * i;
+        tree.addTile(t[3] == 8 ? 1 : 2, openvdb::Coord(t[0], t[1], t[2]), ValueT(tile_value), tiles_active);
+    }
+    return grid;
 }
 
-// A vec3 channel (`normal` or `Cd`) of every leaf, when the grid has one: normals transform
-// covariantly, colours are plain triples.
-inline openvdb::GridBase::Ptr vector_grid(const vk_grid* grid, const Leaves& leaves,
-                                          vk_status (*copy)(const vk_grid*, size_t, size_t, float*),
-                                          const char* name, openvdb::VecType vector_type) {
-    std::vector<float> values(3 * 512 * leaves.count);
-    if (leaves.count == 0 || copy(grid, 0, leaves.count, values.data()) != VK_OK) return nullptr;
-    auto out = from_leaves<openvdb::Vec3SGrid>(leaves, openvdb::Vec3s(0.0f), [&](size_t i, openvdb::Index n) {
-        const float* v = &values[3 * (512 * i + n)];
-        return openvdb::Vec3s(v[0], v[1], v[2]);
-    });
-    out->setName(name);
-    out->setVectorType(vector_type);
-    return out;
-}
-
-// Whole blocks of a voxelkit grid as OpenVDB tiles of level 1 (8^3) and 2 (128^3).
-template <typename TreeT>
-void add_tiles(const vk_grid* grid, TreeT& tree, typename TreeT::ValueType value) {
-    size_t tiles = 0;
-    check(vk_grid_tile_count(grid, &tiles), "vk_grid_tile_count");
-    std::vector<int32_t> origins(3 * tiles), edges(tiles);
-    check(vk_grid_copy_tiles(grid, 0, tiles, origins.data(), edges.data()), "vk_grid_copy_tiles");
-    for (size_t i = 0; i < tiles; ++i) {
-        const openvdb::Coord at(origins[3 * i], origins[3 * i + 1], origins[3 * i + 2]);
-        tree.addTile(edges[i] == 8 ? 1 : 2, at, value, true);
-    }
+// Grid `index` of what voxelkit writes for `grid` (as `options` choose, NULL: the defaults).
+template <typename GridT>
+typename GridT::Ptr exported_grid(const vk_grid* grid, const vk_options* options, size_t index,
+                                  const vk_export_info& info) {
+    const size_t per_leaf = info.value_type == VK_VALUE_VEC3S ? 3 * 512 : info.value_type == VK_VALUE_FLOAT ? 512 : 0;
+    std::vector<int32_t> origins(3 * info.leaf_count), tiles(4 * info.tile_count);
+    std::vector<uint64_t> masks(8 * info.leaf_count);
+    std::vector<float> values(per_leaf * info.leaf_count);
+    check(vk_grid_export_arrays(grid, options, index, origins.data(), masks.data(), values.data(), tiles.data()),
+          "vk_grid_export_arrays");
+    return grid_from_arrays<GridT>(info.background, info.leaf_count, origins.data(), masks.data(), values.data(),
+                                   info.tile_count, tiles.data(), info.tiles_active != 0, info.tile_value);
 }
 
 // What voxelkit takes from an OpenVDB tree: the leaves and whole blocks where `inside` holds
@@ -172,46 +155,31 @@ inline void add_metadata(const vk_grid* grid, openvdb::GridBase& out) {
 
 }  // namespace detail
 
-// A voxelkit grid as the grids voxelkit's .vdb file of it holds, on its transform, with its
-// metadata: a voxel
-// set as the FOG_VOLUME `density` (1 on every voxel, whole blocks as tiles), a level set as
-// the LEVEL_SET `surface` (signed distances in world units, its inside -background beyond
-// the band), unsigned distances as `distance`; then `normal` and `Cd` where the grid has them.
-inline openvdb::GridPtrVec to_openvdb(const vk_grid* grid) {
-    vk_grid_class grid_class = VK_GRID_VOXELS;
-    float background = 0.0f;
-    check(vk_grid_get_class(grid, &grid_class, &background), "vk_grid_get_class");
-    const detail::Leaves leaves(grid);
+// A voxelkit grid as the grids voxelkit's .vdb file of it holds (those `options` choose; NULL:
+// all but `voxels`), on its transform, with its metadata: a voxel set as the FOG_VOLUME
+// `density` (1 on every voxel, whole blocks as tiles), `normal` and `Cd` where the grid has
+// them and the bool grids beside it (a solid's `shell` and `interior` ...); a level set as
+// its fog volume `density` and the LEVEL_SET `surface` (signed distances in world units, its
+// inside -background beyond the band, inactive tiles there); unsigned distances as `distance`.
+inline openvdb::GridPtrVec to_openvdb(const vk_grid* grid, const vk_options* options = nullptr) {
+    size_t count = 0;
+    check(vk_grid_export_count(grid, options, &count), "vk_grid_export_count");
     openvdb::GridPtrVec out;
-    if (grid_class == VK_GRID_VOXELS) {
-        auto density = detail::from_leaves<openvdb::FloatGrid>(leaves, 0.0f, [](size_t, openvdb::Index) { return 1.0f; });
-        // Whole blocks without a voxel off: density 0 where they are off is never asked.
-        detail::add_tiles(grid, density->tree(), 1.0f);
-        density->setGridClass(openvdb::GRID_FOG_VOLUME);
-        density->setName("density");
-        out.push_back(density);
-    } else {
-        std::vector<float> values(512 * leaves.count);
-        if (leaves.count > 0)
-            check(vk_grid_copy_values(grid, 0, leaves.count, values.data()), "vk_grid_copy_values");
-        auto distances = detail::from_leaves<openvdb::FloatGrid>(
-            leaves, background, [&](size_t i, openvdb::Index n) { return values[512 * i + n]; });
-        if (grid_class == VK_GRID_LEVEL_SET) {
-            openvdb::tools::signedFloodFill(distances->tree());
-            distances->setGridClass(openvdb::GRID_LEVEL_SET);
-            distances->setName("surface");
-        } else {
-            distances->setName("distance");
-        }
-        out.push_back(distances);
-    }
-    if (auto normal = detail::vector_grid(grid, leaves, vk_grid_copy_normals, "normal", openvdb::VEC_COVARIANT_NORMALIZE))
-        out.push_back(normal);
-    if (auto color = detail::vector_grid(grid, leaves, vk_grid_copy_colors, "Cd", openvdb::VEC_INVARIANT))
-        out.push_back(color);
-    for (auto& g : out) {
+    for (size_t i = 0; i < count; ++i) {
+        vk_export_info info;
+        check(vk_grid_export_info(grid, options, i, &info), "vk_grid_export_info");
+        openvdb::GridBase::Ptr g;
+        if (info.value_type == VK_VALUE_BOOL) g = detail::exported_grid<openvdb::BoolGrid>(grid, options, i, info);
+        else if (info.value_type == VK_VALUE_VEC3S) g = detail::exported_grid<openvdb::Vec3SGrid>(grid, options, i, info);
+        else g = detail::exported_grid<openvdb::FloatGrid>(grid, options, i, info);
+        g->setName(info.name);
+        if (info.grid_class == VK_CLASS_FOG_VOLUME) g->setGridClass(openvdb::GRID_FOG_VOLUME);
+        if (info.grid_class == VK_CLASS_LEVEL_SET) g->setGridClass(openvdb::GRID_LEVEL_SET);
+        if (info.vector_type == VK_VECTOR_COVARIANT_NORMALIZE) g->setVectorType(openvdb::VEC_COVARIANT_NORMALIZE);
+        if (info.vector_type == VK_VECTOR_INVARIANT) g->setVectorType(openvdb::VEC_INVARIANT);
         g->setTransform(detail::transform_of(grid));
         detail::add_metadata(grid, *g);
+        out.push_back(g);
     }
     return out;
 }

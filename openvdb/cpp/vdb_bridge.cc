@@ -1,9 +1,11 @@
-// OpenVDB side of the bridge, for voxelkit's tests and benchmarks: reads .vdb files into bulk leaf
-// arrays (an independent check of voxelkit's own reader and writer) and runs OpenVDB's own tools
-// (levelSetVolume, mesh conversions). Every exception becomes a Rust Err through cxx (see the
-// trycatch override in trycatch.h).
+// OpenVDB side of the bridge: reads .vdb files into bulk leaf arrays (an independent check of
+// voxelkit's own reader and writer), builds OpenVDB grids from voxelkit's arrays and writes them
+// with OpenVDB's own io::File, and runs OpenVDB's own tools (levelSetVolume, mesh conversions).
+// Every exception becomes a Rust Err through cxx (see the trycatch override in trycatch.h).
 #include "voxelkit-openvdb/cpp/vdb_bridge.h"
 #include "voxelkit-openvdb/src/bridge.rs.h"
+
+#include <voxelkit/openvdb.hpp>
 
 #include <openvdb/tools/LevelSetMeasure.h>
 #include <openvdb/tools/LevelSetUtil.h>
@@ -42,38 +44,44 @@ void free_nodes(const openvdb::GridPtrVec& grids) noexcept {
 
 }  // namespace
 
-VdbFile::~VdbFile() {
+GridSet::~GridSet() {
     if (grids_) free_nodes(*grids_);
 }
 
-double openvdb_level_set_volume(rust::Str path, rust::Str name) {
-    ensure_initialized();
-    openvdb::io::File file{std::string(path)};
-    file.open(/*delayLoad=*/false);
-    auto base = file.readGrid(std::string(name));
-    file.close();
-    auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
-    if (!grid) throw std::invalid_argument("grid " + std::string(name) + " is not a FloatGrid");
-    return openvdb::tools::levelSetVolume(*grid);
+double openvdb_level_set_volume(rust::Str path, rust::Str name) { return open_vdb(path)->level_set_volume(name); }
+
+double GridSet::level_set_volume(rust::Str name) const {
+    for (const auto& base : *grids_) {
+        if (base->getName() != std::string(name)) continue;
+        auto grid = openvdb::gridConstPtrCast<openvdb::FloatGrid>(base);
+        if (!grid) throw std::invalid_argument("grid " + std::string(name) + " is not a FloatGrid");
+        return openvdb::tools::levelSetVolume(*grid);
+    }
+    throw std::invalid_argument("no grid named " + std::string(name));
 }
 
-std::unique_ptr<VdbFile> open_vdb(rust::Str path) {
+std::unique_ptr<GridSet> open_vdb(rust::Str path) {
     ensure_initialized();
     openvdb::io::File file{std::string(path)};
     file.open(/*delayLoad=*/false);  // read now: delayed loading trusts the file's per-leaf metadata
     auto grids = file.getGrids();
     file.close();
-    return std::make_unique<VdbFile>(grids);
+    return std::make_unique<GridSet>(grids);
 }
 
-size_t VdbFile::grid_count() const { return grids_->size(); }
+std::unique_ptr<GridSet> new_grid_set() {
+    ensure_initialized();
+    return std::make_unique<GridSet>(std::make_shared<openvdb::GridPtrVec>());
+}
 
-openvdb::GridBase::ConstPtr VdbFile::grid(size_t index) const {
+size_t GridSet::grid_count() const { return grids_->size(); }
+
+openvdb::GridBase::ConstPtr GridSet::grid(size_t index) const {
     if (index >= grids_->size()) throw std::out_of_range("grid index out of range");
     return (*grids_)[index];
 }
 
-GridInfo VdbFile::grid_info(size_t index) const {
+GridInfo GridSet::grid_info(size_t index) const {
     auto g = grid(index);
     GridInfo info;
     info.name = g->getName();
@@ -164,7 +172,7 @@ void copy_leaves(const GridT& src, rust::Vec<int32_t>& origins, rust::Vec<uint64
 }
 }  // namespace
 
-void VdbFile::read_leaves(size_t index, rust::Vec<int32_t>& leaf_origins, rust::Vec<uint64_t>& masks,
+void GridSet::read_leaves(size_t index, rust::Vec<int32_t>& leaf_origins, rust::Vec<uint64_t>& masks,
                           rust::Vec<float>& values, rust::Vec<int32_t>& tiles) const {
     auto g = grid(index);
     if (auto b = openvdb::gridConstPtrCast<openvdb::BoolGrid>(g)) copy_leaves(*b, leaf_origins, masks, nullptr, tiles);
@@ -176,6 +184,50 @@ void VdbFile::read_leaves(size_t index, rust::Vec<int32_t>& leaf_origins, rust::
         copy_leaves(*v, leaf_origins, masks, &values, tiles);
     else throw std::invalid_argument("grid '" + g->getName() + "' has value type " + g->valueType() +
                                      "; only bool, mask, float and vec3s grids can be read");
+}
+
+namespace {
+// The grid of the arrays, built as the C++ header voxelkit installs builds it.
+template <typename GridT>
+openvdb::GridBase::Ptr build_grid(const GridArrays& a, size_t components) {
+    const size_t leaves = a.leaf_origins.size() / 3;
+    if (a.masks.size() != 8 * leaves || a.values.size() != 512 * components * leaves || a.tiles.size() % 4 != 0)
+        throw std::invalid_argument("grid " + std::string(a.name) + ": the arrays' lengths disagree");
+    return vk::detail::grid_from_arrays<GridT>(a.background, leaves, a.leaf_origins.data(), a.masks.data(),
+                                               a.values.data(), a.tiles.size() / 4, a.tiles.data(), a.tiles_active,
+                                               a.tile_value);
+}
+}  // namespace
+
+void GridSet::add_grid(const GridArrays& a) {
+    const std::string type(a.value_type);
+    openvdb::GridBase::Ptr grid;
+    if (type == "float") grid = build_grid<openvdb::FloatGrid>(a, 1);
+    else if (type == "vec3s") grid = build_grid<openvdb::Vec3SGrid>(a, 3);
+    else if (type == "bool") grid = build_grid<openvdb::BoolGrid>(a, 0);
+    else throw std::invalid_argument("grid " + std::string(a.name) + ": value type " + type + " is not bool, float or vec3s");
+    grid->setName(std::string(a.name));
+    auto xform = openvdb::math::Transform::createLinearTransform(a.voxel_size);
+    xform->postTranslate(openvdb::Vec3d(a.origin[0], a.origin[1], a.origin[2]));
+    grid->setTransform(xform);
+    if (!a.grid_class.empty()) grid->setGridClass(openvdb::GridBase::stringToGridClass(std::string(a.grid_class)));
+    if (!a.vector_type.empty()) grid->setVectorType(openvdb::GridBase::stringToVecType(std::string(a.vector_type)));
+    for (const auto& m : a.metadata) {
+        const std::string key(m.key);
+        const std::string kind(m.kind);
+        if (kind == "string") grid->insertMeta(key, openvdb::StringMetadata(std::string(m.text)));
+        else if (kind == "int64") grid->insertMeta(key, openvdb::Int64Metadata(m.integer));
+        else grid->insertMeta(key, openvdb::DoubleMetadata(m.real));
+    }
+    grids_->push_back(grid);
+}
+
+void GridSet::write(rust::Str path, uint32_t compression, bool half) const {
+    for (const auto& g : *grids_) g->setSaveFloatAsHalf(half);
+    openvdb::io::File file{std::string(path)};
+    file.setCompression(compression | openvdb::io::COMPRESS_ACTIVE_MASK);
+    file.write(*grids_);
+    file.close();
 }
 
 uint64_t openvdb_reference(rust::Str kind, rust::Slice<const float> points, rust::Slice<const uint32_t> triangles,

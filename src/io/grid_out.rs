@@ -124,6 +124,54 @@ impl GridValues<'_> {
             _ => [0; 8],
         }
     }
+
+    /// Every value of `leaf` as a reader sees it, one float (or three for vectors) per voxel
+    /// in offset order into `out`: the active values, and at inactive voxels the background
+    /// (minus it inside a level set). Not for bool grids, whose leaves hold their mask alone.
+    pub(super) fn dense_values(self, leaf: &Leaf, out: &mut [f32]) {
+        let components = match self.value_type() {
+            ValueType::Vec3 => 3,
+            _ => 1,
+        };
+        let background = self.background();
+        let inside = self.inside(leaf.origin);
+        for (n, voxel) in out.chunks_exact_mut(components).enumerate() {
+            let v = if inside[n / 64] >> (n % 64) & 1 == 1 {
+                -background
+            } else {
+                background
+            };
+            voxel.fill(v);
+        }
+        let mut offsets = leaf.offsets();
+        let mut at = 0;
+        let mut component = components;
+        self.for_each_active(leaf, |v| {
+            if component == components {
+                at = offsets.next().expect("one value per active voxel") * components;
+                component = 0;
+            }
+            out[at + component] = v;
+            component += 1;
+        });
+    }
+}
+
+/// The origin of the node or tile at `key`: its root child's, plus its 128^3 slot, plus (for
+/// an 8^3 block, `leaf_level`) its 8^3 slot.
+pub(super) fn block_origin(key: &Key, leaf_level: bool) -> [i32; 3] {
+    let slot = |n: u16, log2: u32, shift: u32| {
+        let side = 1u16 << log2;
+        let c = [n >> (2 * log2), (n >> log2) & (side - 1), n & (side - 1)];
+        c.map(|v| i32::from(v) << shift)
+    };
+    let upper = slot(key.1, NODE_LOG2[0], CHILD_LOG2[0]);
+    let lower = if leaf_level {
+        slot(key.2, NODE_LOG2[1], CHILD_LOG2[1])
+    } else {
+        [0; 3]
+    };
+    [0, 1, 2].map(|a| key.0[a] + upper[a] + lower[a])
 }
 
 /// One grid to write.

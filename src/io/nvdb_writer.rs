@@ -16,7 +16,7 @@
 //! A grid is built whole in memory (counted by the memory plan first), its nodes filled in
 //! parallel; grids are written one after another and the header last.
 
-use super::grid_out::{Entry, GridOut, GridValues, Key, ValueType, tree_entries};
+use super::grid_out::{Entry, GridOut, GridValues, Key, ValueType, block_origin, tree_entries};
 use super::vdb_format::{FOG_VOLUME, LEVEL_SET};
 use crate::error::{Error, Result};
 use crate::grid::{LEAF_VOXELS, Leaf};
@@ -244,42 +244,19 @@ fn fill_leaf(
             }
         }
         value_type => {
-            let background = values.background();
-            let inside = values.inside(leaf.origin);
-            for n in 0..LEAF_VOXELS {
-                let v = if inside[n / 64] >> (n % 64) & 1 == 1 {
-                    -background
-                } else {
-                    background
-                };
-                put_value(
-                    buf,
-                    sizes.leaf_values + n * sizes.value,
-                    value_type,
-                    &[v; 3],
-                );
+            let components = if value_type == ValueType::Vec3 { 3 } else { 1 };
+            let mut dense = [0f32; 3 * LEAF_VOXELS];
+            let dense = &mut dense[..components * LEAF_VOXELS];
+            values.dense_values(leaf, dense);
+            for (n, v) in dense.chunks_exact(components).enumerate() {
+                put_value(buf, sizes.leaf_values + n * sizes.value, value_type, v);
             }
-            let mut offsets = leaf.offsets();
-            let mut vector = [0f32; 3];
-            let mut component = 0;
-            values.for_each_active(leaf, |v| {
-                vector[component] = v;
-                component += 1;
-                if component == 3 || value_type == ValueType::Float {
-                    let n = offsets.next().expect("one value per active voxel");
-                    put_value(
-                        buf,
-                        sizes.leaf_values + n * sizes.value,
-                        value_type,
-                        &vector,
-                    );
-                    if value_type == ValueType::Float {
-                        span.low = span.low.min(v);
-                        span.high = span.high.max(v);
-                    }
-                    component = 0;
+            if value_type == ValueType::Float {
+                for n in leaf.offsets() {
+                    span.low = span.low.min(dense[n]);
+                    span.high = span.high.max(dense[n]);
                 }
-            });
+            }
         }
     }
     put_coord(buf, 0, span.min);
@@ -300,21 +277,11 @@ fn slot(key: &Key, upper: bool) -> usize {
     }
 }
 
-/// The origin of the slot `n` of an internal node at `origin` whose slots are `edge` voxels
-/// wide and `log2` to a side.
-fn slot_origin(origin: [i32; 3], n: usize, log2: u32, edge: i32) -> [i32; 3] {
-    let side = 1usize << log2;
-    let c = [n / (side * side), (n / side) % side, n % side];
-    [0, 1, 2].map(|a| origin[a] + c[a] as i32 * edge)
-}
-
-/// Fills an internal node at `origin` (`upper`: a 4096^3 one) from its entries: its children
+/// Fills an internal node (`upper`: a 4096^3 one) from its entries: its children
 /// at `children` (index of the first, byte offset of each from this node, their spans) and
 /// its tiles. Returns what it spans and its active tile count.
-#[allow(clippy::too_many_arguments)]
 fn fill_internal(
     buf: &mut [u8],
-    origin: [i32; 3],
     upper: bool,
     entries: &[(Key, Entry)],
     child_offsets: &mut dyn Iterator<Item = (i64, Span)>,
@@ -353,11 +320,7 @@ fn fill_internal(
             if values.active_tiles() {
                 set_bit(buf, value_mask, n);
                 active_tiles += 1;
-                span = span.add(&Span::block(
-                    slot_origin(origin, n, log2, child_edge),
-                    child_edge,
-                    v,
-                ));
+                span = span.add(&Span::block(block_origin(key, !upper), child_edge, v));
             }
         } else if last_slot != Some(n) {
             last_slot = Some(n);
@@ -447,18 +410,7 @@ fn build(path: &Path, g: &GridOut) -> Result<GridBuffer> {
             let here = lower_at + i * sizes.lower;
             let mut children =
                 (first..).map(|l| ((leaf_at + l * sizes.leaf - here) as i64, leaf_spans[l]));
-            let (key, _) = node[0];
-            let origin = slot_origin(key.0, key.1 as usize, 5, LOWER_EDGE);
-            fill_internal(
-                buf,
-                origin,
-                false,
-                node,
-                &mut children,
-                g.values,
-                sizes,
-                delta,
-            )
+            fill_internal(buf, false, node, &mut children, g.values, sizes, delta)
         })
         .collect();
     let mut first_lower = 0;
@@ -473,7 +425,6 @@ fn build(path: &Path, g: &GridOut) -> Result<GridBuffer> {
             .count();
         upper_spans.push(fill_internal(
             buf,
-            node[0].0.0,
             true,
             node,
             &mut children,

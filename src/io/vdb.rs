@@ -8,11 +8,12 @@
 //! NanoVDB's layout (`nvdb_writer`). Writes are atomic (temporary file, then rename).
 
 use super::atomic::write_atomic;
+use super::grid_export::{ExportedGrid, export_grid};
 use super::grid_out::{GridOut, GridValues};
 use super::nvdb_writer::write_nvdb_grids;
 use super::vdb_format::{COVARIANT_NORMALIZE, FOG_VOLUME, LEVEL_SET};
 pub use super::vdb_format::{Compression, MetaValue};
-use super::vdb_writer::{Encoding, compression_flags, write_grids};
+use super::vdb_writer::{Encoding, write_grids};
 use crate::error::{Error, Result};
 use crate::grid::{Channels, LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use glam::DVec3;
@@ -75,55 +76,201 @@ pub fn write_vdb(path: &Path, grid: &SparseGrid, metadata: &[(&str, MetaValue)])
 pub fn write_vdb_as(
     path: &Path,
     grid: &SparseGrid,
-    masks_to_add: &[(&str, &SparseGrid)],
+    masks: &[(&str, &SparseGrid)],
     metadata: &[(&str, MetaValue)],
     options: &WriteOptions,
 ) -> Result<()> {
-    check_voxel_size(path, grid.transform.voxel_size)?;
+    let contents = Contents::Voxels {
+        grid,
+        masks: masks.to_vec(),
+    };
+    write_contents(path, &contents, metadata, options)
+}
+
+/// What a write holds: a voxel set with bool grids beside it, or a band of distances.
+pub enum Contents<'a> {
+    /// `density` (and `voxels`), `normal` and `Cd` when the grid has them, then one bool
+    /// grid per `(name, mask)`.
+    Voxels {
+        grid: &'a SparseGrid,
+        masks: Vec<(&'a str, &'a SparseGrid)>,
+    },
+    /// Distances in world units on the grid's voxels, `background` elsewhere. With its
+    /// `interior`, signed distances: the fog volume `density` and the LEVEL_SET grid `surface`
+    /// (Houdini's name) whose inactive voxels and tiles in the interior are -background;
+    /// without, unsigned distances: a FloatGrid `distance`.
+    Distances {
+        grid: &'a SparseGrid,
+        background: f32,
+        interior: Option<&'a SparseGrid>,
+    },
+}
+
+/// Writes `contents` to `path` (`.vdb` or `.nvdb`), every grid with `metadata` plus
+/// `voxelkit_version`, as `options` say, atomically.
+pub fn write_contents(
+    path: &Path,
+    contents: &Contents,
+    metadata: &[(&str, MetaValue)],
+    options: &WriteOptions,
+) -> Result<()> {
     let meta = meta_entries(metadata);
+    let grids = chosen(path, candidates(path, contents, &meta, options)?, options)?;
+    if is_nvdb(path) {
+        if options.half {
+            return Err(Error::InvalidArgument(format!(
+                "{}: half precision is written to .vdb only; a .nvdb holds 32-bit floats",
+                path.display()
+            )));
+        }
+        return write_atomic(path, |tmp| write_nvdb_grids(tmp, path, &grids));
+    }
+    let encoding = Encoding {
+        compression: options.compression.flags(),
+        half: options.half,
+    };
+    write_atomic(path, |tmp| write_grids(tmp, path, &grids, encoding))
+}
+
+/// The grids a write of `contents` makes (only the one at index `which` when given), as plain
+/// arrays for another library to build its own from (see `grid_export`); errors name `what`,
+/// where they are bound.
+pub fn export_contents(
+    what: &Path,
+    contents: &Contents,
+    metadata: &[(&str, MetaValue)],
+    options: &WriteOptions,
+    which: Option<usize>,
+) -> Result<Vec<ExportedGrid>> {
+    let meta = meta_entries(metadata);
+    let grids = chosen(what, candidates(what, contents, &meta, options)?, options)?;
+    let count = grids.len();
+    let grids = match which {
+        Some(i) => grids.get(i..=i).ok_or_else(|| {
+            Error::InvalidArgument(format!("grid {i} is out of range: the write makes {count}"))
+        })?,
+        None => &grids[..],
+    };
+    grids.iter().map(|g| export_grid(what, g)).collect()
+}
+
+/// How many grids a write of `contents` makes, as `options` choose them.
+pub fn content_grid_count(
+    what: &Path,
+    contents: &Contents,
+    options: &WriteOptions,
+) -> Result<usize> {
+    Ok(chosen(what, candidates(what, contents, &[], options)?, options)?.len())
+}
+
+/// Every grid `contents` can write, before `options` choose among them.
+fn candidates<'g>(
+    path: &Path,
+    contents: &Contents<'g>,
+    meta: &'g [(String, MetaValue)],
+    options: &WriteOptions,
+) -> Result<Vec<GridOut<'g>>> {
     let grid_out = |name, grid, values, class, vector_type| GridOut {
         name,
         grid,
         values,
         class,
         vector_type,
-        metadata: &meta,
+        metadata: meta,
     };
-    let mut candidates = vec![
-        grid_out(
-            DENSITY_GRID,
+    match *contents {
+        Contents::Voxels { grid, ref masks } => {
+            check_voxel_size(path, grid.transform.voxel_size)?;
+            let mut candidates = vec![
+                grid_out(
+                    DENSITY_GRID,
+                    grid,
+                    GridValues::Constant(1.0),
+                    Some(FOG_VOLUME),
+                    None,
+                ),
+                grid_out(VOXELS_GRID, grid, GridValues::Bool, None, None),
+            ];
+            // Normals transform covariantly; colours are plain triples.
+            if grid.channels().normal {
+                candidates.push(grid_out(
+                    NORMAL_GRID,
+                    grid,
+                    GridValues::Normals,
+                    None,
+                    Some(COVARIANT_NORMALIZE),
+                ));
+            }
+            if grid.channels().color {
+                candidates.push(grid_out(
+                    COLOR_GRID,
+                    grid,
+                    GridValues::Colors,
+                    None,
+                    Some("invariant"),
+                ));
+            }
+            for (name, mask) in masks {
+                check_voxel_size(path, mask.transform.voxel_size)?;
+                candidates.push(grid_out(name, mask, GridValues::Bool, None, None));
+            }
+            Ok(candidates)
+        }
+        Contents::Distances {
             grid,
-            GridValues::Constant(1.0),
-            Some(FOG_VOLUME),
-            None,
-        ),
-        grid_out(VOXELS_GRID, grid, GridValues::Bool, None, None),
-    ];
-    if grid.channels().normal {
-        // Normals transform covariantly; colours are plain triples.
-        let normals = grid_out(NORMAL_GRID, grid, GridValues::Normals, None, None);
-        candidates.push(GridOut {
-            vector_type: Some(COVARIANT_NORMALIZE),
-            ..normals
-        });
+            background,
+            interior,
+        } => {
+            check_voxel_size(path, grid.transform.voxel_size)?;
+            if grid.leaves().iter().any(|l| l.value.is_none()) {
+                return Err(vdb_error(path, "a distance band needs distances"));
+            }
+            if options.half {
+                check_half_range(path, grid, background)?;
+            }
+            Ok(match interior {
+                Some(interior) => vec![
+                    // Blender's volume object shows `density`: the fog volume of the same solid.
+                    grid_out(
+                        DENSITY_GRID,
+                        interior,
+                        GridValues::Fog {
+                            band: grid,
+                            background,
+                        },
+                        Some(FOG_VOLUME),
+                        None,
+                    ),
+                    grid_out(
+                        LEVEL_SET_GRID,
+                        grid,
+                        GridValues::LevelSet {
+                            background,
+                            interior,
+                        },
+                        Some(LEVEL_SET),
+                        None,
+                    ),
+                ],
+                None => vec![grid_out(
+                    DISTANCE_GRID,
+                    grid,
+                    GridValues::Distances { background },
+                    None,
+                    None,
+                )],
+            })
+        }
     }
-    if grid.channels().color {
-        let colors = grid_out(COLOR_GRID, grid, GridValues::Colors, None, None);
-        candidates.push(GridOut {
-            vector_type: Some("invariant"),
-            ..colors
-        });
-    }
-    for (name, mask) in masks_to_add {
-        check_voxel_size(path, mask.transform.voxel_size)?;
-        candidates.push(grid_out(name, mask, GridValues::Bool, None, None));
-    }
-    write_chosen(path, candidates, options)
 }
 
-/// Writes the grids of `candidates` that `options` asks for to `path` (`.vdb`, or `.nvdb`),
-/// atomically; a grid asked for that is not among them is an error naming those there are.
-fn write_chosen(path: &Path, mut candidates: Vec<GridOut>, options: &WriteOptions) -> Result<()> {
+/// The grids of `candidates` that `options` asks for; a grid asked for that is not among them
+/// is an error naming those there are.
+fn chosen<'g>(
+    path: &Path,
+    mut candidates: Vec<GridOut<'g>>,
+    options: &WriteOptions,
+) -> Result<Vec<GridOut<'g>>> {
     if let Some(missing) = options
         .grids
         .iter()
@@ -139,20 +286,7 @@ fn write_chosen(path: &Path, mut candidates: Vec<GridOut>, options: &WriteOption
         ));
     }
     candidates.retain(|g| options.wants(g.name));
-    if is_nvdb(path) {
-        if options.half {
-            return Err(Error::InvalidArgument(format!(
-                "{}: half precision is written to .vdb only; a .nvdb holds 32-bit floats",
-                path.display()
-            )));
-        }
-        return write_atomic(path, |tmp| write_nvdb_grids(tmp, path, &candidates));
-    }
-    let encoding = Encoding {
-        compression: compression_flags(options.compression),
-        half: options.half,
-    };
-    write_atomic(path, |tmp| write_grids(tmp, path, &candidates, encoding))
+    Ok(candidates)
 }
 
 /// Whether `path` names a NanoVDB file (`.nvdb`): the same grids in NanoVDB's layout,
@@ -195,10 +329,8 @@ pub fn meta_entries(metadata: &[(&str, MetaValue)]) -> Vec<(String, MetaValue)> 
 }
 
 /// Writes the value channel of `grid` (distances in world units on its active voxels) as a
-/// narrow band with `background` outside it, atomically, with `metadata`. With its
-/// `interior`, signed distances: a LEVEL_SET FloatGrid `surface` (Houdini's name) whose
-/// inactive voxels and tiles in the interior are -background, after its fog volume
-/// `density`; without, unsigned distances: a FloatGrid `distance`.
+/// narrow band with `background` outside it, atomically, with `metadata` (see
+/// `Contents::Distances`).
 pub fn write_distance_band(
     path: &Path,
     grid: &SparseGrid,
@@ -207,52 +339,12 @@ pub fn write_distance_band(
     metadata: &[(&str, MetaValue)],
     options: &WriteOptions,
 ) -> Result<()> {
-    check_voxel_size(path, grid.transform.voxel_size)?;
-    if grid.leaves().iter().any(|l| l.value.is_none()) {
-        return Err(vdb_error(path, "a distance band needs distances"));
-    }
-    if options.half {
-        check_half_range(path, grid, background)?;
-    }
-    let meta = meta_entries(metadata);
-    let grid_out = |name, grid, values, class| GridOut {
-        name,
+    let contents = Contents::Distances {
         grid,
-        values,
-        class,
-        vector_type: None,
-        metadata: &meta,
+        background,
+        interior,
     };
-    let grids = match interior {
-        Some(interior) => vec![
-            // Blender's volume object shows `density`: the fog volume of the same solid.
-            grid_out(
-                DENSITY_GRID,
-                interior,
-                GridValues::Fog {
-                    band: grid,
-                    background,
-                },
-                Some(FOG_VOLUME),
-            ),
-            grid_out(
-                LEVEL_SET_GRID,
-                grid,
-                GridValues::LevelSet {
-                    background,
-                    interior,
-                },
-                Some(LEVEL_SET),
-            ),
-        ],
-        None => vec![grid_out(
-            DISTANCE_GRID,
-            grid,
-            GridValues::Distances { background },
-            None,
-        )],
-    };
-    write_chosen(path, grids, options)
+    write_contents(path, &contents, metadata, options)
 }
 
 /// Refuses half precision for distances beyond its range (65504), which it would store as

@@ -69,6 +69,17 @@ pub enum Compression {
     None,
 }
 
+impl Compression {
+    /// OpenVDB's `COMPRESS_*` flags for it (the active-value masks, always on, aside).
+    pub fn flags(self) -> u32 {
+        match self {
+            Compression::Blosc => COMPRESS_BLOSC,
+            Compression::Zip => COMPRESS_ZIP,
+            Compression::None => 0,
+        }
+    }
+}
+
 crate::named_choices! {
     Compression, "the compression":
     "blosc" => Blosc,

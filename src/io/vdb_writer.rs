@@ -9,10 +9,7 @@
 
 use super::grid_out::{Entry, GridOut, GridValues, Key, ValueType, tree_entries};
 use super::vdb_chunks::{compression_name, push_chunk};
-use super::vdb_format::{
-    COMPRESS_ACTIVE_MASK, COMPRESS_BLOSC, COMPRESS_ZIP, FILE_VERSION, LIBRARY_VERSION, MAGIC,
-    tree_type,
-};
+use super::vdb_format::{COMPRESS_ACTIVE_MASK, FILE_VERSION, LIBRARY_VERSION, MAGIC, tree_type};
 use super::vdb_tree_structure::{TreeFormat, tree_memory};
 use crate::error::{Error, Result};
 use crate::grid::{LEAF_VOXELS, Leaf, Transform};
@@ -474,15 +471,5 @@ fn push_transform(out: &mut Vec<u8>, t: Transform) {
     for v in vectors {
         v.iter()
             .for_each(|c| out.extend_from_slice(&c.to_le_bytes()));
-    }
-}
-
-/// The compression flags of `compression`.
-pub(super) fn compression_flags(compression: super::vdb_format::Compression) -> u32 {
-    use super::vdb_format::Compression;
-    match compression {
-        Compression::Blosc => COMPRESS_BLOSC,
-        Compression::Zip => COMPRESS_ZIP,
-        Compression::None => 0,
     }
 }

@@ -12,8 +12,10 @@ use crate::implicit::Formula;
 use crate::io::atomic::check_output;
 use crate::io::binvox::write_binvox;
 use crate::io::brick_set::{BrickSet, is_brick_set};
+use crate::io::grid_export::ExportedGrid;
 use crate::io::vdb::{
-    MetaValue, WriteOptions, is_nvdb, read_vdb_grid, write_distance_band, write_vdb_as,
+    Contents, MetaValue, WriteOptions, content_grid_count, export_contents, is_nvdb, read_vdb_grid,
+    write_contents,
 };
 use crate::io::vox::write_vox;
 use crate::mesh::{GridFit, Mesh};
@@ -54,6 +56,11 @@ pub struct Outcome {
 pub struct Distances {
     pub background: f32,
     pub interior: Option<SparseGrid>,
+}
+
+/// What errors of an export name.
+fn exported() -> &'static Path {
+    Path::new("the exported grids")
 }
 
 /// Output formats by extension; `-` is standard output (as `.vdb`).
@@ -290,24 +297,8 @@ impl Outcome {
             }
             return Ok(());
         }
-        let meta: Vec<(&str, MetaValue)> = self
-            .metadata
-            .iter()
-            .map(|(k, v)| (k.as_str(), v.clone()))
-            .collect();
-        let extra: Vec<(&str, &SparseGrid)> =
-            self.extra.iter().map(|(n, g)| (n.as_str(), g)).collect();
-        let write = |file: &Path| match &self.distances {
-            Some(d) => write_distance_band(
-                file,
-                &self.grid,
-                d.background,
-                d.interior.as_ref(),
-                &meta,
-                options,
-            ),
-            None => write_vdb_as(file, &self.grid, &extra, &meta, options),
-        };
+        let meta = self.metadata_entries();
+        let write = |file: &Path| write_contents(file, &self.contents(), &meta, options);
         // The writer encodes in parallel: on the job's threads, as the work was.
         on_threads(self.threads, || {
             if path == Path::new("-") {
@@ -316,6 +307,49 @@ impl Outcome {
                 write(path)
             }
         })
+    }
+}
+
+impl Outcome {
+    /// What the outcome writes: its voxel set and the bool grids beside it, or its distances.
+    pub fn contents(&self) -> Contents<'_> {
+        match &self.distances {
+            Some(d) => Contents::Distances {
+                grid: &self.grid,
+                background: d.background,
+                interior: d.interior.as_ref(),
+            },
+            None => Contents::Voxels {
+                grid: &self.grid,
+                masks: self.extra.iter().map(|(n, g)| (n.as_str(), g)).collect(),
+            },
+        }
+    }
+
+    fn metadata_entries(&self) -> Vec<(&str, MetaValue)> {
+        self.metadata
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.clone()))
+            .collect()
+    }
+
+    /// The grids `write` puts in a `.vdb` (as `options` choose them; only the one at index
+    /// `which` when given), as plain arrays for another library to build its own grids from
+    /// (the OpenVDB bridge, voxelkit-openvdb; the C interface's `vk_grid_export_*`).
+    pub fn export_grids(
+        &self,
+        options: &WriteOptions,
+        which: Option<usize>,
+    ) -> Result<Vec<ExportedGrid>> {
+        let meta = self.metadata_entries();
+        on_threads(self.threads, || {
+            export_contents(exported(), &self.contents(), &meta, options, which)
+        })
+    }
+
+    /// How many grids `export_grids` gives.
+    pub fn export_grid_count(&self, options: &WriteOptions) -> Result<usize> {
+        content_grid_count(exported(), &self.contents(), options)
     }
 }
 

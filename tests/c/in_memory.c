@@ -4,7 +4,7 @@
  * leaves and tiles. Run (under valgrind) by tests/capi.rs; prints "ok" when every check
  * holds.
  *
- *   in_memory LEVEL_SET.vdb
+ *   in_memory LEVEL_SET.vdb [LEVEL_SET.nvdb]
  */
 #include <voxelkit.h>
 
@@ -14,6 +14,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* A closed box [0, 1] x [0, 1] x [0, 2] as 12 triangles, outward. */
 static vk_mesh *box(void) {
@@ -115,6 +116,37 @@ static void check_rebuilt(const vk_grid *solid) {
     free(edges);
 }
 
+/* The grids a write makes, as arrays: the level set's fog `density`, then `surface` with its
+ * interior as inactive tiles at minus the background and every leaf value within it. */
+static void check_export(const vk_grid *sdf) {
+    size_t count = 0;
+    OK(vk_grid_export_count(sdf, NULL, &count));
+    CHECK(count == 2);
+    vk_export_info info;
+    OK(vk_grid_export_info(sdf, NULL, 0, &info));
+    CHECK(strcmp(info.name, "density") == 0 && info.grid_class == VK_CLASS_FOG_VOLUME);
+    OK(vk_grid_export_info(sdf, NULL, 1, &info));
+    CHECK(strcmp(info.name, "surface") == 0 && info.grid_class == VK_CLASS_LEVEL_SET);
+    CHECK(info.value_type == VK_VALUE_FLOAT && info.leaf_count > 0);
+    CHECK(!info.tiles_active && info.tile_value == -info.background);
+    int32_t *origins = malloc(3 * info.leaf_count * sizeof *origins);
+    uint64_t *masks = malloc(8 * info.leaf_count * sizeof *masks);
+    float *values = malloc(512 * info.leaf_count * sizeof *values);
+    int32_t *tiles = malloc((4 * info.tile_count + 1) * sizeof *tiles);
+    OK(vk_grid_export_arrays(sdf, NULL, 1, origins, masks, values, tiles));
+    size_t negative = 0;
+    for (size_t n = 0; n < 512 * info.leaf_count; n++) {
+        CHECK(fabsf(values[n]) <= info.background);
+        negative += values[n] < 0;
+    }
+    CHECK(negative > 0);
+    CHECK(vk_grid_export_info(sdf, NULL, 2, &info) == VK_ERROR_INVALID_ARGUMENT);
+    free(origins);
+    free(masks);
+    free(values);
+    free(tiles);
+}
+
 int main(int argc, char **argv) {
     if (argc != 2 && argc != 3) {
         fprintf(stderr, "usage: in_memory LEVEL_SET.vdb [LEVEL_SET.nvdb]\n");
@@ -129,6 +161,7 @@ int main(int argc, char **argv) {
     vk_grid *sdf = NULL, *filled = NULL, *solid = NULL, *carved = NULL;
     OK(vk_voxelize_mesh(m, opts, &sdf));
     check_level_set(sdf);
+    check_export(sdf);
     OK(vk_grid_write_vdb(sdf, argv[1]));
     if (argc == 3) {
         OK(vk_grid_write_vdb(sdf, argv[2]));

@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
     vk::check(vk_options_set_resolution(options, uint32_t(std::atoi(argv[2]))), "vk_options_set_resolution");
     vk::check(vk_options_set_sdf(options, 3.0), "vk_options_set_sdf");
     vk::check(vk_voxelize_mesh(mesh, options, &grid), "vk_voxelize_mesh");
-    auto surface = openvdb::gridPtrCast<openvdb::FloatGrid>(vk::to_openvdb(grid).front());
+    auto surface = openvdb::gridPtrCast<openvdb::FloatGrid>(openvdb::findGridByName(vk::to_openvdb(grid), "surface"));
     std::vector<openvdb::Vec3s> points;
     std::vector<openvdb::Vec4I> quads;
     openvdb::tools::volumeToMesh(*surface, points, quads, 0.0);
