@@ -51,7 +51,11 @@ impl StageTime {
         (start, cpu): (Instant, f64),
         (end, cpu_end): (Instant, f64),
     ) -> StageTime {
-        let seconds = end.duration_since(start).as_secs_f64();
+        StageTime::of(name, end.duration_since(start).as_secs_f64(), cpu_end - cpu)
+    }
+
+    /// The stage `name` of `seconds` in which the process used `cpu` CPU seconds.
+    fn of(name: &str, seconds: f64, cpu: f64) -> StageTime {
         // The kernel brings other running threads' CPU time up to date only at its ticks, so a
         // stage shorter than a tick can seem to use more threads than the process may run on.
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
@@ -59,7 +63,7 @@ impl StageTime {
             stage: name.to_string(),
             seconds,
             threads_busy: if seconds > 0.0 {
-                ((cpu_end - cpu) / seconds).clamp(0.0, cores)
+                (cpu / seconds).clamp(0.0, cores)
             } else {
                 0.0
             },
@@ -75,6 +79,38 @@ impl StageTime {
     /// This moment and the process's CPU seconds.
     pub fn now() -> (Instant, f64) {
         (Instant::now(), cpu_seconds())
+    }
+}
+
+/// One stage's time summed over several spans (a write encodes and writes grid by grid).
+pub struct StageClock {
+    name: &'static str,
+    seconds: f64,
+    cpu: f64,
+}
+
+impl StageClock {
+    pub fn new(name: &'static str) -> StageClock {
+        StageClock {
+            name,
+            seconds: 0.0,
+            cpu: 0.0,
+        }
+    }
+
+    /// Runs `work`, adding its time to the stage's.
+    pub fn time<T>(&mut self, work: impl FnOnce() -> T) -> T {
+        let (start, cpu) = StageTime::now();
+        let done = work();
+        let (end, cpu_end) = StageTime::now();
+        self.seconds += end.duration_since(start).as_secs_f64();
+        self.cpu += cpu_end - cpu;
+        done
+    }
+
+    /// The time summed so far.
+    pub fn stage(&self) -> StageTime {
+        StageTime::of(self.name, self.seconds, self.cpu)
     }
 }
 

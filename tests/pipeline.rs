@@ -386,7 +386,12 @@ fn the_report_says_where_the_time_went_stage_by_stage() {
         .unwrap();
     let report = &outcome.report;
     let names: Vec<&str> = report.stages.iter().map(|s| s.stage.as_str()).collect();
-    assert_eq!(names, ["read", "plan", "surface", "filling", "write"]);
+    assert_eq!(
+        names,
+        [
+            "read", "plan", "surface", "filling", "encode", "write", "fsync"
+        ]
+    );
     // The stages before the write cover the run, one after another.
     let run: f64 = report.stages[..4].iter().map(|s| s.seconds).sum();
     assert!(

@@ -11,6 +11,7 @@
 //! temporary files of writes in progress when SIGINT, SIGTERM or SIGHUP ends it.
 
 use crate::error::{Error, Result};
+use crate::progress::StageClock;
 use std::ffi::CString;
 use std::io::ErrorKind;
 use std::os::unix::ffi::OsStrExt;
@@ -20,10 +21,21 @@ use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicU64, Ordering};
 /// Runs `write(temp)`, checks and syncs `temp`, and renames it to the resolved `path`;
 /// removes `temp` on any failure.
 pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    write_atomic_timed(path, &mut StageClock::new("fsync"), write)
+}
+
+/// `write_atomic`, timing the sync on `fsync`.
+pub fn write_atomic_timed(
+    path: &Path,
+    fsync: &mut StageClock,
+    write: impl FnOnce(&Path) -> Result<()>,
+) -> Result<()> {
     let target = resolve_target(path)?;
     let temp = Temporary::new(&target)?;
     write(&temp.path)?;
-    sync_file(&temp.path).map_err(|e| Error::io(path, e))?;
+    fsync
+        .time(|| sync_file(&temp.path))
+        .map_err(|e| Error::io(path, e))?;
     std::fs::rename(&temp.path, &target).map_err(|e| Error::io(path, e))?;
     temp.disarm();
     // Make the rename itself durable; a file system that cannot sync a directory still

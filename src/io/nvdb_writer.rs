@@ -17,6 +17,7 @@
 //! parallel; grids are written one after another and the header last.
 
 use super::grid_out::{Entry, GridOut, GridValues, Key, ValueType, block_origin, tree_entries};
+use super::vdb::WriteClocks;
 use super::vdb_format::{FOG_VOLUME, LEVEL_SET};
 use crate::error::{Error, Result};
 use crate::grid::{LEAF_VOXELS, Leaf};
@@ -628,7 +629,12 @@ fn grid_meta(name: &str, g: &GridBuffer, voxel_size: f64, origin: [f64; 3]) -> V
 
 /// Writes `grids` to the new file `file` as one NanoVDB segment; errors name `path`, the
 /// output it becomes.
-pub(super) fn write_nvdb_grids(file: &Path, path: &Path, grids: &[GridOut]) -> Result<()> {
+pub(super) fn write_nvdb_grids(
+    file: &Path,
+    path: &Path,
+    grids: &[GridOut],
+    clocks: &mut WriteClocks,
+) -> Result<()> {
     let io_error = |e| Error::io(path, e);
     let mut out =
         std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(file).map_err(io_error)?);
@@ -645,8 +651,11 @@ pub(super) fn write_nvdb_grids(file: &Path, path: &Path, grids: &[GridOut]) -> R
     index.extend_from_slice(&(grids.len() as u16).to_le_bytes());
     index.extend_from_slice(&0u16.to_le_bytes()); // codec NONE
     for g in grids {
-        let buffer = build(path, g)?;
-        out.write_all(&buffer.bytes).map_err(io_error)?;
+        let buffer = clocks.encode.time(|| build(path, g))?;
+        clocks
+            .write
+            .time(|| out.write_all(&buffer.bytes))
+            .map_err(io_error)?;
         let t = g.grid.transform;
         index.extend(grid_meta(
             g.name,
@@ -655,9 +664,14 @@ pub(super) fn write_nvdb_grids(file: &Path, path: &Path, grids: &[GridOut]) -> R
             t.origin.to_array(),
         ));
     }
-    out.seek(SeekFrom::Start(0)).map_err(io_error)?;
-    out.write_all(&index).map_err(io_error)?;
-    out.flush().map_err(io_error)
+    clocks
+        .write
+        .time(|| {
+            out.seek(SeekFrom::Start(0))?;
+            out.write_all(&index)?;
+            out.flush()
+        })
+        .map_err(io_error)
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@
 //! Bool, Mask or Float grid reads back, tiles as tiles. The same grids go to a `.nvdb` in
 //! NanoVDB's layout (`nvdb_writer`). Writes are atomic (temporary file, then rename).
 
-use super::atomic::write_atomic;
+use super::atomic::write_atomic_timed;
 use super::grid_export::{ExportedGrid, export_grid};
 use super::grid_out::{GridOut, GridValues};
 use super::nvdb_writer::write_nvdb_grids;
@@ -16,6 +16,7 @@ pub use super::vdb_format::{Compression, MetaValue};
 use super::vdb_writer::{Encoding, write_grids};
 use crate::error::{Error, Result};
 use crate::grid::{Channels, LEAF_VOXELS, Leaf, SparseGrid, Transform};
+use crate::progress::{StageClock, StageTime};
 use glam::DVec3;
 use std::path::Path;
 
@@ -114,8 +115,24 @@ pub fn write_contents(
     metadata: &[(&str, MetaValue)],
     options: &WriteOptions,
 ) -> Result<()> {
+    write_contents_timed(path, contents, metadata, options).map(|_| ())
+}
+
+/// `write_contents`, returning where its time went: encoding the grids, writing the bytes,
+/// syncing the file.
+pub fn write_contents_timed(
+    path: &Path,
+    contents: &Contents,
+    metadata: &[(&str, MetaValue)],
+    options: &WriteOptions,
+) -> Result<[StageTime; 3]> {
     let meta = meta_entries(metadata);
     let grids = chosen(path, candidates(path, contents, &meta, options)?, options)?;
+    let mut clocks = WriteClocks {
+        encode: StageClock::new("encode"),
+        write: StageClock::new("write"),
+    };
+    let mut fsync = StageClock::new("fsync");
     if is_nvdb(path) {
         if options.half {
             return Err(Error::InvalidArgument(format!(
@@ -123,13 +140,25 @@ pub fn write_contents(
                 path.display()
             )));
         }
-        return write_atomic(path, |tmp| write_nvdb_grids(tmp, path, &grids));
+        write_atomic_timed(path, &mut fsync, |tmp| {
+            write_nvdb_grids(tmp, path, &grids, &mut clocks)
+        })?;
+    } else {
+        let encoding = Encoding {
+            compression: options.compression.flags(),
+            half: options.half,
+        };
+        write_atomic_timed(path, &mut fsync, |tmp| {
+            write_grids(tmp, path, &grids, encoding, &mut clocks)
+        })?;
     }
-    let encoding = Encoding {
-        compression: options.compression.flags(),
-        half: options.half,
-    };
-    write_atomic(path, |tmp| write_grids(tmp, path, &grids, encoding))
+    Ok([clocks.encode.stage(), clocks.write.stage(), fsync.stage()])
+}
+
+/// The time a writer spends encoding grids and writing their bytes, grid by grid.
+pub(super) struct WriteClocks {
+    pub encode: StageClock,
+    pub write: StageClock,
 }
 
 /// The grids a write of `contents` makes (only the one at index `which` when given), as plain

@@ -8,6 +8,7 @@
 //! their leaves and 8^3 tiles; then every leaf's buffer in the same order.
 
 use super::grid_out::{Entry, GridOut, GridValues, Key, ValueType, tree_entries};
+use super::vdb::WriteClocks;
 use super::vdb_chunks::{compression_name, push_chunk};
 use super::vdb_format::{COMPRESS_ACTIVE_MASK, FILE_VERSION, LIBRARY_VERSION, MAGIC, tree_type};
 use super::vdb_tree_structure::{TreeFormat, tree_memory};
@@ -83,15 +84,19 @@ pub(super) fn write_grids(
     path: &Path,
     grids: &[GridOut],
     encoding: Encoding,
+    clocks: &mut WriteClocks,
 ) -> Result<()> {
     let io_error = |e| Error::io(path, e);
     let mut file =
         std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(file).map_err(io_error)?);
     let header = file_header(grids.len());
-    file.write_all(&header).map_err(io_error)?;
+    clocks
+        .write
+        .time(|| file.write_all(&header))
+        .map_err(io_error)?;
     let mut pos = header.len() as u64;
     for g in grids {
-        let encoded = encode_grid(path, g, encoding)?;
+        let encoded = clocks.encode.time(|| encode_grid(path, g, encoding))?;
         let mut descriptor = Vec::new();
         push_string(&mut descriptor, g.name);
         let mut tree_type = tree_type_of(g.values);
@@ -106,15 +111,18 @@ pub(super) fn write_grids(
         for p in [grid_pos, block_pos, end_pos] {
             descriptor.extend_from_slice(&(p as i64).to_le_bytes());
         }
-        for bytes in [&descriptor, &encoded.head]
-            .into_iter()
-            .chain(&encoded.buffers)
-        {
-            file.write_all(bytes).map_err(io_error)?;
-        }
+        clocks
+            .write
+            .time(|| {
+                [&descriptor, &encoded.head]
+                    .into_iter()
+                    .chain(&encoded.buffers)
+                    .try_for_each(|bytes| file.write_all(bytes))
+            })
+            .map_err(io_error)?;
         pos = end_pos;
     }
-    file.flush().map_err(io_error)
+    clocks.write.time(|| file.flush()).map_err(io_error)
 }
 
 /// The magic number, versions, a flag for grid offsets, a UUID, no file metadata, the grid

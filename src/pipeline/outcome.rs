@@ -15,7 +15,7 @@ use crate::io::brick_set::{BrickSet, is_brick_set};
 use crate::io::grid_export::ExportedGrid;
 use crate::io::vdb::{
     Contents, MetaValue, WriteOptions, content_grid_count, export_contents, is_nvdb, read_vdb_grid,
-    write_contents,
+    write_contents_timed,
 };
 use crate::io::vox::write_vox;
 use crate::mesh::{GridFit, Mesh};
@@ -273,15 +273,25 @@ impl Outcome {
     /// `options` say, or the voxel set alone to a `.binvox` or `.vox`, atomically, refusing to
     /// replace any of `inputs`; records the output in the report.
     pub fn write(&mut self, path: &Path, inputs: &[&Path], options: &WriteOptions) -> Result<()> {
-        let begun = StageTime::now();
-        self.write_files(path, inputs, options)?;
-        self.report.stages.push(StageTime::since("write", begun));
+        let stages = self.write_timed(path, inputs, options)?;
+        self.report.stages.extend(stages);
         self.report.output = Some(path.display().to_string());
         Ok(())
     }
 
     /// `write` without recording the output: the files alone.
     pub fn write_files(&self, path: &Path, inputs: &[&Path], options: &WriteOptions) -> Result<()> {
+        self.write_timed(path, inputs, options).map(|_| ())
+    }
+
+    /// `write_files`, returning where the time went: encoding, writing and syncing a `.vdb`
+    /// or `.nvdb` (a `.binvox` or `.vox`: its writing alone).
+    fn write_timed(
+        &self,
+        path: &Path,
+        inputs: &[&Path],
+        options: &WriteOptions,
+    ) -> Result<Vec<StageTime>> {
         check_output_path(path, inputs)?;
         if let Some(format) = voxel_file(path) {
             if self.distances.is_some() {
@@ -291,22 +301,24 @@ impl Outcome {
                     path.display()
                 )));
             }
+            let begun = StageTime::now();
             match format {
                 VoxelFile::Binvox => write_binvox(path, &self.grid)?,
                 VoxelFile::Vox => write_vox(path, &self.grid)?,
             }
-            return Ok(());
+            return Ok(vec![StageTime::since("write", begun)]);
         }
         let meta = self.metadata_entries();
-        let write = |file: &Path| write_contents(file, &self.contents(), &meta, options);
+        let write = |file: &Path| write_contents_timed(file, &self.contents(), &meta, options);
         // The writer encodes in parallel: on the job's threads, as the work was.
-        on_threads(self.threads, || {
+        let stages = on_threads(self.threads, || {
             if path == Path::new("-") {
                 write_to_stdout(write)
             } else {
                 write(path)
             }
-        })
+        })?;
+        Ok(stages.into())
     }
 }
 
@@ -355,17 +367,17 @@ impl Outcome {
 
 /// `.vdb` files are written whole, then renamed into place: `write` a private temporary
 /// file, then copy it to stdout.
-fn write_to_stdout(write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+fn write_to_stdout<T>(write: impl FnOnce(&Path) -> Result<T>) -> Result<T> {
     let dir = std::env::temp_dir().join(format!("voxelkit-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
     let file = dir.join("stdout.vdb");
-    let result = write(&file).and_then(|()| {
+    let result = write(&file).and_then(|written| {
         let mut bytes = std::fs::File::open(&file).map_err(|e| Error::io(&file, e))?;
         let mut out = std::io::stdout().lock();
         std::io::copy(&mut bytes, &mut out)
             .and_then(|_| std::io::Write::flush(&mut out))
             .map_err(|e| Error::io("standard output", e))
-            .map(|_| ())
+            .map(|_| written)
     });
     let _ = std::fs::remove_dir_all(&dir);
     result
