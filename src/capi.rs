@@ -10,7 +10,7 @@
 
 use crate::choice::Choice;
 use crate::error::{Error, Result};
-use crate::grid::{Block, Channels, Coord, LEAF_VOXELS, Leaf, SparseGrid, Transform};
+use crate::grid::{Channels, Coord, LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use crate::implicit::Coordinates;
 use crate::io::grid_export::ExportedGrid;
 use crate::io::vdb::{Compression, MetaValue, WriteOptions, meta_entries, read_vdb_solid};
@@ -1601,11 +1601,10 @@ pub extern "C" fn vk_grid_copy_values(
         for (k, leaf) in leaves.iter().enumerate() {
             let dst = &mut out[LEAF_VOXELS * k..LEAF_VOXELS * (k + 1)];
             // What OpenVDB reads at inactive voxels: minus the background inside.
-            let inside = match d.interior.as_ref().map(|i| i.block(leaf.origin)) {
-                Some(Block::Whole) => [u64::MAX; 8],
-                Some(Block::Partial(l)) => l.mask,
-                _ => [0; 8],
-            };
+            let inside = d
+                .interior
+                .as_ref()
+                .map_or([0; 8], |i| i.block_mask(leaf.origin));
             for (n, v) in dst.iter_mut().enumerate() {
                 *v = if inside[n / 64] >> (n % 64) & 1 == 1 {
                     -d.background

@@ -159,6 +159,15 @@ impl SparseGrid {
         }
     }
 
+    /// The voxels the grid holds in the 8^3 block at `origin`, as a leaf's mask words.
+    pub fn block_mask(&self, origin: Coord) -> [u64; 8] {
+        match self.block(origin) {
+            Block::Whole => FULL,
+            Block::Partial(leaf) => leaf.mask,
+            Block::Empty => [0; 8],
+        }
+    }
+
     /// Replaces the value of every active voxel by `f(voxel, value)`, leaves in parallel.
     pub fn map_values(&mut self, f: impl Fn(Coord, f32) -> f32 + Sync) {
         use rayon::prelude::*;

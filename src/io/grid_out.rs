@@ -5,7 +5,7 @@
 
 use super::vdb_format::{CHILD_LOG2, NODE_LOG2, ROOT_TILE};
 use crate::error::{Error, Result};
-use crate::grid::{Block, Leaf, SparseGrid};
+use crate::grid::{Leaf, SparseGrid};
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -118,11 +118,7 @@ impl GridValues<'_> {
     /// The inside voxels of a level set's leaf at `origin` (the others are outside).
     pub(super) fn inside(self, origin: [i64; 3]) -> [u64; 8] {
         match self {
-            GridValues::LevelSet { interior, .. } => match interior.block(origin) {
-                Block::Whole => [u64::MAX; 8],
-                Block::Partial(leaf) => leaf.mask,
-                Block::Empty => [0; 8],
-            },
+            GridValues::LevelSet { interior, .. } => interior.block_mask(origin),
             _ => [0; 8],
         }
     }

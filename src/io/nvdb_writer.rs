@@ -278,8 +278,8 @@ fn slot(key: &Key, upper: bool) -> usize {
     }
 }
 
-/// Fills an internal node (`upper`: a 4096^3 one) from its entries: its children
-/// at `children` (index of the first, byte offset of each from this node, their spans) and
+/// Fills an internal node (`upper`: a 4096^3 one, else a 128^3 one) from its entries: its
+/// children, whose byte offsets from this node and spans `child_offsets` gives in order, and
 /// its tiles. Returns what it spans and its active tile count.
 fn fill_internal(
     buf: &mut [u8],

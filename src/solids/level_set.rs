@@ -12,7 +12,7 @@
 use super::inside_rule::Inside;
 use super::winding_inside::{block_columns, winding_inside};
 use crate::error::Result;
-use crate::grid::{Block, Channels, Coord, Leaf, SparseGrid, Transform};
+use crate::grid::{Channels, Coord, Leaf, SparseGrid, Transform};
 use crate::mesh::inside::ColumnCrossings;
 use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
@@ -62,12 +62,7 @@ pub fn level_set(
     let h = transform.voxel_size as f32;
     let centres = inside.grid(transform);
     grid.leaves_mut().par_iter_mut().for_each(|leaf| {
-        let mask = match centres.block(leaf.origin) {
-            Block::Whole => [u64::MAX; 8],
-            Block::Partial(l) => l.mask,
-            Block::Empty => [0; 8],
-        };
-        sign_leaf(leaf, &mask, h);
+        sign_leaf(leaf, &centres.block_mask(leaf.origin), h);
     });
     // Band leaves stay leaves, even wholly inside: the level set writes its tiles.
     let (full_band, full_free): (Vec<Coord>, Vec<Coord>) = inside
