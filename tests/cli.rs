@@ -302,6 +302,29 @@ fn mesh_shape_info_and_demo_produce_real_files() {
         sphere.to_str().unwrap(),
     ]);
     assert!(o.status.success() && sphere.exists(), "{}", text(&o));
+    assert!(text(&o).contains(", 26-separating,"), "{}", text(&o));
+    // The paper's plain slabs are said to be unguaranteed, in the summary and the JSON.
+    let plain = dir.path().join("plain.vdb");
+    let args = [
+        "shape",
+        "sphere",
+        "--radius",
+        "2",
+        "-r",
+        "32",
+        "--no-curvature-margin",
+        "-o",
+        plain.to_str().unwrap(),
+    ];
+    let o = voxelkit(&args);
+    assert!(
+        o.status.success() && text(&o).contains("separation not guaranteed"),
+        "{}",
+        text(&o)
+    );
+    let o = voxelkit(&[&["--json"][..], &args].concat());
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(report["curvature_margin"], false, "{report}");
     let demo = dir.path().join("demo");
     let o = voxelkit(&["demo", "-o", demo.to_str().unwrap(), "-r", "64"]);
     assert!(o.status.success(), "{}", text(&o));

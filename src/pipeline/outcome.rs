@@ -571,6 +571,7 @@ pub(super) fn shape(
     let details = Details::Shape {
         shape: name,
         separability: sep,
+        curvature_margin,
     };
     Ok(Outcome::new(grid, meta, details).timed(start))
 }

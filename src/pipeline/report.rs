@@ -64,6 +64,9 @@ pub enum Details {
     Shape {
         shape: String,
         separability: u32,
+        /// Whether the slabs carry the margin for curvature that the separation proof needs on
+        /// curved surfaces (off: the paper's plain slabs, which can leave holes).
+        curvature_margin: bool,
     },
     Subdivision(SubdivisionDetails),
     Implicit(ImplicitDetails),
@@ -331,9 +334,20 @@ impl Report {
             Details::Shape {
                 shape,
                 separability,
+                curvature_margin,
             } => format!(
-                "{place}: {shape}: {} voxels in {} leaves, {separability}-separating, voxel size {:.6}, {timing}",
-                self.voxels, self.leaves, self.voxel_size
+                "{place}: {shape}: {} voxels in {} leaves, {}, voxel size {:.6}, {timing}",
+                self.voxels,
+                self.leaves,
+                if *curvature_margin {
+                    format!("{separability}-separating")
+                } else {
+                    format!(
+                        "the paper's plain {separability}-separating slabs without the curvature \
+                         margin (separation not guaranteed on a curved surface)"
+                    )
+                },
+                self.voxel_size
             ),
             Details::Subdivision(s) => format!(
                 "{place}: {} voxels ({} crossed by opposite sheets) from {} patches; {} evaluations \
