@@ -291,31 +291,17 @@ fn mesh_shape_info_and_demo_produce_real_files() {
         assert!(t.contains(s), "`{s}` missing from info: {t}");
     }
     let sphere = dir.path().join("sphere.vdb");
-    let o = voxelkit(&[
-        "shape",
-        "sphere",
-        "--radius",
-        "2",
-        "-r",
-        "32",
-        "-o",
-        sphere.to_str().unwrap(),
-    ]);
+    let plain = dir.path().join("plain.vdb");
+    let ball = ["shape", "sphere", "--radius", "2", "-r", "32", "-o"];
+    let o = voxelkit(&[&ball[..], &[sphere.to_str().unwrap()]].concat());
     assert!(o.status.success() && sphere.exists(), "{}", text(&o));
     assert!(text(&o).contains(", 26-separating,"), "{}", text(&o));
     // The paper's plain slabs are said to be unguaranteed, in the summary and the JSON.
-    let plain = dir.path().join("plain.vdb");
     let args = [
-        "shape",
-        "sphere",
-        "--radius",
-        "2",
-        "-r",
-        "32",
-        "--no-curvature-margin",
-        "-o",
-        plain.to_str().unwrap(),
-    ];
+        &ball[..],
+        &[plain.to_str().unwrap(), "--no-curvature-margin"],
+    ]
+    .concat();
     let o = voxelkit(&args);
     assert!(
         o.status.success() && text(&o).contains("separation not guaranteed"),
