@@ -170,6 +170,15 @@ def _stopped_by_signals():
         raise _Stopped(f"stopped by signal {signal.Signals(signum).name}")
 
     previous = {s: signal.signal(s, stop) for s in (signal.SIGTERM, signal.SIGINT)}
+    previous_hook = sys.unraisablehook
+
+    def unraisable(info):
+        # A stop raised where it cannot propagate (a garbage-collector callback of Dask's)
+        # would print a traceback; `check` raises it again at the next stage.
+        if not isinstance(info.exc_value, _Stopped):
+            previous_hook(info)
+
+    sys.unraisablehook = unraisable
 
     def check():
         if caught:
@@ -178,6 +187,7 @@ def _stopped_by_signals():
     try:
         yield check
     finally:
+        sys.unraisablehook = previous_hook
         for s, handler in previous.items():
             signal.signal(s, handler)
 
