@@ -1179,7 +1179,7 @@ pub extern "C" fn vk_grid_write_vdb(grid: *const VkGrid, path: *const c_char) ->
         let g = borrow(grid, Kind::Grid)?;
         let path = PathBuf::from(c_str(path, "path")?);
         Ok(g.outcome
-            .write_files(&path, &[], &WriteRequest::default().options())?)
+            .write_files(&path, &[], &write_options_of(std::ptr::null())?)?)
     })
 }
 

@@ -222,7 +222,7 @@ void GridSet::add_grid(const GridArrays& a) {
     grids_->push_back(grid);
 }
 
-void GridSet::write(rust::Str path, uint32_t compression, bool half) const {
+void GridSet::write(rust::Str path, uint32_t compression, bool half) {
     for (const auto& g : *grids_) g->setSaveFloatAsHalf(half);
     openvdb::io::File file{std::string(path)};
     file.setCompression(compression | openvdb::io::COMPRESS_ACTIVE_MASK);

@@ -24,7 +24,7 @@ public:
                      rust::Vec<float>& values, rust::Vec<int32_t>& tiles) const;
     void add_grid(const GridArrays& arrays);
     double level_set_volume(rust::Str name) const;
-    void write(rust::Str path, uint32_t compression, bool half) const;
+    void write(rust::Str path, uint32_t compression, bool half);
 
 private:
     openvdb::GridBase::ConstPtr grid(size_t index) const;

@@ -77,8 +77,9 @@ pub mod ffi {
         /// OpenVDB's `tools::levelSetVolume` of the grid `name`.
         fn level_set_volume(self: &GridSet, name: &str) -> Result<f64>;
         /// Writes every grid with OpenVDB's `io::File`, with its `COMPRESS_*` flags
-        /// `compression` (active masks added) and floats at half precision when `half`.
-        fn write(self: &GridSet, path: &str, compression: u32, half: bool) -> Result<()>;
+        /// `compression` (active masks added) and floats at half precision when `half` (which
+        /// it records on the grids: the set changes).
+        fn write(self: Pin<&mut GridSet>, path: &str, compression: u32, half: bool) -> Result<()>;
         /// Active voxels of a Bool, Mask, Float or Vec3S grid, leaf by leaf, and its active
         /// tiles as (x, y, z, edge) with edge 8 or 128 (larger tiles split into 128^3 ones);
         /// `values` gets 512 floats per leaf for Float grids, 3 x 512 for Vec3S grids, and

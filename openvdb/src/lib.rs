@@ -48,7 +48,8 @@ pub struct OpenVdbGrids {
 }
 
 // SAFETY: the set is OpenVDB's grid vector, owned by this value alone; OpenVDB's grids may be
-// moved between threads and read from several at once.
+// moved between threads and read from several at once, and every method that changes them
+// (`write` records the precision on each grid) takes `&mut self`.
 unsafe impl Send for OpenVdbGrids {}
 unsafe impl Sync for OpenVdbGrids {}
 
@@ -148,12 +149,13 @@ impl OpenVdbGrids {
 
     /// Writes every grid to `path` with OpenVDB's own `io::File`, compressed and at the
     /// precision `options` say, atomically (a temporary file, then renamed).
-    pub fn write(&self, path: &Path, options: &WriteOptions) -> Result<()> {
+    pub fn write(&mut self, path: &Path, options: &WriteOptions) -> Result<()> {
         voxelkit::io::atomic::write_atomic(path, |tmp| {
             let tmp = tmp
                 .to_str()
                 .ok_or_else(|| openvdb_error(path, "the path is not UTF-8"))?;
             self.set
+                .pin_mut()
                 .write(tmp, options.compression.flags(), options.half)
                 .map_err(|e| openvdb_error(path, e))
         })
