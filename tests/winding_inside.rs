@@ -355,3 +355,68 @@ fn on_closed_meshes_winding_and_parity_give_the_same_level_set() {
         }
     }
 }
+
+/// A distributed run's solid by the winding number: every brick (with faces or only within the
+/// mesh's box) keeps its surface and the centres the single run keeps, so the bricks together
+/// are the single run's solid, at brick sizes that cut the generated cases anywhere.
+#[test]
+fn winding_bricks_give_the_single_runs_solid() {
+    use voxelkit::pipeline::bricks::{BrickRun, sub_mesh};
+    use voxelkit::pipeline::request::BricksRequest;
+    use voxelkit::pipeline::{BrickStage, BrickTask, Job, Task};
+    for mesh in generated() {
+        let single = run(
+            SolidRequest {
+                resolution: Some(40),
+                ..SolidRequest::default()
+            },
+            &mesh,
+        )
+        .grid;
+        for size in [8, 24] {
+            let request = BricksRequest {
+                resolution: Some(40),
+                brick: size,
+                ..BricksRequest::default()
+            };
+            let source = MeshSource::Mesh(mesh.clone());
+            let plan =
+                BrickRun::plan(&source, &request, true, std::path::Path::new("bricks")).unwrap();
+            assert!(plan.winding, "{}", mesh.source.display());
+            let mut bricks = SparseGrid::new(plan.layout.transform, Default::default());
+            let without_faces = plan
+                .winding_bricks()
+                .into_iter()
+                .map(|b| {
+                    let faces = plan.bins.get(&b).map_or(&[][..], Vec::as_slice);
+                    let task = Task::Brick(BrickTask {
+                        faces: sub_mesh(&plan.mesh, faces),
+                        brick: b,
+                        size: i64::from(size),
+                        stage: BrickStage::Winding {
+                            mesh: plan.mesh.clone(),
+                        },
+                    });
+                    let placed = voxelkit::mesh::GridFit::Placed(plan.layout.transform);
+                    bricks.union(&Job::new(task, placed).run(&Unobserved).unwrap().grid);
+                    faces.is_empty()
+                })
+                .filter(|&empty| empty)
+                .count();
+            let mut extra = bricks.clone();
+            extra.difference(&single);
+            let mut missing = single.clone();
+            missing.difference(&bricks);
+            assert_eq!(
+                (extra.voxel_count(), missing.voxel_count()),
+                (0, 0),
+                "{} in bricks of {size}: {} voxels",
+                mesh.source.display(),
+                single.voxel_count()
+            );
+            if size == 8 {
+                assert!(without_faces > 0, "bricks wholly inside or outside run too");
+            }
+        }
+    }
+}

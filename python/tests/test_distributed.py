@@ -1,5 +1,5 @@
 """Dask scale-out: a brick run gives exactly the single-process voxels, for surfaces and
-solids, on every closed mesh of the shared data; it succeeds where the single run does not fit
+solids, on every closed mesh of the shared data and, by the winding number, on the open ones; it succeeds where the single run does not fit
 the memory limit; kept brick sets read back as one grid."""
 
 import os
@@ -46,8 +46,7 @@ def test_bricks_equal_the_single_run(meshes, client, tmp_path, solid):
     for path in meshes:
         out = tmp_path / f"{path.stem}-{solid}.vdb"
         result = vd.run(path, out, solid=solid, resolution=512, brick=128, client=client)
-        # Bricks fill by the exterior flood, across bricks: the single run's parity rule.
-        single = voxelkit.solid(path, resolution=512, inside="parity") if solid else voxelkit.mesh(path, resolution=512)
+        single = voxelkit.solid(path, resolution=512) if solid else voxelkit.mesh(path, resolution=512)
         assert result["grid"].same_voxels(single), path.name
         assert result["voxels"] == len(single) and result["bricks"] > 8
         assert result["output"] == str(out) and voxelkit.read_vdb(out).same_voxels(single)
@@ -62,12 +61,25 @@ def test_bricks_fit_where_the_single_run_does_not(data, client, tmp_path):
     assert single.report["estimated_mib"] > limit > estimate
     with pytest.raises(MemoryError):
         voxelkit.solid(path, resolution=768, max_memory_mib=limit)
-    result = vd.solid(path, tmp_path / "b.vdb", resolution=768, brick=128, max_memory_mib=limit, client=client)
+    # The exterior flood across bricks (the winding number's bricks are all tasks).
+    result = vd.solid(path, tmp_path / "b.vdb", resolution=768, brick=128, max_memory_mib=limit, client=client,
+                      inside="parity")
     assert result["grid"].same_voxels(single)
     assert result["full_bricks"] > 0, "bricks wholly inside are written as tiles"
     # A brick that cannot fit is refused with the reason.
     with pytest.raises(MemoryError, match="brick"):
-        vd.solid(path, tmp_path / "c.vdb", resolution=768, brick=1024, max_memory_mib=limit, client=client)
+        vd.solid(path, tmp_path / "c.vdb", resolution=768, brick=1024, max_memory_mib=limit, client=client,
+                 inside="parity")
+
+
+@pytest.mark.parametrize("name", ["stanford-bunny", "teapot", "cube_no_bottom", "ogre"])
+def test_bricks_of_open_meshes_give_the_single_runs_winding_solid(data, client, tmp_path, name):
+    path = data / "meshes" / f"{name}.obj"
+    result = vd.solid(path, tmp_path / f"{name}.vdb", resolution=160, brick=32, client=client)
+    single = voxelkit.solid(path, resolution=160)
+    assert result["inside_rule"].startswith("winding") and "open" in result["inside_rule"]
+    assert result["bricks"] > 8
+    assert result["grid"].same_voxels(single), name
 
 
 def test_kept_bricks_read_as_one_grid(data, client, cli, tmp_path):

@@ -104,9 +104,13 @@ def test_numpy_numbers_are_options():
 
 
 def test_every_dask_option_is_the_tables_in_run_and_on_the_command_line(capsys):
-    with pytest.raises(SystemExit):
-        distributed.main(["mesh", "--help"])
-    text = " ".join(capsys.readouterr().out.split())
+    helps = {}
+    for command in ("mesh", "solid"):
+        with pytest.raises(SystemExit):
+            distributed.main([command, "--help"])
+        helps[command] = " ".join(capsys.readouterr().out.split())
+    # Each command shows the options that act on it: separability the surface's, inside the solid's.
+    only = {"separability": "mesh", "inside": "solid"}
     params = inspect.signature(distributed.run).parameters
     flags = {"max_memory_mib": "--max-memory"}
     fields = voxelkit.OPTIONS["distributed"]["fields"]
@@ -114,12 +118,17 @@ def test_every_dask_option_is_the_tables_in_run_and_on_the_command_line(capsys):
         name, default = f["name"], f["default"]
         assert params[name].default == default, name
         assert f"\n{name} = " in distributed.run.__doc__, name
-        assert flags.get(name, "--" + name.replace("_", "-")) in text, name
-        if default is not None:
-            assert f"(default {default})" in text, name
-        for choice in f["choices"]:
-            assert str(choice) in text, (name, choice)
-    assert len(fields) >= 6
+        flag = flags.get(name, "--" + name.replace("_", "-"))
+        for command, text in helps.items():
+            if only.get(name, command) != command:
+                assert flag not in text, (command, name)
+                continue
+            assert flag in text, (command, name)
+            if default is not None:
+                assert f"(default {default})" in text, (command, name)
+            for choice in f["choices"]:
+                assert str(choice) in text, (command, name, choice)
+    assert len(fields) >= 7
 
 
 def test_a_bad_dask_option_gets_the_tables_error_before_any_work(data, tmp_path):

@@ -111,6 +111,15 @@ class BrickPlan:
     def faces_of(
         self, b: Index
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32], npt.NDArray[np.uint32]]: ...
+    def mesh_arrays(
+        self,
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32], npt.NDArray[np.uint32]]: ...
+    @property
+    def winding(self) -> bool: ...
+    @property
+    def inside_reason(self) -> Optional[str]: ...
+    @property
+    def winding_bricks(self) -> List[Index]: ...
 
 def brick_plan(
     source: MeshSource,
@@ -121,6 +130,9 @@ def brick_plan(
     voxel_size: Optional[float] = None,
     origin: Optional[Sequence[float]] = None,
     up_axis: str = "z",
+    separability: int = 26,
+    max_memory_mib: Optional[int] = None,
+    inside: str = "auto",
 ) -> BrickPlan:
     """The plan of a distributed run; the keywords are OPTIONS["distributed"]'s."""
 def brick_surface_file(
@@ -154,6 +166,20 @@ def brick_solid_file(
     brick: Index,
     size: int,
     exterior: Sequence[int],
+    path: Path,
+    max_memory_mib: Optional[int] = None,
+) -> int: ...
+def brick_winding_file(
+    positions: npt.NDArray[np.float64],
+    indices: npt.NDArray[np.uint32],
+    starts: npt.NDArray[np.uint32],
+    mesh_positions: npt.NDArray[np.float64],
+    mesh_indices: npt.NDArray[np.uint32],
+    mesh_starts: npt.NDArray[np.uint32],
+    origin: Sequence[float],
+    voxel_size: float,
+    brick: Index,
+    size: int,
     path: Path,
     max_memory_mib: Optional[int] = None,
 ) -> int: ...

@@ -6,10 +6,16 @@
 The grid is placed as a single run would place it and cut into cubic bricks of ``--brick``
 voxels. The client reads the mesh once and bins its faces: each brick receives only the
 faces whose box, grown by one voxel, reaches it (the separating criterion is local, so this
-halo is all a brick needs), voxelizes them and writes its part as a ``.vdb``. Solids take
-two rounds: each brick labels its outside components and returns the labels on its faces;
-the client joins them across bricks and finds the exterior (what reaches the grid's border);
-each brick then writes its surface and the components that are not exterior. Bricks without
+halo is all a brick needs), voxelizes them and writes its part as a ``.vdb``.
+
+Solids take the inside rule a single run takes (option ``inside``). By the winding number
+(``auto`` on a consistently oriented mesh, open or not, or ``winding``) every brick within the
+mesh's box also receives the whole mesh (sent to each worker once) and writes its surface and
+the centres whose winding number is at least 1/2: one round, no brick waits for another. By
+parity (``parity``, or ``auto`` where orientations disagree; closed meshes) they take two
+rounds: each brick labels its outside components and returns the labels on its faces; the
+client joins them across bricks and finds the exterior (what reaches the grid's border); each
+brick then writes its surface and the components that are not exterior, and bricks without
 faces are wholly outside or wholly inside (written as tiles, no task).
 
 The bricks are merged into ``OUT.vdb`` when the result fits in the client's memory, else (or
@@ -63,6 +69,14 @@ def _solid_brick(arrays, origin, voxel_size, brick, size, exterior, path, max_me
     positions, indices, starts = arrays
     return vk.brick_solid_file(
         positions, indices, starts, origin, voxel_size, brick, size, exterior, path,
+        max_memory_mib=max_memory_mib,
+    )
+
+
+def _winding_brick(arrays, mesh, origin, voxel_size, brick, size, path, max_memory_mib):
+    positions, indices, starts = arrays
+    return vk.brick_winding_file(
+        positions, indices, starts, *mesh, origin, voxel_size, brick, size, path,
         max_memory_mib=max_memory_mib,
     )
 
@@ -255,11 +269,20 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
         client, cluster = _client(scheduler, workers, threads)
     try:
         origin, h, size = plan.origin, plan.voxel_size, plan.size
-        arrays = {b: plan.faces_of(b) for b in plan.bricks}
-        files = {b: _brick_file(b) for b in plan.bricks}
-        path = {b: os.path.abspath(os.path.join(folder, files[b])) for b in plan.bricks}
+        bricks = plan.winding_bricks if solid and plan.winding else plan.bricks
+        arrays = {b: plan.faces_of(b) for b in bricks}
+        files = {b: _brick_file(b) for b in bricks}
+        path = {b: os.path.abspath(os.path.join(folder, files[b])) for b in bricks}
         full_bricks = []
-        if solid:
+        if solid and plan.winding:
+            # Every worker holds the mesh once; a worker lost takes no brick's only copy.
+            mesh = client.scatter(plan.mesh_arrays(), broadcast=True)
+            calls = {
+                b: (_winding_brick, (arrays[b], mesh, origin, h, b, size, path[b], max_memory_mib))
+                for b in bricks
+            }
+            counts = _run(client, calls, "solid", show, check)
+        elif solid:
             faces = _run(
                 client,
                 {b: (_brick_faces, (arrays[b], origin, h, b, size, max_memory_mib)) for b in plan.bricks},
@@ -300,8 +323,9 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
     return {
         "grid": grid,
         "output": output if merge else index,
-        "bricks": len(plan.bricks),
+        "bricks": len(bricks),
         "full_bricks": len(full_bricks),
+        "inside_rule": plan.inside_reason,
         "voxels": voxels,
         "seconds": time.perf_counter() - start,
         "worker_peak_mib": peaks,
@@ -322,8 +346,9 @@ run.__doc__ = """Voxelizes ``source`` (a path or a (vertices, faces) pair) in br
 else on a local cluster of ``workers`` processes started for the call.
 
 Returns a dict: the merged ``grid`` (a voxelkit.Grid, or None when the bricks were kept),
-``output`` (the .vdb, or the brick set's index), ``bricks`` (with faces), ``full_bricks``,
-``voxels``, ``seconds``, and ``worker_peak_mib`` (each worker process's peak memory).
+``output`` (the .vdb, or the brick set's index), ``bricks`` (the bricks run), ``full_bricks``
+(wholly inside without a task), ``voxels``, ``inside_rule`` (a solid's rule and why),
+``seconds``, and ``worker_peak_mib`` (each worker process's peak memory).
 
 The options, as for every voxelkit function (``voxelkit.OPTIONS["distributed"]``):
 """
@@ -336,7 +361,7 @@ def mesh(source, output, **options):
 
 
 def solid(source, output, **options):
-    """The solid of a closed mesh in bricks (see ``run`` for the options)."""
+    """The solid of a mesh in bricks, by the inside rule a single run takes (see ``run``)."""
     return run(source, output, solid=True, **options)
 
 
@@ -377,14 +402,14 @@ def main(argv=None):
     commands = parser.add_subparsers(dest="command", required=True)
     for name, help_text in (
         ("mesh", "the separating surface"),
-        ("solid", "the solid of a closed mesh (surface and inside)"),
+        ("solid", "the solid (surface and inside, by the option inside)"),
     ):
         p = commands.add_parser(name, help=help_text)
         p.add_argument("input", help="mesh file (.obj, .stl, .ply, .off, .gltf, .glb)")
         p.add_argument("-o", "--output", required=True, help="output .vdb")
         fit = p.add_mutually_exclusive_group()
         for field in _FIELDS:
-            if field["name"] == "separability" and name == "solid":
+            if (field["name"], name) in (("separability", "solid"), ("inside", "mesh")):
                 continue
             _add_option(fit if field["name"] in ("resolution", "voxel_size") else p, field)
         where = p.add_mutually_exclusive_group()
@@ -415,6 +440,7 @@ def main(argv=None):
         f"{result['output']}: {result['voxels']} voxels from {result['bricks']} bricks "
         f"(+{result['full_bricks']} whole) in {result['seconds']:.2f} s; "
         f"worker peak memory {peaks} MiB"
+        + (f"; inside: {result['inside_rule']}" if result["inside_rule"] else "")
     )
     return 0
 

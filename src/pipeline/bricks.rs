@@ -5,22 +5,32 @@
 //! criterion is local to a face's neighbourhood, so the brick's part of the surface is
 //! exactly the part of the whole surface inside it.
 //!
-//! Solids: each brick labels its outside components (clear voxels, face-connected, as the
-//! exterior flood goes) and hands in the labels on its six faces; `exterior_labels` joins
-//! them across bricks and finds those connected to the layout's border, which lies at
-//! least one voxel beyond the surface; each brick then keeps the rest as inside.
+//! Solids by the winding number (option `inside` auto or winding, as a single run chooses it):
+//! each brick receives the whole mesh besides its faces and keeps its surface and the centres
+//! whose winding number is at least 1/2, exactly as the single run decides them; no brick
+//! needs another's answer. Every brick meeting the mesh's box runs, with faces or without (a
+//! brick wholly inside comes back as tiles).
+//!
+//! Solids by parity (the exterior flood, closed meshes): each brick labels its outside
+//! components (clear voxels, face-connected, as the exterior flood goes) and hands in the
+//! labels on its six faces; `exterior_labels` joins them across bricks and finds those
+//! connected to the layout's border, which lies at least one voxel beyond the surface; each
+//! brick then keeps the rest as inside.
 
 use super::request::BricksRequest;
 use super::{BrickFaceDetails, BrickStage, BrickTask, Details, MeshSource, Outcome};
 use crate::error::{Error, Result};
-use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
+use crate::grid::{Channels, CoordBox, DenseMask, SparseGrid, Transform};
 use crate::io::brick_set::brick_voxels;
 use crate::io::vdb::check_voxel_size;
+use crate::mesh::boundary_caps::boundary_caps;
 use crate::mesh::{GridFit, Mesh, fit_transform, index_box};
 use crate::ops::flood::padded;
 use crate::ops::labels::{ClearRuns, label_clear_runs};
 use crate::progress::Progress;
 use crate::solids::flooded_mesh::FLOOD_NEEDS_CLOSED;
+use crate::solids::inside_rule::{Inside, choose_inside};
+use crate::solids::winding_inside::winding_inside;
 use crate::voxelize::Separability;
 use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh};
 use std::collections::BTreeMap;
@@ -210,13 +220,16 @@ impl BrickOutside {
     }
 }
 
-/// A distributed run's plan: the mesh read as the CLI reads it (checked closed for a solid),
-/// placed on the grid one run would use, its voxel size one a `.vdb` holds, and cut into
-/// bricks with the faces each receives.
+/// A distributed run's plan: the mesh read as the CLI reads it (for a solid, its inside rule
+/// chosen as a single run chooses it), placed on the grid one run would use, its voxel size
+/// one a `.vdb` holds, and cut into bricks with the faces each receives.
 pub struct BrickRun {
     pub mesh: Mesh,
     pub layout: BrickLayout,
     pub bins: BTreeMap<BrickIndex, Vec<u32>>,
+    /// A solid's inside rule: winding (true) or the exterior flood, and why.
+    pub winding: bool,
+    pub inside_reason: Option<String>,
 }
 
 impl BrickRun {
@@ -228,13 +241,40 @@ impl BrickRun {
         output: &Path,
     ) -> Result<BrickRun> {
         let mesh = source.load(false, request.up_axis)?;
-        if solid {
-            mesh.require_closed(FLOOD_NEEDS_CLOSED)?;
-        }
+        let (winding, inside_reason) = if solid {
+            let choice = choose_inside(request.inside, &mesh, FLOOD_NEEDS_CLOSED)?;
+            (
+                matches!(choice.inside, Inside::Winding(_)),
+                Some(choice.reason),
+            )
+        } else {
+            (false, None)
+        };
         let layout = BrickLayout::new(&mesh, request.fit()?, request.brick)?;
         check_voxel_size(output, layout.transform.voxel_size)?;
         let bins = layout.bin_faces(&mesh);
-        Ok(BrickRun { mesh, layout, bins })
+        Ok(BrickRun {
+            mesh,
+            layout,
+            bins,
+            winding,
+            inside_reason,
+        })
+    }
+
+    /// The bricks a winding solid runs: those with faces and those meeting the mesh's box
+    /// (where centres can wind at least 1/2), ascending.
+    pub fn winding_bricks(&self) -> Vec<BrickIndex> {
+        let region = index_box(&self.mesh.bbox(), &self.layout.transform);
+        let mut bricks: Vec<BrickIndex> = self
+            .layout
+            .all()
+            .filter(|&b| {
+                self.bins.contains_key(&b) || self.layout.voxels(b).intersection(&region).is_some()
+            })
+            .collect();
+        bricks.sort_unstable();
+        bricks
     }
 }
 
@@ -267,6 +307,22 @@ pub(super) fn run_brick(task: &BrickTask, t: Transform, progress: &Progress) -> 
             let surface = surface(Separability::TwentySix)?;
             let outside = BrickOutside::label(&surface, voxels)?;
             (outside.solid(&surface, &exterior), Details::None)
+        }
+        BrickStage::Winding { mesh } => {
+            let surface = if task.faces.face_count() == 0 {
+                SparseGrid::new(t, Channels::NONE)
+            } else {
+                surface(Separability::TwentySix)?
+            };
+            let region = index_box(&mesh.bbox(), &t).intersection(&voxels);
+            let mut whole = match region {
+                Some(region) => {
+                    winding_inside(mesh, &boundary_caps(mesh), t, region, progress)?.grid(t)
+                }
+                None => SparseGrid::new(t, surface.channels()),
+            };
+            whole.union(&surface);
+            (whole, Details::None)
         }
     };
     let meta = vec![("method", "voxelkit brick".into())];

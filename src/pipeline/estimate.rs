@@ -277,18 +277,38 @@ const CHECK_LEAF_BYTES: f64 = 900.0;
 /// Bytes per labelled run of clear voxels: its span, label and union-find parent.
 const RUN_BYTES: f64 = 16.0;
 
-/// Peak bytes of one brick's work (see `bricks`): the surface of its `faces`, and for a
-/// solid the two bit masks over its `size^3` voxels, the labelled runs (a few per row) and
-/// the solid's leaves.
-fn brick_bytes(faces: &Mesh, t: &Transform, size: i64, solid: bool) -> f64 {
-    let edge = size as f64;
-    let fill = if solid {
-        let runs = 4.0 * edge * edge;
-        edge.powi(3) / 4.0 + runs * RUN_BYTES + leaf_bytes(edge.powi(3) * SOLID_FILL / 512.0, 0)
-    } else {
-        0.0
+/// Peak bytes of one brick's work (see `bricks`): the surface of its faces; for a solid by
+/// the exterior flood the two bit masks over its `size^3` voxels, the labelled runs (a few per
+/// row) and the solid's leaves; for a solid by the winding number the whole mesh it holds, the
+/// crossings of its columns (at most those of every triangle over them) and the solid's leaves.
+fn brick_bytes(brick: &BrickTask, t: &Transform) -> f64 {
+    let edge = brick.size as f64;
+    let leaves = || leaf_bytes(edge.powi(3) * SOLID_FILL / 512.0, 0);
+    let fill = match &brick.stage {
+        BrickStage::Surface(_) => 0.0,
+        BrickStage::FaceLabels | BrickStage::Solid { .. } => {
+            let runs = 4.0 * edge * edge;
+            edge.powi(3) / 4.0 + runs * RUN_BYTES + leaves()
+        }
+        BrickStage::Winding { mesh } => {
+            let columns = brick_voxels(brick.brick, brick.size);
+            let over = |v: DVec3| {
+                let p = t.world_to_index(v);
+                (0..2).all(|a| {
+                    p[a] >= columns.min[a] as f64 - 1.0 && p[a] <= columns.max[a] as f64 + 1.0
+                })
+            };
+            let near: Vec<[DVec3; 3]> = mesh
+                .triangles()
+                .map(|(_, tri)| tri.map(|v| mesh.p(v)))
+                .filter(|tri| tri.iter().any(|&v| over(v)))
+                .collect();
+            mesh.triangle_count() as f64 * BAND_TRIANGLE_BYTES
+                + crossings_in_voxels(near.into_iter(), t) * WINDING_CROSSING_BYTES
+                + leaves()
+        }
     };
-    surface_bytes(area_in_voxels(faces, t), 0) + fill
+    surface_bytes(area_in_voxels(&brick.faces, t), 0) + fill
 }
 
 /// A brick on its run's grid, which only `GridFit::Placed` gives.
@@ -304,8 +324,7 @@ fn brick_plan(brick: &BrickTask, fit: GridFit) -> Result<Plan> {
         min: t.index_to_world(voxels.min),
         max: t.index_to_world(voxels.max),
     };
-    let solid = !matches!(brick.stage, BrickStage::Surface(_));
-    let bytes = brick_bytes(&brick.faces, &t, brick.size, solid);
+    let bytes = brick_bytes(brick, &t);
     Ok(plan_of(
         t,
         &bbox,
@@ -628,18 +647,19 @@ const WINDING_CROSSING_BYTES: f64 = 36.0;
 /// decides: the crossings added.
 fn winding_plan(mesh: &Mesh, fit: GridFit, cost: &FillCost) -> Result<Plan> {
     let mut plan = fill_plan(mesh, fit, cost, |m, _| separating::work_items(m))?;
-    let h2 = plan.transform.voxel_size.powi(2);
-    // A ray along z crosses a triangle where its projection covers the ray's column.
-    let crossings: f64 = mesh
-        .triangles()
-        .map(|(_, [a, b, c])| {
-            let (a, b, c) = (mesh.p(a), mesh.p(b), mesh.p(c));
-            0.5 * ((b - a).truncate().perp_dot((c - a).truncate())).abs() / h2
-        })
-        .sum();
-    let bytes = crossings * WINDING_CROSSING_BYTES;
+    let triangles = mesh.triangles().map(|(_, t)| t.map(|v| mesh.p(v)));
+    let bytes = crossings_in_voxels(triangles, &plan.transform) * WINDING_CROSSING_BYTES;
     plan.estimated_bytes = plan.estimated_bytes.saturating_add(bytes as u64);
     Ok(plan)
+}
+
+/// The crossings of rays along z through voxel columns with `triangles`: a ray crosses a
+/// triangle where its projection covers the ray's column.
+fn crossings_in_voxels(triangles: impl Iterator<Item = [DVec3; 3]>, t: &Transform) -> f64 {
+    let h2 = t.voxel_size.powi(2);
+    triangles
+        .map(|[a, b, c]| 0.5 * ((b - a).truncate().perp_dot((c - a).truncate())).abs() / h2)
+        .sum()
 }
 
 /// The cost of a flood: `blocks` for the block flood (writing a solid or measuring it), the

@@ -3,8 +3,8 @@
 //! one enum and never a task against what was loaded for it.
 
 use super::{
-    BrickTask, CsgSource, Fill, GridSource, MeasureSource, MeshSource, ShapeTask, SubdivisionFill,
-    SurfaceMethod, Task, lines_source,
+    BrickStage, BrickTask, CsgSource, Fill, GridSource, MeasureSource, MeshSource, ShapeTask,
+    SubdivisionFill, SurfaceMethod, Task, lines_source,
 };
 use crate::error::{Error, Result};
 use crate::grid::SparseGrid;
@@ -211,7 +211,16 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
             }
         })),
         Task::Brick(brick) => {
-            brick.faces.validate()?;
+            match &brick.stage {
+                // A winding brick may lie wholly inside the mesh, without faces of its own.
+                BrickStage::Winding { mesh } => {
+                    mesh.validate()?;
+                    if brick.faces.face_count() > 0 {
+                        brick.faces.validate()?;
+                    }
+                }
+                _ => brick.faces.validate()?,
+            }
             Work::Brick(brick.clone())
         }
         Task::Combine {

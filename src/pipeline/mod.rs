@@ -226,6 +226,9 @@ pub enum BrickStage {
     /// Its part of the solid: the surface and the components not in `exterior` (labels of
     /// the face-label stage).
     Solid { exterior: Vec<u32> },
+    /// Its part of a solid whose inside is the winding number of `mesh`, the whole mesh (the
+    /// brick's own faces give its surface).
+    Winding { mesh: Mesh },
 }
 
 /// How a Catmull-Clark solid is filled and weighed.

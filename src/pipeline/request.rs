@@ -546,6 +546,8 @@ request! {
         separability: Separability = Separability::default(),
         /// Refuse a brick estimated above this many MiB (none or 0: the memory available).
         max_memory_mib: Option<u64> = None,
+        #[doc = inside_doc!()]
+        inside: InsideRule = InsideRule::default(),
     }
 }
 

@@ -94,31 +94,75 @@ impl BrickPlan {
     }
 
     /// The faces brick `b` receives, as (positions, indices, starts).
-    #[allow(clippy::type_complexity)]
-    fn faces_of<'py>(
-        &self,
-        py: Python<'py>,
-        b: PyBrick,
-    ) -> (
-        Bound<'py, PyArray2<f64>>,
-        Bound<'py, PyArray1<u32>>,
-        Bound<'py, PyArray1<u32>>,
-    ) {
+    fn faces_of<'py>(&self, py: Python<'py>, b: PyBrick) -> PyMeshArrays<'py> {
         let faces = self.0.bins.get(&from_py(b)).map_or(&[][..], Vec::as_slice);
-        let sub = sub_mesh(&self.0.mesh, faces);
-        let flat: Vec<f64> = sub.positions.iter().flat_map(|p| p.to_array()).collect();
-        (
-            Array2::from_shape_vec((sub.positions.len(), 3), flat)
-                .expect("three coordinates per vertex")
-                .into_pyarray(py),
-            Array1::from_vec(sub.indices).into_pyarray(py),
-            Array1::from_vec(sub.face_starts).into_pyarray(py),
-        )
+        to_arrays(py, sub_mesh(&self.0.mesh, faces))
+    }
+
+    /// The whole mesh, as (positions, indices, starts): what each brick of a winding solid
+    /// receives besides its faces.
+    fn mesh_arrays<'py>(&self, py: Python<'py>) -> PyMeshArrays<'py> {
+        to_arrays(py, self.0.mesh.clone())
+    }
+
+    /// Whether a solid's inside is the winding number (else the exterior flood).
+    #[getter]
+    fn winding(&self) -> bool {
+        self.0.winding
+    }
+
+    /// Which inside rule a solid takes, and why.
+    #[getter]
+    fn inside_reason(&self) -> Option<String> {
+        self.0.inside_reason.clone()
+    }
+
+    /// The bricks a winding solid runs (with faces, or within the mesh's box).
+    #[getter]
+    fn winding_bricks(&self) -> Vec<PyBrick> {
+        self.0.winding_bricks().into_iter().map(to_py).collect()
     }
 }
 
-/// The plan of a distributed run (`BricksRequest`'s options as keywords): the mesh read, checked, fitted and cut into bricks
-/// by the pipeline; `solid`: the mesh must be closed.
+/// A mesh as Python holds it: positions (k, 3), the faces' vertex indices back to back, and
+/// where each face starts (m + 1 entries).
+type PyMeshArrays<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<u32>>,
+    Bound<'py, PyArray1<u32>>,
+);
+
+fn to_arrays(py: Python<'_>, mesh: Mesh) -> PyMeshArrays<'_> {
+    let flat: Vec<f64> = mesh.positions.iter().flat_map(|p| p.to_array()).collect();
+    (
+        Array2::from_shape_vec((mesh.positions.len(), 3), flat)
+            .expect("three coordinates per vertex")
+            .into_pyarray(py),
+        Array1::from_vec(mesh.indices).into_pyarray(py),
+        Array1::from_vec(mesh.face_starts).into_pyarray(py),
+    )
+}
+
+/// The mesh of arrays Python hands in (see `PyMeshArrays`), named `source` in errors.
+fn from_arrays((positions, indices, starts): BrickArrays, source: &str) -> Mesh {
+    Mesh {
+        positions: positions
+            .as_array()
+            .rows()
+            .into_iter()
+            .map(|r| DVec3::new(r[0], r[1], r[2]))
+            .collect(),
+        indices: indices.as_array().to_vec(),
+        face_starts: starts.as_array().to_vec(),
+        source: source.into(),
+        numbered_from_zero: true,
+        ..Default::default()
+    }
+}
+
+/// The plan of a distributed run (`BricksRequest`'s options as keywords): the mesh read,
+/// fitted and cut into bricks by the pipeline; `solid`: its inside rule chosen as a single
+/// run chooses it.
 #[pyfunction]
 #[pyo3(signature = (source, solid = false, output = None, **options))]
 pub fn brick_plan(
@@ -142,32 +186,19 @@ pub fn brick_plan(
         .map_err(to_py_err)
 }
 
+/// Where a brick lies: the run's grid (origin, voxel size), the brick and its edge, and its
+/// memory limit in MiB.
+type BrickAt = ([f64; 3], f64, PyBrick, i64, Option<u64>);
+
 /// Runs one brick's job from its arrays (positions (k, 3), the faces' vertex indices back to
-/// back, where each face starts) on the run's grid, under `max_memory_mib`.
-#[allow(clippy::too_many_arguments)]
+/// back, where each face starts) on the run's grid, under its memory limit.
 fn run_brick(
     py: Python<'_>,
-    (positions, indices, starts): BrickArrays,
-    origin: [f64; 3],
-    voxel_size: f64,
-    brick: PyBrick,
-    size: i64,
+    arrays: BrickArrays,
     stage: BrickStage,
-    max_memory_mib: Option<u64>,
+    (origin, voxel_size, brick, size, max_memory_mib): BrickAt,
 ) -> PyResult<Outcome> {
-    let faces = Mesh {
-        positions: positions
-            .as_array()
-            .rows()
-            .into_iter()
-            .map(|r| DVec3::new(r[0], r[1], r[2]))
-            .collect(),
-        indices: indices.as_array().to_vec(),
-        face_starts: starts.as_array().to_vec(),
-        source: "a brick's faces".into(),
-        numbered_from_zero: true,
-        ..Default::default()
-    };
+    let faces = from_arrays(arrays, "a brick's faces");
     let task = Task::Brick(BrickTask {
         faces,
         brick: from_py(brick),
@@ -224,12 +255,8 @@ pub fn brick_surface_file(
     let outcome = run_brick(
         py,
         arrays,
-        origin,
-        voxel_size,
-        brick,
-        size,
         stage,
-        max_memory_mib,
+        (origin, voxel_size, brick, size, max_memory_mib),
     )?;
     write_brick(py, outcome, &path)
 }
@@ -256,12 +283,8 @@ pub fn brick_faces<'py>(
     let outcome = run_brick(
         py,
         arrays,
-        origin,
-        voxel_size,
-        brick,
-        size,
         stage,
-        max_memory_mib,
+        (origin, voxel_size, brick, size, max_memory_mib),
     )?;
     let Details::BrickFaces(faces) = outcome.report.details else {
         return Err(PyValueError::new_err(
@@ -299,12 +322,45 @@ pub fn brick_solid_file(
     let outcome = run_brick(
         py,
         arrays,
-        origin,
-        voxel_size,
-        brick,
-        size,
         stage,
-        max_memory_mib,
+        (origin, voxel_size, brick, size, max_memory_mib),
+    )?;
+    write_brick(py, outcome, &path)
+}
+
+/// A brick of a solid whose inside is the winding number of the whole mesh (`mesh_*`, as
+/// `BrickPlan.mesh_arrays` gives it): its surface and the centres inside, written to `path`;
+/// returns its voxel count.
+#[pyfunction]
+#[pyo3(signature = (positions, indices, starts, mesh_positions, mesh_indices, mesh_starts,
+    origin, voxel_size, brick, size, path, max_memory_mib = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn brick_winding_file(
+    py: Python<'_>,
+    positions: PyReadonlyArray2<f64>,
+    indices: PyReadonlyArray1<u32>,
+    starts: PyReadonlyArray1<u32>,
+    mesh_positions: PyReadonlyArray2<f64>,
+    mesh_indices: PyReadonlyArray1<u32>,
+    mesh_starts: PyReadonlyArray1<u32>,
+    origin: [f64; 3],
+    voxel_size: f64,
+    brick: PyBrick,
+    size: i64,
+    path: PathBuf,
+    max_memory_mib: Option<u64>,
+) -> PyResult<u64> {
+    let mesh = from_arrays(
+        (mesh_positions, mesh_indices, mesh_starts),
+        "the run's mesh",
+    );
+    let stage = BrickStage::Winding { mesh };
+    let arrays = (positions, indices, starts);
+    let outcome = run_brick(
+        py,
+        arrays,
+        stage,
+        (origin, voxel_size, brick, size, max_memory_mib),
     )?;
     write_brick(py, outcome, &path)
 }
@@ -377,6 +433,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(brick_surface_file, m)?)?;
     m.add_function(wrap_pyfunction!(brick_faces, m)?)?;
     m.add_function(wrap_pyfunction!(brick_solid_file, m)?)?;
+    m.add_function(wrap_pyfunction!(brick_winding_file, m)?)?;
     m.add_function(wrap_pyfunction!(brick_exterior, m)?)?;
     m.add_function(wrap_pyfunction!(brick_finish, m)?)?;
     Ok(())
