@@ -65,6 +65,12 @@ enum Block {
     Near { low: f64, high: f64 },
 }
 
+/// How far from the region's centres the mesh's own surface is asked about: `continuous_sign`
+/// asks about balls of radius at most 4 sqrt(3) (half an 8^3 block's diagonal) around them.
+/// The caps are asked about within `TOP_BLOCK` sqrt(3) of the region: every ball `Caps::range`
+/// asks about lies in the circumsphere of a block that meets the region.
+const SURFACE_REACH: f64 = 8.0;
+
 /// Blocks decided by threshold 1 are not listed: the default far from any cap.
 const DEFAULT_THRESHOLD: i32 = 1;
 
@@ -117,24 +123,41 @@ pub fn winding_inside(
         .collect();
     // Each cap triangle is (centroid, rim vertex, rim vertex).
     let rim = RimBound::new(corners.iter().map(|&[_, a, b]| [a, b]).collect());
+    // Boxes of the region grown by `reach`: what may be asked about near it.
+    let near_region = |reach: f64| {
+        let lo = DVec3::from_array(region.min.map(|v| v as f64)) - reach;
+        let hi = DVec3::from_array(region.max.map(|v| v as f64)) + reach;
+        move |t: &[DVec3; 3]| {
+            let (a, b) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+            a.cmple(hi).all() && b.cmpge(lo).all()
+        }
+    };
     let ((tree, fans), surface) = rayon::join(
         || {
             rayon::join(
                 || {
+                    let near = near_region(TOP_BLOCK as f64 * 3f64.sqrt());
                     WindingTree::of_triangles(
-                        corners.iter().flat_map(|&t| refined(t, CAP_EDGE)).collect(),
+                        corners
+                            .iter()
+                            .filter(|t| near(t))
+                            .flat_map(|&t| refined(t, CAP_EDGE))
+                            .collect(),
                     )
                 },
                 || WindingTree::of_triangles(corners.clone()),
             )
         },
         || {
-            // Only where caps exist is the mesh's own surface asked about.
+            // Only where caps exist is the mesh's own surface asked about, and only near the
+            // region (a part of the grid, as a brick is, needs the triangles near it alone).
             let near_caps = if caps.is_empty() {
                 Vec::new()
             } else {
+                let near = near_region(SURFACE_REACH);
                 mesh.triangles()
                     .map(|(_, t)| t.map(|v| index[v as usize]))
+                    .filter(|t| near(t))
                     .collect()
             };
             WindingTree::of_triangles(near_caps)
