@@ -207,3 +207,59 @@ def test_a_scheduler_that_never_answers_is_an_error_within_seconds(data, dask, t
         silent.close()
     assert time.monotonic() - started < 60
     assert not list(tmp_path.iterdir()), "nothing is left behind"
+
+
+def _free_port():
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_a_cluster_of_separate_scheduler_and_worker_processes(data, dask, tmp_path):
+    """As a cluster is run: `dask scheduler` and two `dask worker` processes started on their
+    own, on loopback, the output folder shared; the command line sends them an open mesh's
+    solid, which comes back as the single run's."""
+    dask_cli = os.path.join(os.path.dirname(sys.executable), "dask")
+    port = _free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    env = dict(os.environ, RAYON_NUM_THREADS="1")
+    quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, cwd=tmp_path)
+    started = [subprocess.Popen([dask_cli, "scheduler", "--host", "127.0.0.1", "--port", str(port),
+                                 "--no-dashboard"], **quiet)]
+    try:
+        started += [
+            subprocess.Popen([dask_cli, "worker", address, "--nthreads", "1", "--no-dashboard",
+                              "--local-directory", str(tmp_path / f"worker-{n}")], **quiet)
+            for n in range(2)
+        ]
+        path = data / "meshes" / "stanford-bunny.obj"
+        out = tmp_path / "shared" / "bunny.vdb"
+        out.parent.mkdir()
+        done = subprocess.run(
+            [sys.executable, "-m", "voxelkit.distributed", "solid", str(path), "-r", "200",
+             "--brick", "64", "--scheduler", address, "-o", str(out)],
+            capture_output=True, text=True, timeout=300,
+        )
+        assert done.returncode == 0, done.stderr
+        assert "inside: winding" in done.stdout, done.stdout
+        assert voxelkit.read_vdb(out).same_voxels(voxelkit.solid(path, resolution=200))
+        assert [p.name for p in out.parent.iterdir()] == ["bunny.vdb"], "the bricks went after the merge"
+    finally:
+        for p in reversed(started):
+            p.terminate()
+        for p in started:
+            p.wait(timeout=60)
+
+
+def test_two_runs_to_one_output_are_refused_while_the_first_runs(data, dask, tmp_path):
+    path = data / "meshes" / "igea.obj"
+    out = tmp_path / "igea.vdb"
+    first = _start(path, out)
+    assert _wait_for_bricks(first, tmp_path / "igea.bricks"), "no brick was written"
+    with pytest.raises(OSError, match="already exists"):
+        vd.mesh(path, out, resolution=64, brick=64, workers=1)
+    _, err = first.communicate(timeout=600)
+    assert first.returncode == 0, err
+    assert voxel_set(voxelkit.read_vdb(out).ijk) == voxel_set(voxelkit.mesh(path, resolution=1024).ijk)
