@@ -1,8 +1,10 @@
 //! `voxelkit csg --tree`: the bundled mechanical part against its exact volume, trees over
-//! meshes and .vdb grids, and errors that name the file and the node.
+//! meshes and .vdb grids, placed leaves (Lai & Cheng's moved copies), and errors that name the
+//! file and the node.
 #![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 mod cli_support;
+mod common;
 
 use cli_support::{json_field, text, voxelkit};
 use glam::DVec3;
@@ -150,6 +152,12 @@ fn bad_trees_are_refused_naming_the_file_and_the_node() {
             "tree.difference[1].cylinder.radius",
         ),
         (
+            "place.json",
+            r#"{ "tree": { "union": [ { "sphere": { "center": [0, 0, 0], "radius": 1 } },
+                 { "sphere": { "center": [0, 0, 0], "radius": 1, "place": { "scale": -2 } } } ] } }"#,
+            "tree.union[1].sphere.place.scale: must be positive",
+        ),
+        (
             "nobounds.json",
             r#"{ "tree": { "formula": "x^2 + y^2 + z^2 - 1" } }"#,
             "no leaf has bounds",
@@ -198,4 +206,127 @@ fn the_summary_prints_the_leaves_numbers_as_typed() {
         "{t}"
     );
     assert!(!t.contains("99999"), "{t}");
+}
+
+/// Runs `csg --tree` on `tree` (JSON text, written into `dir`), giving the voxel count.
+fn tree_voxels(dir: &std::path::Path, name: &str, tree: &str) -> f64 {
+    let path = dir.join(format!("{name}.json"));
+    std::fs::write(&path, tree).unwrap();
+    let out = dir.join(format!("{name}.vdb"));
+    let o = voxelkit(&[
+        "--json",
+        "csg",
+        "--tree",
+        path.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let t = text(&o);
+    assert!(o.status.success(), "{name}: {t}");
+    json_field(&t, "voxels")
+}
+
+#[test]
+fn placed_leaves_are_their_shapes_moved_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, tree: &str| {
+        let top = r#""bounds": {"min": [-1, -1, -1], "max": [1, 1, 1]}, "resolution": 200"#;
+        tree_voxels(dir.path(), name, &format!(r#"{{ {top}, "tree": {tree} }}"#))
+    };
+    // A unit cube and itself turned 45 degrees about z meet in a regular octagonal prism.
+    let cube = r#"{"box": {"min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]}}"#;
+    let turned = r#"{"box": {"min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5],
+        "place": {"rotate": {"axis": [0, 0, 1], "degrees": 45}}}}"#;
+    let h: f64 = 2.0 / 200.0;
+    let octagon = run(
+        "octagon",
+        &format!(r#"{{"intersection": [{cube}, {turned}]}}"#),
+    ) * h.powi(3);
+    let exact = 8.0 * 0.25 * (PI / 8.0).tan();
+    assert!(
+        (octagon - exact).abs() < 0.01 * exact,
+        "{octagon} against {exact}"
+    );
+    // The same by Euler angles and by a matrix.
+    for (name, place) in [
+        ("euler", r#"{"rotate": {"euler": [0, 0, 45]}}"#),
+        (
+            "matrix",
+            r#"{"matrix": [[0.7071067811865476, -0.7071067811865476, 0, 0],
+            [0.7071067811865476, 0.7071067811865476, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]}"#,
+        ),
+    ] {
+        let other = format!(
+            r#"{{"box": {{"min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5], "place": {place}}}}}"#
+        );
+        let differ = run(name, &format!(r#"{{"difference": [{turned}, {other}]}}"#));
+        assert!(differ <= 4.0, "{name}: {differ} voxels differ");
+    }
+    // A formula's sphere moved is the sphere at the moved centre, voxel for voxel.
+    let formula = r#"{"formula": {"text": "x^2 + y^2 + z^2 - 0.16",
+        "bounds": {"min": [-0.5, -0.5, -0.5], "max": [0.5, 0.5, 0.5]},
+        "place": {"translate": [0.3, -0.2, 0.1]}}}"#;
+    let sphere = r#"{"sphere": {"center": [0.3, -0.2, 0.1], "radius": 0.4}}"#;
+    let both = run("sphere", sphere);
+    assert!(both > 1000.0);
+    assert_eq!(
+        run(
+            "f-s",
+            &format!(r#"{{"difference": [{formula}, {sphere}]}}"#)
+        ),
+        0.0
+    );
+    assert_eq!(
+        run(
+            "s-f",
+            &format!(r#"{{"difference": [{sphere}, {formula}]}}"#)
+        ),
+        0.0
+    );
+}
+
+/// Fig. 4 (i)-(j) of Lai & Cheng: a cow less a moved copy, united with a turned one. Its
+/// voxels obey inclusion-exclusion over its parts' trees on the same grid, and a placed cow
+/// keeps its volume.
+#[test]
+fn moved_cows_differenced_then_united() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let cow = data.join("meshes/cow.obj");
+    let cow = cow.to_str().unwrap();
+    let a = format!(r#"{{"mesh": "{cow}"}}"#);
+    let b = format!(r#"{{"mesh": {{"file": "{cow}", "place": {{"translate": [2.5, 1, 0]}}}}}}"#);
+    let c = format!(
+        r#"{{"mesh": {{"file": "{cow}", "place": {{"rotate": {{"axis": [0, 0, 1], "degrees": 90}}, "scale": 0.8}}}}}}"#
+    );
+    // One grid for every tree: the box of all three cows.
+    let run = |name: &str, tree: &str| {
+        let top =
+            r#""bounds": {"min": [-4.5, -4.6, -1.8], "max": [8.6, 4.9, 1.8]}, "resolution": 200"#;
+        tree_voxels(dir.path(), name, &format!(r#"{{ {top}, "tree": {tree} }}"#))
+    };
+    let whole = run(
+        "whole",
+        &format!(r#"{{"union": [{{"difference": [{a}, {b}]}}, {c}]}}"#),
+    );
+    let (va, vb, vc) = (run("a", &a), run("b", &b), run("c", &c));
+    let ab = run("ab", &format!(r#"{{"intersection": [{a}, {b}]}}"#));
+    let ac = run("ac", &format!(r#"{{"intersection": [{a}, {c}]}}"#));
+    let abc = run("abc", &format!(r#"{{"intersection": [{a}, {b}, {c}]}}"#));
+    eprintln!("cows: whole {whole}, a {va}, b {vb}, c {vc}, ab {ab}, ac {ac}, abc {abc}");
+    // |(A - B) ∪ C| = |A| - |A ∩ B| + |C| - |A ∩ C| + |A ∩ B ∩ C|.
+    assert_eq!(whole, va - ab + vc - ac + abc);
+    assert!(
+        ab > 0.0 && ac > 0.0 && va - ab > 0.0,
+        "the copies overlap the cow"
+    );
+    // Moving keeps the volume; scaling by 0.8 scales it by 0.512.
+    assert!((vb - va).abs() < 0.01 * va, "{vb} against {va}");
+    assert!(
+        (vc - 0.512 * va).abs() < 0.02 * va,
+        "{vc} against {}",
+        0.512 * va
+    );
 }

@@ -242,7 +242,7 @@ fn csg_tree_bytes(root: &CsgNode, t: &Transform, b: &CoordBox) -> f64 {
                 subdivision_solid_bytes(control, t) + control.patch_count() as f64 * PATCH_BYTES
             }
             CsgNode::Grid { grid, .. } => grid.leaf_count() as f64 * LEAF_BYTES,
-            CsgNode::Primitive(_) | CsgNode::Formula { .. } => 0.0,
+            CsgNode::Primitive { .. } | CsgNode::Formula { .. } => 0.0,
         }
     }
     CSG_VOLUMES * cells(b) / 8.0

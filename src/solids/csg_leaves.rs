@@ -4,6 +4,7 @@
 //! inconsistently oriented closed meshes depth layers, exact ray parity at the centres); voxel
 //! grids from .vdb files as they are, resampled when their transform differs.
 
+use super::csg_placement::placed_box;
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
 use crate::implicit::Formula;
@@ -15,7 +16,7 @@ use crate::shapes::{Cuboid, Cylinder, Sphere};
 use crate::solids::depth_layers::{DepthLayerOptions, Layers, depth_layer_solid};
 use crate::solids::inside_rule::{Inside, InsideRule, choose_inside};
 use crate::solids::winding_inside::winding_inside;
-use glam::DVec3;
+use glam::{DAffine3, DVec3};
 use rayon::prelude::*;
 
 /// A solid leaf given by its shape, in world units.
@@ -105,14 +106,28 @@ fn fill_centres<S>(
     Ok(mask)
 }
 
-pub fn primitive_solid(p: &Primitive, transform: &Transform, bbox: CoordBox) -> Result<DenseMask> {
-    fill_centres(bbox, transform, &p.bounds(), || (), |_, c| p.contains(c))
+pub fn primitive_solid(
+    p: &Primitive,
+    to_local: &DAffine3,
+    transform: &Transform,
+    bbox: CoordBox,
+) -> Result<DenseMask> {
+    let bounds = placed_box(&p.bounds(), &to_local.inverse());
+    fill_centres(
+        bbox,
+        transform,
+        &bounds,
+        || (),
+        |_, c| p.contains(to_local.transform_point3(c)),
+    )
 }
 
-/// Voxels whose centres lie in `bounds` with F < 0.
+/// Voxels whose centres lie in `bounds` (world) with F < 0 at the centre mapped by
+/// `to_local` into the formula's frame.
 pub fn formula_solid(
     f: &Formula,
     bounds: &Aabb,
+    to_local: &DAffine3,
     transform: &Transform,
     bbox: CoordBox,
 ) -> Result<DenseMask> {
@@ -122,7 +137,7 @@ pub fn formula_solid(
         bounds,
         || Vec::with_capacity(f.tape.len()),
         |slots, c| {
-            let vars = f.coordinates_of(c.to_array());
+            let vars = f.coordinates_of(to_local.transform_point3(c).to_array());
             f.tape.eval_with(vars, slots) < 0.0
         },
     )
@@ -187,8 +202,30 @@ pub fn subdivision_leaf(
 }
 
 /// The active voxels of `grid` on `transform` (resampled when the transforms differ) that
-/// lie in `bbox`.
-pub fn grid_solid(grid: &SparseGrid, transform: &Transform, bbox: CoordBox) -> Result<DenseMask> {
+/// lie in `bbox`; placed elsewhere (`to_local` not the identity), the centres whose image in
+/// the grid's frame lies in an active voxel.
+pub fn grid_solid(
+    grid: &SparseGrid,
+    to_local: &DAffine3,
+    transform: &Transform,
+    bbox: CoordBox,
+) -> Result<DenseMask> {
+    if *to_local != DAffine3::IDENTITY {
+        let Some(local) = grid_bounds(grid) else {
+            return DenseMask::new(bbox);
+        };
+        let bounds = placed_box(&local, &to_local.inverse());
+        return fill_centres(
+            bbox,
+            transform,
+            &bounds,
+            || (),
+            |_, c| {
+                let i = grid.transform.world_to_index(to_local.transform_point3(c));
+                grid.contains(i.round().as_i64vec3().to_array())
+            },
+        );
+    }
     let resampled;
     let grid = if same_transform(&grid.transform, transform) {
         grid
@@ -219,7 +256,7 @@ pub fn measure_formula_solid(
     use crate::mesh::{GridFit, fit_transform, index_box};
     let transform = fit_transform(bounds, GridFit::Resolution(resolution))?;
     let bbox = index_box(bounds, &transform);
-    let solid = formula_solid(formula, bounds, &transform, bbox)?;
+    let solid = formula_solid(formula, bounds, &DAffine3::IDENTITY, &transform, bbox)?;
     let volume = solid.count() as f64 * transform.voxel_size.powi(3);
     let (area, _) = crate::ops::surface_area::face_weighted_area(&solid, &transform, |p| {
         formula.gradient_at(p.to_array(), &mut Vec::new())

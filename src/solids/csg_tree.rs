@@ -26,12 +26,14 @@
 //! operands from the first. A formula's solid is where F < 0. `voxel_size` may replace
 //! `resolution` (voxels along the longest axis of the bounds); `bounds` (top level) fixes the
 //! grid's extent, which otherwise covers every leaf (formulas need their own `bounds` then).
-//! Files are found relative to the tree file.
+//! Files are found relative to the tree file. Every leaf may carry `"place"` (`csg_placement`):
+//! `{"mesh": {"file": "cow.obj", "place": {"translate": [2, 0, 0]}}}`.
 
 use super::csg_leaves::{
     ALL_DIRECTIONS, Primitive, formula_solid, grid_bounds, grid_solid, mesh_solid, primitive_solid,
     subdivision_leaf,
 };
+use super::csg_placement::{PlaceSpec, placed_box, to_world};
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, SparseGrid, Transform};
 use crate::implicit::{Coordinates, Formula};
@@ -40,25 +42,32 @@ use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
 use crate::ops::csg::BooleanOp;
 use crate::shapes::{Cuboid, Cylinder, Sphere};
 use crate::subd::ControlMesh;
-use glam::DVec3;
+use glam::{DAffine3, DVec3};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
+/// A node of the tree. Meshes and control meshes are read placed; the other leaves keep their
+/// own frame and the map from the world into it (`to_local`, the identity unless placed).
 pub enum CsgNode {
     Boolean {
         op: BooleanOp,
         operands: Vec<CsgNode>,
     },
-    Primitive(Primitive),
+    Primitive {
+        shape: Primitive,
+        to_local: DAffine3,
+    },
     Formula {
         formula: Formula,
         bounds: Option<Aabb>,
+        to_local: DAffine3,
     },
     Mesh(Mesh),
     Subdivision(ControlMesh),
     Grid {
         grid: SparseGrid,
         source: PathBuf,
+        to_local: DAffine3,
     },
 }
 
@@ -91,7 +100,7 @@ impl CsgTree {
                 CsgNode::Mesh(mesh) => files.push(mesh.source.clone()),
                 CsgNode::Subdivision(control) => files.push(control.source.clone()),
                 CsgNode::Grid { source, .. } => files.push(source.clone()),
-                CsgNode::Primitive(_) | CsgNode::Formula { .. } => {}
+                CsgNode::Primitive { .. } | CsgNode::Formula { .. } => {}
             }
         }
         let mut files = vec![self.source.clone()];
@@ -129,13 +138,21 @@ enum NodeSpec {
     Union(Vec<NodeSpec>),
     Intersection(Vec<NodeSpec>),
     Difference(Vec<NodeSpec>),
-    Box(BoundsSpec),
+    Box(BoxSpec),
     Cylinder(CylinderSpec),
     Sphere(SphereSpec),
     Formula(FormulaSpec),
-    Mesh(String),
-    Subdiv(String),
+    Mesh(FileSpec),
+    Subdiv(FileSpec),
     Vdb(VdbSpec),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BoxSpec {
+    min: [f64; 3],
+    max: [f64; 3],
+    place: Option<Box<PlaceSpec>>,
 }
 
 #[derive(Deserialize)]
@@ -145,6 +162,7 @@ struct CylinderSpec {
     axis: [f64; 3],
     radius: f64,
     height: f64,
+    place: Option<Box<PlaceSpec>>,
 }
 
 #[derive(Deserialize)]
@@ -152,6 +170,30 @@ struct CylinderSpec {
 struct SphereSpec {
     center: [f64; 3],
     radius: f64,
+    place: Option<Box<PlaceSpec>>,
+}
+
+/// `"part.obj"`, or `{"file": "part.obj", "place": {...}}`.
+#[derive(Deserialize)]
+#[serde(
+    untagged,
+    expecting = "a file name, or {\"file\": ..., \"place\": ...}"
+)]
+enum FileSpec {
+    File(String),
+    Full {
+        file: String,
+        place: Option<Box<PlaceSpec>>,
+    },
+}
+
+impl FileSpec {
+    fn parts(self) -> (String, Option<Box<PlaceSpec>>) {
+        match self {
+            FileSpec::File(file) => (file, None),
+            FileSpec::Full { file, place } => (file, place),
+        }
+    }
 }
 
 /// `"F"`, or `{"text": "F", "coordinates": "spherical", "bounds": {...}}`.
@@ -166,6 +208,7 @@ enum FormulaSpec {
         text: String,
         coordinates: Option<String>,
         bounds: Option<BoundsSpec>,
+        place: Option<Box<PlaceSpec>>,
     },
 }
 
@@ -177,7 +220,11 @@ enum FormulaSpec {
 )]
 enum VdbSpec {
     File(String),
-    Full { file: String, grid: Option<String> },
+    Full {
+        file: String,
+        grid: Option<String>,
+        place: Option<Box<PlaceSpec>>,
+    },
 }
 
 /// Reads the tree in `path`, loading its meshes and grids. Errors name the file and the
@@ -256,6 +303,16 @@ impl Reader<'_> {
         }
     }
 
+    /// The map from a leaf's frame into the world, the identity when it is not placed.
+    fn to_world(&self, place: Option<Box<PlaceSpec>>, at: &str) -> Result<DAffine3> {
+        place.map_or(Ok(DAffine3::IDENTITY), |p| {
+            to_world(&p).map_err(|e| {
+                let (field, message) = e.split_once(": ").unwrap_or(("", &e));
+                self.error(&format!("{at}.place.{field}"), message)
+            })
+        })
+    }
+
     fn aabb(&self, b: BoundsSpec, at: &str) -> Result<Aabb> {
         let min = self.vec3(b.min, &format!("{at}.min"))?;
         let max = self.vec3(b.max, &format!("{at}.max"))?;
@@ -263,6 +320,18 @@ impl Reader<'_> {
             return Err(self.error(at, "min must be below max on every axis"));
         }
         Ok(Aabb { min, max })
+    }
+
+    fn primitive(
+        &self,
+        shape: Primitive,
+        place: Option<Box<PlaceSpec>>,
+        at: &str,
+    ) -> Result<CsgNode> {
+        Ok(CsgNode::Primitive {
+            shape,
+            to_local: self.to_world(place, at)?.inverse(),
+        })
     }
 
     fn node(&self, spec: NodeSpec, at: &str) -> Result<CsgNode> {
@@ -285,11 +354,17 @@ impl Reader<'_> {
             }
             NodeSpec::Difference(items) => boolean(BooleanOp::Difference, "difference", items),
             NodeSpec::Box(b) => {
-                let b = self.aabb(b, &format!("{at}.box"))?;
-                Ok(CsgNode::Primitive(Primitive::Cuboid(Cuboid {
+                let at = format!("{at}.box");
+                let bounds = BoundsSpec {
                     min: b.min,
                     max: b.max,
-                })))
+                };
+                let b2 = self.aabb(bounds, &at)?;
+                let shape = Primitive::Cuboid(Cuboid {
+                    min: b2.min,
+                    max: b2.max,
+                });
+                self.primitive(shape, b.place, &at)
             }
             NodeSpec::Cylinder(c) => {
                 let at = format!("{at}.cylinder");
@@ -297,31 +372,32 @@ impl Reader<'_> {
                 let axis = axis
                     .try_normalize()
                     .ok_or_else(|| self.error(&format!("{at}.axis"), "must not be zero"))?;
-                Ok(CsgNode::Primitive(Primitive::Cylinder(
-                    Cylinder::from_base(
-                        self.vec3(c.base, &format!("{at}.base"))?,
-                        axis,
-                        self.positive(c.radius, &format!("{at}.radius"))?,
-                        self.positive(c.height, &format!("{at}.height"))?,
-                    ),
-                )))
+                let shape = Primitive::Cylinder(Cylinder::from_base(
+                    self.vec3(c.base, &format!("{at}.base"))?,
+                    axis,
+                    self.positive(c.radius, &format!("{at}.radius"))?,
+                    self.positive(c.height, &format!("{at}.height"))?,
+                ));
+                self.primitive(shape, c.place, &at)
             }
             NodeSpec::Sphere(s) => {
                 let at = format!("{at}.sphere");
-                Ok(CsgNode::Primitive(Primitive::Sphere(Sphere {
+                let shape = Primitive::Sphere(Sphere {
                     center: self.vec3(s.center, &format!("{at}.center"))?,
                     radius: self.positive(s.radius, &format!("{at}.radius"))?,
-                })))
+                });
+                self.primitive(shape, s.place, &at)
             }
             NodeSpec::Formula(f) => {
                 let at = format!("{at}.formula");
-                let (text, coordinates, bounds) = match f {
-                    FormulaSpec::Text(text) => (text, None, None),
+                let (text, coordinates, bounds, place) = match f {
+                    FormulaSpec::Text(text) => (text, None, None, None),
                     FormulaSpec::Full {
                         text,
                         coordinates,
                         bounds,
-                    } => (text, coordinates, bounds),
+                        place,
+                    } => (text, coordinates, bounds, place),
                 };
                 let coordinates = match coordinates {
                     None => Coordinates::Cartesian,
@@ -334,23 +410,48 @@ impl Reader<'_> {
                 let bounds = bounds
                     .map(|b| self.aabb(b, &format!("{at}.bounds")))
                     .transpose()?;
-                Ok(CsgNode::Formula { formula, bounds })
+                let to_local = self.to_world(place, &at)?.inverse();
+                Ok(CsgNode::Formula {
+                    formula,
+                    bounds,
+                    to_local,
+                })
             }
-            NodeSpec::Mesh(file) => Mesh::load(&self.folder.join(file))
-                .map(CsgNode::Mesh)
-                .map_err(|e| self.error(&format!("{at}.mesh"), &e.to_string())),
-            NodeSpec::Subdiv(file) => ControlMesh::load(&self.folder.join(file))
-                .map(CsgNode::Subdivision)
-                .map_err(|e| self.error(&format!("{at}.subdiv"), &e.to_string())),
+            NodeSpec::Mesh(spec) => {
+                let at = format!("{at}.mesh");
+                let (file, place) = spec.parts();
+                let to_world = self.to_world(place, &at)?;
+                let mut mesh = Mesh::load(&self.folder.join(file))
+                    .map_err(|e| self.error(&at, &e.to_string()))?;
+                for p in &mut mesh.positions {
+                    *p = to_world.transform_point3(*p);
+                }
+                Ok(CsgNode::Mesh(mesh))
+            }
+            NodeSpec::Subdiv(spec) => {
+                let at = format!("{at}.subdiv");
+                let (file, place) = spec.parts();
+                let to_world = self.to_world(place, &at)?;
+                let mut control = ControlMesh::load(&self.folder.join(file))
+                    .map_err(|e| self.error(&at, &e.to_string()))?;
+                control.map_points(|p| to_world.transform_point3(p));
+                Ok(CsgNode::Subdivision(control))
+            }
             NodeSpec::Vdb(v) => {
-                let (file, name) = match v {
-                    VdbSpec::File(file) => (file, None),
-                    VdbSpec::Full { file, grid } => (file, grid),
+                let at = format!("{at}.vdb");
+                let (file, name, place) = match v {
+                    VdbSpec::File(file) => (file, None, None),
+                    VdbSpec::Full { file, grid, place } => (file, grid, place),
                 };
+                let to_local = self.to_world(place, &at)?.inverse();
                 let source = self.folder.join(file);
                 let grid = read_vdb_solid(&source, name.as_deref())
-                    .map_err(|e| self.error(&format!("{at}.vdb"), &e.to_string()))?;
-                Ok(CsgNode::Grid { grid, source })
+                    .map_err(|e| self.error(&at, &e.to_string()))?;
+                Ok(CsgNode::Grid {
+                    grid,
+                    source,
+                    to_local,
+                })
             }
         }
     }
@@ -373,11 +474,27 @@ impl CsgNode {
             CsgNode::Boolean { operands, .. } => {
                 operands.iter().map(CsgNode::bounds).fold(None, union)
             }
-            CsgNode::Primitive(p) => Some(p.bounds()),
-            CsgNode::Formula { bounds, .. } => *bounds,
+            CsgNode::Primitive { shape, to_local } => {
+                Some(placed_box(&shape.bounds(), &to_local.inverse()))
+            }
+            CsgNode::Formula {
+                bounds, to_local, ..
+            } => bounds.map(|b| placed_box(&b, &to_local.inverse())),
             CsgNode::Mesh(m) => Some(m.bbox()),
             CsgNode::Subdivision(c) => Some(c.bbox()),
-            CsgNode::Grid { grid, .. } => grid_bounds(grid),
+            CsgNode::Grid { grid, to_local, .. } => {
+                grid_bounds(grid).map(|b| placed_box(&b, &to_local.inverse()))
+            }
+        }
+    }
+
+    /// The map from the world into a leaf's own frame (the identity for meshes, read placed).
+    fn to_local(&self) -> &DAffine3 {
+        match self {
+            CsgNode::Primitive { to_local, .. }
+            | CsgNode::Formula { to_local, .. }
+            | CsgNode::Grid { to_local, .. } => to_local,
+            _ => &DAffine3::IDENTITY,
         }
     }
 
@@ -401,10 +518,19 @@ impl CsgNode {
                 }
                 return Ok(acc);
             }
-            CsgNode::Primitive(p) => (p.describe(), primitive_solid(p, transform, bbox)?),
-            CsgNode::Formula { formula, bounds } => (
+            CsgNode::Primitive { shape, to_local } => (
+                shape.describe(),
+                primitive_solid(shape, to_local, transform, bbox)?,
+            ),
+            CsgNode::Formula { formula, .. } => (
                 format!("formula {}", formula.text),
-                formula_solid(formula, &bounds.unwrap_or(*whole), transform, bbox)?,
+                formula_solid(
+                    formula,
+                    &self.bounds().unwrap_or(*whole),
+                    self.to_local(),
+                    transform,
+                    bbox,
+                )?,
             ),
             CsgNode::Mesh(m) => (
                 format!("mesh {}", m.source.display()),
@@ -414,13 +540,22 @@ impl CsgNode {
                 format!("subdiv {}", c.source.display()),
                 subdivision_leaf(c, transform, bbox)?,
             ),
-            CsgNode::Grid { grid, source } => (
+            CsgNode::Grid {
+                grid,
+                source,
+                to_local,
+            } => (
                 format!("vdb {}", source.display()),
-                grid_solid(grid, transform, bbox)?,
+                grid_solid(grid, to_local, transform, bbox)?,
             ),
         };
+        let placed = *self.to_local() != DAffine3::IDENTITY;
         leaves.push(LeafReport {
-            what,
+            what: if placed {
+                format!("{what} (placed)")
+            } else {
+                what
+            },
             voxels: mask.count(),
         });
         Ok(mask)

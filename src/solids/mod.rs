@@ -5,6 +5,7 @@
 pub mod beam;
 pub mod cavities;
 pub mod csg_leaves;
+pub mod csg_placement;
 #[cfg(feature = "vdb")]
 pub mod csg_tree;
 pub mod depth_layers;
