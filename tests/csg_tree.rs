@@ -330,3 +330,60 @@ fn moved_cows_differenced_then_united() {
         0.512 * va
     );
 }
+
+/// Catmull-Clark solids and grids placed in a multi-level tree: two tori side by side (one
+/// moved, one turned) less a box through both, against their parts on the same grid; a grid
+/// leaf turned a quarter about z is the torus turned so, up to nearest sampling.
+#[test]
+fn placed_catmull_clark_and_grid_leaves_in_a_multi_level_tree() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let torus = data.join("subd/catmark_torus.obj");
+    let torus = torus.to_str().unwrap();
+    let a = format!(r#"{{"subdiv": "{torus}"}}"#);
+    let b = format!(
+        r#"{{"subdiv": {{"file": "{torus}", "place": {{"translate": [3, 0, 0], "rotate": {{"axis": [1, 0, 0], "degrees": 90}}}}}}}}"#
+    );
+    let cut = r#"{"box": {"min": [-0.5, -0.2, -2], "max": [3.5, 0.2, 2]}}"#;
+    let run = |name: &str, tree: &str| {
+        let top =
+            r#""bounds": {"min": [-1.6, -1.6, -1.6], "max": [4.6, 1.6, 1.6]}, "resolution": 240"#;
+        tree_voxels(dir.path(), name, &format!(r#"{{ {top}, "tree": {tree} }}"#))
+    };
+    let (va, vb) = (run("a", &a), run("b", &b));
+    let whole = run(
+        "whole",
+        &format!(r#"{{"difference": [{{"union": [{a}, {b}]}}, {cut}]}}"#),
+    );
+    let (a_cut, b_cut) = (
+        run("acut", &format!(r#"{{"intersection": [{a}, {cut}]}}"#)),
+        run("bcut", &format!(r#"{{"intersection": [{b}, {cut}]}}"#)),
+    );
+    eprintln!("tori: a {va}, b {vb}, whole {whole}, cut {a_cut} and {b_cut}");
+    assert!(a_cut > 0.0 && b_cut > 0.0, "the box cuts both tori");
+    // Apart, the tori share no voxel: the tree is each less its cut.
+    assert_eq!(whole, va - a_cut + vb - b_cut);
+    assert!((vb - va).abs() < 0.01 * va, "{vb} against {va}");
+    // The grid of the first torus turned a quarter about z is the torus turned so.
+    let grid = dir.path().join("a.vdb");
+    let quarter = r#"{"rotate": {"axis": [0, 0, 1], "degrees": 90}}"#;
+    let turned_grid = format!(
+        r#"{{"vdb": {{"file": "{}", "place": {quarter}}}}}"#,
+        grid.to_str().unwrap()
+    );
+    let turned_torus = format!(r#"{{"subdiv": {{"file": "{torus}", "place": {quarter}}}}}"#);
+    let vt = run("turned", &turned_grid);
+    let apart = run(
+        "apart",
+        &format!(r#"{{"difference": [{turned_grid}, {turned_torus}]}}"#),
+    ) + run(
+        "apart2",
+        &format!(r#"{{"difference": [{turned_torus}, {turned_grid}]}}"#),
+    );
+    eprintln!("turned grid {vt}, {apart} voxels apart from the turned torus");
+    assert!((vt - va).abs() < 0.01 * va, "{vt} against {va}");
+    // Nearest sampling moves the boundary by at most a voxel: a thin shell of the 112,877.
+    assert!(apart < 0.02 * va, "{apart} voxels apart");
+}
