@@ -120,6 +120,8 @@ class BrickPlan:
     def inside_reason(self) -> Optional[str]: ...
     @property
     def winding_bricks(self) -> List[Index]: ...
+    @property
+    def full_brick_bytes(self) -> int: ...
 
 def brick_plan(
     source: MeshSource,
@@ -146,7 +148,7 @@ def brick_surface_file(
     path: Path,
     separability: int,
     max_memory_mib: Optional[int] = None,
-) -> int: ...
+) -> Tuple[int, int]: ...
 def brick_faces(
     positions: npt.NDArray[np.float64],
     indices: npt.NDArray[np.uint32],
@@ -168,7 +170,7 @@ def brick_solid_file(
     exterior: Sequence[int],
     path: Path,
     max_memory_mib: Optional[int] = None,
-) -> int: ...
+) -> Tuple[int, int]: ...
 def brick_winding_file(
     positions: npt.NDArray[np.float64],
     indices: npt.NDArray[np.uint32],
@@ -182,7 +184,7 @@ def brick_winding_file(
     size: int,
     path: Path,
     max_memory_mib: Optional[int] = None,
-) -> int: ...
+) -> Tuple[int, int]: ...
 def brick_exterior(
     plan: BrickPlan, faces: Dict[Index, Sequence[npt.NDArray[np.uint32]]]
 ) -> Dict[Index, List[int]]: ...

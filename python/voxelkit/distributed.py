@@ -18,7 +18,8 @@ client joins them across bricks and finds the exterior (what reaches the grid's 
 brick then writes its surface and the components that are not exterior, and bricks without
 faces are wholly outside or wholly inside (written as tiles, no task).
 
-The bricks are merged into ``OUT.vdb`` when the result fits in the client's memory, else (or
+The bricks are merged into ``OUT.vdb`` when the result fits in the client's memory (each
+brick reports the bytes its leaves and tiles take; a solid's inside is mostly tiles), else (or
 with ``--keep-bricks``) kept as ``OUT.bricks/`` with an index ``OUT.bricks/index.json`` that
 ``voxelkit info`` and ``voxelkit.read_vdb`` read as one grid. Workers write brick files into
 that folder, so with ``--scheduler`` it must be on a file system every worker sees.
@@ -45,8 +46,6 @@ from . import _voxelkit as vk
 #: The options of a distributed run, their defaults, choices and docs: the library's table.
 _FIELDS = OPTIONS["distributed"]["fields"]
 
-#: Bytes of memory per merged voxel, generously (leaves hold 512 voxels in about 3.5 KiB).
-_MERGED_BYTES_PER_VOXEL = 16
 
 
 def _surface_brick(arrays, origin, voxel_size, brick, size, path, separability, max_memory_mib):
@@ -310,11 +309,11 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
             client.close()
             if cluster is not None:
                 cluster.close()
-    voxels = sum(counts.values()) + len(full_bricks) * size**3
+    # Each brick task gives its voxels and the bytes its leaves and tiles take in the merge.
+    voxels = sum(v for v, _ in counts.values()) + len(full_bricks) * size**3
+    merged_bytes = sum(b for _, b in counts.values()) + len(full_bricks) * plan.full_brick_bytes
     available = _available_bytes()
-    merge = not keep_bricks and (
-        available is None or voxels * _MERGED_BYTES_PER_VOXEL < available
-    )
+    merge = not keep_bricks and (available is None or merged_bytes < available)
     check()
     index = os.path.join(folder, "index.json")
     grid = vk.brick_finish(plan, files, full_bricks, index, merged=output if merge else None)

@@ -40,6 +40,13 @@ const SOLID_FILL: f64 = 0.5;
 /// 211 leaves; 39 MiB while OpenVDB was loaded).
 pub const BASE_BYTES: f64 = 10.0 * (1 << 20) as f64;
 
+/// Bytes a grid read back holds, leaves and tiles, with the reader's 300 bytes a leaf (as
+/// `grid_plan` prices them): what merging it with others into one output costs.
+pub fn merged_bytes(grid: &SparseGrid) -> u64 {
+    (leaf_bytes(grid.leaf_count() as f64, 0) + grid.leaf_count() as f64 * 300.0 + tile_bytes(grid))
+        as u64
+}
+
 /// Peak bytes of a set of `leaves` leaves with `vector_channels` normal or colour channels.
 fn leaf_bytes(leaves: f64, vector_channels: u32) -> f64 {
     (leaves + 1.0) * (LEAF_BYTES + f64::from(vector_channels) * VECTOR_LEAF_BYTES)

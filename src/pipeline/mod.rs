@@ -15,7 +15,7 @@ pub mod request;
 mod solid;
 
 pub use crate::solids::flooded_mesh::FLOOD_NEEDS_CLOSED;
-pub use estimate::BASE_BYTES;
+pub use estimate::{BASE_BYTES, merged_bytes};
 pub use outcome::{Outcome, check_output_path};
 pub use report::*;
 

@@ -17,7 +17,7 @@ use crate::mesh::Mesh;
 use crate::pipeline::brick_exterior::exterior_labels;
 use crate::pipeline::bricks::{BrickIndex, BrickRun, sub_mesh};
 use crate::pipeline::request::{BricksRequest, mib_limit};
-use crate::pipeline::{BrickStage, BrickTask, Details, Job, Limits, Outcome, Task};
+use crate::pipeline::{BrickStage, BrickTask, Details, Job, Limits, Outcome, Task, merged_bytes};
 use crate::progress::Unobserved;
 use crate::voxelize::Separability;
 use glam::DVec3;
@@ -115,6 +115,15 @@ impl BrickPlan {
     #[getter]
     fn inside_reason(&self) -> Option<String> {
         self.0.inside_reason.clone()
+    }
+
+    /// The bytes a brick wholly inside takes in a merge (its tiles).
+    #[getter]
+    fn full_brick_bytes(&self) -> u64 {
+        let layout = &self.0.layout;
+        let mut full = crate::grid::SparseGrid::new(layout.transform, Default::default());
+        crate::io::brick_set::fill_box(&mut full, layout.voxels(layout.min));
+        merged_bytes(&full)
     }
 
     /// The bricks a winding solid runs (with faces, or within the mesh's box).
@@ -223,14 +232,16 @@ type BrickArrays<'py> = (
     PyReadonlyArray1<'py, u32>,
 );
 
-/// Writes a brick's grid to `path` (atomically) and returns its voxel count.
-fn write_brick(py: Python<'_>, mut outcome: Outcome, path: &Path) -> PyResult<u64> {
+/// Writes a brick's grid to `path` (atomically) and returns its voxel count and the bytes
+/// it takes in a merge (`merged_bytes`).
+fn write_brick(py: Python<'_>, mut outcome: Outcome, path: &Path) -> PyResult<(u64, u64)> {
     py.detach(|| outcome.write(path, &[], &WriteOptions::default()))
         .map_err(to_py_err)?;
-    Ok(outcome.grid.voxel_count())
+    Ok((outcome.grid.voxel_count(), merged_bytes(&outcome.grid)))
 }
 
-/// A brick's part of the separating surface, written to `path`; returns its voxel count.
+/// A brick's part of the separating surface, written to `path`; returns its voxel count and
+/// merge bytes.
 #[pyfunction]
 #[pyo3(signature = (positions, indices, starts, origin, voxel_size, brick, size, path,
     separability, max_memory_mib = None))]
@@ -247,7 +258,7 @@ pub fn brick_surface_file(
     path: PathBuf,
     separability: u32,
     max_memory_mib: Option<u64>,
-) -> PyResult<u64> {
+) -> PyResult<(u64, u64)> {
     let separability =
         Separability::from_number(i64::from(separability)).map_err(PyValueError::new_err)?;
     let arrays = (positions, indices, starts);
@@ -299,7 +310,7 @@ pub fn brick_faces<'py>(
 }
 
 /// A brick of the solid (its surface and the components not in `exterior`), written to
-/// `path`; returns its voxel count.
+/// `path`; returns its voxel count and merge bytes.
 #[pyfunction]
 #[pyo3(signature = (positions, indices, starts, origin, voxel_size, brick, size, exterior,
     path, max_memory_mib = None))]
@@ -316,7 +327,7 @@ pub fn brick_solid_file(
     exterior: Vec<u32>,
     path: PathBuf,
     max_memory_mib: Option<u64>,
-) -> PyResult<u64> {
+) -> PyResult<(u64, u64)> {
     let arrays = (positions, indices, starts);
     let stage = BrickStage::Solid { exterior };
     let outcome = run_brick(
@@ -330,7 +341,7 @@ pub fn brick_solid_file(
 
 /// A brick of a solid whose inside is the winding number of the whole mesh (`mesh_*`, as
 /// `BrickPlan.mesh_arrays` gives it): its surface and the centres inside, written to `path`;
-/// returns its voxel count.
+/// returns its voxel count and merge bytes.
 #[pyfunction]
 #[pyo3(signature = (positions, indices, starts, mesh_positions, mesh_indices, mesh_starts,
     origin, voxel_size, brick, size, path, max_memory_mib = None))]
@@ -349,7 +360,7 @@ pub fn brick_winding_file(
     size: i64,
     path: PathBuf,
     max_memory_mib: Option<u64>,
-) -> PyResult<u64> {
+) -> PyResult<(u64, u64)> {
     let mesh = from_arrays(
         (mesh_positions, mesh_indices, mesh_starts),
         "the run's mesh",
