@@ -40,11 +40,16 @@ const SOLID_FILL: f64 = 0.5;
 /// 211 leaves; 39 MiB while OpenVDB was loaded).
 pub const BASE_BYTES: f64 = 10.0 * (1 << 20) as f64;
 
-/// Bytes a grid read back holds, leaves and tiles, with the reader's 300 bytes a leaf (as
-/// `grid_plan` prices them): what merging it with others into one output costs.
+/// What reading a `.vdb` costs besides the leaves it keeps: per leaf of a voxel set, and per
+/// leaf whose values are read too.
+const READ_LEAF_BYTES: f64 = 300.0;
+const READ_VALUE_LEAF_BYTES: f64 = 4300.0;
+
+/// Bytes a grid read back holds, leaves and tiles, with the reader's cost a leaf: what
+/// merging it with others into one voxel set costs.
 pub fn merged_bytes(grid: &SparseGrid) -> u64 {
-    (leaf_bytes(grid.leaf_count() as f64, 0) + grid.leaf_count() as f64 * 300.0 + tile_bytes(grid))
-        as u64
+    let leaves = grid.leaf_count() as f64;
+    (leaf_bytes(leaves, 0) + leaves * READ_LEAF_BYTES + tile_bytes(grid)) as u64
 }
 
 /// Peak bytes of a set of `leaves` leaves with `vector_channels` normal or colour channels.
@@ -298,20 +303,21 @@ fn brick_bytes(brick: &BrickTask, t: &Transform) -> f64 {
             edge.powi(3) / 4.0 + runs * RUN_BYTES + leaves()
         }
         BrickStage::Winding { mesh } => {
+            // The triangles whose projection's box meets the brick's columns.
             let columns = brick_voxels(brick.brick, brick.size);
-            let over = |v: DVec3| {
-                let p = t.world_to_index(v);
-                (0..2).all(|a| {
-                    p[a] >= columns.min[a] as f64 - 1.0 && p[a] <= columns.max[a] as f64 + 1.0
+            let over = |tri: &[DVec3; 3]| {
+                let [a, b, c] = tri.map(|v| t.world_to_index(v));
+                let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+                (0..2).all(|i| {
+                    hi[i] >= columns.min[i] as f64 - 1.0 && lo[i] <= columns.max[i] as f64 + 1.0
                 })
             };
-            let near: Vec<[DVec3; 3]> = mesh
+            let near = mesh
                 .triangles()
                 .map(|(_, tri)| tri.map(|v| mesh.p(v)))
-                .filter(|tri| tri.iter().any(|&v| over(v)))
-                .collect();
+                .filter(over);
             mesh.triangle_count() as f64 * BAND_TRIANGLE_BYTES
-                + crossings_in_voxels(near.into_iter(), t) * WINDING_CROSSING_BYTES
+                + crossings_in_voxels(near, t) * WINDING_CROSSING_BYTES
                 + leaves()
         }
     };
@@ -729,7 +735,11 @@ fn world_box(grid: &SparseGrid) -> Aabb {
 /// with the input's name.
 fn grid_plan(grid: &SparseGrid, what: &str) -> Result<Plan> {
     let box_cells = cells(&padded(grid_box(grid), 2));
-    let read_bytes = if grid.channels().value { 4300.0 } else { 300.0 };
+    let read_bytes = if grid.channels().value {
+        READ_VALUE_LEAF_BYTES
+    } else {
+        READ_LEAF_BYTES
+    };
     let bytes = (1.0 + 0.3 * MEASURE_COST.inside_volumes) * box_cells / 8.0
         + grid.leaf_count() as f64 * (MEASURE_COST.leaf_bytes + read_bytes)
         + tile_bytes(grid);

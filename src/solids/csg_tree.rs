@@ -355,16 +355,9 @@ impl Reader<'_> {
             NodeSpec::Difference(items) => boolean(BooleanOp::Difference, "difference", items),
             NodeSpec::Box(b) => {
                 let at = format!("{at}.box");
-                let bounds = BoundsSpec {
-                    min: b.min,
-                    max: b.max,
-                };
-                let b2 = self.aabb(bounds, &at)?;
-                let shape = Primitive::Cuboid(Cuboid {
-                    min: b2.min,
-                    max: b2.max,
-                });
-                self.primitive(shape, b.place, &at)
+                let BoxSpec { min, max, place } = b;
+                let Aabb { min, max } = self.aabb(BoundsSpec { min, max }, &at)?;
+                self.primitive(Primitive::Cuboid(Cuboid { min, max }), place, &at)
             }
             NodeSpec::Cylinder(c) => {
                 let at = format!("{at}.cylinder");
