@@ -4,6 +4,7 @@
 //! (Huang et al.), checked by flooding, and written as OpenVDB files.
 
 pub mod choice;
+pub mod contour;
 pub mod error;
 pub mod grid;
 pub mod huge_pages;

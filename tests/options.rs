@@ -16,7 +16,7 @@ use voxelkit::pipeline::request::{FillKind, SurfaceKind, schema};
 use voxelkit::voxelize::separating::Criterion;
 
 /// The subcommand whose flags fill each request.
-const SUBCOMMANDS: [(&str, &[&str]); 9] = [
+const SUBCOMMANDS: [(&str, &[&str]); 10] = [
     ("mesh", &["mesh"]),
     ("solid", &["solid"]),
     ("measure", &["measure"]),
@@ -24,6 +24,7 @@ const SUBCOMMANDS: [(&str, &[&str]); 9] = [
     ("implicit", &["implicit"]),
     ("lines", &["lines"]),
     ("combine", &["csg"]),
+    ("to_mesh", &["to-mesh"]),
     ("limits", &["mesh"]),
     ("write", &["mesh"]),
 ];

@@ -22,6 +22,10 @@ impl Channels {
         normal: false,
         color: false,
     };
+    pub const VALUE: Channels = Channels {
+        value: true,
+        ..Channels::NONE
+    };
 }
 
 #[derive(Clone, Debug)]

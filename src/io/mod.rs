@@ -7,6 +7,7 @@ pub mod brick_set;
 pub mod grid_export;
 #[cfg(feature = "vdb")]
 mod grid_out;
+pub mod mesh_out;
 #[cfg(feature = "vdb")]
 mod nvdb_writer;
 pub mod preview;

@@ -14,6 +14,7 @@ use super::nvdb_writer::write_nvdb_grids;
 use super::vdb_format::{COVARIANT_NORMALIZE, FOG_VOLUME, LEVEL_SET};
 pub use super::vdb_format::{Compression, MetaValue};
 use super::vdb_writer::{Encoding, write_grids};
+use crate::contour::{Meaning, ScalarField};
 use crate::error::{Error, Result};
 use crate::grid::{Channels, LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use crate::progress::{StageClock, StageTime};
@@ -436,10 +437,7 @@ fn unreadable(path: &Path, e: impl std::fmt::Display) -> Error {
 
 /// Describes every grid in the file.
 pub fn read_vdb_info(path: &Path) -> Result<Vec<GridInfo>> {
-    let file = open(path)?;
-    (0..file.grid_count())
-        .map(|i| file.grid_info(i).map_err(|e| unreadable(path, e)))
-        .collect()
+    grid_infos(path, &open(path)?)
 }
 
 /// Reads the Bool, Mask, Float or Vec3S grid `name` into a grid, or without a name the voxel
@@ -461,9 +459,114 @@ pub fn read_vdb_solid(path: &Path, name: Option<&str>) -> Result<SparseGrid> {
 
 fn read_grid(path: &Path, name: Option<&str>, solid: bool) -> Result<SparseGrid> {
     let file = open(path)?;
-    let infos: Vec<GridInfo> = (0..file.grid_count())
+    let infos = grid_infos(path, &file)?;
+    let index = choose_grid(path, &infos, name)?;
+    read_chosen(path, &file, &infos[index], index, solid)
+}
+
+/// The field whose zero set `voxelkit to-mesh` draws, from grid `name`, or without a name the
+/// level set (`surface`) when the file has one, else the grid `read_vdb_grid` chooses: a level
+/// set's values (every leaf voxel's, inactive ones too) less `iso` (default 0), a fog volume's
+/// `iso` (default 0.5) less its density, a voxel set's voxels.
+pub fn read_vdb_field(path: &Path, name: Option<&str>, iso: Option<f64>) -> Result<ScalarField> {
+    let file = open(path)?;
+    let infos = grid_infos(path, &file)?;
+    let level_set = infos
+        .iter()
+        .position(|i| i.name == LEVEL_SET_GRID && is_level_set(i));
+    let chosen = match (name, level_set) {
+        (None, Some(i)) => i,
+        _ => choose_grid(path, &infos, name)?,
+    };
+    let info = &infos[chosen];
+    if !matches!(info.value_type.as_str(), "bool" | "mask" | "float") {
+        return Err(vdb_error(
+            path,
+            format!(
+                "grid `{}` holds {} values: a mesh is drawn from a level set, a fog volume or a \
+                 voxel set (float, bool or mask grids)",
+                info.name, info.value_type
+            ),
+        ));
+    }
+    if is_level_set(info) {
+        let iso = iso.unwrap_or(0.0) as f32;
+        plan_read(path, info)?;
+        let tree = file
+            .read_negative(chosen)
+            .map_err(|e| unreadable(path, e))?;
+        let leaves = tree
+            .leaves
+            .into_par_iter()
+            .map(|read| {
+                let mut leaf = Leaf::new(read.origin.map(i64::from), Channels::VALUE);
+                leaf.mask = read.mask;
+                if let Some(v) = leaf.value.as_mut() {
+                    v.copy_from_slice(&read.values);
+                }
+                leaf
+            })
+            .collect();
+        let mut grid = SparseGrid::from_leaves(transform_of(info), Channels::VALUE, leaves);
+        fill_tiles(&mut grid, tree.tiles);
+        return ScalarField::level_set(grid, iso).ok_or_else(|| {
+            vdb_error(
+                path,
+                format!(
+                    "iso {iso} lies beyond the band of level set `{}`: its values are known \
+                     only within the band",
+                    info.name
+                ),
+            )
+        });
+    }
+    let grid = read_chosen(path, &file, info, chosen, false)?;
+    let fog = info.value_type == "float";
+    if !fog && iso.is_some() {
+        return Err(vdb_error(
+            path,
+            format!(
+                "grid `{}` is a voxel set ({}): it has no values for an iso value to choose \
+                 among",
+                info.name, info.value_type
+            ),
+        ));
+    }
+    let iso = iso.unwrap_or(if fog { 0.5 } else { 0.0 });
+    if fog && !(iso > 0.0 && iso.is_finite()) {
+        return Err(vdb_error(
+            path,
+            format!(
+                "grid `{}` is a fog volume (density 0 outside): its iso value must be above 0, \
+                 not {iso}",
+                info.name
+            ),
+        ));
+    }
+    Ok(ScalarField {
+        grid,
+        meaning: if fog { Meaning::Fog } else { Meaning::Voxels },
+        iso: iso as f32,
+    })
+}
+
+fn is_level_set(info: &GridInfo) -> bool {
+    info.grid_class == "level set" && info.value_type == "float"
+}
+
+fn grid_infos(path: &Path, file: &VdbFile) -> Result<Vec<GridInfo>> {
+    (0..file.grid_count())
         .map(|i| file.grid_info(i).map_err(|e| unreadable(path, e)))
-        .collect::<Result<_>>()?;
+        .collect()
+}
+
+fn transform_of(info: &GridInfo) -> Transform {
+    Transform::new(DVec3::from_array(info.origin), info.voxel_size[0])
+}
+
+/// Grid `name`, or the voxel set voxelkit writes (`voxels`, else `density`, else the first
+/// bool, mask or float grid).
+fn choose_grid(path: &Path, infos: &[GridInfo], name: Option<&str>) -> Result<usize> {
     let readable = |i: &GridInfo| matches!(i.value_type.as_str(), "bool" | "mask" | "float");
     let named = |n: &str| infos.iter().position(|i| i.name == n && readable(i));
     let index = match name {
@@ -476,7 +579,12 @@ fn read_grid(path: &Path, name: Option<&str>, solid: bool) -> Result<SparseGrid>
         Some(n) => vdb_error(path, format!("no grid named `{n}`")),
         None => vdb_error(path, "no bool, mask or float grid in the file"),
     })?;
-    let info = &infos[index];
+    Ok(index)
+}
+
+/// Checks that `info`'s grid is placed as voxelkit places grids, and that its copy fits
+/// before anything is allocated: leaves with their values, tiles as origins.
+fn plan_read(path: &Path, info: &GridInfo) -> Result<()> {
     if !info.uniform_linear {
         return Err(vdb_error(
             path,
@@ -488,7 +596,6 @@ fn read_grid(path: &Path, name: Option<&str>, solid: bool) -> Result<SparseGrid>
             ),
         ));
     }
-    // Plan the copy before anything is allocated: leaves with their values, tiles as origins.
     let per_leaf = match info.value_type.as_str() {
         "float" => 3 * 4 * LEAF_VOXELS,
         "vec3s" => 3 * 3 * 4 * LEAF_VOXELS,
@@ -505,10 +612,19 @@ fn read_grid(path: &Path, name: Option<&str>, solid: bool) -> Result<SparseGrid>
             info.name,
             info.active_voxels
         ),
-    )?;
-    let level_set = solid && info.grid_class == "level set" && info.value_type == "float";
-    let transform = Transform::new(DVec3::from_array(info.origin), info.voxel_size[0]);
-    if level_set {
+    )
+}
+
+fn read_chosen(
+    path: &Path,
+    file: &VdbFile,
+    info: &GridInfo,
+    index: usize,
+    solid: bool,
+) -> Result<SparseGrid> {
+    plan_read(path, info)?;
+    let transform = transform_of(info);
+    if solid && is_level_set(info) {
         let tree = file.read_negative(index).map_err(|e| unreadable(path, e))?;
         let leaves = tree
             .leaves

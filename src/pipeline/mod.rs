@@ -13,6 +13,7 @@ mod outcome;
 mod report;
 pub mod request;
 mod solid;
+pub mod to_mesh;
 
 pub use crate::solids::flooded_mesh::FLOOD_NEEDS_CLOSED;
 pub use estimate::{BASE_BYTES, merged_bytes};

@@ -537,6 +537,19 @@ request! {
 }
 
 request! {
+    /// A mesh drawn from a grid: the closed, manifold surface of a level set's zero set, a fog
+    /// volume's iso surface or a voxel set's boundary.
+    ToMeshRequest as "to_mesh" {
+        /// The grid read from a file (none: the level set `surface` when there is one, else
+        /// `voxels`, else `density`, else the first bool, mask or float grid).
+        grid: Option<String> = None,
+        /// The value the surface passes through (none: 0 for a level set, 0.5 for a fog
+        /// volume; a voxel set takes none).
+        iso: Option<f64> = None,
+    }
+}
+
+request! {
     /// The separating surface (or solid) of a mesh cut into bricks and voxelized by Dask
     /// workers, merged into one .vdb.
     BricksRequest as "distributed" placed {
@@ -890,6 +903,7 @@ pub fn schema() -> Value {
             entry::<ImplicitRequest>(),
             entry::<LinesRequest>(),
             entry::<CombineRequest>(),
+            entry::<ToMeshRequest>(),
             entry::<QueryRequest>(),
             entry::<BricksRequest>(),
             entry::<LimitsRequest>(),

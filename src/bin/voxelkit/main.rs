@@ -9,6 +9,7 @@ mod run;
 mod solid_depth;
 mod solids;
 mod subdiv;
+mod to_mesh;
 
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
@@ -224,6 +225,10 @@ enum Command {
     /// Volume, mass, components and genus of a mesh (its inside by --inside) or of a closed
     /// .vdb surface.
     Measure(solids::MeasureArgs),
+    /// Draw the surface of a grid in a .vdb as a closed, manifold triangle mesh (.obj, .ply,
+    /// .stl or .glb): a level set's zero set, a fog volume's iso surface or a voxel set's
+    /// boundary.
+    ToMesh(to_mesh::ToMeshArgs),
     /// Voxelize an implicit surface F = 0 typed as a formula, by interval octree (Stolte &
     /// Kaufman): every level of the octree envelops the surface.
     Implicit(implicit::ImplicitArgs),
@@ -247,7 +252,7 @@ impl Command {
             Command::Measure(a) => (None, Some(a.up.up_axis)),
             Command::Implicit(a) => (Some(&a.write), None),
             Command::Subdiv(a) => (Some(&a.voxelize.write), Some(a.voxelize.up.up_axis)),
-            Command::Info { .. } | Command::Render(_) => (None, None),
+            Command::Info { .. } | Command::Render(_) | Command::ToMesh(_) => (None, None),
         }
     }
 }
@@ -318,6 +323,7 @@ fn main() -> ExitCode {
         Command::Csg(args) => solids::csg(&args, &global),
         Command::Intersect(args) => solids::intersect(&args, &global),
         Command::Measure(args) => solids::measure(&args, &global),
+        Command::ToMesh(args) => to_mesh::run(&args, &global),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,12 @@
+//! Meshes out of grids: the closed, 2-manifold, outward-oriented triangle mesh of a level
+//! set's zero set, a fog volume's iso surface or a voxel set's boundary (`extract`), over the
+//! per-cell surface cycles (`cell_cycles`) with vertices placed on the tangent planes the
+//! values give (`vertex_placement`).
+
+mod cell_cycles;
+mod extract;
+mod field;
+mod vertex_placement;
+
+pub use extract::{TriangleMesh, contour};
+pub use field::{Meaning, ScalarField};

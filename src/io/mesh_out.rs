@@ -1,0 +1,206 @@
+//! Triangle meshes written as files, the format chosen by the extension: OBJ (text),
+//! binary little-endian PLY, binary STL or binary glTF (`.glb`). Coordinates are written as
+//! 32-bit floats (OBJ's text too: the shortest text that reads back to the same float), which
+//! every reader of these formats expects. Writes are atomic.
+
+use super::atomic::write_atomic;
+use crate::contour::TriangleMesh;
+use crate::error::{Error, Result};
+use rayon::prelude::*;
+use std::io::Write;
+use std::path::Path;
+
+/// The mesh formats written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshFormat {
+    Obj,
+    Ply,
+    Stl,
+    Glb,
+}
+
+impl MeshFormat {
+    /// The format named by `path`'s extension, or an error naming the ones written.
+    pub fn of(path: &Path) -> Result<MeshFormat> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("obj") => Ok(MeshFormat::Obj),
+            Some("ply") => Ok(MeshFormat::Ply),
+            Some("stl") => Ok(MeshFormat::Stl),
+            Some("glb") => Ok(MeshFormat::Glb),
+            _ => Err(Error::InvalidArgument(format!(
+                "{}: a mesh is written as .obj, .ply, .stl or .glb (named by the extension)",
+                path.display()
+            ))),
+        }
+    }
+}
+
+/// Writes `mesh` to `path` in the format its extension names.
+pub fn write_mesh(path: &Path, mesh: &TriangleMesh) -> Result<()> {
+    let format = MeshFormat::of(path)?;
+    // Binary glTF counts its bytes in 32 bits; STL its triangles.
+    let glb_bytes = 12 * (mesh.positions.len() as u64 + mesh.triangles.len() as u64) + 4096;
+    if format == MeshFormat::Glb && glb_bytes > u32::MAX as u64 {
+        return Err(Error::InvalidArgument(format!(
+            "{}: {} triangles do not fit a .glb (4 GiB at most): write .ply instead",
+            path.display(),
+            mesh.triangles.len()
+        )));
+    }
+    let bytes = match format {
+        MeshFormat::Obj => obj(mesh),
+        MeshFormat::Ply => ply(mesh),
+        MeshFormat::Stl => stl(mesh),
+        MeshFormat::Glb => glb(mesh),
+    };
+    write_atomic(path, |tmp| {
+        let mut file = std::fs::File::create(tmp).map_err(|e| Error::io(tmp, e))?;
+        file.write_all(&bytes).map_err(|e| Error::io(tmp, e))
+    })
+}
+
+fn point(mesh: &TriangleMesh, i: u32) -> [f32; 3] {
+    mesh.positions[i as usize].as_vec3().to_array()
+}
+
+/// Rows formatted in parallel chunks, joined in order.
+fn text_rows<T: Sync>(rows: &[T], row: impl Fn(&mut String, &T) + Sync) -> Vec<u8> {
+    let chunks: Vec<String> = rows
+        .par_chunks(1 << 14)
+        .map(|chunk| {
+            let mut s = String::with_capacity(chunk.len() * 32);
+            for r in chunk {
+                row(&mut s, r);
+            }
+            s
+        })
+        .collect();
+    chunks.concat().into_bytes()
+}
+
+fn obj(mesh: &TriangleMesh) -> Vec<u8> {
+    use std::fmt::Write as _;
+    let mut out = format!(
+        "# written by voxelkit {}: {} vertices, {} triangles\n",
+        env!("CARGO_PKG_VERSION"),
+        mesh.positions.len(),
+        mesh.triangles.len()
+    )
+    .into_bytes();
+    out.extend(text_rows(&mesh.positions, |s, p| {
+        let p = p.as_vec3();
+        let _ = writeln!(s, "v {} {} {}", p.x, p.y, p.z);
+    }));
+    out.extend(text_rows(&mesh.triangles, |s, t| {
+        let _ = writeln!(s, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+    }));
+    out
+}
+
+fn ply(mesh: &TriangleMesh) -> Vec<u8> {
+    let header = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment written by voxelkit {}\nelement vertex {}\n\
+         property float x\nproperty float y\nproperty float z\nelement face {}\n\
+         property list uchar int vertex_indices\nend_header\n",
+        env!("CARGO_PKG_VERSION"),
+        mesh.positions.len(),
+        mesh.triangles.len()
+    );
+    let mut out =
+        Vec::with_capacity(header.len() + 12 * mesh.positions.len() + 13 * mesh.triangles.len());
+    out.extend_from_slice(header.as_bytes());
+    for p in &mesh.positions {
+        for v in p.as_vec3().to_array() {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    for t in &mesh.triangles {
+        out.push(3);
+        for v in t {
+            out.extend_from_slice(&(*v as i32).to_le_bytes());
+        }
+    }
+    out
+}
+
+fn stl(mesh: &TriangleMesh) -> Vec<u8> {
+    let mut out = Vec::with_capacity(84 + 50 * mesh.triangles.len());
+    let mut header = format!(
+        "binary STL written by voxelkit {}",
+        env!("CARGO_PKG_VERSION")
+    )
+    .into_bytes();
+    header.resize(80, b' ');
+    out.extend_from_slice(&header);
+    out.extend_from_slice(&(mesh.triangles.len() as u32).to_le_bytes());
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+        let normal = (b - a)
+            .cross(c - a)
+            .normalize_or_zero()
+            .as_vec3()
+            .to_array();
+        out.extend(normal.iter().flat_map(|v| v.to_le_bytes()));
+        for &i in t {
+            out.extend(point(mesh, i).iter().flat_map(|v| v.to_le_bytes()));
+        }
+        out.extend_from_slice(&0u16.to_le_bytes());
+    }
+    out
+}
+
+/// One buffer (positions, then indices), two accessors, one mesh, one node.
+fn glb(mesh: &TriangleMesh) -> Vec<u8> {
+    let mut bin = Vec::with_capacity(12 * mesh.positions.len() + 12 * mesh.triangles.len());
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for p in &mesh.positions {
+        for (a, v) in p.as_vec3().to_array().into_iter().enumerate() {
+            lo[a] = lo[a].min(v);
+            hi[a] = hi[a].max(v);
+            bin.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    let positions_len = bin.len();
+    for t in &mesh.triangles {
+        for v in t {
+            bin.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    let json = serde_json::json!({
+        "asset": {"version": "2.0", "generator": format!("voxelkit {}", env!("CARGO_PKG_VERSION"))},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": positions_len, "target": 34962},
+            {"buffer": 0, "byteOffset": positions_len, "byteLength": bin.len() - positions_len, "target": 34963},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": mesh.positions.len(), "type": "VEC3",
+             "min": lo, "max": hi},
+            {"bufferView": 1, "componentType": 5125, "count": 3 * mesh.triangles.len(), "type": "SCALAR"},
+        ],
+    });
+    let mut json = json.to_string().into_bytes();
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json);
+    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&bin);
+    out
+}
