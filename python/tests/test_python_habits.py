@@ -270,3 +270,27 @@ def test_progress_is_heard_from_the_fill_stage_to_its_end(trimesh):
         stage, done, total = heard[-1]
         assert (stage, done) == (last, total) and total > 0, (options, heard[-1])
         assert all(told[0] and told[1] <= told[2] for told in heard), options
+
+
+def test_to_mesh_gives_a_closed_mesh_trimesh_takes(trimesh, tmp_path):
+    """A level set's surface as numpy arrays: trimesh finds it watertight, consistently wound
+    and of the torus's volume; a solid's boundary encloses its voxels; write() by a mesh
+    extension writes the same mesh."""
+    torus = trimesh.creation.torus(major_radius=1.0, minor_radius=0.3)
+    grid = voxelkit.mesh(torus, sdf=True, resolution=96)
+    vertices, triangles = grid.to_mesh()
+    assert vertices.dtype == np.float64 and vertices.shape[1] == 3
+    assert triangles.dtype == np.int64 and triangles.shape[1] == 3
+    out = trimesh.Trimesh(vertices, triangles, process=False)
+    assert out.is_watertight and out.is_winding_consistent
+    assert abs(out.volume / torus.volume - 1) < 0.005
+    # A solid's mesh bounds its voxels, the surface voxels included.
+    voxels = voxelkit.solid(torus, resolution=96)
+    solid = trimesh.Trimesh(*voxels.to_mesh(), process=False)
+    assert solid.is_watertight
+    report = voxels.report
+    assert report["volume_inside"] < solid.volume < report["volume_with_surface"]
+    grid.write(tmp_path / "torus.ply")
+    back = trimesh.load(tmp_path / "torus.ply", process=False)
+    assert len(back.faces) == len(triangles)
+    assert np.allclose(back.vertices, vertices, atol=1e-6)

@@ -62,7 +62,12 @@ class Grid:
         compression: str = "blosc",
         half: bool = False,
     ) -> None:
-        """Writes .vdb, .nvdb (NanoVDB), .binvox or .vox by extension, atomically, never over an input."""
+        """Writes .vdb, .nvdb (NanoVDB), .binvox or .vox by extension, or the surface as a mesh
+        (to_mesh's) to .obj, .ply, .stl or .glb; atomically, never over an input."""
+    def to_mesh(self) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+        """The surface as a closed, manifold triangle mesh: (vertices (n, 3) world positions,
+        triangles (m, 3) vertex rows, counter-clockwise seen from outside). A level set's zero
+        set (sdf=True), a solid's or a voxel surface's boundary."""
     def render(
         self, path: Path, view: str = "iso", size: Tuple[int, int] = (800, 600)
     ) -> None:

@@ -4,7 +4,9 @@
 //! density 1, empty space 0); a voxel set's -1/2 on its voxels and tiles, +1/2 elsewhere, so
 //! that its surface passes half way between a voxel and an empty neighbour.
 
-use crate::grid::{Block, Coord, Leaf, SparseGrid};
+use crate::grid::{Block, Channels, Coord, Leaf, SparseGrid, offset_coord};
+use rayon::prelude::*;
+use std::borrow::Cow;
 
 /// How a grid's contents are read as values.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -19,17 +21,17 @@ pub enum Meaning {
 }
 
 /// A grid read as a field, with the iso value of the surface wanted.
-pub struct ScalarField {
-    pub grid: SparseGrid,
+pub struct ScalarField<'g> {
+    pub grid: Cow<'g, SparseGrid>,
     pub meaning: Meaning,
     pub iso: f32,
 }
 
-impl ScalarField {
+impl<'g> ScalarField<'g> {
     /// The field of a level set grid (leaves holding every voxel's value, tiles only where
     /// negative), or none when `iso` lies beyond its band: beyond the leaves its values are the
     /// largest magnitude they hold, the band's edge, signed by the tiles.
-    pub fn level_set(grid: SparseGrid, iso: f32) -> Option<ScalarField> {
+    pub fn level_set(grid: SparseGrid, iso: f32) -> Option<ScalarField<'g>> {
         let outside = grid
             .leaves()
             .iter()
@@ -37,8 +39,75 @@ impl ScalarField {
             .flat_map(|v| v.iter())
             .fold(0f32, |m, v| m.max(v.abs()));
         (iso.abs() < outside).then_some(ScalarField {
-            grid,
+            grid: Cow::Owned(grid),
             meaning: Meaning::LevelSet { outside },
+            iso,
+        })
+    }
+
+    /// The field of a distance band held in memory: distances on `band`'s voxels, elsewhere
+    /// `-background` in `interior` (a level set's inside) and `background` beyond it (an
+    /// unsigned band has no interior); none when `iso` lies beyond the band.
+    pub fn from_band(
+        band: &SparseGrid,
+        background: f32,
+        interior: Option<&SparseGrid>,
+        iso: f32,
+    ) -> Option<ScalarField<'g>> {
+        if iso.abs() >= background {
+            return None;
+        }
+        let inside = |c: Coord| interior.is_some_and(|g| g.contains(c));
+        let sign = |c: Coord| if inside(c) { -background } else { background };
+        let mut leaves: Vec<Leaf> = band
+            .leaves()
+            .par_iter()
+            .map(|l| {
+                let mut leaf = Leaf::new(l.origin, Channels::VALUE);
+                leaf.mask = l.mask;
+                let values = leaf.value.as_mut().expect("a value leaf");
+                for (n, v) in values.iter_mut().enumerate() {
+                    *v = match &l.value {
+                        Some(d) if l.is_on(n) => d[n],
+                        _ => sign(offset_coord(l.origin, n)),
+                    };
+                }
+                leaf
+            })
+            .collect();
+        if let Some(interior) = interior {
+            leaves.extend(
+                interior
+                    .leaves()
+                    .iter()
+                    .filter(|l| band.leaf(l.origin).is_none())
+                    .map(|l| {
+                        let mut leaf = Leaf::new(l.origin, Channels::VALUE);
+                        let values = leaf.value.as_mut().expect("a value leaf");
+                        for (n, v) in values.iter_mut().enumerate() {
+                            *v = if l.is_on(n) { -background } else { background };
+                        }
+                        leaf
+                    }),
+            );
+        }
+        let mut grid = SparseGrid::from_distinct_leaves(band.transform, Channels::VALUE, leaves);
+        if let Some(interior) = interior {
+            // Band leaves inside a tile keep their distances (a block with a leaf is not whole).
+            interior
+                .tiles()
+                .leaf_tiles()
+                .for_each(|o| grid.fill_leaf_block(o));
+            interior
+                .tiles()
+                .node_tiles()
+                .for_each(|o| grid.fill_node_block(o));
+        }
+        Some(ScalarField {
+            grid: Cow::Owned(grid),
+            meaning: Meaning::LevelSet {
+                outside: background,
+            },
             iso,
         })
     }

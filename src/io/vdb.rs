@@ -468,7 +468,11 @@ fn read_grid(path: &Path, name: Option<&str>, solid: bool) -> Result<SparseGrid>
 /// level set (`surface`) when the file has one, else the grid `read_vdb_grid` chooses: a level
 /// set's values (every leaf voxel's, inactive ones too) less `iso` (default 0), a fog volume's
 /// `iso` (default 0.5) less its density, a voxel set's voxels.
-pub fn read_vdb_field(path: &Path, name: Option<&str>, iso: Option<f64>) -> Result<ScalarField> {
+pub fn read_vdb_field(
+    path: &Path,
+    name: Option<&str>,
+    iso: Option<f64>,
+) -> Result<ScalarField<'static>> {
     let file = open(path)?;
     let infos = grid_infos(path, &file)?;
     let level_set = infos
@@ -544,7 +548,7 @@ pub fn read_vdb_field(path: &Path, name: Option<&str>, iso: Option<f64>) -> Resu
         ));
     }
     Ok(ScalarField {
-        grid,
+        grid: std::borrow::Cow::Owned(grid),
         meaning: if fog { Meaning::Fog } else { Meaning::Voxels },
         iso: iso as f32,
     })

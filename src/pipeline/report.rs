@@ -5,6 +5,14 @@ use crate::progress::StageTime;
 use crate::solids::winding_inside::AMBIGUOUS;
 use serde::Serialize;
 
+/// A mesh written from a grid.
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct MeshWritten {
+    pub file: String,
+    pub vertices: u64,
+    pub triangles: u64,
+}
+
 /// The report of one job. Every number is a number; `seconds` is the whole run.
 #[derive(Serialize, Debug, Clone, Default)]
 pub struct Report {
@@ -16,6 +24,9 @@ pub struct Report {
     /// The preview picture written beside the output (`--preview`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub preview: Option<String>,
+    /// The mesh of the result's surface written beside it (`--mesh-out`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mesh: Option<MeshWritten>,
     /// The method, as written to the `.vdb` metadata.
     pub method: String,
     /// Voxels of the main grid (the surface, or the whole solid).
@@ -410,6 +421,12 @@ impl Report {
         };
         if let Some(p) = &self.preview {
             text.push_str(&format!("\npreview: {p}"));
+        }
+        if let Some(m) = &self.mesh {
+            text.push_str(&format!(
+                "\nmesh: {} ({} vertices, {} triangles, closed and manifold)",
+                m.file, m.vertices, m.triangles
+            ));
         }
         if !self.stages.is_empty() {
             let each: Vec<String> = self

@@ -1,27 +1,28 @@
-//! A mesh from a `.vdb` file: its grid read as a field, contoured and written, timed by stage
-//! and reported.
+//! Meshes of results: a `.vdb` file's grid, or a job's outcome, read as a field, contoured
+//! and written, timed by stage and reported.
 
+use super::Outcome;
 use super::request::ToMeshRequest;
-use super::{Limits, on_threads};
-use crate::contour::{Meaning, contour};
+use super::{Limits, MeshWritten, on_threads};
+use crate::contour::{Meaning, ScalarField, TriangleMesh, contour};
 use crate::error::{Error, Result};
 use crate::io::atomic::check_output;
 use crate::io::mesh_out::{MeshFormat, write_mesh};
 use crate::io::vdb::read_vdb_field;
 use crate::progress::{StageClock, StageTime};
 use serde::Serialize;
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 /// What a mesh run did.
 #[derive(Clone, Debug, Serialize)]
 pub struct MeshReport {
     pub input: PathBuf,
-    pub output: PathBuf,
+    #[serde(flatten)]
+    pub mesh: MeshWritten,
     /// The grid's meaning: level set, fog volume or voxels.
     pub meaning: &'static str,
     pub iso: f64,
-    pub vertices: u64,
-    pub triangles: u64,
     /// Read, contour and write, with their seconds and threads busy.
     pub stages: Vec<StageTime>,
 }
@@ -29,11 +30,10 @@ pub struct MeshReport {
 impl MeshReport {
     pub fn summary(&self) -> String {
         format!(
-            "{}: {} vertices, {} triangles (closed, manifold) from {} of {} at iso {}\n\
-             {}",
-            self.output.display(),
-            self.vertices,
-            self.triangles,
+            "{}: {} vertices, {} triangles (closed, manifold) from the {} of {} at iso {}\n{}",
+            self.mesh.file,
+            self.mesh.vertices,
+            self.mesh.triangles,
             self.meaning,
             self.input.display(),
             self.iso,
@@ -59,29 +59,86 @@ pub fn vdb_to_mesh(
     on_threads(limits.threads, || {
         let mut read = StageClock::new("read");
         let field = read.time(|| read_vdb_field(input, request.grid.as_deref(), request.iso))?;
-        let mut contouring = StageClock::new("contour");
-        let mesh = contouring.time(|| contour(&field));
-        if mesh.triangles.is_empty() {
-            return Err(Error::InvalidArgument(format!(
-                "{}: the grid has no surface at iso {} (its values never cross it)",
-                input.display(),
-                field.iso
-            )));
-        }
-        let mut writing = StageClock::new("write");
-        writing.time(|| write_mesh(output, &mesh))?;
+        let (mesh, mut stages) = contour_to_file(&field, output, input)?;
+        stages.insert(0, read.stage());
         Ok(MeshReport {
             input: input.to_path_buf(),
-            output: output.to_path_buf(),
+            mesh,
             meaning: match field.meaning {
                 Meaning::LevelSet { .. } => "level set",
                 Meaning::Fog => "fog volume",
                 Meaning::Voxels => "voxels",
             },
             iso: field.iso as f64,
-            vertices: mesh.positions.len() as u64,
-            triangles: mesh.triangles.len() as u64,
-            stages: vec![read.stage(), contouring.stage(), writing.stage()],
+            stages,
         })
     })
+}
+
+/// Checks before a job runs that its mesh can be written to `output`.
+pub fn check_mesh_output(output: &Path, inputs: &[&Path]) -> Result<()> {
+    MeshFormat::of(output)?;
+    check_output(output, inputs)
+}
+
+impl Outcome {
+    /// The result as a field: a level set's distances (its zero set the surface), or a voxel
+    /// set (its boundary).
+    fn field(&self) -> Result<ScalarField<'_>> {
+        match &self.distances {
+            Some(d) => ScalarField::from_band(&self.grid, d.background, d.interior.as_ref(), 0.0)
+                .ok_or_else(|| Error::InvalidArgument("the distance band is empty".into())),
+            None => Ok(ScalarField {
+                grid: Cow::Borrowed(&self.grid),
+                meaning: Meaning::Voxels,
+                iso: 0.0,
+            }),
+        }
+    }
+
+    /// The surface of the result as a closed, manifold triangle mesh (empty when the
+    /// result is).
+    pub fn surface_mesh(&self) -> Result<TriangleMesh> {
+        let field = self.field()?;
+        on_threads(self.threads, || Ok(contour(&field)))
+    }
+
+    /// Writes the surface of the result to `output` (.obj, .ply, .stl or .glb), noted in the
+    /// report.
+    pub fn write_mesh(&mut self, output: &Path) -> Result<()> {
+        let field = self.field()?;
+        let source = PathBuf::from(&self.report.input);
+        let (mesh, stages) = on_threads(self.threads, || contour_to_file(&field, output, &source))?;
+        self.report.stages.extend(stages);
+        self.report.mesh = Some(mesh);
+        Ok(())
+    }
+}
+
+/// Contours `field` and writes the mesh to `output`; refuses a field without a surface,
+/// naming `source`.
+fn contour_to_file(
+    field: &ScalarField,
+    output: &Path,
+    source: &Path,
+) -> Result<(MeshWritten, Vec<StageTime>)> {
+    let mut contouring = StageClock::new("contour");
+    let mesh = contouring.time(|| contour(field));
+    if mesh.triangles.is_empty() {
+        return Err(Error::InvalidArgument(format!(
+            "{}: the grid has no surface at iso {} (its values never cross it)",
+            source.display(),
+            field.iso
+        )));
+    }
+    let mut writing = StageClock::new("write mesh");
+    writing.time(|| write_mesh(output, &mesh))?;
+    Ok((
+        MeshWritten {
+            file: output.display().to_string(),
+            vertices: mesh.positions.len() as u64,
+            triangles: mesh.triangles.len() as u64,
+        },
+        vec![contouring.stage(), writing.stage()],
+    ))
 }

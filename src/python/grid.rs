@@ -7,9 +7,11 @@ use crate::grid::Transform;
 use crate::io::preview::{Scene, View, check_picture_output, render, write_png};
 use crate::io::vdb::{COLOR_GRID, DISTANCE_GRID, LEVEL_SET_GRID, NORMAL_GRID};
 
+use crate::io::mesh_out::MeshFormat;
 use crate::mesh::UpAxis;
 use crate::pipeline::Outcome;
 use crate::pipeline::request::WriteRequest;
+use crate::pipeline::to_mesh::check_mesh_output;
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArrayLike2};
 use pyo3::exceptions::{PyKeyError, PyValueError};
@@ -370,7 +372,8 @@ impl Grid {
 
     /// Writes the grid as the CLI does, by extension: `.vdb` (all grids, or those `grids`
     /// names: `density`, `voxels`, `normal`, `Cd`, `shell`, ...), `.nvdb` (the same grids
-    /// for NanoVDB), `.binvox` or `.vox`; atomically, never over an input of the job. The keywords are `OPTIONS["write"]`'s:
+    /// for NanoVDB), `.binvox` or `.vox`; or its surface as a mesh (`to_mesh`'s): `.obj`,
+    /// `.ply`, `.stl` or `.glb`; atomically, never over an input of the job. The keywords are `OPTIONS["write"]`'s:
     /// `grids`, `compression` (blosc, zip or none) and `half`.
     #[pyo3(signature = (path, **options))]
     fn write(
@@ -382,8 +385,38 @@ impl Grid {
         let options = Keywords::<WriteRequest>::new(options)?.request.options();
         let inputs: Vec<&std::path::Path> = self.inputs.iter().map(PathBuf::as_path).collect();
         let outcome = &mut self.outcome;
-        py.detach(|| outcome.write(&path, &inputs, &options))
-            .map_err(to_py_err)
+        py.detach(|| {
+            if MeshFormat::of(&path).is_ok() {
+                check_mesh_output(&path, &inputs)?;
+                return outcome.write_mesh(&path);
+            }
+            outcome.write(&path, &inputs, &options)
+        })
+        .map_err(to_py_err)
+    }
+
+    /// The surface as a closed, manifold triangle mesh, counter-clockwise seen from outside:
+    /// `(vertices, triangles)`, an (n, 3) float64 array of world positions and an (m, 3)
+    /// int64 array of vertex rows. A level set's zero set (sdf), a solid's or a voxel
+    /// surface's boundary, half way between its voxels and empty ones.
+    #[allow(clippy::type_complexity)]
+    fn to_mesh<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>)> {
+        let outcome = &self.outcome;
+        let mesh = py.detach(|| outcome.surface_mesh()).map_err(to_py_err)?;
+        let vertices: Vec<f64> = mesh.positions.iter().flat_map(|p| p.to_array()).collect();
+        let triangles: Vec<i64> = mesh
+            .triangles
+            .iter()
+            .flat_map(|t| t.map(i64::from))
+            .collect();
+        let vertices = Array2::from_shape_vec((mesh.positions.len(), 3), vertices)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let triangles = Array2::from_shape_vec((mesh.triangles.len(), 3), triangles)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok((vertices.into_pyarray(py), triangles.into_pyarray(py)))
     }
 
     /// Draws the voxels into a PNG at `path`, as `voxelkit render` does: each voxel a cube,

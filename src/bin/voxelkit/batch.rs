@@ -87,6 +87,11 @@ pub fn run(
         let job = Job::new(task(MeshSource::File(input.clone()))?, fit);
         return run_and_report(job, output, global);
     }
+    if global.mesh_out.is_some() {
+        return Err(Error::InvalidArgument(
+            "--mesh-out names one mesh file: it takes one input, not a batch".into(),
+        ));
+    }
     let fit = if out.frames.is_some() || out.shared_grid {
         let files: Vec<PathBuf> = pairs.iter().map(|(i, _)| i.clone()).collect();
         shared_placement(&files, fit, global.up_axis)?

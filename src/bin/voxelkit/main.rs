@@ -77,6 +77,10 @@ pub struct WriteArgs {
     /// `voxelkit render` takes views and sizes).
     #[arg(long)]
     pub preview: bool,
+    /// Also write the result's surface as a closed, manifold triangle mesh (.obj, .ply, .stl
+    /// or .glb): a level set's zero set (--sdf), a solid's or a voxel surface's boundary.
+    #[arg(long, value_name = "MESH")]
+    pub mesh_out: Option<PathBuf>,
 }
 
 /// The up axis of input mesh files: an option of the commands that read meshes.
@@ -276,6 +280,7 @@ fn main() -> ExitCode {
         up_axis: up_axis.unwrap_or_default(),
         json: cli.json,
         preview: write.is_some_and(|w| w.preview),
+        mesh_out: write.and_then(|w| w.mesh_out.clone()),
         write: write.map_or_else(Default::default, |w| voxelkit::io::vdb::WriteOptions {
             grids: w.grids.clone(),
             compression: w.compression,

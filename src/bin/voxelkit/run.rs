@@ -10,6 +10,7 @@ use std::time::Instant;
 use voxelkit::Result;
 use voxelkit::io::vdb::{WriteOptions, check_voxel_size};
 use voxelkit::pipeline::request::LimitsRequest;
+use voxelkit::pipeline::to_mesh::check_mesh_output;
 use voxelkit::pipeline::{Job, Limits, Outcome, PlannedJob, check_output_path};
 use voxelkit::progress::Observer;
 
@@ -22,6 +23,8 @@ pub struct Global {
     pub write: WriteOptions,
     /// Draw a picture of each result beside its output (`--preview`).
     pub preview: bool,
+    /// Also write the result's surface as a mesh (`--mesh-out`).
+    pub mesh_out: Option<std::path::PathBuf>,
 }
 
 impl Global {
@@ -94,6 +97,10 @@ pub fn plan_job(
         inputs.extend_from_slice(also_read);
         check_output_path(out, &inputs)?;
         check_voxel_size(out, planned.plan().transform.voxel_size)?;
+        if let Some(mesh) = &global.mesh_out {
+            inputs.push(out);
+            check_mesh_output(mesh, &inputs)?;
+        }
     }
     Ok(planned)
 }
@@ -116,6 +123,9 @@ pub fn finish_job(
             let limit = global.limits().max_memory;
             let png = crate::render::beside(&outcome.grid, out, Default::default(), limit)?;
             outcome.report.preview = Some(png.display().to_string());
+        }
+        if let Some(mesh) = &global.mesh_out {
+            outcome.write_mesh(mesh)?;
         }
     }
     outcome.report.finish(start);
