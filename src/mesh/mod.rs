@@ -16,6 +16,7 @@ mod off;
 mod ply;
 pub mod shells;
 mod stl;
+pub mod surface_distance;
 pub mod triangle_distance;
 mod up_axis;
 pub mod winding;

@@ -11,6 +11,12 @@ pub struct MeshWritten {
     pub file: String,
     pub vertices: u64,
     pub triangles: u64,
+    /// Remeshing: the largest distance from the mesh to its source and from the source to
+    /// it (world units).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub distance_to_source: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub source_to_mesh: Option<f64>,
 }
 
 /// The report of one job. Every number is a number; `seconds` is the whole run.
@@ -427,6 +433,14 @@ impl Report {
                 "\nmesh: {} ({} vertices, {} triangles, closed and manifold)",
                 m.file, m.vertices, m.triangles
             ));
+            if let (Some(to), Some(from)) = (m.distance_to_source, m.source_to_mesh) {
+                text.push_str(&format!(
+                    "\n  two-sided distance to the input: mesh to input {to:.6} ({:.3} voxels), \
+                     input to mesh {from:.6} ({:.3} voxels)",
+                    to / self.voxel_size,
+                    from / self.voxel_size
+                ));
+            }
         }
         if !self.stages.is_empty() {
             let each: Vec<String> = self

@@ -9,7 +9,10 @@ use crate::error::{Error, Result};
 use crate::io::atomic::check_output;
 use crate::io::mesh_out::{MeshFormat, write_mesh};
 use crate::io::vdb::read_vdb_field;
+use crate::mesh::Mesh;
+use crate::mesh::surface_distance::two_sided_distance;
 use crate::progress::{StageClock, StageTime};
+use glam::DVec3;
 use serde::Serialize;
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
@@ -59,7 +62,7 @@ pub fn vdb_to_mesh(
     on_threads(limits.threads, || {
         let mut read = StageClock::new("read");
         let field = read.time(|| read_vdb_field(input, request.grid.as_deref(), request.iso))?;
-        let (mesh, mut stages) = contour_to_file(&field, output, input)?;
+        let (_, mesh, mut stages) = contour_to_file(&field, output, input)?;
         stages.insert(0, read.stage());
         Ok(MeshReport {
             input: input.to_path_buf(),
@@ -106,11 +109,43 @@ impl Outcome {
     /// Writes the surface of the result to `output` (.obj, .ply, .stl or .glb), noted in the
     /// report.
     pub fn write_mesh(&mut self, output: &Path) -> Result<()> {
+        self.write_mesh_of(output, None)
+    }
+
+    /// Writes the surface as `write_mesh` does, and measures how far it lies from `source`,
+    /// the mesh the result was made of: a mesh remade closed and manifold.
+    pub fn write_remesh(&mut self, output: &Path, source: &Mesh) -> Result<()> {
+        self.write_mesh_of(output, Some(source))
+    }
+
+    fn write_mesh_of(&mut self, output: &Path, source: Option<&Mesh>) -> Result<()> {
         let field = self.field()?;
-        let source = PathBuf::from(&self.report.input);
-        let (mesh, stages) = on_threads(self.threads, || contour_to_file(&field, output, &source))?;
+        let input = PathBuf::from(&self.report.input);
+        let (mesh, mut written, mut stages) =
+            on_threads(self.threads, || contour_to_file(&field, output, &input))?;
+        if let Some(source) = source {
+            let mut measure = StageClock::new("distance to input");
+            let distance = measure.time(|| {
+                let corners = |m: &TriangleMesh| -> Vec<[DVec3; 3]> {
+                    m.triangles
+                        .iter()
+                        .map(|t| t.map(|i| m.positions[i as usize]))
+                        .collect()
+                };
+                let source: Vec<[DVec3; 3]> = source
+                    .triangles()
+                    .map(|(_, t)| t.map(|v| source.p(v)))
+                    .collect();
+                on_threads(self.threads, || {
+                    Ok(two_sided_distance(&corners(&mesh), &source))
+                })
+            })?;
+            written.distance_to_source = Some(distance.a_to_b);
+            written.source_to_mesh = Some(distance.b_to_a);
+            stages.push(measure.stage());
+        }
         self.report.stages.extend(stages);
-        self.report.mesh = Some(mesh);
+        self.report.mesh = Some(written);
         Ok(())
     }
 }
@@ -121,7 +156,7 @@ fn contour_to_file(
     field: &ScalarField,
     output: &Path,
     source: &Path,
-) -> Result<(MeshWritten, Vec<StageTime>)> {
+) -> Result<(TriangleMesh, MeshWritten, Vec<StageTime>)> {
     let mut contouring = StageClock::new("contour");
     let mesh = contouring.time(|| contour(field));
     if mesh.triangles.is_empty() {
@@ -133,12 +168,11 @@ fn contour_to_file(
     }
     let mut writing = StageClock::new("write mesh");
     writing.time(|| write_mesh(output, &mesh))?;
-    Ok((
-        MeshWritten {
-            file: output.display().to_string(),
-            vertices: mesh.positions.len() as u64,
-            triangles: mesh.triangles.len() as u64,
-        },
-        vec![contouring.stage(), writing.stage()],
-    ))
+    let written = MeshWritten {
+        file: output.display().to_string(),
+        vertices: mesh.positions.len() as u64,
+        triangles: mesh.triangles.len() as u64,
+        ..MeshWritten::default()
+    };
+    Ok((mesh, written, vec![contouring.stage(), writing.stage()]))
 }

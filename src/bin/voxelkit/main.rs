@@ -233,6 +233,10 @@ enum Command {
     /// .stl or .glb): a level set's zero set, a fog volume's iso surface or a voxel set's
     /// boundary.
     ToMesh(to_mesh::ToMeshArgs),
+    /// Remake any mesh (open, overlapping, self-intersecting too) as a closed, manifold mesh:
+    /// its level set on a grid, signed by --inside, drawn as a mesh; reports the two-sided
+    /// distance to the input.
+    Remesh(to_mesh::RemeshArgs),
     /// Voxelize an implicit surface F = 0 typed as a formula, by interval octree (Stolte &
     /// Kaufman): every level of the octree envelops the surface.
     Implicit(implicit::ImplicitArgs),
@@ -256,6 +260,7 @@ impl Command {
             Command::Measure(a) => (None, Some(a.up.up_axis)),
             Command::Implicit(a) => (Some(&a.write), None),
             Command::Subdiv(a) => (Some(&a.voxelize.write), Some(a.voxelize.up.up_axis)),
+            Command::Remesh(a) => (None, Some(a.up.up_axis)),
             Command::Info { .. } | Command::Render(_) | Command::ToMesh(_) => (None, None),
         }
     }
@@ -329,6 +334,7 @@ fn main() -> ExitCode {
         Command::Intersect(args) => solids::intersect(&args, &global),
         Command::Measure(args) => solids::measure(&args, &global),
         Command::ToMesh(args) => to_mesh::run(&args, &global),
+        Command::Remesh(args) => to_mesh::remesh(&args, &global),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

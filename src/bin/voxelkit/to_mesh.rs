@@ -1,11 +1,13 @@
-//! `voxelkit to-mesh`: the surface of a grid in a .vdb file as a triangle mesh.
+//! `voxelkit to-mesh`: the surface of a grid in a .vdb file as a triangle mesh; `voxelkit
+//! remesh`: any mesh remade closed and manifold through its level set.
 
-use crate::run::Global;
+use crate::run::{Global, run_job, with_flags};
 use clap::Args;
 use std::path::PathBuf;
 use voxelkit::Result;
-use voxelkit::pipeline::request::ToMeshRequest;
-use voxelkit::pipeline::to_mesh::vdb_to_mesh;
+use voxelkit::pipeline::request::{MeshRequest, Request, ToMeshRequest};
+use voxelkit::pipeline::to_mesh::{check_mesh_output, vdb_to_mesh};
+use voxelkit::pipeline::{Job, MeshSource};
 
 #[derive(Args)]
 pub struct ToMeshArgs {
@@ -35,5 +37,46 @@ pub fn run(args: &ToMeshArgs, global: &Global) -> Result<()> {
     } else {
         println!("{}", report.summary());
     }
+    Ok(())
+}
+
+#[derive(Args)]
+pub struct RemeshArgs {
+    /// Any mesh (.obj, .stl, .ply, .off, .gltf or .glb): open, overlapping and
+    /// self-intersecting ones take their inside from --inside.
+    pub input: PathBuf,
+    /// The closed, manifold mesh written: .obj, .ply, .stl or .glb.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub fit: crate::FitArgs,
+    #[command(flatten)]
+    pub inside: crate::solids::InsideArgs,
+    #[command(flatten)]
+    pub up: crate::UpAxisArgs,
+}
+
+/// The mesh's level set on the grid, signed by the inside rule, drawn as a mesh, and its
+/// distance to the input measured.
+pub fn remesh(args: &RemeshArgs, global: &Global) -> Result<()> {
+    let source = MeshSource::File(args.input.clone());
+    let request = MeshRequest {
+        sdf: true,
+        inside: args.inside.inside,
+        ..MeshRequest::default()
+    };
+    check_mesh_output(&args.output, &[&args.input])?;
+    let mesh = source.load(false, global.up_axis)?;
+    let job = Job::new(request.task(source)?, args.fit.grid_fit()?);
+    let mut outcome = run_job(job, None, global)?;
+    outcome.write_remesh(&args.output, &mesh)?;
+    println!(
+        "{}",
+        if global.json {
+            outcome.report.to_json()
+        } else {
+            with_flags(&outcome.report.summary())
+        }
+    );
     Ok(())
 }
