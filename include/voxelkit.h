@@ -147,6 +147,13 @@ vk_status vk_mesh_from_triangles(const double *positions, size_t vertex_count,
 /* Vertex and face counts. */
 vk_status vk_mesh_counts(const vk_mesh *mesh, size_t *vertices, size_t *faces);
 
+/*
+ * Copies a triangle mesh out: 3 * vertices doubles (x, y, z) into `positions` and
+ * 3 * faces zero-based vertex indices into `triangles` (the counts of vk_mesh_counts).
+ * VK_ERROR_INVALID_ARGUMENT when a face is not a triangle.
+ */
+vk_status vk_mesh_copy_triangles(const vk_mesh *mesh, double *positions, uint32_t *triangles);
+
 vk_status vk_mesh_free(vk_mesh *mesh);
 
 /* ---- options ---------------------------------------------------------------------------- */
@@ -284,6 +291,16 @@ vk_status vk_grid_write_vdb(const vk_grid *grid, const char *path);
  * the compression and half precision. */
 vk_status vk_grid_write_vdb_with(const vk_grid *grid, const char *path,
                                  const vk_options *options);
+
+/*
+ * The grid's surface as a closed, 2-manifold triangle mesh, counter-clockwise seen from
+ * outside (world coordinates): a level set's zero set (vk_options_set_sdf), a solid's or a
+ * voxel surface's boundary, half way between its voxels and empty ones. Read it with
+ * vk_mesh_counts and vk_mesh_copy_triangles; free it with vk_mesh_free.
+ */
+vk_status vk_grid_to_mesh(const vk_grid *grid, vk_mesh **out);
+/* The same mesh written to `path`: .obj, .ply, .stl or .glb by the extension (atomically). */
+vk_status vk_grid_write_mesh(const vk_grid *grid, const char *path);
 
 /*
  * The grids vk_grid_write_vdb_with(grid, path, options) writes (options NULL: those

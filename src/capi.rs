@@ -13,6 +13,7 @@ use crate::error::{Error, Result};
 use crate::grid::{Channels, Coord, LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use crate::implicit::Coordinates;
 use crate::io::grid_export::ExportedGrid;
+use crate::io::mesh_out::write_mesh;
 use crate::io::vdb::{Compression, MetaValue, WriteOptions, meta_entries, read_vdb_solid};
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::BooleanOp;
@@ -21,6 +22,7 @@ use crate::pipeline::request::{
     MeasureRequest, MeshRequest, Placement, Request, Schema, SolidRequest, SubdivRequest,
     SurfaceKind, WriteRequest,
 };
+use crate::pipeline::to_mesh::check_mesh_output;
 use crate::pipeline::{Details, GridSource, Job, MeasureSource, MeshSource, Outcome, Task};
 use crate::progress::Observer;
 use crate::solids::depth_layers::Layers;
@@ -648,6 +650,30 @@ pub extern "C" fn vk_mesh_counts(
 }
 
 #[unsafe(no_mangle)]
+pub extern "C" fn vk_mesh_copy_triangles(
+    mesh: *const VkMesh,
+    positions: *mut f64,
+    triangles: *mut u32,
+) -> VkStatus {
+    guard(|| {
+        let m = &borrow(mesh, Kind::Mesh)?.0;
+        if let Some(f) = (0..m.face_count()).find(|&f| m.face(f).len() != 3) {
+            return Err(invalid(format!(
+                "face {f} has {} corners: vk_mesh_copy_triangles copies triangle meshes",
+                m.face(f).len()
+            )));
+        }
+        let p = slice_mut(positions, 3 * m.positions.len(), "positions")?;
+        for (out, v) in p.chunks_exact_mut(3).zip(&m.positions) {
+            out.copy_from_slice(&v.to_array());
+        }
+        let t = slice_mut(triangles, 3 * m.face_count(), "triangles")?;
+        t.copy_from_slice(&m.indices);
+        Ok(())
+    })
+}
+
+#[unsafe(no_mangle)]
 pub extern "C" fn vk_mesh_free(mesh: *mut VkMesh) -> VkStatus {
     guard(|| release(mesh, Kind::Mesh))
 }
@@ -1194,6 +1220,32 @@ pub extern "C" fn vk_grid_write_vdb_with(
         let path = PathBuf::from(c_str(path, "path")?);
         let write = options_of(options)?.write.options();
         Ok(g.outcome.write_files(&path, &[], &write)?)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_to_mesh(grid: *const VkGrid, out: *mut *mut VkMesh) -> VkStatus {
+    guard(|| {
+        non_null_out(out)?;
+        let g = borrow(grid, Kind::Grid)?;
+        let surface = g.outcome.surface_mesh()?;
+        let polygons: Vec<Vec<u32>> = surface.triangles.iter().map(|t| t.to_vec()).collect();
+        let mut mesh = Mesh::from_polygons("vk_grid_to_mesh", surface.positions, &polygons);
+        mesh.numbered_from_zero = true;
+        hand_out(VkMesh(mesh), Kind::Mesh, out)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_write_mesh(grid: *const VkGrid, path: *const c_char) -> VkStatus {
+    guard(|| {
+        let path = PathBuf::from(c_str(path, "path")?);
+        check_mesh_output(&path, &[])?;
+        let surface = borrow(grid, Kind::Grid)?.outcome.surface_mesh()?;
+        if surface.triangles.is_empty() {
+            return Err(invalid("the grid has no surface to write: it is empty"));
+        }
+        Ok(write_mesh(&path, &surface)?)
     })
 }
 

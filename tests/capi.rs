@@ -498,9 +498,9 @@ fn a_level_set_read_through_c_stands_for_its_inside() {
 }
 
 /// A level set made and read in memory through C (values against the exact distance of a
-/// box, measures, a Boolean operand) and a grid rebuilt from its leaves: `in_memory.c`, under
-/// valgrind; its level set file holds what the CLI's `--sdf` file holds, and its `.nvdb`
-/// passes NanoVDB's validation.
+/// box, measures, a Boolean operand, its surface mesh) and a grid rebuilt from its leaves:
+/// `in_memory.c`, under valgrind; its level set file holds what the CLI's `--sdf` file holds,
+/// its mesh file the CLI's `--mesh-out`, and its `.nvdb` passes NanoVDB's validation.
 #[test]
 fn a_level_set_in_memory_through_c_is_the_clis_and_grids_rebuild_from_leaves() {
     if !have("pkg-config") || !have("gcc") {
@@ -552,7 +552,16 @@ fn a_level_set_in_memory_through_c_is_the_clis_and_grids_rebuild_from_leaves() {
     run(Command::new(env!("CARGO_BIN_EXE_voxelkit"))
         .args(["mesh", "--sdf", "-r", "40", "-o"])
         .arg(&from_cli)
+        .arg("--mesh-out")
+        .arg(dir.join("cli.ply"))
         .arg(&obj));
+    // The surface mesh C wrote is the CLI's --mesh-out.
+    let (c_mesh, cli_mesh) = (
+        Mesh::load(&dir.join("c.vdb.ply")).unwrap(),
+        Mesh::load(&dir.join("cli.ply")).unwrap(),
+    );
+    assert_eq!(c_mesh.positions, cli_mesh.positions);
+    assert_eq!(c_mesh.indices, cli_mesh.indices);
     let (c, cli) = (
         read_vdb_grid(&from_c, Some("surface")).unwrap(),
         read_vdb_grid(&from_cli, Some("surface")).unwrap(),
