@@ -127,7 +127,7 @@ fn random_fields_give_closed_manifold_meshes() {
             }
         });
         let voxel = grid.transform.voxel_size;
-        let mesh = contour(&ScalarField::level_set(grid, 0.0).unwrap());
+        let mesh = contour(&ScalarField::level_set(grid, 0.0).unwrap()).unwrap();
         assert!(
             mesh.triangles.len() > 10_000,
             "seed {seed}: {}",
@@ -167,7 +167,7 @@ fn random_voxel_sets_give_closed_manifold_meshes() {
             meaning: Meaning::Voxels,
             iso: 0.0,
         };
-        let mesh = contour(&field);
+        let mesh = contour(&field).unwrap();
         assert_closed_manifold(
             &format!("random voxels {seed}"),
             &mesh.positions,
@@ -194,7 +194,7 @@ fn a_sphere_level_set_gives_the_sphere() {
         (DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) - centre).length() as f32 - r as f32
     });
     let t = grid.transform;
-    let mesh = contour(&ScalarField::level_set(grid, 0.0).unwrap());
+    let mesh = contour(&ScalarField::level_set(grid, 0.0).unwrap()).unwrap();
     assert_closed_manifold("sphere", &mesh.positions, &mesh.triangles, 1e-9);
     let world_centre = t.origin + t.voxel_size * centre;
     let worst = mesh

@@ -24,6 +24,15 @@ pub fn edge_axis(e: usize) -> usize {
     e / 4
 }
 
+/// Whether edges `a` and `b` lie on a common face of the cube.
+pub fn edges_share_face(a: usize, b: usize) -> bool {
+    let corners = [EDGES[a].0, EDGES[a].1, EDGES[b].0, EDGES[b].1];
+    (0..3).any(|axis| {
+        let side = corners[0] >> axis & 1;
+        corners.iter().all(|k| k >> axis & 1 == side)
+    })
+}
+
 const fn edges() -> [(u8, u8); 12] {
     let mut out = [(0u8, 0u8); 12];
     let mut n = 0;

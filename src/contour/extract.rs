@@ -14,10 +14,11 @@
 //! vertices and triangles, naming a crossing owned by a neighbouring block by its place
 //! there; a second numbers the vertices and resolves those names.
 
-use super::cell_cycles::{EDGES, case_cycles, edge_axis};
-use super::field::ScalarField;
+use super::cell_cycles::{EDGES, case_cycles, edge_axis, edges_share_face};
+use super::field::{BlockSign, ScalarField};
 use super::vertex_placement::{INSET, cycle_vertex};
-use crate::grid::{Block, Coord, NODE_DIM, SparseGrid};
+use crate::error::{Error, Result};
+use crate::grid::{Block, Coord, NODE_DIM};
 use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -48,71 +49,91 @@ struct BlockPiece {
 }
 
 /// The zero set of `field` as a closed, oriented triangle mesh.
-pub fn contour(field: &ScalarField) -> TriangleMesh {
-    let blocks = candidate_blocks(&field.grid);
+pub fn contour(field: &ScalarField) -> Result<TriangleMesh> {
+    let blocks = candidate_blocks(field);
     let index: FxHashMap<Coord, u32> = blocks
         .iter()
         .enumerate()
         .map(|(i, b)| (*b, i as u32))
         .collect();
-    let mut pieces: Vec<BlockPiece> = blocks
+    let pieces: Vec<BlockPiece> = blocks
         .par_iter()
-        .map_init(Vec::new, |samples, &origin| {
-            block_piece(field, origin, samples)
+        .map_init(Scratch::default, |scratch, &origin| {
+            block_piece(field, origin, scratch)
         })
         .collect();
     let mut bases = Vec::with_capacity(pieces.len());
-    let mut total = 0u32;
+    let mut total = 0u64;
     for p in &pieces {
-        bases.push(total);
-        total += p.positions.len() as u32;
+        bases.push(total as u32);
+        total += p.positions.len() as u64;
     }
-    let refs: Vec<([u64; EDGE_WORDS], [u32; EDGE_WORDS])> =
-        pieces.iter().map(|p| (p.crossings, p.ranks)).collect();
-    pieces
-        .par_iter_mut()
-        .zip(&bases)
-        .for_each(|(piece, &base)| {
-            let origin = piece.origin;
-            for t in &mut piece.triangles {
-                for v in t.iter_mut() {
-                    *v = if *v & CROSSING_REF == 0 {
-                        base + *v
-                    } else {
-                        let code = (*v >> 12) & 7;
-                        let bit = (*v & 0xfff) as usize;
-                        let owner = [
-                            origin[0] + 8 * (code & 1) as i64,
-                            origin[1] + 8 * (code >> 1 & 1) as i64,
-                            origin[2] + 8 * (code >> 2 & 1) as i64,
-                        ];
-                        let i = index[&owner] as usize;
-                        let (words, ranks) = &refs[i];
-                        let below = words[bit / 64] & ((1u64 << (bit % 64)) - 1);
-                        bases[i] + ranks[bit / 64] + below.count_ones()
-                    };
-                }
+    if total > u32::MAX as u64 {
+        return Err(Error::Unsupported(format!(
+            "the surface has {total} vertices: a mesh holds at most {} (32-bit indices)",
+            u32::MAX
+        )));
+    }
+    let triangle_count = pieces.iter().map(|p| p.triangles.len()).sum();
+    let mut mesh = TriangleMesh {
+        positions: vec![DVec3::ZERO; total as usize],
+        triangles: vec![[0; 3]; triangle_count],
+    };
+    // Each block's share of the output, filled on all threads.
+    let mut shares = Vec::with_capacity(pieces.len());
+    let (mut positions, mut triangles) = (&mut mesh.positions[..], &mut mesh.triangles[..]);
+    for p in &pieces {
+        let (mine, rest) = positions.split_at_mut(p.positions.len());
+        positions = rest;
+        let (my_triangles, rest) = triangles.split_at_mut(p.triangles.len());
+        triangles = rest;
+        shares.push((mine, my_triangles));
+    }
+    let transform = field.grid.transform;
+    let resolve = |piece: &BlockPiece, base: u32, v: u32| -> u32 {
+        if v & CROSSING_REF == 0 {
+            return base + v;
+        }
+        let code = (v >> 12) & 7;
+        let bit = (v & 0xfff) as usize;
+        let owner = [
+            piece.origin[0] + 8 * (code & 1) as i64,
+            piece.origin[1] + 8 * (code >> 1 & 1) as i64,
+            piece.origin[2] + 8 * (code >> 2 & 1) as i64,
+        ];
+        let i = index[&owner] as usize;
+        let other = &pieces[i];
+        let below = other.crossings[bit / 64] & ((1u64 << (bit % 64)) - 1);
+        bases[i] + other.ranks[bit / 64] + below.count_ones()
+    };
+    shares
+        .into_par_iter()
+        .zip(pieces.par_iter().zip(&bases))
+        .for_each(|((positions, triangles), (piece, &base))| {
+            for (out, q) in positions.iter_mut().zip(&piece.positions) {
+                *out = transform.origin + transform.voxel_size * *q;
+            }
+            for (out, t) in triangles.iter_mut().zip(&piece.triangles) {
+                *out = t.map(|v| resolve(piece, base, v));
             }
         });
-    let mut mesh = TriangleMesh {
-        positions: Vec::with_capacity(total as usize),
-        triangles: Vec::with_capacity(pieces.iter().map(|p| p.triangles.len()).sum()),
-    };
-    let transform = field.grid.transform;
-    for p in pieces {
-        mesh.positions.extend(
-            p.positions
-                .iter()
-                .map(|q| transform.origin + transform.voxel_size * *q),
-        );
-        mesh.triangles.extend_from_slice(&p.triangles);
-    }
-    mesh
+    Ok(mesh)
 }
 
-/// The blocks whose cells may hold a sign change: every leaf and every tile beside empty
-/// space, each with the blocks below it on any axis (whose cells reach into it).
-fn candidate_blocks(grid: &SparseGrid) -> Vec<Coord> {
+/// The blocks whose cells hold a sign change: those whose cells' corners (the block and the
+/// next blocks up on each axis) are not all of one sign. Only a leaf, a tile beside empty
+/// space, or a block below one on some axis can be such a block.
+fn candidate_blocks(field: &ScalarField) -> Vec<Coord> {
+    let grid = &field.grid;
+    let leaf_signs: FxHashMap<Coord, BlockSign> = grid
+        .leaves()
+        .par_iter()
+        .map(|l| (l.origin, field.block_sign(Block::Partial(l))))
+        .collect();
+    let sign = |origin: Coord| match leaf_signs.get(&origin) {
+        Some(&s) => s,
+        None => field.block_sign(grid.block(origin)),
+    };
     let mut seeds: Vec<Coord> = grid.leaves().iter().map(|l| l.origin).collect();
     let beside_empty = |origin: Coord| {
         (0..3).any(|a| {
@@ -139,28 +160,74 @@ fn candidate_blocks(grid: &SparseGrid) -> Vec<Coord> {
             }
         }
     }
+    let step = |o: Coord, code: i64, d: i64| {
+        [
+            o[0] + d * (code & 1),
+            o[1] + d * (code >> 1 & 1),
+            o[2] + d * (code >> 2 & 1),
+        ]
+    };
     let mut set = FxHashSet::default();
     for s in seeds {
-        for code in 0..8 {
-            set.insert([
-                s[0] - 8 * (code & 1),
-                s[1] - 8 * (code >> 1 & 1),
-                s[2] - 8 * (code >> 2 & 1),
-            ]);
-        }
+        set.extend((0..8).map(|code| step(s, code, -8)));
     }
-    let mut blocks: Vec<Coord> = set.into_iter().collect();
-    blocks.sort_unstable();
+    let mut blocks: Vec<Coord> = set
+        .into_par_iter()
+        .filter(|&b| {
+            let first = sign(b);
+            first == BlockSign::Both || (1..8).any(|code| sign(step(b, code, 8)) != first)
+        })
+        .collect();
+    blocks.par_sort_unstable();
     blocks
 }
 
+/// What a thread reuses from block to block.
+#[derive(Default)]
+struct Scratch {
+    samples: Vec<f32>,
+    /// Per edge from a voxel of `[0, 9)^3` along an axis, its crossing in `crossings`.
+    slots: Vec<u32>,
+    /// Crossings in index space with their unit normals.
+    crossings: Vec<(DVec3, DVec3)>,
+    points: Vec<DVec3>,
+    normals: Vec<DVec3>,
+    refs: Vec<u32>,
+}
+
+const NO_SLOT: u32 = u32::MAX;
+
+fn slot(c: [i64; 3], axis: usize) -> usize {
+    (((c[0] * 9 + c[1]) * 9 + c[2]) * 3) as usize + axis
+}
+
 /// The vertices and triangles of the cells whose low corner lies in the block at `origin`.
-fn block_piece(field: &ScalarField, origin: Coord, samples: &mut Vec<f32>) -> BlockPiece {
-    field.gather(origin.map(|v| v - 1), SPAN, samples);
+fn block_piece(field: &ScalarField, origin: Coord, scratch: &mut Scratch) -> BlockPiece {
+    field.gather(origin.map(|v| v - 1), SPAN, &mut scratch.samples);
+    let samples = &scratch.samples;
     let s = |x: i64, y: i64, z: i64| -> f64 {
         samples[(((x + 1) * SPAN as i64 + (y + 1)) * SPAN as i64 + (z + 1)) as usize] as f64
     };
-    let inside = |x: i64, y: i64, z: i64| s(x, y, z) < 0.0;
+    // The signs of the cells' corners, [0, 9)^3; a block of one sign has no surface.
+    let mut signs = [false; 729];
+    for x in 0..9 {
+        for y in 0..9 {
+            for z in 0..9 {
+                signs[((x * 9 + y) * 9 + z) as usize] = s(x, y, z) < 0.0;
+            }
+        }
+    }
+    let mut piece = BlockPiece {
+        origin,
+        crossings: [0; EDGE_WORDS],
+        ranks: [0; EDGE_WORDS],
+        positions: Vec::new(),
+        triangles: Vec::new(),
+    };
+    if signs.iter().all(|&b| b == signs[0]) {
+        return piece;
+    }
+    let inside = |x: i64, y: i64, z: i64| signs[((x * 9 + y) * 9 + z) as usize];
     let gradient = |x: i64, y: i64, z: i64| {
         DVec3::new(
             s(x + 1, y, z) - s(x - 1, y, z),
@@ -186,24 +253,32 @@ fn block_piece(field: &ScalarField, origin: Coord, samples: &mut Vec<f32>) -> Bl
         (p, n)
     };
     let local = |p: DVec3| p + DVec3::new(origin[0] as f64, origin[1] as f64, origin[2] as f64);
-    let mut piece = BlockPiece {
-        origin,
-        crossings: [0; EDGE_WORDS],
-        ranks: [0; EDGE_WORDS],
-        positions: Vec::new(),
-        triangles: Vec::new(),
-    };
-    for x in 0..8i64 {
-        for y in 0..8i64 {
-            for z in 0..8i64 {
+    // Every crossing the block's cells use, once: edges from [0, 9)^3, less than 8 along
+    // their own axis. Those from [0, 8)^3 are the block's own, in bit order.
+    scratch.slots.clear();
+    scratch.slots.resize(9 * 9 * 9 * 3, NO_SLOT);
+    scratch.crossings.clear();
+    for x in 0..9i64 {
+        for y in 0..9i64 {
+            for z in 0..9i64 {
+                let c = [x, y, z];
                 let here = inside(x, y, z);
                 for axis in 0..3 {
-                    let mut d = [x, y, z];
+                    if c[axis] == 8 {
+                        continue;
+                    }
+                    let mut d = c;
                     d[axis] += 1;
-                    if inside(d[0], d[1], d[2]) != here {
+                    if inside(d[0], d[1], d[2]) == here {
+                        continue;
+                    }
+                    let found = crossing(c, axis);
+                    scratch.slots[slot(c, axis)] = scratch.crossings.len() as u32;
+                    scratch.crossings.push(found);
+                    if x < 8 && y < 8 && z < 8 {
                         let bit = ((x * 64 + y * 8 + z) * 3) as usize + axis;
                         piece.crossings[bit / 64] |= 1 << (bit % 64);
-                        piece.positions.push(local(crossing([x, y, z], axis).0));
+                        piece.positions.push(local(found.0));
                     }
                 }
             }
@@ -215,7 +290,6 @@ fn block_piece(field: &ScalarField, origin: Coord, samples: &mut Vec<f32>) -> Bl
         rank += piece.crossings[w].count_ones();
     }
     let table = case_cycles();
-    let (mut points, mut normals, mut refs) = (Vec::new(), Vec::new(), Vec::new());
     for x in 0..8i64 {
         for y in 0..8i64 {
             for z in 0..8i64 {
@@ -229,17 +303,17 @@ fn block_piece(field: &ScalarField, origin: Coord, samples: &mut Vec<f32>) -> Bl
                     continue;
                 }
                 for cycle in table[case].cycles() {
-                    points.clear();
-                    normals.clear();
-                    refs.clear();
+                    scratch.points.clear();
+                    scratch.normals.clear();
+                    scratch.refs.clear();
                     for &e in cycle {
                         let e = e as usize;
                         let a = EDGES[e].0 as i64;
                         let c = [x + (a & 1), y + (a >> 1 & 1), z + (a >> 2 & 1)];
                         let axis = edge_axis(e);
-                        let (p, n) = crossing(c, axis);
-                        points.push(p);
-                        normals.push(n);
+                        let (p, n) = scratch.crossings[scratch.slots[slot(c, axis)] as usize];
+                        scratch.points.push(p);
+                        scratch.normals.push(n);
                         // The crossing's owner: this block, or the next one up on the axes
                         // where the edge starts on the far face.
                         let code = (0..3)
@@ -248,20 +322,68 @@ fn block_piece(field: &ScalarField, origin: Coord, samples: &mut Vec<f32>) -> Bl
                             .sum::<u32>();
                         let l = c.map(|v| v & 7);
                         let bit = ((l[0] * 64 + l[1] * 8 + l[2]) * 3) as u32 + axis as u32;
-                        refs.push(CROSSING_REF | code << 12 | bit);
+                        scratch.refs.push(CROSSING_REF | code << 12 | bit);
                     }
                     let low = DVec3::new(x as f64, y as f64, z as f64);
-                    let centre = cycle_vertex(&points, &normals, low);
-                    let id = piece.positions.len() as u32;
-                    piece.positions.push(local(centre));
-                    for i in 0..refs.len() {
-                        piece
+                    let centre = cycle_vertex(&scratch.points, &scratch.normals, low);
+                    let refs = &scratch.refs;
+                    match without_centre(cycle, &scratch.points, centre) {
+                        Some(split) => piece
                             .triangles
-                            .push([id, refs[i], refs[(i + 1) % refs.len()]]);
+                            .extend(split.iter().map(|t| t.map(|i| refs[i]))),
+                        None => {
+                            let id = piece.positions.len() as u32;
+                            piece.positions.push(local(centre));
+                            for i in 0..refs.len() {
+                                piece
+                                    .triangles
+                                    .push([id, refs[i], refs[(i + 1) % refs.len()]]);
+                            }
+                        }
                     }
                 }
             }
         }
     }
     piece
+}
+
+/// How far a cycle's vertex may lie off its crossings' plane, in voxels, for the cycle to be
+/// drawn without it.
+const FLAT: f64 = 0.02;
+
+/// The triangles (positions in the cycle) of a cycle of three or four crossings drawn without
+/// its own vertex, when that vertex adds nothing (it lies within `FLAT` of the crossings'
+/// plane) and the split is safe: a quadrilateral's diagonal joins crossings of edges on no
+/// common face, so no other cell can draw it, and neither triangle turns against the cycle.
+fn without_centre(cycle: &[u8], points: &[DVec3], centre: DVec3) -> Option<Vec<[usize; 3]>> {
+    let n = points.len();
+    if n > 4 {
+        return None;
+    }
+    let mean = points.iter().copied().sum::<DVec3>() / n as f64;
+    let area: DVec3 = (0..n)
+        .map(|i| (points[i] - mean).cross(points[(i + 1) % n] - mean))
+        .sum();
+    let normal = area.try_normalize()?;
+    if normal.dot(centre - mean).abs() > FLAT {
+        return None;
+    }
+    let split = if n == 3 {
+        vec![[0, 1, 2]]
+    } else {
+        let share = |a: usize, b: usize| edges_share_face(cycle[a] as usize, cycle[b] as usize);
+        if !share(0, 2) {
+            vec![[0, 1, 2], [0, 2, 3]]
+        } else if !share(1, 3) {
+            vec![[1, 2, 3], [1, 3, 0]]
+        } else {
+            return None;
+        }
+    };
+    let turns_with = |t: &[usize; 3]| {
+        let [a, b, c] = t.map(|i| points[i]);
+        (b - a).cross(c - a).dot(area) > 0.0
+    };
+    split.iter().all(turns_with).then_some(split)
 }

@@ -20,6 +20,24 @@ pub enum Meaning {
     Voxels,
 }
 
+/// The signs of a block's values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlockSign {
+    Inside,
+    Outside,
+    Both,
+}
+
+impl BlockSign {
+    fn of(value: f32) -> BlockSign {
+        if value < 0.0 {
+            BlockSign::Inside
+        } else {
+            BlockSign::Outside
+        }
+    }
+}
+
 /// A grid read as a field, with the iso value of the surface wanted.
 pub struct ScalarField<'g> {
     pub grid: Cow<'g, SparseGrid>,
@@ -144,6 +162,23 @@ impl<'g> ScalarField<'g> {
                     -0.5
                 } else {
                     0.5
+                }
+            }
+        }
+    }
+
+    /// The signs of the values in the 8^3 block `block` holds (tiles and empty space are of
+    /// one sign).
+    pub fn block_sign(&self, block: Block) -> BlockSign {
+        match block {
+            Block::Empty => BlockSign::of(self.empty()),
+            Block::Whole => BlockSign::of(self.whole()),
+            Block::Partial(leaf) => {
+                let first = BlockSign::of(self.in_leaf(leaf, 0));
+                if (1..512).all(|n| BlockSign::of(self.in_leaf(leaf, n)) == first) {
+                    first
+                } else {
+                    BlockSign::Both
                 }
             }
         }

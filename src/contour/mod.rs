@@ -9,4 +9,4 @@ mod field;
 mod vertex_placement;
 
 pub use extract::{TriangleMesh, contour};
-pub use field::{Meaning, ScalarField};
+pub use field::{BlockSign, Meaning, ScalarField};

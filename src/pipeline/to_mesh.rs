@@ -103,7 +103,7 @@ impl Outcome {
     /// result is).
     pub fn surface_mesh(&self) -> Result<TriangleMesh> {
         let field = self.field()?;
-        on_threads(self.threads, || Ok(contour(&field)))
+        on_threads(self.threads, || contour(&field))
     }
 
     /// Writes the surface of the result to `output` (.obj, .ply, .stl or .glb), noted in the
@@ -158,7 +158,7 @@ fn contour_to_file(
     source: &Path,
 ) -> Result<(TriangleMesh, MeshWritten, Vec<StageTime>)> {
     let mut contouring = StageClock::new("contour");
-    let mesh = contouring.time(|| contour(field));
+    let mesh = contouring.time(|| contour(field))?;
     if mesh.triangles.is_empty() {
         return Err(Error::InvalidArgument(format!(
             "{}: the grid has no surface at iso {} (its values never cross it)",
