@@ -1,6 +1,6 @@
 //! Meshes out of grids (`voxelkit to-mesh`, `contour`): every mesh closed and 2-manifold,
 //! consistently oriented outward, free of flat triangles, on random fields full of ambiguous
-//! cells as on the shared meshes' level sets; and on those, the volume and the two-sided
+//! cells as on the shared meshes' level sets, and free of self-intersections on the small ones; and on those, the volume and the two-sided
 //! distance to the input mesh.
 #![cfg(all(feature = "vdb", feature = "fixtures"))]
 
@@ -74,6 +74,79 @@ fn assert_closed_manifold(what: &str, positions: &[DVec3], triangles: &[[u32; 3]
     }
 }
 
+/// Whether two triangles meet (closed sets): no separating axis among their normals, the
+/// cross products of their edges, and their edges turned in each one's plane.
+fn triangles_meet(a: [DVec3; 3], b: [DVec3; 3]) -> bool {
+    let edges = |t: [DVec3; 3]| [t[1] - t[0], t[2] - t[1], t[0] - t[2]];
+    let (ea, eb) = (edges(a), edges(b));
+    let (na, nb) = (ea[0].cross(ea[1]), eb[0].cross(eb[1]));
+    let mut axes = vec![na, nb];
+    for i in 0..3 {
+        for j in 0..3 {
+            axes.push(ea[i].cross(eb[j]));
+        }
+        axes.push(na.cross(ea[i]));
+        axes.push(nb.cross(eb[i]));
+    }
+    !axes.iter().any(|axis| {
+        if axis.length_squared() < 1e-24 {
+            return false;
+        }
+        let span = |t: [DVec3; 3]| {
+            let d = t.map(|p| p.dot(*axis));
+            (d[0].min(d[1]).min(d[2]), d[0].max(d[1]).max(d[2]))
+        };
+        let ((lo_a, hi_a), (lo_b, hi_b)) = (span(a), span(b));
+        hi_a < lo_b || hi_b < lo_a
+    })
+}
+
+/// Checks that no two triangles meet but at the corners and edges they share, through a grid
+/// of buckets of `cell` world units.
+fn assert_no_self_intersections(
+    what: &str,
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    cell: f64,
+) {
+    let key = |p: DVec3| ((p / cell).floor()).as_i64vec3().to_array();
+    let mut buckets: FxHashMap<[i64; 3], Vec<usize>> = FxHashMap::default();
+    for (n, t) in triangles.iter().enumerate() {
+        let c = t.map(|i| positions[i as usize]);
+        let (lo, hi) = (key(c[0].min(c[1]).min(c[2])), key(c[0].max(c[1]).max(c[2])));
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    buckets.entry([x, y, z]).or_default().push(n);
+                }
+            }
+        }
+    }
+    for members in buckets.values() {
+        for (k, &i) in members.iter().enumerate() {
+            for &j in &members[k + 1..] {
+                let (s, t) = (triangles[i], triangles[j]);
+                let shared = s.iter().filter(|v| t.contains(v)).count();
+                if shared > 1 {
+                    continue;
+                }
+                // Triangles with a corner in common may touch there only: shrunk a little
+                // towards their centroids they must part.
+                let shrink = if shared == 1 { 1e-6 } else { 0.0 };
+                let corners = |t: [u32; 3]| {
+                    let c = t.map(|v| positions[v as usize]);
+                    let mid = (c[0] + c[1] + c[2]) / 3.0;
+                    c.map(|p| p + (mid - p) * shrink)
+                };
+                assert!(
+                    !triangles_meet(corners(s), corners(t)),
+                    "{what}: triangles {s:?} and {t:?} meet"
+                );
+            }
+        }
+    }
+}
+
 fn signed_volume(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
     triangles
         .iter()
@@ -140,6 +213,12 @@ fn random_fields_give_closed_manifold_meshes() {
             1e-7 * voxel * voxel,
         );
         assert!(signed_volume(&mesh.positions, &mesh.triangles) > 0.0);
+        assert_no_self_intersections(
+            &format!("random field {seed}"),
+            &mesh.positions,
+            &mesh.triangles,
+            voxel,
+        );
     }
 }
 
@@ -174,6 +253,12 @@ fn random_voxel_sets_give_closed_manifold_meshes() {
             &mesh.triangles,
             1e-7,
         );
+        assert_no_self_intersections(
+            &format!("random voxels {seed}"),
+            &mesh.positions,
+            &mesh.triangles,
+            1.0,
+        );
         let volume = signed_volume(&mesh.positions, &mesh.triangles);
         // Each voxel's surface passes half way to its empty neighbours: about a voxel each.
         let voxels = (count + 512) as f64;
@@ -196,6 +281,7 @@ fn a_sphere_level_set_gives_the_sphere() {
     let t = grid.transform;
     let mesh = contour(&ScalarField::level_set(grid, 0.0).unwrap()).unwrap();
     assert_closed_manifold("sphere", &mesh.positions, &mesh.triangles, 1e-9);
+    assert_no_self_intersections("sphere", &mesh.positions, &mesh.triangles, t.voxel_size);
     let world_centre = t.origin + t.voxel_size * centre;
     let worst = mesh
         .positions
@@ -246,7 +332,8 @@ fn triangles_of(mesh: &Mesh) -> Vec<[u32; 3]> {
 }
 
 /// The shared closed meshes' level sets at 128 and 256, through the CLI and back from the
-/// file by voxelkit's own reader: closed, manifold, outward, the volume within 0.5% of the
+/// file by voxelkit's own reader: closed, manifold, outward, free of self-intersections (at
+/// 128), the volume within 0.5% of the
 /// mesh's, and the two-sided distance to the mesh within the figures measured (a level set
 /// sampled at voxel centres cannot show a feature thinner than a voxel: the bunny's ear tips and
 /// the rocker arm's sharp rims are where the mesh lies farthest from it).
@@ -288,6 +375,9 @@ fn shared_level_sets_give_closed_accurate_meshes() {
             let voxel = source.bbox().extent().max_element() / r as f64;
             let what = format!("{name} at {r}");
             assert_closed_manifold(&what, &out.positions, &triangles, 1e-9 * voxel * voxel);
+            if r == 128 {
+                assert_no_self_intersections(&what, &out.positions, &triangles, voxel);
+            }
             let volume = signed_volume(&out.positions, &triangles);
             assert!(volume > 0.0, "{what}: the mesh faces inward");
             let error = (volume / source_volume - 1.0).abs();

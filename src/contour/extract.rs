@@ -302,7 +302,8 @@ fn block_piece(field: &ScalarField, origin: Coord, scratch: &mut Scratch) -> Blo
                 if case == 0 || case == 255 {
                     continue;
                 }
-                for cycle in table[case].cycles() {
+                let cycles = &table[case];
+                for cycle in cycles.cycles() {
                     scratch.points.clear();
                     scratch.normals.clear();
                     scratch.refs.clear();
@@ -325,7 +326,13 @@ fn block_piece(field: &ScalarField, origin: Coord, scratch: &mut Scratch) -> Blo
                         scratch.refs.push(CROSSING_REF | code << 12 | bit);
                     }
                     let low = DVec3::new(x as f64, y as f64, z as f64);
-                    let centre = cycle_vertex(&scratch.points, &scratch.normals, low);
+                    // A cell's several cycles keep to their crossings' means, where their fans
+                    // cannot reach into each other.
+                    let centre = if cycles.count == 1 {
+                        cycle_vertex(&scratch.points, &scratch.normals, low)
+                    } else {
+                        mean(&scratch.points)
+                    };
                     let refs = &scratch.refs;
                     match without_centre(cycle, &scratch.points, centre) {
                         Some(split) => piece
@@ -346,6 +353,10 @@ fn block_piece(field: &ScalarField, origin: Coord, scratch: &mut Scratch) -> Blo
         }
     }
     piece
+}
+
+fn mean(points: &[DVec3]) -> DVec3 {
+    points.iter().copied().sum::<DVec3>() / points.len() as f64
 }
 
 /// How far a cycle's vertex may lie off its crossings' plane, in voxels, for the cycle to be
