@@ -147,3 +147,59 @@ fn assert_first_grid_is_density(text: &str) {
     let first = text.lines().find(|l| l.starts_with("GRID")).unwrap_or("");
     assert!(first.starts_with("GRID density "), "{text}");
 }
+
+/// Blender imports the meshes voxelkit writes (OBJ by its own importer, binary glTF) with every
+/// vertex and triangle, every edge joining two faces and the volume of the mesh written.
+#[test]
+fn blender_imports_the_meshes() {
+    if Command::new("blender").arg("--version").output().is_err() {
+        return common::skip_or_fail("blender is not installed: the Blender mesh import test");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("torus.obj");
+    generate::torus(glam::DVec3::new(2.0, -1.0, 0.5), 1.0, 0.3, 64, 16)
+        .write_obj(&obj)
+        .unwrap();
+    let mut counts = Vec::new();
+    for ext in ["obj", "glb"] {
+        let out = dir.path().join(format!("out.{ext}"));
+        let status = Command::new(env!("CARGO_BIN_EXE_voxelkit"))
+            .args(["mesh", "--sdf", "-r", "64", "-o"])
+            .arg(dir.path().join("torus.vdb"))
+            .arg("--mesh-out")
+            .arg(&out)
+            .arg(&obj)
+            .output()
+            .unwrap();
+        assert!(status.status.success(), "{status:?}");
+        let written = voxelkit::mesh::Mesh::load(&out).unwrap();
+        let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/blender/inspect_mesh.py");
+        let o = Command::new("blender")
+            .args(["-b", "--factory-startup", "--python", script, "--"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&o.stdout).into_owned();
+        let line = text
+            .lines()
+            .find(|l| l.starts_with("MESH "))
+            .unwrap_or_else(|| panic!("{ext}: {text}"));
+        let fields: Vec<&str> = line.split(' ').collect();
+        assert_eq!(
+            fields[1].parse::<usize>().unwrap(),
+            written.positions.len(),
+            "{ext}: {line}"
+        );
+        assert_eq!(
+            fields[2].parse::<usize>().unwrap(),
+            written.face_count(),
+            "{ext}: {line}"
+        );
+        assert_eq!(fields[3], "True", "{ext}: not manifold in Blender: {line}");
+        let volume: f64 = fields[4].parse().unwrap();
+        // The torus's volume, 2 pi^2 R r^2, less what its 16-sided tube cuts off.
+        assert!((volume - 1.72).abs() < 0.03, "{ext}: volume {volume}");
+        counts.push(fields[2].to_string());
+    }
+    assert_eq!(counts[0], counts[1]);
+}

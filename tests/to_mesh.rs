@@ -82,9 +82,7 @@ fn triangles_meet(a: [DVec3; 3], b: [DVec3; 3]) -> bool {
     let (na, nb) = (ea[0].cross(ea[1]), eb[0].cross(eb[1]));
     let mut axes = vec![na, nb];
     for i in 0..3 {
-        for j in 0..3 {
-            axes.push(ea[i].cross(eb[j]));
-        }
+        axes.extend(eb.iter().map(|e| ea[i].cross(*e)));
         axes.push(na.cross(ea[i]));
         axes.push(nb.cross(eb[i]));
     }
