@@ -16,6 +16,7 @@
 
 use super::cell_cycles::{EDGES, case_cycles, edge_axis, edges_share_face};
 use super::field::{BlockSign, ScalarField};
+use super::hermite::{ExactSurface, exact_crossing};
 use super::vertex_placement::{INSET, cycle_vertex};
 use crate::error::{Error, Result};
 use crate::grid::{Block, Coord, NODE_DIM};
@@ -48,8 +49,9 @@ struct BlockPiece {
     triangles: Vec<[u32; 3]>,
 }
 
-/// The zero set of `field` as a closed, oriented triangle mesh.
-pub fn contour(field: &ScalarField) -> Result<TriangleMesh> {
+/// The zero set of `field` as a closed, oriented triangle mesh; where `exact` knows the
+/// source, its crossings and normals place the vertices.
+pub fn contour(field: &ScalarField, exact: Option<&dyn ExactSurface>) -> Result<TriangleMesh> {
     let blocks = candidate_blocks(field);
     let index: FxHashMap<Coord, u32> = blocks
         .iter()
@@ -59,7 +61,7 @@ pub fn contour(field: &ScalarField) -> Result<TriangleMesh> {
     let pieces: Vec<BlockPiece> = blocks
         .par_iter()
         .map_init(Scratch::default, |scratch, &origin| {
-            block_piece(field, origin, scratch)
+            block_piece(field, exact, origin, scratch)
         })
         .collect();
     let mut bases = Vec::with_capacity(pieces.len());
@@ -202,7 +204,12 @@ fn slot(c: [i64; 3], axis: usize) -> usize {
 }
 
 /// The vertices and triangles of the cells whose low corner lies in the block at `origin`.
-fn block_piece(field: &ScalarField, origin: Coord, scratch: &mut Scratch) -> BlockPiece {
+fn block_piece(
+    field: &ScalarField,
+    exact: Option<&dyn ExactSurface>,
+    origin: Coord,
+    scratch: &mut Scratch,
+) -> BlockPiece {
     field.gather(origin.map(|v| v - 1), SPAN, &mut scratch.samples);
     let samples = &scratch.samples;
     let s = |x: i64, y: i64, z: i64| -> f64 {
@@ -236,13 +243,26 @@ fn block_piece(field: &ScalarField, origin: Coord, scratch: &mut Scratch) -> Blo
         )
     };
     let steer = field.has_gradients();
-    // The crossing on the edge from local voxel `c` along `axis`, and its unit normal.
+    let transform = field.grid.transform;
+    let world = |c: [i64; 3]| {
+        let index = DVec3::from_array(std::array::from_fn(|a| (origin[a] + c[a]) as f64));
+        transform.origin + transform.voxel_size * index
+    };
+    // The crossing on the edge from local voxel `c` along `axis`, and its unit normal: the
+    // source's where it is known exactly, else the samples'.
     let crossing = |c: [i64; 3], axis: usize| -> (DVec3, DVec3) {
         let mut d = c;
         d[axis] += 1;
+        let mut p = DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
+        if let Some(surface) = exact
+            && let Some((t, n)) =
+                exact_crossing(surface, world(c), world(d), inside(c[0], c[1], c[2]))
+        {
+            p[axis] += t.clamp(INSET, 1.0 - INSET);
+            return (p, n);
+        }
         let (g0, g1) = (s(c[0], c[1], c[2]), s(d[0], d[1], d[2]));
         let t = (g0 / (g0 - g1)).clamp(INSET, 1.0 - INSET);
-        let mut p = DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
         p[axis] += t;
         let n = if steer {
             let g = gradient(c[0], c[1], c[2]) * (1.0 - t) + gradient(d[0], d[1], d[2]) * t;
@@ -334,7 +354,7 @@ fn block_piece(field: &ScalarField, origin: Coord, scratch: &mut Scratch) -> Blo
                         mean(&scratch.points)
                     };
                     let refs = &scratch.refs;
-                    match without_centre(cycle, &scratch.points, centre) {
+                    match without_centre(cycle, &scratch.points, &scratch.normals, centre) {
                         Some(split) => piece
                             .triangles
                             .extend(split.iter().map(|t| t.map(|i| refs[i]))),
@@ -363,13 +383,30 @@ fn mean(points: &[DVec3]) -> DVec3 {
 /// drawn without it.
 const FLAT: f64 = 0.02;
 
+/// The least cosine between two crossings' normals of a cycle drawn without its vertex: where
+/// they turn more, the vertex marks a sharp edge or corner, however near the plane it lies.
+const SMOOTH: f64 = 0.9;
+
 /// The triangles (positions in the cycle) of a cycle of three or four crossings drawn without
 /// its own vertex, when that vertex adds nothing (it lies within `FLAT` of the crossings'
-/// plane) and the split is safe: a quadrilateral's diagonal joins crossings of edges on no
-/// common face, so no other cell can draw it, and neither triangle turns against the cycle.
-fn without_centre(cycle: &[u8], points: &[DVec3], centre: DVec3) -> Option<Vec<[usize; 3]>> {
+/// plane and the normals it fits agree) and the split is safe: a quadrilateral's diagonal
+/// joins crossings of edges on no common face, so no other cell can draw it, and neither
+/// triangle turns against the cycle.
+fn without_centre(
+    cycle: &[u8],
+    points: &[DVec3],
+    normals: &[DVec3],
+    centre: DVec3,
+) -> Option<Vec<[usize; 3]>> {
     let n = points.len();
     if n > 4 {
+        return None;
+    }
+    let turns = normals
+        .iter()
+        .enumerate()
+        .any(|(i, a)| normals[i + 1..].iter().any(|b| a.dot(*b) < SMOOTH));
+    if turns && normals.iter().all(|v| *v != DVec3::ZERO) {
         return None;
     }
     let mean = points.iter().copied().sum::<DVec3>() / n as f64;

@@ -39,14 +39,25 @@ pub fn cycle_vertex(points: &[DVec3], normals: &[DVec3], low: DVec3) -> DVec3 {
     if folds(points, x) { mean } else { x }
 }
 
-/// Whether the fan from `centre` over the cycle turns any triangle against the cycle's own
-/// orientation.
+/// How far off a triangle's plane its fan's centre must lie for the fan to stand clear of it.
+const OFF_PLANE: f64 = 1e-6;
+
+/// Whether the fan from `centre` over the cycle may cross itself: whether it turns any
+/// triangle against the cycle's own orientation. A triangle's fan is three faces of a
+/// tetrahedron, which meet only along their edges, wherever the centre lies off its plane:
+/// a corner of a solid (three planes) lands where it is, however the tetrahedron leans.
 fn folds(points: &[DVec3], centre: DVec3) -> bool {
     let n = points.len();
     let mean = points.iter().copied().sum::<DVec3>() / n as f64;
     let area: DVec3 = (0..n)
         .map(|i| (points[i] - mean).cross(points[(i + 1) % n] - mean))
         .sum();
+    if n == 3
+        && let Some(normal) = area.try_normalize()
+        && normal.dot(centre - mean).abs() > OFF_PLANE
+    {
+        return false;
+    }
     (0..n).any(|i| {
         (points[i] - centre)
             .cross(points[(i + 1) % n] - centre)

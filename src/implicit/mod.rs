@@ -95,8 +95,13 @@ impl Formula {
 
     /// The Cartesian gradient of F at the world point `p`; `slots` is scratch space.
     pub fn gradient_at(&self, p: [f64; 3], slots: &mut Vec<Dual>) -> glam::DVec3 {
+        self.value_and_gradient_at(p, slots).1
+    }
+
+    /// F and its Cartesian gradient at the world point `p`; `slots` is scratch space.
+    pub fn value_and_gradient_at(&self, p: [f64; 3], slots: &mut Vec<Dual>) -> (f64, glam::DVec3) {
         let vars: [Dual; 3] = std::array::from_fn(|a| Dual::variable(p[a], a));
-        let g = self.tape.eval_with(self.coordinates_of(vars), slots).grad;
-        glam::DVec3::from_array(g)
+        let d = self.tape.eval_with(self.coordinates_of(vars), slots);
+        (d.value, glam::DVec3::from_array(d.grad))
     }
 }

@@ -6,6 +6,7 @@ use super::report::{
     SubdivisionDetails,
 };
 use super::{ShapeTask, SurfaceMethod, on_threads};
+use crate::contour::ExactSurface;
 use crate::error::{Error, Result};
 use crate::grid::{Channels, CoordBox, Leaf, SparseGrid, Transform};
 use crate::implicit::Formula;
@@ -49,6 +50,9 @@ pub struct Outcome {
     pub distances: Option<Distances>,
     /// The threads the job ran on (all when `None`): writing encodes on them too.
     pub threads: Option<usize>,
+    /// The source known exactly (a CSG tree of shapes and formulas): its meshes take their
+    /// crossings and normals from it.
+    pub exact: Option<std::sync::Arc<dyn ExactSurface>>,
 }
 
 /// How a distance band is written: its background, and for a level set the interior it
@@ -130,6 +134,7 @@ impl Outcome {
             report,
             distances: None,
             threads: None,
+            exact: None,
         }
     }
 
@@ -229,6 +234,7 @@ impl Outcome {
             report,
             distances: None,
             threads: parent.threads,
+            exact: None,
         }
     }
 

@@ -9,12 +9,14 @@ use super::report::{
     FloodingXyzDetails, SolidDetails,
 };
 use super::{Fill, SubdivisionFill};
+use crate::contour::ExactSurface;
 use crate::error::Result;
 use crate::grid::{DenseMask, SparseGrid, Transform};
 use crate::io::vdb::MetaValue;
 use crate::mesh::{GridFit, Mesh, index_box};
 use crate::progress::Progress;
 use crate::solids::beam::{BeamFill, beam_solid};
+use crate::solids::csg_exact::ExactTree;
 use crate::solids::csg_tree::CsgTree;
 use crate::solids::depth_layers::{Layers, depth_layer_solid};
 use crate::solids::exterior_flood::{FloodMethod, Solid};
@@ -24,6 +26,7 @@ use crate::solids::level_set::{SIGN_NEEDS_CLOSED, level_set, unsigned_distance};
 use crate::subd::ControlMesh;
 use crate::voxelize::parametric::ParametricOptions;
 use rayon::prelude::*;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// What inside means for the exterior flood.
@@ -387,7 +390,9 @@ pub(super) fn csg_tree(tree: &CsgTree, progress: &Progress) -> Result<Outcome> {
         ("method", "csg-tree (voxel centres)".into()),
         ("source_file", tree.source.display().to_string().into()),
     ];
-    Ok(centre_solid(&solid, t, meta, Details::Csg(details)).timed(start))
+    let mut outcome = centre_solid(&solid, t, meta, Details::Csg(details));
+    outcome.exact = ExactTree::of(tree, &t).map(|e| Arc::new(e) as Arc<dyn ExactSurface>);
+    Ok(outcome.timed(start))
 }
 
 /// Lai & Cheng's Catmull-Clark solid: the limit surface, the inside flooded from seeds by

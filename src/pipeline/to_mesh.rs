@@ -4,7 +4,7 @@
 use super::Outcome;
 use super::request::ToMeshRequest;
 use super::{Limits, MeshWritten, on_threads};
-use crate::contour::{Meaning, ScalarField, TriangleMesh, contour};
+use crate::contour::{ExactSurface, Meaning, ScalarField, TriangleMesh, contour};
 use crate::error::{Error, Result};
 use crate::io::atomic::check_output;
 use crate::io::mesh_out::{MeshFormat, write_mesh};
@@ -62,7 +62,7 @@ pub fn vdb_to_mesh(
     on_threads(limits.threads, || {
         let mut read = StageClock::new("read");
         let field = read.time(|| read_vdb_field(input, request.grid.as_deref(), request.iso))?;
-        let (_, mesh, mut stages) = contour_to_file(&field, output, input)?;
+        let (_, mesh, mut stages) = contour_to_file(&field, None, output, input)?;
         stages.insert(0, read.stage());
         Ok(MeshReport {
             input: input.to_path_buf(),
@@ -103,7 +103,7 @@ impl Outcome {
     /// result is).
     pub fn surface_mesh(&self) -> Result<TriangleMesh> {
         let field = self.field()?;
-        on_threads(self.threads, || contour(&field))
+        on_threads(self.threads, || contour(&field, self.exact.as_deref()))
     }
 
     /// Writes the surface of the result to `output` (.obj, .ply, .stl or .glb), noted in the
@@ -121,8 +121,9 @@ impl Outcome {
     fn write_mesh_of(&mut self, output: &Path, source: Option<&Mesh>) -> Result<()> {
         let field = self.field()?;
         let input = PathBuf::from(&self.report.input);
-        let (mesh, mut written, mut stages) =
-            on_threads(self.threads, || contour_to_file(&field, output, &input))?;
+        let (mesh, mut written, mut stages) = on_threads(self.threads, || {
+            contour_to_file(&field, self.exact.as_deref(), output, &input)
+        })?;
         if let Some(source) = source {
             let mut measure = StageClock::new("distance to input");
             let distance = measure.time(|| {
@@ -150,15 +151,16 @@ impl Outcome {
     }
 }
 
-/// Contours `field` and writes the mesh to `output`; refuses a field without a surface,
-/// naming `source`.
+/// Contours `field` (placed by `exact` where it knows the source) and writes the mesh to
+/// `output`; refuses a field without a surface, naming `source`.
 fn contour_to_file(
     field: &ScalarField,
+    exact: Option<&dyn ExactSurface>,
     output: &Path,
     source: &Path,
 ) -> Result<(TriangleMesh, MeshWritten, Vec<StageTime>)> {
     let mut contouring = StageClock::new("contour");
-    let mesh = contouring.time(|| contour(field))?;
+    let mesh = contouring.time(|| contour(field, exact))?;
     if mesh.triangles.is_empty() {
         return Err(Error::InvalidArgument(format!(
             "{}: the grid has no surface at iso {} (its values never cross it)",

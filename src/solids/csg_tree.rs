@@ -462,7 +462,7 @@ fn union(a: Option<Aabb>, b: Option<Aabb>) -> Option<Aabb> {
 
 impl CsgNode {
     /// The world box the leaves cover (formulas only with their own bounds).
-    fn bounds(&self) -> Option<Aabb> {
+    pub(super) fn bounds(&self) -> Option<Aabb> {
         match self {
             CsgNode::Boolean { operands, .. } => {
                 operands.iter().map(CsgNode::bounds).fold(None, union)

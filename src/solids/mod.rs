@@ -4,6 +4,8 @@
 
 pub mod beam;
 pub mod cavities;
+#[cfg(feature = "vdb")]
+pub mod csg_exact;
 pub mod csg_leaves;
 pub mod csg_placement;
 #[cfg(feature = "vdb")]

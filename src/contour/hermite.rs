@@ -1,0 +1,97 @@
+//! Hermite data from the source itself (dual contouring's edge crossings and normals, Ju et
+//! al. 2002): where a solid known exactly crosses a lattice edge, found on the segment to
+//! within a millionth of a voxel, and its outward normal there. The grid's samples say only
+//! roughly where a surface passes; with the source's own crossings and normals, the vertices
+//! of the cells a sharp edge or corner passes through land on it.
+
+use glam::DVec3;
+
+/// A solid known exactly at every point (world units): a value negative inside and positive
+/// outside, zero on its surface and near it about the distance to it, with the unit outward
+/// normal of the part of the surface that value measures.
+pub trait ExactSurface: Send + Sync {
+    fn sample(&self, p: DVec3) -> (f64, DVec3);
+}
+
+/// Where on the segment the crossing is sought to: a millionth of it.
+const TOLERANCE: f64 = 1e-6;
+/// Enough halvings for any segment to reach the tolerance.
+const MOST_STEPS: usize = 64;
+
+/// Where `surface` crosses the segment from `a` (inside, as the grid says, when `a_inside`)
+/// to `b`: the fraction along it and the unit normal there. None where the source's signs at
+/// the ends are not the grid's (a leaf known only by its voxels, a clip the source does not
+/// see) or its normal is unknown: the grid's own crossing stands there.
+pub fn exact_crossing(
+    surface: &dyn ExactSurface,
+    a: DVec3,
+    b: DVec3,
+    a_inside: bool,
+) -> Option<(f64, DVec3)> {
+    // Inside as the grid counts it: a point on the surface belongs to the solid.
+    let value = |t: f64| surface.sample(a + (b - a) * t).0;
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    let (mut f_lo, mut f_hi) = (value(lo), value(hi));
+    if (f_lo <= 0.0) != a_inside || (f_hi <= 0.0) == a_inside {
+        return None;
+    }
+    // Regula falsi with the Illinois rule, which keeps it from stalling on one end, and a
+    // halving where the interpolation lands outside the bracket.
+    let mut side = 0i8;
+    for _ in 0..MOST_STEPS {
+        if hi - lo <= TOLERANCE {
+            break;
+        }
+        let mut t = lo + (hi - lo) * f_lo / (f_lo - f_hi);
+        if !(t > lo && t < hi) {
+            t = 0.5 * (lo + hi);
+        }
+        let f = value(t);
+        if f == 0.0 {
+            (lo, hi) = (t, t);
+            break;
+        }
+        if (f <= 0.0) == (f_lo <= 0.0) {
+            (lo, f_lo) = (t, f);
+            if side == -1 {
+                f_hi *= 0.5;
+            }
+            side = -1;
+        } else {
+            (hi, f_hi) = (t, f);
+            if side == 1 {
+                f_lo *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    let t = 0.5 * (lo + hi);
+    let normal = surface.sample(a + (b - a) * t).1.try_normalize()?;
+    Some((t, normal))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Ball;
+
+    impl ExactSurface for Ball {
+        fn sample(&self, p: DVec3) -> (f64, DVec3) {
+            (p.length() - 1.0, p.normalize_or_zero())
+        }
+    }
+
+    #[test]
+    fn a_ball_is_crossed_at_its_radius_with_its_normal() {
+        let a = DVec3::new(0.2, 0.3, 0.1);
+        let b = DVec3::new(1.5, 0.9, 0.4);
+        let (t, n) = exact_crossing(&Ball, a, b, true).unwrap();
+        let p = a + (b - a) * t;
+        assert!((p.length() - 1.0).abs() < 1e-6, "{p}");
+        assert!((n - p.normalize()).length() < 1e-9);
+        // Ends of one sign, or signs the grid does not share: no crossing.
+        assert!(exact_crossing(&Ball, a, a * 0.5, true).is_none());
+        assert!(exact_crossing(&Ball, a, b, false).is_none());
+    }
+}
