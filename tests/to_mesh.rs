@@ -730,3 +730,82 @@ fn csg_meshes_keep_the_sharp_corners_of_the_exact_solid() {
         }
     }
 }
+
+/// A mesh's level set meshed from the mesh's own crossings and face planes: a box remeshed at
+/// 32 keeps its eight corners within 0.1 voxel of a vertex, and its edges are cut only where
+/// they cross the cells' faces (both ways within 0.25 voxel of the input), through `remesh` and
+/// `mesh --sdf --mesh-out` alike; `to-mesh` of the same level set, which has only the values,
+/// rounds them off at least twice as far.
+#[test]
+fn a_meshs_own_planes_keep_its_edges_and_corners() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    let (lo, hi) = (DVec3::new(-0.3, 0.1, 0.2), DVec3::new(0.9, 0.8, 0.65));
+    let source = voxelkit::mesh::generate::cuboid(lo, hi);
+    source
+        .write_obj(std::path::Path::new(&p("box.obj")))
+        .unwrap();
+    let corners_of = |m: &Mesh| -> Vec<[DVec3; 3]> {
+        triangles_of(m).iter().map(|t| t.map(|i| m.p(i))).collect()
+    };
+    let distance = |out: &str| {
+        let mesh = Mesh::load(std::path::Path::new(&p(out))).unwrap();
+        let d = voxelkit::mesh::surface_distance::two_sided_distance(
+            &corners_of(&mesh),
+            &corners_of(&source),
+        );
+        (mesh, d.a_to_b.max(d.b_to_a))
+    };
+    let runs: [&[&str]; 2] = [
+        &[
+            "remesh",
+            &p("box.obj"),
+            "-r",
+            "32",
+            "-o",
+            &p("remeshed.ply"),
+            "--json",
+        ],
+        &[
+            "mesh",
+            &p("box.obj"),
+            "--sdf",
+            "-r",
+            "32",
+            "-o",
+            &p("box.vdb"),
+            "--mesh-out",
+            &p("level.ply"),
+            "--json",
+        ],
+    ];
+    let mut sharp: f64 = 0.0;
+    let mut voxel = 0.0;
+    for (args, out) in runs.iter().zip(["remeshed.ply", "level.ply"]) {
+        let o = voxelkit(args);
+        assert!(o.status.success(), "{}", text(&o));
+        voxel = cli_support::json_field(&text(&o), "voxel_size");
+        let (mesh, d) = distance(out);
+        let corners: Vec<DVec3> = (0..8)
+            .map(|k| DVec3::select(glam::BVec3::new(k & 1 == 1, k & 2 == 2, k & 4 == 4), hi, lo))
+            .collect();
+        let worst = farthest_corner(&mesh, &corners, voxel);
+        assert!(worst < 0.1, "{out}: a corner {worst} voxel from the mesh");
+        assert_closed_manifold(out, &mesh.positions, &triangles_of(&mesh), 0.0);
+        assert!(
+            d < 0.25 * voxel,
+            "{out}: {} voxel from the input",
+            d / voxel
+        );
+        sharp = sharp.max(d);
+    }
+    let o = voxelkit(&["to-mesh", &p("box.vdb"), "-o", &p("values.ply")]);
+    assert!(o.status.success(), "{}", text(&o));
+    let (_, rounded) = distance("values.ply");
+    assert!(
+        rounded > 2.0 * sharp,
+        "from the values {} voxel, from the mesh {} voxel",
+        rounded / voxel,
+        sharp / voxel
+    );
+}

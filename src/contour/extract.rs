@@ -16,7 +16,7 @@
 
 use super::cell_cycles::{EDGES, case_cycles, edge_axis, edges_share_face};
 use super::field::{BlockSign, ScalarField};
-use super::hermite::{ExactSurface, exact_crossing};
+use super::hermite::ExactSurface;
 use super::vertex_placement::{INSET, cycle_vertex};
 use crate::error::{Error, Result};
 use crate::grid::{Block, Coord, NODE_DIM};
@@ -248,21 +248,21 @@ fn block_piece(
         let index = DVec3::from_array(std::array::from_fn(|a| (origin[a] + c[a]) as f64));
         transform.origin + transform.voxel_size * index
     };
+    let exact = exact.map(|e| e.near(world([0; 3]), world([8; 3])));
     // The crossing on the edge from local voxel `c` along `axis`, and its unit normal: the
     // source's where it is known exactly, else the samples'.
     let crossing = |c: [i64; 3], axis: usize| -> (DVec3, DVec3) {
         let mut d = c;
         d[axis] += 1;
         let mut p = DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
-        if let Some(surface) = exact
-            && let Some((t, n)) =
-                exact_crossing(surface, world(c), world(d), inside(c[0], c[1], c[2]))
+        let (g0, g1) = (s(c[0], c[1], c[2]), s(d[0], d[1], d[2]));
+        let t = (g0 / (g0 - g1)).clamp(INSET, 1.0 - INSET);
+        if let Some(surface) = &exact
+            && let Some((t, n)) = surface.crossing(world(c), world(d), inside(c[0], c[1], c[2]), t)
         {
             p[axis] += t.clamp(INSET, 1.0 - INSET);
             return (p, n);
         }
-        let (g0, g1) = (s(c[0], c[1], c[2]), s(d[0], d[1], d[2]));
-        let t = (g0 / (g0 - g1)).clamp(INSET, 1.0 - INSET);
         p[axis] += t;
         let n = if steer {
             let g = gradient(c[0], c[1], c[2]) * (1.0 - t) + gradient(d[0], d[1], d[2]) * t;

@@ -6,11 +6,21 @@
 
 use glam::DVec3;
 
-/// A solid known exactly at every point (world units): a value negative inside and positive
-/// outside, zero on its surface and near it about the distance to it, with the unit outward
-/// normal of the part of the surface that value measures.
+/// A solid known exactly: where its surface crosses a segment, and its outward normal there.
 pub trait ExactSurface: Send + Sync {
-    fn sample(&self, p: DVec3) -> (f64, DVec3);
+    /// The source as the segments within the world box `[lo, hi]` meet it (a block's edges
+    /// ask it together: what lies near the block is found once).
+    fn near(&self, lo: DVec3, hi: DVec3) -> Box<dyn SegmentCrossings + '_>;
+}
+
+/// Where a source's surface crosses segments.
+pub trait SegmentCrossings {
+    /// Where the surface crosses the segment from `a` (inside, as the grid says, when
+    /// `a_inside`) to `b` (world units): the fraction along it, nearest `guess` (the grid's
+    /// own) where it crosses more than once, and the unit normal there, pointing out of the
+    /// solid. None where the source cannot say (a leaf known only by its voxels, a clip it does
+    /// not see, a sheet spanning a hole): the grid's crossing stands there.
+    fn crossing(&self, a: DVec3, b: DVec3, a_inside: bool, guess: f64) -> Option<(f64, DVec3)>;
 }
 
 /// Where on the segment the crossing is sought to: a millionth of it.
@@ -18,18 +28,18 @@ const TOLERANCE: f64 = 1e-6;
 /// Enough halvings for any segment to reach the tolerance.
 const MOST_STEPS: usize = 64;
 
-/// Where `surface` crosses the segment from `a` (inside, as the grid says, when `a_inside`)
-/// to `b`: the fraction along it and the unit normal there. None where the source's signs at
-/// the ends are not the grid's (a leaf known only by its voxels, a clip the source does not
-/// see) or its normal is unknown: the grid's own crossing stands there.
-pub fn exact_crossing(
-    surface: &dyn ExactSurface,
+/// The crossing of a solid given by its values (`sample`: negative inside, positive outside,
+/// zero on the surface, with the unit outward normal of the part of the surface the value
+/// measures), as `ExactSurface::crossing` answers it: by regula falsi on the segment; none
+/// where the values' signs at the ends are not the grid's.
+pub fn crossing_of_values(
+    sample: impl Fn(DVec3) -> (f64, DVec3),
     a: DVec3,
     b: DVec3,
     a_inside: bool,
 ) -> Option<(f64, DVec3)> {
     // Inside as the grid counts it: a point on the surface belongs to the solid.
-    let value = |t: f64| surface.sample(a + (b - a) * t).0;
+    let value = |t: f64| sample(a + (b - a) * t).0;
     let (mut lo, mut hi) = (0.0f64, 1.0f64);
     let (mut f_lo, mut f_hi) = (value(lo), value(hi));
     if (f_lo <= 0.0) != a_inside || (f_hi <= 0.0) == a_inside {
@@ -66,7 +76,7 @@ pub fn exact_crossing(
         }
     }
     let t = 0.5 * (lo + hi);
-    let normal = surface.sample(a + (b - a) * t).1.try_normalize()?;
+    let normal = sample(a + (b - a) * t).1.try_normalize()?;
     Some((t, normal))
 }
 
@@ -74,24 +84,20 @@ pub fn exact_crossing(
 mod tests {
     use super::*;
 
-    struct Ball;
-
-    impl ExactSurface for Ball {
-        fn sample(&self, p: DVec3) -> (f64, DVec3) {
-            (p.length() - 1.0, p.normalize_or_zero())
-        }
+    fn ball(p: DVec3) -> (f64, DVec3) {
+        (p.length() - 1.0, p.normalize_or_zero())
     }
 
     #[test]
     fn a_ball_is_crossed_at_its_radius_with_its_normal() {
         let a = DVec3::new(0.2, 0.3, 0.1);
         let b = DVec3::new(1.5, 0.9, 0.4);
-        let (t, n) = exact_crossing(&Ball, a, b, true).unwrap();
+        let (t, n) = crossing_of_values(ball, a, b, true).unwrap();
         let p = a + (b - a) * t;
         assert!((p.length() - 1.0).abs() < 1e-6, "{p}");
         assert!((n - p.normalize()).length() < 1e-9);
         // Ends of one sign, or signs the grid does not share: no crossing.
-        assert!(exact_crossing(&Ball, a, a * 0.5, true).is_none());
-        assert!(exact_crossing(&Ball, a, b, false).is_none());
+        assert!(crossing_of_values(ball, a, a * 0.5, true).is_none());
+        assert!(crossing_of_values(ball, a, b, false).is_none());
     }
 }

@@ -11,4 +11,4 @@ mod vertex_placement;
 
 pub use extract::{TriangleMesh, contour};
 pub use field::{BlockSign, Meaning, ScalarField};
-pub use hermite::ExactSurface;
+pub use hermite::{ExactSurface, SegmentCrossings, crossing_of_values};

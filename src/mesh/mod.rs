@@ -14,6 +14,7 @@ pub mod key_groups;
 mod obj;
 mod off;
 mod ply;
+pub mod segment_hits;
 pub mod shells;
 mod stl;
 pub mod surface_distance;

@@ -50,8 +50,8 @@ pub struct Outcome {
     pub distances: Option<Distances>,
     /// The threads the job ran on (all when `None`): writing encodes on them too.
     pub threads: Option<usize>,
-    /// The source known exactly (a CSG tree of shapes and formulas): its meshes take their
-    /// crossings and normals from it.
+    /// The source known exactly (a CSG tree of shapes and formulas; the mesh of a level set):
+    /// the meshes of the result take their crossings and normals from it.
     pub exact: Option<std::sync::Arc<dyn ExactSurface>>,
 }
 

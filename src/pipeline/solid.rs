@@ -13,6 +13,7 @@ use crate::contour::ExactSurface;
 use crate::error::Result;
 use crate::grid::{DenseMask, SparseGrid, Transform};
 use crate::io::vdb::MetaValue;
+use crate::mesh::segment_hits::MeshHits;
 use crate::mesh::{GridFit, Mesh, index_box};
 use crate::progress::Progress;
 use crate::solids::beam::{BeamFill, beam_solid};
@@ -301,6 +302,9 @@ pub(super) fn distance_band(
         ambiguous_voxels: ambiguous.as_ref().map(SparseGrid::voxel_count),
     };
     let mut outcome = Outcome::new(grid, meta, Details::DistanceBand(details));
+    if signed {
+        outcome.exact = Some(Arc::new(MeshHits::new(mesh.clone())));
+    }
     outcome.distances = Some(Distances {
         background: background as f32,
         interior,

@@ -10,7 +10,7 @@
 
 use super::csg_leaves::Primitive;
 use super::csg_tree::{CsgNode, CsgTree};
-use crate::contour::ExactSurface;
+use crate::contour::{ExactSurface, SegmentCrossings, crossing_of_values};
 use crate::grid::Transform;
 use crate::implicit::Formula;
 use crate::mesh::index_box;
@@ -83,10 +83,23 @@ fn exact_node(node: &CsgNode, transform: &Transform) -> Option<ExactNode> {
     })
 }
 
-impl ExactSurface for ExactTree {
+impl ExactTree {
+    /// The tree's value at `p` and the normal of the leaf surface it measures.
     fn sample(&self, p: DVec3) -> (f64, DVec3) {
         let mut slots = Vec::new();
         self.root.sample(p, &mut slots)
+    }
+}
+
+impl ExactSurface for ExactTree {
+    fn near(&self, _lo: DVec3, _hi: DVec3) -> Box<dyn SegmentCrossings + '_> {
+        Box::new(self)
+    }
+}
+
+impl SegmentCrossings for &ExactTree {
+    fn crossing(&self, a: DVec3, b: DVec3, a_inside: bool, _guess: f64) -> Option<(f64, DVec3)> {
+        crossing_of_values(|p| self.sample(p), a, b, a_inside)
     }
 }
 
