@@ -110,6 +110,25 @@ impl Cuboid {
     pub fn contains(&self, p: DVec3) -> bool {
         p.cmpge(self.min).all() && p.cmple(self.max).all()
     }
+
+    /// The signed distance from `p` to the box's surface (negative inside) and its gradient,
+    /// the unit outward normal of the nearest face, edge or corner.
+    pub fn signed_distance(&self, p: DVec3) -> (f64, DVec3) {
+        let centre = 0.5 * (self.min + self.max);
+        let d = p - centre;
+        let q = d.abs() - 0.5 * (self.max - self.min);
+        let outside = q.max(DVec3::ZERO);
+        let length = outside.length();
+        let sign = DVec3::select(d.cmpge(DVec3::ZERO), DVec3::ONE, DVec3::NEG_ONE);
+        if length > 0.0 {
+            (length, sign * outside / length)
+        } else {
+            let axis = q.max_position();
+            let mut n = DVec3::ZERO;
+            n[axis] = sign[axis];
+            (q[axis], n)
+        }
+    }
 }
 
 impl Quadric {

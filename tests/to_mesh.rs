@@ -809,3 +809,53 @@ fn a_meshs_own_planes_keep_its_edges_and_corners() {
         sharp / voxel
     );
 }
+
+/// `implicit --mesh-out` draws the formula's solid F < 0 within the bounds, not the boundary
+/// of its enveloping voxels: a sphere's vertices on the sphere and its volume; a half-space
+/// cut by the bounds is the box, with its corners; the gear closed and manifold.
+#[test]
+fn implicit_meshes_are_the_formulas_solid() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    let run = |args: &[&str], name: &str| -> (Mesh, f64) {
+        let mut all = vec!["implicit"];
+        all.extend_from_slice(args);
+        let (vdb, mesh) = (p(&format!("{name}.vdb")), p(&format!("{name}.obj")));
+        all.extend_from_slice(&["-o", &vdb, "--mesh-out", &mesh, "--json"]);
+        let o = voxelkit(&all);
+        assert!(o.status.success(), "{}", text(&o));
+        let voxel = cli_support::json_field(&text(&o), "voxel_size");
+        let m = Mesh::load(std::path::Path::new(&mesh)).unwrap();
+        assert_closed_manifold(name, &m.positions, &triangles_of(&m), 0.0);
+        (m, voxel)
+    };
+    let (sphere, voxel) = run(&["x^2 + y^2 + z^2 - 0.64", "-r", "64"], "sphere");
+    let off = sphere
+        .positions
+        .iter()
+        .map(|v| (v.length() - 0.8).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        off < 0.05 * voxel,
+        "a vertex {} voxel off the sphere",
+        off / voxel
+    );
+    let volume = signed_volume(&sphere.positions, &triangles_of(&sphere));
+    let exact = 4.0 / 3.0 * std::f64::consts::PI * 0.8f64.powi(3);
+    assert!(
+        (volume / exact - 1.0).abs() < 0.001,
+        "{volume} against {exact}"
+    );
+    let (half, voxel) = run(&["z - 0.3", "-r", "32"], "half-space");
+    let volume = signed_volume(&half.positions, &triangles_of(&half));
+    assert!((volume / 5.2 - 1.0).abs() < 0.001, "{volume} against 5.2");
+    let corners: Vec<DVec3> = (0..8)
+        .map(|k| {
+            let pick = |bit: usize, lo: f64, hi: f64| if k >> bit & 1 == 1 { hi } else { lo };
+            DVec3::new(pick(0, -1.0, 1.0), pick(1, -1.0, 1.0), pick(2, -1.0, 0.3))
+        })
+        .collect();
+    let worst = farthest_corner(&half, &corners, voxel);
+    assert!(worst < 0.1, "a corner {worst} voxel from the mesh");
+    run(&["--example", "gear", "-r", "64"], "gear");
+}

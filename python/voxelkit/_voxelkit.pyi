@@ -67,7 +67,8 @@ class Grid:
     def to_mesh(self) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
         """The surface as a closed, manifold triangle mesh: (vertices (n, 3) world positions,
         triangles (m, 3) vertex rows, counter-clockwise seen from outside). A level set's zero
-        set (sdf=True), a solid's or a voxel surface's boundary."""
+        set (sdf=True), a formula's F < 0 within its bounds, a solid's or a voxel surface's
+        boundary."""
     def render(
         self, path: Path, view: str = "iso", size: Tuple[int, int] = (800, 600)
     ) -> None:

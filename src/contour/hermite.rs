@@ -4,6 +4,8 @@
 //! roughly where a surface passes; with the source's own crossings and normals, the vertices
 //! of the cells a sharp edge or corner passes through land on it.
 
+use super::field::ScalarField;
+use crate::grid::SparseGrid;
 use glam::DVec3;
 
 /// A solid known exactly: where its surface crosses a segment, and its outward normal there.
@@ -11,6 +13,13 @@ pub trait ExactSurface: Send + Sync {
     /// The source as the segments within the world box `[lo, hi]` meet it (a block's edges
     /// ask it together: what lies near the block is found once).
     fn near(&self, lo: DVec3, hi: DVec3) -> Box<dyn SegmentCrossings + '_>;
+
+    /// The solid's own values on the lattice around `grid` (the result's voxels), where the
+    /// result holds none its surface can be drawn from (a formula's enveloping shell); none:
+    /// the result's grid is contoured as it is.
+    fn field_around(&self, _grid: &SparseGrid) -> Option<ScalarField<'static>> {
+        None
+    }
 }
 
 /// Where a source's surface crosses segments.
@@ -33,13 +42,13 @@ const MOST_STEPS: usize = 64;
 /// measures), as `ExactSurface::crossing` answers it: by regula falsi on the segment; none
 /// where the values' signs at the ends are not the grid's.
 pub fn crossing_of_values(
-    sample: impl Fn(DVec3) -> (f64, DVec3),
+    mut sample: impl FnMut(DVec3) -> (f64, DVec3),
     a: DVec3,
     b: DVec3,
     a_inside: bool,
 ) -> Option<(f64, DVec3)> {
     // Inside as the grid counts it: a point on the surface belongs to the solid.
-    let value = |t: f64| sample(a + (b - a) * t).0;
+    let mut value = |t: f64| sample(a + (b - a) * t).0;
     let (mut lo, mut hi) = (0.0f64, 1.0f64);
     let (mut f_lo, mut f_hi) = (value(lo), value(hi));
     if (f_lo <= 0.0) != a_inside || (f_hi <= 0.0) == a_inside {

@@ -4,6 +4,7 @@
 
 mod coordinates;
 mod dual;
+pub mod formula_solid;
 mod interval;
 mod parse;
 pub mod reference;
@@ -96,6 +97,19 @@ impl Formula {
     /// The Cartesian gradient of F at the world point `p`; `slots` is scratch space.
     pub fn gradient_at(&self, p: [f64; 3], slots: &mut Vec<Dual>) -> glam::DVec3 {
         self.value_and_gradient_at(p, slots).1
+    }
+
+    /// F over the length of its gradient at the world point `p`, the distance to F = 0 to
+    /// first order (its sign F's), and the unit gradient (zero where F has none); `slots` is
+    /// scratch space.
+    pub fn first_order_distance(&self, p: [f64; 3], slots: &mut Vec<Dual>) -> (f64, glam::DVec3) {
+        let (f, g) = self.value_and_gradient_at(p, slots);
+        let length = g.length();
+        if length > 0.0 && length.is_finite() {
+            (f / length, g / length)
+        } else {
+            (f, glam::DVec3::ZERO)
+        }
     }
 
     /// F and its Cartesian gradient at the world point `p`; `slots` is scratch space.

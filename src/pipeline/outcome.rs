@@ -10,6 +10,7 @@ use crate::contour::ExactSurface;
 use crate::error::{Error, Result};
 use crate::grid::{Channels, CoordBox, Leaf, SparseGrid, Transform};
 use crate::implicit::Formula;
+use crate::implicit::formula_solid::FormulaSolid;
 use crate::io::atomic::check_output;
 use crate::io::binvox::write_binvox;
 use crate::io::brick_set::{BrickSet, is_brick_set};
@@ -25,6 +26,7 @@ use crate::ops::measure::SolidMeasures;
 use crate::ops::minimality::simple_voxel_count;
 use crate::ops::separability::check_mesh_separation;
 use crate::progress::{Progress, StageTime};
+use crate::shapes::Cuboid;
 use crate::subd::ControlMesh;
 use crate::voxelize::interval_octree::{OctreeOptions, voxelize_implicit};
 use crate::voxelize::parametric::{ParametricOptions, voxelize_subdivision};
@@ -648,6 +650,10 @@ pub(super) fn implicit(
         depth: s.depth,
     };
     let mut outcome = Outcome::new(out.surface, meta, Details::Implicit(details));
+    let bounds = Cuboid { min, max };
+    if let Some(solid) = FormulaSolid::new(formula, bounds, options.both_signs) {
+        outcome.exact = Some(std::sync::Arc::new(solid));
+    }
     for (l, level) in out.levels.into_iter().enumerate() {
         outcome = outcome.with(&format!("level_{l}"), level);
     }

@@ -85,9 +85,15 @@ pub fn check_mesh_output(output: &Path, inputs: &[&Path]) -> Result<()> {
 }
 
 impl Outcome {
-    /// The result as a field: a level set's distances (its zero set the surface), or a voxel
-    /// set (its boundary).
+    /// The result as a field: a level set's distances (its zero set the surface), the source's
+    /// own values around a shell that only envelops it (a formula's), or a voxel set (its
+    /// boundary).
     fn field(&self) -> Result<ScalarField<'_>> {
+        if self.distances.is_none()
+            && let Some(field) = self.exact.as_ref().and_then(|e| e.field_around(&self.grid))
+        {
+            return Ok(field);
+        }
         match &self.distances {
             Some(d) => ScalarField::from_band(&self.grid, d.background, d.interior.as_ref(), 0.0)
                 .ok_or_else(|| Error::InvalidArgument("the distance band is empty".into())),

@@ -397,8 +397,9 @@ impl Grid {
 
     /// The surface as a closed, manifold triangle mesh, counter-clockwise seen from outside:
     /// `(vertices, triangles)`, an (n, 3) float64 array of world positions and an (m, 3)
-    /// int64 array of vertex rows. A level set's zero set (sdf), a solid's or a voxel
-    /// surface's boundary, half way between its voxels and empty ones.
+    /// int64 array of vertex rows. A level set's zero set (sdf), a formula's F < 0 within its
+    /// bounds, a solid's or a voxel surface's boundary, half way between its voxels and empty
+    /// ones.
     #[allow(clippy::type_complexity)]
     fn to_mesh<'py>(
         &self,

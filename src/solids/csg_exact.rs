@@ -119,7 +119,7 @@ impl ExactNode {
             ExactNode::Primitive { shape, to_local } => {
                 let local = to_local.transform_point3(p);
                 let (value, normal) = match shape {
-                    Primitive::Cuboid(b) => cuboid_distance(b, local),
+                    Primitive::Cuboid(b) => b.signed_distance(local),
                     Primitive::Cylinder(c) => {
                         let d = local - c.center;
                         let along = d.dot(c.axis);
@@ -146,16 +146,11 @@ impl ExactNode {
                 to_local,
             } => {
                 let local = to_local.transform_point3(p);
-                let (f, g) = formula.value_and_gradient_at(local.to_array(), slots);
-                let length = g.length();
-                let leaf = if length > 0.0 && length.is_finite() {
-                    to_world(to_local, f / length, g / length)
-                } else {
-                    (f, DVec3::ZERO)
-                };
+                let (d, n) = formula.first_order_distance(local.to_array(), slots);
+                let leaf = to_world(to_local, d, n);
                 match clip {
                     Some(b) => {
-                        let c = cuboid_distance(b, p);
+                        let c = b.signed_distance(p);
                         if c.0 > leaf.0 { c } else { leaf }
                     }
                     None => leaf,
@@ -175,24 +170,6 @@ fn to_world(to_local: &DAffine3, value: f64, normal: DVec3) -> (f64, DVec3) {
         (value / length, g / length)
     } else {
         (value, DVec3::ZERO)
-    }
-}
-
-/// The signed distance to the box and its gradient.
-fn cuboid_distance(b: &Cuboid, p: DVec3) -> (f64, DVec3) {
-    let centre = 0.5 * (b.min + b.max);
-    let d = p - centre;
-    let q = d.abs() - 0.5 * (b.max - b.min);
-    let outside = q.max(DVec3::ZERO);
-    let length = outside.length();
-    let sign = DVec3::select(d.cmpge(DVec3::ZERO), DVec3::ONE, DVec3::NEG_ONE);
-    if length > 0.0 {
-        (length, sign * outside / length)
-    } else {
-        let axis = q.max_position();
-        let mut n = DVec3::ZERO;
-        n[axis] = sign[axis];
-        (q[axis], n)
     }
 }
 

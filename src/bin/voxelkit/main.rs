@@ -78,7 +78,8 @@ pub struct WriteArgs {
     #[arg(long)]
     pub preview: bool,
     /// Also write the result's surface as a closed, manifold triangle mesh (.obj, .ply, .stl
-    /// or .glb): a level set's zero set (--sdf), a solid's or a voxel surface's boundary.
+    /// or .glb): a level set's zero set (--sdf), a formula's F < 0 within its bounds, a
+    /// solid's or a voxel surface's boundary (sharp where the source is known exactly).
     #[arg(long, value_name = "MESH")]
     pub mesh_out: Option<PathBuf>,
 }
