@@ -4,7 +4,10 @@
 //! both peaks are measured alike:
 //! - `mesh`: the surface against `meshToUnsignedDistanceField` with a one-voxel band;
 //! - `solid`: the solid against `meshToLevelSet` (half width 3) plus `sdfInteriorMask`;
-//! - `sdf`: `mesh --sdf` against `meshToLevelSet` with the same band.
+//! - `sdf`: `mesh --sdf` against `meshToLevelSet` with the same band;
+//! - `to-mesh`: `to-mesh` of the mesh's level set (made once beforehand by `mesh --sdf`), its
+//!   `.vdb` in and a PLY on disk, against `volumeToMesh` (adaptivity 0) on the same grid
+//!   already read; counts are triangles (OpenVDB's quads as two).
 
 use crate::bench::{best_of, data_folder};
 use crate::json::Json;
@@ -22,6 +25,7 @@ pub enum WholeTask {
     Mesh,
     Solid,
     Sdf,
+    ToMesh,
 }
 
 impl WholeTask {
@@ -30,7 +34,7 @@ impl WholeTask {
         match self {
             WholeTask::Mesh => (OpenVdbReference::Unsigned, 1.0),
             WholeTask::Solid => (OpenVdbReference::Solid, 3.0),
-            WholeTask::Sdf => (OpenVdbReference::LevelSet, band),
+            WholeTask::Sdf | WholeTask::ToMesh => (OpenVdbReference::LevelSet, band),
         }
     }
 
@@ -43,6 +47,15 @@ impl WholeTask {
                 vec!["mesh".into()],
                 vec!["--sdf".into(), "--band".into(), band.to_string()],
             ),
+            WholeTask::ToMesh => (vec!["to-mesh".into()], vec![]),
+        }
+    }
+
+    /// What the counts count.
+    fn counted(self) -> &'static str {
+        match self {
+            WholeTask::ToMesh => "triangles",
+            _ => "voxels",
         }
     }
 }
@@ -70,11 +83,13 @@ pub struct WholeBenchArgs {
 }
 
 /// `voxelkit-bench openvdb`: one OpenVDB reference in this process, for `whole` to time
-/// and measure; prints `{"seconds", "voxels", "peak_mib"}`.
+/// and measure; prints `{"seconds", "voxels", "peak_mib"}` (`voxels`: triangles for
+/// `to-mesh`).
 #[derive(Args)]
 pub struct OpenVdbRunArgs {
     #[arg(long, value_enum)]
     task: WholeTask,
+    /// The mesh, or for `to-mesh` the level set's `.vdb` (its grid `surface`).
     #[arg(long)]
     mesh: PathBuf,
     #[arg(long)]
@@ -86,13 +101,26 @@ pub struct OpenVdbRunArgs {
 }
 
 pub fn run_openvdb(args: &OpenVdbRunArgs) -> Result<()> {
-    let mesh = Mesh::load(&args.mesh)?;
-    let t = fit_transform(&mesh.bbox(), GridFit::Resolution(args.resolution))?;
-    let (points, tris) = crate::bench::openvdb_mesh(&mesh, &t);
-    let (kind, band) = args.task.reference(args.band);
-    let start = Instant::now();
-    let voxels = openvdb_reference(kind, &points, &tris, t.voxel_size, band, args.threads)?;
-    let seconds = start.elapsed().as_secs_f64();
+    let (seconds, voxels) = if args.task == WholeTask::ToMesh {
+        let path = args.mesh.display().to_string();
+        let failed = |message: String| Error::Vdb {
+            path: args.mesh.clone(),
+            message,
+        };
+        let grids = voxelkit_openvdb::OpenVdbGrids::read(&path).map_err(failed)?;
+        let made = grids
+            .volume_to_mesh("surface", 0.0, 0.0, args.threads)
+            .map_err(failed)?;
+        (made.seconds, made.triangles + 2 * made.quads)
+    } else {
+        let mesh = Mesh::load(&args.mesh)?;
+        let t = fit_transform(&mesh.bbox(), GridFit::Resolution(args.resolution))?;
+        let (points, tris) = crate::bench::openvdb_mesh(&mesh, &t);
+        let (kind, band) = args.task.reference(args.band);
+        let start = Instant::now();
+        let voxels = openvdb_reference(kind, &points, &tris, t.voxel_size, band, args.threads)?;
+        (start.elapsed().as_secs_f64(), voxels)
+    };
     let peak = voxelkit::system::peak_memory_bytes().unwrap_or(0) as f64 / (1 << 20) as f64;
     println!(
         "{}",
@@ -132,22 +160,49 @@ fn ours(
     band: f32,
 ) -> Result<serde_json::Value> {
     let this = std::env::current_exe().map_err(|e| Error::io("voxelkit-bench", e))?;
-    let out = std::env::temp_dir().join(format!("voxelkit-bench-{}.vdb", std::process::id()));
+    let extension = if task == WholeTask::ToMesh {
+        "ply"
+    } else {
+        "vdb"
+    };
+    let out =
+        std::env::temp_dir().join(format!("voxelkit-bench-{}.{extension}", std::process::id()));
     let (before, after) = task.arguments(band);
     let mut args: Vec<String> = vec!["--json".into(), "--threads".into(), threads.to_string()];
     args.extend(before);
     args.push(mesh.display().to_string());
     args.extend(after);
-    args.extend([
-        "-r".into(),
-        res.to_string(),
-        "-o".into(),
-        out.display().to_string(),
-    ]);
+    if task != WholeTask::ToMesh {
+        args.extend(["-r".into(), res.to_string()]);
+    }
+    args.extend(["-o".into(), out.display().to_string()]);
     let mut report = json_of(&this.with_file_name("voxelkit"), &args)?;
     report["file_bytes"] = std::fs::metadata(&out).map(|m| m.len()).unwrap_or(0).into();
     let _ = std::fs::remove_file(&out);
     Ok(report)
+}
+
+/// The level set of `mesh` at `res` by `voxelkit mesh --sdf`, for `to-mesh` to start from.
+fn level_set(mesh: &Path, res: u32, band: f32) -> Result<PathBuf> {
+    let this = std::env::current_exe().map_err(|e| Error::io("voxelkit-bench", e))?;
+    let out = std::env::temp_dir().join(format!(
+        "voxelkit-bench-level-set-{}.vdb",
+        std::process::id()
+    ));
+    let args: Vec<String> = vec![
+        "--json".into(),
+        "mesh".into(),
+        mesh.display().to_string(),
+        "--sdf".into(),
+        "--band".into(),
+        band.to_string(),
+        "-r".into(),
+        res.to_string(),
+        "-o".into(),
+        out.display().to_string(),
+    ];
+    json_of(&this.with_file_name("voxelkit"), &args)?;
+    Ok(out)
 }
 
 /// The OpenVDB reference in its own process: (compute seconds, voxels, peak MiB).
@@ -159,7 +214,10 @@ fn openvdb(
     band: f32,
 ) -> Result<(f64, u64, f64)> {
     let this = std::env::current_exe().map_err(|e| Error::io("voxelkit-bench", e))?;
-    let task_name = format!("{task:?}").to_lowercase();
+    let task_name = task
+        .to_possible_value()
+        .map(|v| v.get_name().to_string())
+        .unwrap_or_default();
     let args: Vec<String> = [
         "openvdb",
         "--task",
@@ -203,8 +261,13 @@ pub fn run(args: &WholeBenchArgs, json: bool) -> Result<()> {
         );
     }
     for name in &args.meshes {
-        let path = crate::bench::resolve(name, &data, "meshes");
+        let mesh = crate::bench::resolve(name, &data, "meshes");
         for &res in &args.resolutions {
+            // `to-mesh` starts from the level set, made once and not timed.
+            let level_set = (args.task == WholeTask::ToMesh)
+                .then(|| level_set(&mesh, res, args.band))
+                .transpose()?;
+            let path = level_set.as_ref().unwrap_or(&mesh);
             for &threads in &args.thread_counts {
                 let (ours_s, report) = best_of(args.repeat, || {
                     ours(args.task, &path, res, threads, args.band)
@@ -217,13 +280,19 @@ pub fn run(args: &WholeBenchArgs, json: bool) -> Result<()> {
                     }
                 }
                 let (vdb_s, vdb_voxels, vdb_peak) = reference;
-                let voxels = report["voxels"].as_u64().unwrap_or(0);
+                let voxels = report[args.task.counted()].as_u64().unwrap_or(0);
                 let file_mb = report["file_bytes"].as_f64().unwrap_or(0.0) / 1e6;
                 let peak = report["peak_mib"].as_f64().unwrap_or(0.0);
                 if json {
                     rows.push(
                         Json::default()
-                            .str("task", format!("{:?}", args.task).to_lowercase())
+                            .str(
+                                "task",
+                                args.task
+                                    .to_possible_value()
+                                    .map(|v| v.get_name().to_string())
+                                    .unwrap_or_default(),
+                            )
                             .str("mesh", name.clone())
                             .int("resolution", res as u64)
                             .int("threads", threads as u64)
@@ -243,15 +312,28 @@ pub fn run(args: &WholeBenchArgs, json: bool) -> Result<()> {
                     );
                 }
             }
+            if let Some(made) = &level_set {
+                let _ = std::fs::remove_file(made);
+            }
         }
     }
     if json {
         println!("{}", Json::default().arr("runs", rows).render());
     } else {
-        let (kind, _) = args.task.reference(args.band);
+        let reference = match args.task {
+            WholeTask::ToMesh => {
+                "volumeToMesh (adaptivity 0) compute only, the grid already read; \
+                                  counts: triangles"
+                    .to_string()
+            }
+            task => format!(
+                "{:?} compute only, the mesh already in memory",
+                task.reference(args.band).0
+            ),
+        };
         println!(
-            "ours: the whole voxelkit process (read, compute, write the .vdb); openvdb: {kind:?} \
-             compute only, the mesh already in memory; peaks: each process's maximum resident set"
+            "ours: the whole voxelkit process (read, compute, write its output); openvdb: \
+             {reference}; peaks: each process's maximum resident set"
         );
     }
     Ok(())

@@ -10,8 +10,10 @@
 #include <openvdb/tools/LevelSetMeasure.h>
 #include <openvdb/tools/LevelSetUtil.h>
 #include <openvdb/tools/MeshToVolume.h>
+#include <openvdb/tools/VolumeToMesh.h>
 #include <tbb/global_control.h>
 #include <algorithm>
+#include <chrono>
 #include <limits>
 #include <exception>
 #include <mutex>
@@ -50,14 +52,28 @@ GridSet::~GridSet() {
 
 double openvdb_level_set_volume(rust::Str path, rust::Str name) { return open_vdb(path)->level_set_volume(name); }
 
-double GridSet::level_set_volume(rust::Str name) const {
+openvdb::FloatGrid::ConstPtr GridSet::float_grid(rust::Str name) const {
     for (const auto& base : *grids_) {
         if (base->getName() != std::string(name)) continue;
         auto grid = openvdb::gridConstPtrCast<openvdb::FloatGrid>(base);
         if (!grid) throw std::invalid_argument("grid " + std::string(name) + " is not a FloatGrid");
-        return openvdb::tools::levelSetVolume(*grid);
+        return grid;
     }
     throw std::invalid_argument("no grid named " + std::string(name));
+}
+
+double GridSet::level_set_volume(rust::Str name) const { return openvdb::tools::levelSetVolume(*float_grid(name)); }
+
+MeshCounts GridSet::volume_to_mesh(rust::Str name, double iso, double adaptivity, size_t threads) const {
+    auto grid = float_grid(name);
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    std::vector<openvdb::Vec3s> points;
+    std::vector<openvdb::Vec3I> triangles;
+    std::vector<openvdb::Vec4I> quads;
+    const auto start = std::chrono::steady_clock::now();
+    openvdb::tools::volumeToMesh(*grid, points, triangles, quads, iso, adaptivity);
+    const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
+    return MeshCounts{took.count(), points.size(), triangles.size(), quads.size()};
 }
 
 std::unique_ptr<GridSet> open_vdb(rust::Str path) {

@@ -11,6 +11,7 @@ namespace voxelkit {
 struct MetaEntry;
 struct GridInfo;
 struct GridArrays;
+struct MeshCounts;
 
 class GridSet {
 public:
@@ -24,10 +25,12 @@ public:
                      rust::Vec<float>& values, rust::Vec<int32_t>& tiles) const;
     void add_grid(const GridArrays& arrays);
     double level_set_volume(rust::Str name) const;
+    MeshCounts volume_to_mesh(rust::Str name, double iso, double adaptivity, size_t threads) const;
     void write(rust::Str path, uint32_t compression, bool half);
 
 private:
     openvdb::GridBase::ConstPtr grid(size_t index) const;
+    openvdb::FloatGrid::ConstPtr float_grid(rust::Str name) const;
     openvdb::GridPtrVecPtr grids_;
 };
 

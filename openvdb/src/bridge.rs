@@ -61,6 +61,14 @@ pub mod ffi {
         tile_value: f32,
     }
 
+    /// What OpenVDB's `tools::volumeToMesh` made, and its seconds.
+    struct MeshCounts {
+        seconds: f64,
+        points: u64,
+        triangles: u64,
+        quads: u64,
+    }
+
     unsafe extern "C++" {
         include!("voxelkit-openvdb/cpp/vdb_bridge.h");
 
@@ -76,6 +84,15 @@ pub mod ffi {
         fn add_grid(self: Pin<&mut GridSet>, arrays: &GridArrays) -> Result<()>;
         /// OpenVDB's `tools::levelSetVolume` of the grid `name`.
         fn level_set_volume(self: &GridSet, name: &str) -> Result<f64>;
+        /// OpenVDB's `tools::volumeToMesh` of the float grid `name` at `iso` with `adaptivity`,
+        /// on at most `threads` threads, timed on the call alone.
+        fn volume_to_mesh(
+            self: &GridSet,
+            name: &str,
+            iso: f64,
+            adaptivity: f64,
+            threads: usize,
+        ) -> Result<MeshCounts>;
         /// Writes every grid with OpenVDB's `io::File`, with its `COMPRESS_*` flags
         /// `compression` (active masks added) and floats at half precision when `half` (which
         /// it records on the grids: the set changes).

@@ -26,7 +26,7 @@
 
 mod bridge;
 
-pub use bridge::ffi::{GridInfo, MetaEntry};
+pub use bridge::ffi::{GridInfo, MeshCounts, MetaEntry};
 use std::path::Path;
 use voxelkit::io::vdb::{MetaValue, WriteOptions};
 use voxelkit::pipeline::Outcome;
@@ -145,6 +145,19 @@ impl OpenVdbGrids {
     /// OpenVDB's `tools::levelSetVolume` of the grid `name`.
     pub fn level_set_volume(&self, name: &str) -> std::result::Result<f64, String> {
         self.set.level_set_volume(name).map_err(|e| e.to_string())
+    }
+
+    /// OpenVDB's `tools::volumeToMesh` of the float grid `name` (its seconds and counts).
+    pub fn volume_to_mesh(
+        &self,
+        name: &str,
+        iso: f64,
+        adaptivity: f64,
+        threads: usize,
+    ) -> std::result::Result<MeshCounts, String> {
+        self.set
+            .volume_to_mesh(name, iso, adaptivity, threads)
+            .map_err(|e| e.to_string())
     }
 
     /// Writes every grid to `path` with OpenVDB's own `io::File`, compressed and at the

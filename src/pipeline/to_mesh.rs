@@ -28,18 +28,24 @@ pub struct MeshReport {
     pub iso: f64,
     /// Read, contour and write, with their seconds and threads busy.
     pub stages: Vec<StageTime>,
+    /// The whole run's seconds and the process's peak memory.
+    pub seconds: f64,
+    pub peak_mib: f64,
 }
 
 impl MeshReport {
     pub fn summary(&self) -> String {
         format!(
-            "{}: {} vertices, {} triangles (closed, manifold) from the {} of {} at iso {}\n{}",
+            "{}: {} vertices, {} triangles (closed, manifold) from the {} of {} at iso {}\n\
+             {:.2} s, peak {:.0} MiB: {}",
             self.mesh.file,
             self.mesh.vertices,
             self.mesh.triangles,
             self.meaning,
             self.input.display(),
             self.iso,
+            self.seconds,
+            self.peak_mib,
             self.stages
                 .iter()
                 .map(|s| format!("{} {:.3} s", s.stage, s.seconds))
@@ -59,6 +65,7 @@ pub fn vdb_to_mesh(
 ) -> Result<MeshReport> {
     MeshFormat::of(output)?;
     check_output(output, &[input])?;
+    let start = std::time::Instant::now();
     on_threads(limits.threads, || {
         let mut read = StageClock::new("read");
         let field = read.time(|| read_vdb_field(input, request.grid.as_deref(), request.iso))?;
@@ -74,6 +81,8 @@ pub fn vdb_to_mesh(
             },
             iso: field.iso as f64,
             stages,
+            seconds: start.elapsed().as_secs_f64(),
+            peak_mib: crate::system::peak_memory_bytes().unwrap_or(0) as f64 / (1 << 20) as f64,
         })
     })
 }
