@@ -270,11 +270,11 @@ pub fn run(args: &WholeBenchArgs, json: bool) -> Result<()> {
             let path = level_set.as_ref().unwrap_or(&mesh);
             for &threads in &args.thread_counts {
                 let (ours_s, report) = best_of(args.repeat, || {
-                    ours(args.task, &path, res, threads, args.band)
+                    ours(args.task, path, res, threads, args.band)
                 })?;
-                let mut reference = openvdb(args.task, &path, res, threads, args.band)?;
+                let mut reference = openvdb(args.task, path, res, threads, args.band)?;
                 for _ in 1..args.repeat {
-                    let again = openvdb(args.task, &path, res, threads, args.band)?;
+                    let again = openvdb(args.task, path, res, threads, args.band)?;
                     if again.0 < reference.0 {
                         reference = again;
                     }
