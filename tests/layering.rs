@@ -5,10 +5,11 @@
 use std::path::Path;
 
 /// The top-level modules from the bottom up; modules on one rank may not use each other.
-const LAYERS: [&[&str]; 13] = [
+const LAYERS: [&[&str]; 14] = [
     &["error"],
     &["system", "huge_pages", "progress", "random", "choice"],
     &["grid"],
+    &["contour"],
     &["ffi"],
     &["io"],
     &["mesh"],
