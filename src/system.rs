@@ -74,6 +74,11 @@ pub fn peak_memory_bytes() -> Option<u64> {
     proc_kib("/proc/self/status", "VmHWM:").map(|k| k * 1024)
 }
 
+/// Peak resident memory of this process so far, in MiB (0 where unknown), as reports give it.
+pub fn peak_memory_mib() -> f64 {
+    peak_memory_bytes().unwrap_or(0) as f64 / (1 << 20) as f64
+}
+
 /// The limit a front end gives for the whole process (0: none), which every check without a
 /// limit of its own (reading a file, drawing a picture) honours.
 static PROCESS_LIMIT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);

@@ -121,7 +121,7 @@ pub fn run_openvdb(args: &OpenVdbRunArgs) -> Result<()> {
         let voxels = openvdb_reference(kind, &points, &tris, t.voxel_size, band, args.threads)?;
         (start.elapsed().as_secs_f64(), voxels)
     };
-    let peak = voxelkit::system::peak_memory_bytes().unwrap_or(0) as f64 / (1 << 20) as f64;
+    let peak = voxelkit::system::peak_memory_mib();
     println!(
         "{}",
         Json::default()
@@ -189,18 +189,17 @@ fn level_set(mesh: &Path, res: u32, band: f32) -> Result<PathBuf> {
         "voxelkit-bench-level-set-{}.vdb",
         std::process::id()
     ));
-    let args: Vec<String> = vec![
-        "--json".into(),
-        "mesh".into(),
-        mesh.display().to_string(),
-        "--sdf".into(),
-        "--band".into(),
-        band.to_string(),
+    let (before, after) = WholeTask::Sdf.arguments(band);
+    let mut args: Vec<String> = vec!["--json".into()];
+    args.extend(before);
+    args.push(mesh.display().to_string());
+    args.extend(after);
+    args.extend([
         "-r".into(),
         res.to_string(),
         "-o".into(),
         out.display().to_string(),
-    ];
+    ]);
     json_of(&this.with_file_name("voxelkit"), &args)?;
     Ok(out)
 }

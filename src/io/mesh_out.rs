@@ -187,10 +187,13 @@ fn glb(mesh: &TriangleMesh) -> Vec<u8> {
             {"bufferView": 1, "componentType": 5125, "count": 3 * mesh.triangles.len(), "type": "SCALAR"},
         ],
     });
-    let mut json = json.to_string().into_bytes();
-    while !json.len().is_multiple_of(4) {
-        json.push(b' ');
-    }
+    glb_container(json.to_string().into_bytes(), &bin)
+}
+
+/// A binary glTF file: its header, the JSON chunk (padded with spaces to four bytes) and the
+/// binary chunk `bin` (already a multiple of four bytes).
+pub fn glb_container(mut json: Vec<u8>, bin: &[u8]) -> Vec<u8> {
+    json.resize(json.len().next_multiple_of(4), b' ');
     let total = 12 + 8 + json.len() + 8 + bin.len();
     let mut out = Vec::with_capacity(total);
     out.extend_from_slice(b"glTF");
@@ -201,6 +204,6 @@ fn glb(mesh: &TriangleMesh) -> Vec<u8> {
     out.extend_from_slice(&json);
     out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
     out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
+    out.extend_from_slice(bin);
     out
 }

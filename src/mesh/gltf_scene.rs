@@ -441,21 +441,9 @@ impl Mesh {
             "bufferViews": views,
             "accessors": accessors,
         });
-        let mut text = json.to_string().into_bytes();
+        let text = json.to_string().into_bytes();
         let bytes = if layout == GltfLayout::Binary {
-            text.resize(text.len().next_multiple_of(4), b' ');
-            let total = 12 + 8 + text.len() + 8 + bin.len();
-            let mut glb = Vec::with_capacity(total);
-            glb.extend_from_slice(b"glTF");
-            glb.extend_from_slice(&2u32.to_le_bytes());
-            glb.extend_from_slice(&(total as u32).to_le_bytes());
-            glb.extend_from_slice(&(text.len() as u32).to_le_bytes());
-            glb.extend_from_slice(b"JSON");
-            glb.extend_from_slice(&text);
-            glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-            glb.extend_from_slice(b"BIN\0");
-            glb.extend_from_slice(&bin);
-            glb
+            crate::io::mesh_out::glb_container(text, &bin)
         } else {
             text
         };

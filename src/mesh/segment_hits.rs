@@ -10,16 +10,16 @@ use super::Mesh;
 use super::winding::WindingTree;
 use crate::contour::{ExactSurface, SegmentCrossings};
 use glam::DVec3;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 /// A mesh made ready for segment queries; its tree is built on the first one.
 pub struct MeshHits {
-    mesh: Mesh,
+    mesh: Arc<Mesh>,
     tree: OnceLock<WindingTree>,
 }
 
 impl MeshHits {
-    pub fn new(mesh: Mesh) -> MeshHits {
+    pub fn new(mesh: Arc<Mesh>) -> MeshHits {
         MeshHits {
             mesh,
             tree: OnceLock::new(),
@@ -96,7 +96,7 @@ mod tests {
 
     #[test]
     fn segments_meet_a_cube_on_its_faces_with_their_normals() {
-        let mesh = MeshHits::new(generate::cuboid(DVec3::ZERO, DVec3::ONE));
+        let mesh = MeshHits::new(Arc::new(generate::cuboid(DVec3::ZERO, DVec3::ONE)));
         let hits = mesh.near(DVec3::splat(-1.0), DVec3::splat(4.0));
         let (a, b) = (DVec3::new(0.5, 0.3, 0.2), DVec3::new(1.5, 0.4, 0.3));
         let (t, n) = hits.crossing(a, b, true, 0.5).unwrap();

@@ -21,6 +21,7 @@ use crate::voxelize::projective::{Coloring, LineSource};
 use crate::voxelize::separating::SeparatingOptions;
 use glam::DVec3;
 use std::path::Path;
+use std::sync::Arc;
 
 /// A task with its inputs in memory.
 pub(super) enum Work {
@@ -52,7 +53,8 @@ pub(super) enum Work {
         negative_r: bool,
     },
     DistanceBand {
-        mesh: Mesh,
+        /// Shared with the outcome, whose meshes take their crossings from it.
+        mesh: Arc<Mesh>,
         band: f64,
         signed: bool,
         inside: InsideRule,
@@ -163,7 +165,7 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
             signed,
             inside,
         } => Work::DistanceBand {
-            mesh: mesh(m)?,
+            mesh: Arc::new(mesh(m)?),
             band: *band,
             signed: *signed,
             inside: *inside,

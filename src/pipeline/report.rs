@@ -282,7 +282,7 @@ impl Report {
     /// Sets the whole run's time and the peak memory: the last thing before printing.
     pub fn finish(&mut self, start: std::time::Instant) {
         self.seconds = start.elapsed().as_secs_f64();
-        self.peak_mib = crate::system::peak_memory_bytes().unwrap_or(0) as f64 / (1 << 20) as f64;
+        self.peak_mib = crate::system::peak_memory_mib();
     }
 
     /// The report as one JSON object.

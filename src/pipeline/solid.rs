@@ -257,7 +257,7 @@ pub(super) fn mesh_solid(
 }
 
 pub(super) fn distance_band(
-    mesh: &Mesh,
+    mesh: &Arc<Mesh>,
     t: Transform,
     band: f64,
     signed: bool,
@@ -303,7 +303,7 @@ pub(super) fn distance_band(
     };
     let mut outcome = Outcome::new(grid, meta, Details::DistanceBand(details));
     if signed {
-        outcome.exact = Some(Arc::new(MeshHits::new(mesh.clone())));
+        outcome.exact = Some(Arc::new(MeshHits::new(Arc::clone(mesh))));
     }
     outcome.distances = Some(Distances {
         background: background as f32,

@@ -82,7 +82,7 @@ pub fn vdb_to_mesh(
             iso: field.iso as f64,
             stages,
             seconds: start.elapsed().as_secs_f64(),
-            peak_mib: crate::system::peak_memory_bytes().unwrap_or(0) as f64 / (1 << 20) as f64,
+            peak_mib: crate::system::peak_memory_mib(),
         })
     })
 }
