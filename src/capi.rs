@@ -13,7 +13,6 @@ use crate::error::{Error, Result};
 use crate::grid::{Channels, Coord, LEAF_VOXELS, Leaf, SparseGrid, Transform};
 use crate::implicit::Coordinates;
 use crate::io::grid_export::ExportedGrid;
-use crate::io::mesh_out::write_mesh;
 use crate::io::vdb::{Compression, MetaValue, WriteOptions, meta_entries, read_vdb_solid};
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::BooleanOp;
@@ -1241,11 +1240,7 @@ pub extern "C" fn vk_grid_write_mesh(grid: *const VkGrid, path: *const c_char) -
     guard(|| {
         let path = PathBuf::from(c_str(path, "path")?);
         check_mesh_output(&path, &[])?;
-        let surface = borrow(grid, Kind::Grid)?.outcome.surface_mesh()?;
-        if surface.triangles.is_empty() {
-            return Err(invalid("the grid has no surface to write: it is empty"));
-        }
-        Ok(write_mesh(&path, &surface)?)
+        Ok(borrow(grid, Kind::Grid)?.outcome.save_mesh(&path)?)
     })
 }
 

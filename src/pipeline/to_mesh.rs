@@ -133,12 +133,26 @@ impl Outcome {
         self.write_mesh_of(output, Some(source))
     }
 
-    fn write_mesh_of(&mut self, output: &Path, source: Option<&Mesh>) -> Result<()> {
+    /// Writes the surface of the result to `output` as `write_mesh` does, without noting it
+    /// in the report (the result is only borrowed, as the C interface holds it).
+    pub fn save_mesh(&self, output: &Path) -> Result<()> {
+        self.contour_and_write(output).map(|_| ())
+    }
+
+    /// The surface contoured (placed by the exact source where there is one) and written.
+    fn contour_and_write(
+        &self,
+        output: &Path,
+    ) -> Result<(TriangleMesh, MeshWritten, Vec<StageTime>)> {
         let field = self.field()?;
         let input = PathBuf::from(&self.report.input);
-        let (mesh, mut written, mut stages) = on_threads(self.threads, || {
+        on_threads(self.threads, || {
             contour_to_file(&field, self.exact.as_deref(), output, &input)
-        })?;
+        })
+    }
+
+    fn write_mesh_of(&mut self, output: &Path, source: Option<&Mesh>) -> Result<()> {
+        let (mesh, mut written, mut stages) = self.contour_and_write(output)?;
         if let Some(source) = source {
             let mut measure = StageClock::new("distance to input");
             let distance = measure.time(|| {
