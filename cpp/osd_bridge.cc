@@ -41,9 +41,10 @@ void record_error(Far::ErrorType, const char* message) {
 
 using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
 
-std::unique_ptr<Far::TopologyRefiner> make_refiner(rust::Slice<const double> positions,
-                                                   rust::Slice<const int32_t> face_sizes,
-                                                   rust::Slice<const int32_t> face_verts) {
+std::unique_ptr<Far::TopologyRefiner> make_refiner(ControlCage const& cage) {
+    auto const& positions = cage.positions;
+    auto const& face_sizes = cage.face_sizes;
+    auto const& face_verts = cage.face_verts;
     if (positions.size() % 3 != 0) throw std::invalid_argument("positions must be x,y,z triples");
     const int vertex_count = static_cast<int>(positions.size() / 3);
     size_t corners = 0;
@@ -55,6 +56,13 @@ std::unique_ptr<Far::TopologyRefiner> make_refiner(rust::Slice<const double> pos
     for (int32_t v : face_verts) {
         if (v < 0 || v >= vertex_count) throw std::invalid_argument("a face corner is out of range");
     }
+    if (cage.crease_verts.size() != 2 * cage.crease_weights.size() ||
+        cage.corner_verts.size() != cage.corner_weights.size())
+        throw std::invalid_argument("one sharpness per crease edge and per corner is needed");
+    for (int32_t v : cage.crease_verts)
+        if (v < 0 || v >= vertex_count) throw std::invalid_argument("a crease vertex is out of range");
+    for (int32_t v : cage.corner_verts)
+        if (v < 0 || v >= vertex_count) throw std::invalid_argument("a corner vertex is out of range");
     Sdc::Options sdc;
     sdc.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
     Far::TopologyDescriptor desc;
@@ -62,6 +70,12 @@ std::unique_ptr<Far::TopologyRefiner> make_refiner(rust::Slice<const double> pos
     desc.numFaces = static_cast<int>(face_sizes.size());
     desc.numVertsPerFace = face_sizes.data();
     desc.vertIndicesPerFace = face_verts.data();
+    desc.numCreases = static_cast<int>(cage.crease_weights.size());
+    desc.creaseVertexIndexPairs = cage.crease_verts.data();
+    desc.creaseWeights = cage.crease_weights.data();
+    desc.numCorners = static_cast<int>(cage.corner_weights.size());
+    desc.cornerVertexIndices = cage.corner_verts.data();
+    desc.cornerWeights = cage.corner_weights.data();
     {
         std::lock_guard<std::mutex> lock(error_mutex);
         last_error.clear();
@@ -103,10 +117,12 @@ struct FaceDomain {
 
 }  // namespace
 
-LimitPoints limit_at_dyadic(rust::Slice<const double> positions, rust::Slice<const int32_t> face_sizes,
-                            rust::Slice<const int32_t> face_verts, int32_t level) {
+LimitPoints limit_at_dyadic(ControlCage const& cage, int32_t level, int32_t lattice_level) {
     if (level < 1 || level > 8) throw std::invalid_argument("refinement level must be 1..8");
-    auto refiner = make_refiner(positions, face_sizes, face_verts);
+    if (lattice_level < 1 || lattice_level > level) throw std::invalid_argument("lattice level must be 1..level");
+    auto const& positions = cage.positions;
+    auto const& face_sizes = cage.face_sizes;
+    auto refiner = make_refiner(cage);
     Far::TopologyRefiner::UniformOptions uniform(level);
     uniform.fullTopologyInLastLevel = true;  // vertex-face relations of the last level are read
     refiner->RefineUniform(uniform);
@@ -196,6 +212,15 @@ LimitPoints limit_at_dyadic(rust::Slice<const double> positions, rust::Slice<con
             const int faces_here = last.GetVertexFaces(x).size();
             const bool boundary = last.IsVertexBoundary(x);
             if ((faces_here == 2 && !boundary) || (faces_here >= 3 && boundary)) continue;
+            // Nor at vertices on tagged creases: Limit() gives a crease vertex one normal for
+            // both sides, and a dart (a crease's end) the smooth masks, which are not its limit.
+            bool tagged = !boundary && last.GetVertexSharpness(x) > 0.0f;
+            for (int e : last.GetVertexEdges(x))
+                tagged = tagged || (!last.IsEdgeBoundary(e) && last.GetEdgeSharpness(e) > 0.0f);
+            if (tagged) continue;
+            const double lattice = std::ldexp(1.0, lattice_level);
+            const double u = domains[f].u[k] * lattice, v = domains[f].v[k] * lattice;
+            if (u != std::floor(u) || v != std::floor(v)) continue;
             push_point(out, domains[f].base, domains[f].u[k], domains[f].v[k], limit[x].p, tan1[x].p,
                        tan2[x].p);
         }
@@ -203,11 +228,12 @@ LimitPoints limit_at_dyadic(rust::Slice<const double> positions, rust::Slice<con
     return out;
 }
 
-LimitPoints limit_at(rust::Slice<const double> positions, rust::Slice<const int32_t> face_sizes,
-                     rust::Slice<const int32_t> face_verts, rust::Slice<const uint32_t> faces,
-                     rust::Slice<const double> uv, int32_t approx_level) {
+LimitPoints limit_at(ControlCage const& cage, rust::Slice<const uint32_t> faces, rust::Slice<const double> uv,
+                     int32_t approx_level) {
     if (uv.size() != 2 * faces.size()) throw std::invalid_argument("one (u, v) per face index is needed");
-    auto refiner = make_refiner(positions, face_sizes, face_verts);
+    auto const& positions = cage.positions;
+    auto const& face_sizes = cage.face_sizes;
+    auto refiner = make_refiner(cage);
     Bfr::SurfaceFactory::Options options;
     options.SetApproxLevelSmooth(approx_level).SetApproxLevelSharp(approx_level);
     Bfr::RefinerSurfaceFactory<> factory(*refiner, options);

@@ -11,9 +11,7 @@ use cli_support::{text, voxelkit};
 use voxelkit::io::vdb::read_vdb_info;
 use voxelkit::subd::{ControlMesh, LimitSurface};
 
-/// A cube control mesh: 8 valence-3 extraordinary vertices.
-const CUBE: &str = "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
-f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+use common::CUBE_OBJ as CUBE;
 
 fn write(dir: &Path, name: &str, content: &str) -> String {
     let p = dir.join(name);

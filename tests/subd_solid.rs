@@ -46,7 +46,7 @@ fn solid_at(control: &ControlMesh, resolution: u32) -> (SubdivisionSolid, f64) {
 }
 
 /// The tessellations' volumes converge on the quadrature's at second order (the error falls
-/// about fourfold per doubling of the segments per patch). Beast is left out: its 32k patches
+/// about fourfold per doubling of the segments per patch), creased ones included. Beast is left out: its 32k patches
 /// take a minute to tessellate finely; its volume is checked against the voxels below.
 #[test]
 fn the_limit_volume_is_what_fine_tessellations_converge_to() {
@@ -60,7 +60,14 @@ fn the_limit_volume_is_what_fine_tessellations_converge_to() {
             let tessellated = surface.tessellate(|_| n).signed_volume();
             (exact - tessellated).abs() / exact.abs()
         };
-        let errors = [error(8), error(16), error(32)];
+        // Creases of sharpness 5 bend the surface within 2^-5 of a patch's edge: the
+        // tessellations converge once their segments are finer than that.
+        let n = if surface.control().tags.is_empty() {
+            8
+        } else {
+            64
+        };
+        let errors = [error(n), error(2 * n), error(4 * n)];
         eprintln!("{name}: limit volume {exact:.9}; tessellation errors {errors:?}");
         assert!(errors[2] < 2e-3, "{name}: {errors:?}");
         assert!(

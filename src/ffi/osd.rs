@@ -12,20 +12,30 @@ pub mod bridge {
         normal: Vec<f64>,
     }
 
+    /// A control mesh with its creases and corners, as OpenSubdiv's `TopologyDescriptor`
+    /// takes it.
+    struct ControlCage {
+        positions: Vec<f64>,
+        face_sizes: Vec<i32>,
+        face_verts: Vec<i32>,
+        /// Vertex pairs of the sharp edges, and one sharpness per pair.
+        crease_verts: Vec<i32>,
+        crease_weights: Vec<f32>,
+        corner_verts: Vec<i32>,
+        corner_weights: Vec<f32>,
+    }
+
     unsafe extern "C++" {
         include!("voxelkit/cpp/osd_bridge.h");
 
         fn limit_at_dyadic(
-            positions: &[f64],
-            face_sizes: &[i32],
-            face_verts: &[i32],
+            cage: &ControlCage,
             level: i32,
+            lattice_level: i32,
         ) -> Result<LimitPoints>;
 
         fn limit_at(
-            positions: &[f64],
-            face_sizes: &[i32],
-            face_verts: &[i32],
+            cage: &ControlCage,
             faces: &[u32],
             uv: &[f64],
             approx_level: i32,

@@ -3,7 +3,7 @@
 
 use super::report::{
     Details, ImplicitDetails, ProjectiveDetails, Report, SeparatingClasses, SeparationCheckDetails,
-    SubdivisionDetails,
+    SubdivisionDetails, TagSummary,
 };
 use super::{ShapeTask, SurfaceMethod, on_threads};
 use crate::contour::ExactSurface;
@@ -392,6 +392,14 @@ fn write_to_stdout<T>(write: impl FnOnce(&Path) -> Result<T>) -> Result<T> {
 }
 
 /// `method`, `source_file` and the grid's fit, the metadata every output carries.
+/// A control mesh's crease and corner counts in a grid's metadata.
+pub(super) fn tag_metadata(meta: &mut Vec<(&'static str, MetaValue)>, tags: &Option<TagSummary>) {
+    if let Some(t) = tags {
+        meta.push(("creases", t.creases.into()));
+        meta.push(("corners", t.corners.into()));
+    }
+}
+
 pub(super) fn provenance(
     method: &str,
     source: &str,
@@ -604,6 +612,8 @@ pub(super) fn subdivision(
     meta.insert(1, ("adjacency", adjacency.into()));
     meta.push(("presplit", options.presplit.into()));
     meta.push(("surface_area", s.area.into()));
+    let tags = TagSummary::of(&control.tags);
+    tag_metadata(&mut meta, &tags);
     let details = SubdivisionDetails {
         adjacency,
         opposite_normal_voxels: s.opposite_voxels,
@@ -615,6 +625,7 @@ pub(super) fn subdivision(
         enclose_splits: s.enclose_splits,
         tolerance_voxels: s.guard_voxels,
         area: s.area,
+        tags,
     };
     Ok(
         Outcome::new(out.surface, meta, Details::Subdivision(details))

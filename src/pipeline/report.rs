@@ -165,6 +165,43 @@ pub struct SubdivisionDetails {
     pub tolerance_voxels: u64,
     /// Limit-surface area summed over the final sub-patches, world units.
     pub area: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tags: Option<TagSummary>,
+}
+
+/// OpenSubdiv crease and corner tags applied to a control mesh, and the files they came from.
+#[derive(Serialize, Debug, Clone, Default)]
+pub struct TagSummary {
+    pub creases: u64,
+    pub corners: u64,
+    pub from: Vec<String>,
+}
+
+impl TagSummary {
+    /// `None` for a control mesh without tags.
+    pub fn of(tags: &crate::subd::Tags) -> Option<TagSummary> {
+        (!tags.is_empty()).then(|| TagSummary {
+            creases: tags.creases.len() as u64,
+            corners: tags.corners.len() as u64,
+            from: tags
+                .sources
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect(),
+        })
+    }
+
+    /// The summary's words for `tags`, empty without any.
+    fn phrase(tags: &Option<TagSummary>) -> String {
+        tags.as_ref().map_or(String::new(), |t| {
+            format!(
+                "; {} creases and {} corners from {}",
+                t.creases,
+                t.corners,
+                t.from.join(", ")
+            )
+        })
+    }
 }
 
 #[derive(Serialize, Debug, Clone, Default)]
@@ -224,6 +261,9 @@ pub struct SolidDetails {
     /// The exact volume a Catmull-Clark limit surface encloses (Gauss quadrature).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub limit_volume: Option<f64>,
+    /// A Catmull-Clark control mesh's crease and corner tags.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tags: Option<TagSummary>,
     #[serde(skip_serializing_if = "Option::is_none", flatten)]
     pub flooding_xyz: Option<FloodingXyzDetails>,
 }
@@ -369,7 +409,7 @@ impl Report {
             Details::Subdivision(s) => format!(
                 "{place}: {} voxels ({} crossed by opposite sheets) from {} patches; {} evaluations \
                  (a uniform grid at the same density: {}), {} sub-patches ({} stopped by the depth \
-                 guard, {} tolerance voxels); area {:.6}; {}-adjacent; voxel size {:.6}, {timing}",
+                 guard, {} tolerance voxels); area {:.6}; {}-adjacent{}; voxel size {:.6}, {timing}",
                 self.voxels,
                 s.opposite_normal_voxels,
                 s.patches,
@@ -380,6 +420,7 @@ impl Report {
                 s.tolerance_voxels,
                 s.area,
                 s.adjacency,
+                TagSummary::phrase(&s.tags),
                 self.voxel_size
             ),
             Details::Implicit(s) => format!(
@@ -480,9 +521,10 @@ fn inside_summary(rule: Option<&str>, ambiguous: Option<u64>) -> String {
 
 fn solid_summary(place: &str, s: &SolidDetails, timing: &str) -> String {
     let mesh = match (s.mesh_signed_volume, s.mesh_area, s.limit_volume) {
-        (_, Some(a), Some(v)) => {
-            format!(" (limit surface, Gauss quadrature: area {a:.6}, volume {v:.6})")
-        }
+        (_, Some(a), Some(v)) => format!(
+            " (limit surface, Gauss quadrature: area {a:.6}, volume {v:.6}{})",
+            TagSummary::phrase(&s.tags)
+        ),
         (Some(v), Some(a), None) => format!(" (faces: area {a:.6}, signed volume {v:.6})"),
         (Some(v), None, None) => format!(" (mesh signed volume {v:.6})"),
         _ => String::new(),

@@ -2,11 +2,11 @@
 //! distance band, measure a mesh or a `.vdb` surface, evaluate a CSG tree; with volumes,
 //! mass, components and genus.
 
-use super::outcome::provenance;
 use super::outcome::{Distances, Outcome};
+use super::outcome::{provenance, tag_metadata};
 use super::report::{
     CsgDetails, CsgLeafCount, DepthLayerDetails, Details, DirectionCounts, DistanceBandDetails,
-    FloodingXyzDetails, SolidDetails,
+    FloodingXyzDetails, SolidDetails, TagSummary,
 };
 use super::{Fill, SubdivisionFill};
 use crate::contour::ExactSurface;
@@ -93,6 +93,7 @@ fn solid_details(
         mesh_signed_volume: mesh.map(Mesh::signed_volume),
         mesh_area: None,
         limit_volume: None,
+        tags: None,
         flooding_xyz: solid.xyz_stats.map(|s| FloodingXyzDetails {
             line_floods: s.line_floods,
             sweeps: s.sweeps,
@@ -426,6 +427,8 @@ pub(super) fn subdivision_solid(
     // Steps along tilted normals can leave the solid; their floods reach the border and are
     // dropped (`solids::subdivision`).
     meta.push(("outside_seeds", made.outside_seeds.into()));
+    let tags = TagSummary::of(&control.tags);
+    tag_metadata(&mut meta, &tags);
     let (limit_volume, limit_area) = (made.limit_volume, made.limit_area);
     let opposite = made.surface.opposite;
     let parts = SurfaceAndInside::of(made.surface.surface, made.solid);
@@ -440,6 +443,7 @@ pub(super) fn subdivision_solid(
         )?;
         details.limit_volume = Some(limit_volume);
         details.mesh_area = Some(limit_area);
+        details.tags = tags.clone();
         Ok(details)
     })?;
     Ok(outcome.with("opposite_normals", opposite).timed(start))

@@ -28,10 +28,11 @@ const WEIGHTS: [f64; 5] = [
     0.118_463_442_528_094_54,
 ];
 
-/// Cells per patch side; the B-spline pieces of a patch are aligned with them.
+/// Cells per patch side to start from.
 const CELLS: usize = 8;
-/// Cells touching an extraordinary corner are halved this many times more: the surface is
-/// piecewise polynomial on ever smaller rings there.
+/// A cell is halved until it lies within one bicubic piece of its patch, at most this many
+/// times: towards an extraordinary corner the surface is piecewise polynomial on ever smaller
+/// rings; along a semi-sharp crease down to 2^-sharpness.
 const CORNER_DEPTH: u32 = 30;
 
 pub fn limit_area(surface: &LimitSurface) -> f64 {
@@ -76,13 +77,12 @@ where
     (0..surface.patch_count())
         .into_par_iter()
         .map(|pid| {
-            let irregular = surface.irregular_corners(pid);
             let h = 1.0 / CELLS as f64;
             let mut sum = T::default();
             for j in 0..CELLS {
                 for i in 0..CELLS {
                     let at = [i as f64 * h, j as f64 * h];
-                    sum = sum + cell(surface, pid, &irregular, at, h, 0, &f);
+                    sum = sum + cell(surface, pid, at, h, 0, &f);
                 }
             }
             sum
@@ -93,7 +93,6 @@ where
 fn cell<T>(
     surface: &LimitSurface,
     pid: usize,
-    irregular: &[bool; 4],
     at: [f64; 2],
     h: f64,
     depth: u32,
@@ -102,26 +101,12 @@ fn cell<T>(
 where
     T: Copy + Default + Sum + Add<Output = T> + Mul<f64, Output = T>,
 {
-    let corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
-    let touches = corners.iter().zip(irregular).any(|(&(cu, cv), &irr)| {
-        irr && (at[0] - cu).abs().min((at[0] + h - cu).abs()) == 0.0
-            && (at[1] - cv).abs().min((at[1] + h - cv).abs()) == 0.0
-    });
-    if touches && depth < CORNER_DEPTH {
+    let polynomial = surface.polynomial_on(pid, at[0], at[0] + h, at[1], at[1] + h);
+    if !polynomial && depth < CORNER_DEPTH {
         let g = h / 2.0;
         return [(0.0, 0.0), (g, 0.0), (0.0, g), (g, g)]
             .iter()
-            .map(|&(du, dv)| {
-                cell(
-                    surface,
-                    pid,
-                    irregular,
-                    [at[0] + du, at[1] + dv],
-                    g,
-                    depth + 1,
-                    f,
-                )
-            })
+            .map(|&(du, dv)| cell(surface, pid, [at[0] + du, at[1] + dv], g, depth + 1, f))
             .sum();
     }
     let mut sum = T::default();

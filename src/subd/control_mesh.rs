@@ -3,6 +3,7 @@
 //! isolated vertices), each failure named by vertex or face.
 
 use super::poly_mesh::PolyMesh;
+use super::tags::Tags;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use glam::DVec3;
@@ -14,6 +15,8 @@ pub struct ControlMesh {
     /// One outgoing half-edge per vertex, the start of its counter-clockwise ring.
     pub(crate) outgoing: Vec<u32>,
     pub source: PathBuf,
+    /// The crease and corner tags applied (empty for a smooth surface).
+    pub tags: Tags,
 }
 
 /// What a control mesh is made of, for summaries.
@@ -34,10 +37,74 @@ pub struct ControlStats {
 pub const MAX_CORNERS: usize = 256;
 
 impl ControlMesh {
-    /// Loads an OBJ control mesh (tags such as creases are not read).
+    /// Loads a control mesh with its crease and corner tags (`tags.rs`).
     pub fn load(path: &Path) -> Result<ControlMesh> {
         let mesh = Mesh::load(path)?;
-        ControlMesh::from_mesh(&mesh)
+        ControlMesh::from_mesh(&mesh)?.with_tags(Tags::read(path)?)
+    }
+
+    /// Makes the tagged edges and vertices sharp. Every tagged edge must be an edge of the
+    /// mesh, and a boundary rule other than OpenSubdiv's default is refused on an open mesh
+    /// (on a closed one it changes nothing).
+    pub fn with_tags(mut self, tags: Tags) -> Result<ControlMesh> {
+        let source = tags.sources.first().cloned().unwrap_or(self.source.clone());
+        let vertices = self.vertex_count() as u32;
+        let out_of_range = |v: u32| Error::Parse {
+            path: source.clone(),
+            line: 0,
+            message: format!(
+                "a tag names vertex {v}, but the control mesh has {vertices} vertices                      (tags count vertices from 0)"
+            ),
+        };
+        if let Some((rule, place)) = &tags.boundary_rule
+            && !self.is_closed()
+        {
+            return Err(super::tags::parse_error(
+                place,
+                format!(
+                    "boundary interpolation {rule} is not evaluated on this open mesh;                      voxelkit follows OpenSubdiv's default (1: edges and corners)"
+                ),
+            ));
+        }
+        let mut sharp_edges = rustc_hash::FxHashMap::default();
+        for &(a, b, s) in &tags.creases {
+            if a >= vertices || b >= vertices {
+                return Err(out_of_range(a.max(b)));
+            }
+            let key = (a.min(b), a.max(b));
+            sharp_edges.insert(key, s);
+        }
+        let mut found = rustc_hash::FxHashSet::default();
+        let mesh = &mut self.mesh;
+        for h in 0..mesh.verts.len() as u32 {
+            let (a, b) = (mesh.from(h), mesh.to(h));
+            if sharp_edges.contains_key(&(a.min(b), a.max(b))) {
+                found.insert((a.min(b), a.max(b)));
+            }
+        }
+        if let Some(&(a, b)) = sharp_edges.keys().find(|k| !found.contains(k)) {
+            return Err(Error::Parse {
+                path: source.clone(),
+                line: 0,
+                message: format!(
+                    "a crease tag names vertices {a} and {b}, which share no edge of the                      control mesh"
+                ),
+            });
+        }
+        mesh.set_edge_sharpness(|a, b| {
+            sharp_edges
+                .get(&(a.min(b), a.max(b)))
+                .copied()
+                .unwrap_or(0.0)
+        });
+        for &(v, s) in &tags.corners {
+            if v >= vertices {
+                return Err(out_of_range(v));
+            }
+            mesh.vertex_sharpness[v as usize] = s;
+        }
+        self.tags = tags;
+        Ok(self)
     }
 
     /// Checks the topology of a polygon mesh and builds the control mesh.
@@ -141,6 +208,7 @@ impl ControlMesh {
             mesh: poly,
             outgoing,
             source,
+            tags: Tags::default(),
         })
     }
 
@@ -189,7 +257,7 @@ impl ControlMesh {
             .outgoing()
             .iter()
             .enumerate()
-            .map(|(v, &h)| super::limit_masks::vertex_limit(&child, v as u32, h).0)
+            .map(|(v, &h)| super::limit_masks::vertex_limit(&child, v as u32, h, h).0)
             .collect();
         let faces: Vec<Vec<u32>> = (0..child.face_count())
             .map(|f| child.face(f).to_vec())
@@ -219,6 +287,34 @@ impl ControlMesh {
             b.max = b.max.max(p);
         }
         b
+    }
+
+    /// Quadtree nodes that semi-sharp tags add to the patches, for a voxel of `voxel_size`:
+    /// each side of an edge of sharpness s is subdivided ceil(s) levels deep along it (2^level
+    /// nodes per side at the last level, as many again above), but only where the voxelizer
+    /// samples it: about two paths per voxel of the edge's length, each ceil(s) nodes deep. A
+    /// corner of sharpness s adds about 4 nodes per level in each of its faces.
+    pub fn crease_nodes(&self, voxel_size: f64) -> f64 {
+        let levels =
+            |s: f32| (s > 0.0 && !super::crease::is_infinite(s)).then(|| f64::from(s.ceil()));
+        let mesh = &self.mesh;
+        let edges: f64 = (0..mesh.verts.len() as u32)
+            .filter(|&h| mesh.twin(h).is_some_and(|t| t > h))
+            .filter_map(|h| {
+                let l = levels(mesh.sharpness[h as usize])?;
+                let length =
+                    mesh.points[mesh.from(h) as usize].distance(mesh.points[mesh.to(h) as usize]);
+                let sampled = 2.0 * l * (length / voxel_size).max(1.0);
+                Some(2.0 * 2f64.powf(l + 1.0).min(sampled))
+            })
+            .sum();
+        let corners: f64 = self
+            .outgoing
+            .iter()
+            .zip(&mesh.vertex_sharpness)
+            .filter_map(|(&h, &s)| Some(mesh.ring(h).0.len() as f64 * 4.0 * levels(s)?))
+            .sum();
+        edges + corners
     }
 
     /// Patch corners at extraordinary points: each interior vertex of valence n != 4 is a

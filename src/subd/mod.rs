@@ -3,10 +3,11 @@
 
 mod area;
 mod bicubic;
-mod boundary_tangent;
 mod compare;
 mod control_mesh;
+mod crease;
 mod limit_masks;
+mod local_eigen;
 #[cfg(feature = "osd")]
 pub mod opensubdiv;
 mod patch;
@@ -14,6 +15,7 @@ mod points_file;
 mod poly_mesh;
 mod subdivide;
 mod surface;
+mod tags;
 
 pub use area::{limit_area, limit_volume, limit_volume_and_area};
 pub use compare::{Comparison, angle_between, compare_points};
@@ -21,3 +23,4 @@ pub use control_mesh::{ControlMesh, ControlStats};
 pub use patch::LimitSample;
 pub use points_file::{SurfacePoint, parse_points, read_points};
 pub use surface::{LimitSurface, PatchDomain, subface_tiles};
+pub use tags::Tags;

@@ -8,9 +8,10 @@
 //! are `(2u - i, 2v - j)` in quadrant `(i, j)`.
 
 use super::bicubic::Bicubic;
-use super::limit_masks::vertex_limit;
+use super::crease::{self, Rule, is_infinite, is_sharp};
+use super::limit_masks::{sector_range, vertex_limit};
 use super::poly_mesh::PolyMesh;
-use super::subdivide::subdivide;
+use super::subdivide::{edges_at, subdivide, vertex_sharpness};
 use glam::DVec3;
 use std::sync::OnceLock;
 
@@ -35,8 +36,8 @@ pub(crate) enum PatchNode {
 pub(crate) struct IrregularPatch {
     /// Face 0 and every face sharing a vertex with it.
     net: PolyMesh,
-    /// Which corners of face 0 are extraordinary (the quadtree never ends there).
-    irregular_corner: [bool; 4],
+    /// How each corner of face 0 behaves (the quadtree never ends at an extraordinary one).
+    corners: [CornerKind; 4],
     children: OnceLock<Box<[PatchNode; 4]>>,
 }
 
@@ -57,30 +58,23 @@ fn corner_at(u: f64, v: f64) -> Option<usize> {
 }
 
 impl PatchNode {
-    /// The patch of face 0 of `net`, a quad whose corners are complete in `net`.
+    /// The patch of face 0 of `net`, a quad whose corners are complete in `net`: a bicubic
+    /// B-spline when every corner is regular (infinitely sharp edges of face 0 act as
+    /// boundaries), otherwise a node of the quadtree.
     pub fn new(net: PolyMesh) -> PatchNode {
         let outgoing = net.outgoing();
-        let mut irregular_corner = [false; 4];
-        for (k, flag) in irregular_corner.iter_mut().enumerate() {
-            let (ring, closed) = net.ring(outgoing[net.from(k as u32) as usize]);
-            let quads = ring
-                .iter()
-                .all(|&h| net.face_len(net.face_of[h as usize] as usize) == 4);
-            let regular_count = if closed {
-                ring.len() == 4
-            } else {
-                ring.len() <= 2
-            };
-            *flag = !(quads && regular_count);
-        }
-        if irregular_corner.iter().any(|&b| b) {
+        let corners: [CornerKind; 4] = std::array::from_fn(|k| {
+            let start = outgoing[net.from(k as u32) as usize];
+            corner_kind(&net, start, k as u32)
+        });
+        if corners.iter().all(|&c| c == CornerKind::Regular) {
+            PatchNode::Regular(gather_bicubic(&net))
+        } else {
             PatchNode::Irregular(Box::new(IrregularPatch {
                 net,
-                irregular_corner,
+                corners,
                 children: OnceLock::new(),
             }))
-        } else {
-            PatchNode::Regular(gather_bicubic(&net))
         }
     }
 
@@ -101,7 +95,8 @@ impl PatchNode {
                     };
                 }
                 PatchNode::Irregular(p) => {
-                    if let Some(k) = corner_at(u, v).filter(|&k| p.irregular_corner[k])
+                    if let Some(k) =
+                        corner_at(u, v).filter(|&k| p.corners[k] == CornerKind::Extraordinary)
                         && let Some(sample) = p.corner_limit(k)
                     {
                         return sample;
@@ -117,11 +112,27 @@ impl PatchNode {
         }
     }
 
-    /// Which corners are extraordinary (where the patch is not polynomial nearby).
-    pub fn irregular_corners(&self) -> [bool; 4] {
+    /// Whether the patch is one polynomial over `[u0,u1] x [v0,v1]`: the square lies within
+    /// one bicubic leaf of the quadtree (never where it touches an extraordinary corner, nor
+    /// across the finer pieces along a semi-sharp crease).
+    pub fn polynomial_on(&self, u0: f64, u1: f64, v0: f64, v1: f64) -> bool {
         match self {
-            PatchNode::Regular(_) => [false; 4],
-            PatchNode::Irregular(p) => p.irregular_corner,
+            PatchNode::Regular(_) => true,
+            PatchNode::Irregular(p) => {
+                let i = usize::from(u0 >= 0.5);
+                let j = usize::from(v0 >= 0.5);
+                let within =
+                    |lo: f64, hi: f64, k: usize| if k == 0 { hi <= 0.5 } else { lo >= 0.5 };
+                if !(within(u0, u1, i) && within(v0, v1, j)) {
+                    return false;
+                }
+                p.children()[quadrant_index(i, j)].polynomial_on(
+                    2.0 * u0 - i as f64,
+                    2.0 * u1 - i as f64,
+                    2.0 * v0 - j as f64,
+                    2.0 * v1 - j as f64,
+                )
+            }
         }
     }
 
@@ -201,7 +212,7 @@ impl IrregularPatch {
         {
             return None;
         }
-        let (position, normal) = vertex_limit(&self.net, v, start);
+        let (position, normal) = vertex_limit(&self.net, v, start, k as u32);
         let normal = normal.unwrap_or_else(|| self.normal_near_corner(k));
         Some(LimitSample {
             position,
@@ -226,9 +237,53 @@ impl IrregularPatch {
     }
 }
 
+/// How the limit surface behaves at a corner of face 0, seen from face 0's side.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum CornerKind {
+    /// As a bicubic B-spline: an interior vertex of 4 quads without sharp edges, a crease
+    /// with two quads on this side, or a corner with face 0 alone on this side.
+    Regular,
+    /// Semi-sharp edges or a semi-sharp vertex: regular or extraordinary once subdivision has
+    /// used up their sharpness, after finitely many levels.
+    Softening,
+    /// Irregular at every level (valence, darts, creases that turn): the quadtree never ends
+    /// there and the limit masks give the exact corner.
+    Extraordinary,
+}
+
+/// The corner whose ring starts at `start`, for the face of outgoing half-edge `side`.
+fn corner_kind(net: &PolyMesh, start: u32, side: u32) -> CornerKind {
+    let (ring, closed) = net.ring(start);
+    let v = net.from(start) as usize;
+    let edges = edges_at(net, &ring, closed);
+    let sharpness = vertex_sharpness(net, v, &ring, closed);
+    let softening = |s: f32| is_sharp(s) && !is_infinite(s);
+    if softening(sharpness) || edges.iter().any(|e| softening(e.0)) {
+        return CornerKind::Softening;
+    }
+    let quads = ring
+        .iter()
+        .all(|&h| net.face_len(net.face_of[h as usize] as usize) == 4);
+    let (first, end) = sector_range(net, &ring, closed, side);
+    let sector = end - first;
+    let rule = crease::vertex_rule(sharpness, edges.iter().map(|e| e.0));
+    let regular = quads
+        && match rule {
+            Rule::Smooth => closed && ring.len() == 4,
+            Rule::Dart => false,
+            Rule::Crease => sector == 2,
+            Rule::Corner => sector == 1,
+        };
+    if regular {
+        CornerKind::Regular
+    } else {
+        CornerKind::Extraordinary
+    }
+}
+
 /// The 16 control points of a regular quad (face 0 of `net`), with the phantom points of
 /// boundary patches extrapolated so the limit interpolates the boundary curve (2a - b across a
-/// boundary edge; the tensor product of that at a corner).
+/// boundary edge or an infinitely sharp crease; the tensor product of that at a corner).
 fn gather_bicubic(net: &PolyMesh) -> Bicubic {
     const CORNER: [(i32, i32); 4] = [(1, 1), (2, 1), (2, 2), (1, 2)];
     const ALONG: [(i32, i32); 4] = [(1, 0), (0, 1), (-1, 0), (0, -1)];
@@ -258,7 +313,7 @@ fn gather_bicubic(net: &PolyMesh) -> Bicubic {
             put((c.0 - a.0, c.1 - a.1), net.to(net.next(net.next(t))));
         }
     }
-    let boundary = |k: usize| net.twin(k as u32).is_none();
+    let boundary = |k: usize| net.twin(k as u32).is_none() || is_infinite(net.sharpness[k]);
     let mut p = grid;
     let get =
         |p: &[[Option<DVec3>; 4]; 4], i: usize, j: usize| p[i][j].expect("inner control point");

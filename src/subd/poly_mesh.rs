@@ -5,6 +5,7 @@
 //! next corner of the same face. A half-edge without a twin is either a true boundary of the
 //! surface (`boundary[h]`) or, in a local neighbourhood, the rim where the copy stops.
 
+use super::crease::INFINITE;
 use glam::DVec3;
 
 pub(crate) const NONE: u32 = u32::MAX;
@@ -22,6 +23,10 @@ pub(crate) struct PolyMesh {
     pub twin: Vec<u32>,
     /// True where the half-edge lies on the boundary of the surface itself.
     pub boundary: Vec<bool>,
+    /// Crease sharpness of every half-edge's edge (equal on both halves; 0 is smooth).
+    pub sharpness: Vec<f32>,
+    /// Corner sharpness of every vertex (0 is smooth).
+    pub vertex_sharpness: Vec<f32>,
 }
 
 impl PolyMesh {
@@ -46,6 +51,8 @@ impl PolyMesh {
         let count = m.verts.len();
         m.twin = vec![NONE; count];
         m.boundary = vec![false; count];
+        m.sharpness = vec![0.0; count];
+        m.vertex_sharpness = vec![0.0; m.points.len()];
         let mut by_edge = rustc_hash::FxHashMap::default();
         by_edge.reserve(count);
         for h in 0..count as u32 {
@@ -104,6 +111,24 @@ impl PolyMesh {
     #[inline]
     pub fn to(&self, h: u32) -> u32 {
         self.from(self.next(h))
+    }
+
+    /// Sharpness of the edge of `h`; a boundary of the surface is an infinitely sharp crease.
+    #[inline]
+    pub fn edge_sharpness(&self, h: u32) -> f32 {
+        if self.boundary[h as usize] {
+            INFINITE
+        } else {
+            self.sharpness[h as usize]
+        }
+    }
+
+    /// Whether any edge or vertex carries a crease or corner tag.
+    pub fn has_creases(&self) -> bool {
+        self.sharpness
+            .iter()
+            .chain(&self.vertex_sharpness)
+            .any(|&s| s > 0.0)
     }
 
     #[inline]
@@ -171,6 +196,7 @@ impl PolyMesh {
         let mut points = Vec::new();
         let mut local_faces: Vec<Vec<u32>> = Vec::with_capacity(faces.len());
         let mut true_boundary = rustc_hash::FxHashSet::default();
+        let mut sharp_edges = rustc_hash::FxHashMap::default();
         for &f in faces {
             let start = self.face_starts[f];
             let local: Vec<u32> = self
@@ -184,15 +210,36 @@ impl PolyMesh {
                 })
                 .collect();
             for (k, _) in local.iter().enumerate() {
+                let edge = (local[k], local[(k + 1) % local.len()]);
                 if self.boundary[start as usize + k] {
-                    true_boundary.insert((local[k], local[(k + 1) % local.len()]));
+                    true_boundary.insert(edge);
+                }
+                let s = self.sharpness[start as usize + k];
+                if s > 0.0 {
+                    sharp_edges.insert(edge, s);
                 }
             }
             local_faces.push(local);
         }
         local_faces[0].rotate_left(rotation);
         let refs: Vec<&[u32]> = local_faces.iter().map(|f| f.as_slice()).collect();
-        PolyMesh::build(points, &refs, |a, b| true_boundary.contains(&(a, b)))
-            .expect("a copy of a valid mesh is valid")
+        let mut copy = PolyMesh::build(points, &refs, |a, b| true_boundary.contains(&(a, b)))
+            .expect("a copy of a valid mesh is valid");
+        if !sharp_edges.is_empty() {
+            copy.set_edge_sharpness(|a, b| sharp_edges.get(&(a, b)).copied().unwrap_or(0.0));
+        }
+        for (&v, &local) in &map {
+            copy.vertex_sharpness[local as usize] = self.vertex_sharpness[v as usize];
+        }
+        copy
+    }
+
+    /// Sets every edge's sharpness from `sharpness(a, b)` of its half-edges (the sharper of
+    /// the two directions, so a caller may name either).
+    pub fn set_edge_sharpness(&mut self, sharpness: impl Fn(u32, u32) -> f32) {
+        for h in 0..self.verts.len() as u32 {
+            let (a, b) = (self.from(h), self.to(h));
+            self.sharpness[h as usize] = sharpness(a, b).max(sharpness(b, a));
+        }
     }
 }

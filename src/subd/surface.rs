@@ -104,9 +104,10 @@ impl LimitSurface {
         self.patches[pid].bound(s0, s1, t0, t1)
     }
 
-    /// Corners of patch `pid` at extraordinary vertices, in the order (0,0), (1,0), (1,1), (0,1).
-    pub fn irregular_corners(&self, pid: usize) -> [bool; 4] {
-        self.patches[pid].irregular_corners()
+    /// Whether patch `pid` is one polynomial over `[s0,s1] x [t0,t1]` (see
+    /// `PatchNode::polynomial_on`).
+    pub fn polynomial_on(&self, pid: usize, s0: f64, s1: f64, t0: f64, t1: f64) -> bool {
+        self.patches[pid].polynomial_on(s0, s1, t0, t1)
     }
 
     /// Every patch `pid` sampled on an `(n+1) x (n+1)` grid, `n = segments(pid)`, and split

@@ -7,6 +7,10 @@ use std::path::PathBuf;
 mod skip;
 pub use skip::skip_or_fail;
 
+/// A cube control mesh, [-1, 1]^3 with outward faces: 8 valence-3 extraordinary vertices.
+pub const CUBE_OBJ: &str = "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n\
+f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+
 /// The shared test data folder: `$VOXELKIT_DATA`, or `../shared/data` beside the crate.
 /// `None` (with a loud warning) when it is missing, so a clean clone still passes; CI
 /// (`.ci/run`) refuses to run without it.

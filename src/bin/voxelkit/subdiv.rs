@@ -147,7 +147,7 @@ fn check(input: &Path, per_patch: usize, reference: Option<&Path>, json: bool) -
         None => None,
     };
     let rows = [
-        ("OpenSubdiv Limit() at level-3 corners", Some(live.dyadic)),
+        ("OpenSubdiv Limit() at level-3 corners", live.dyadic),
         (
             "OpenSubdiv Bfr::Surface at random (u, v)",
             Some(live.random),
@@ -170,7 +170,7 @@ fn check(input: &Path, per_patch: usize, reference: Option<&Path>, json: bool) -
             "faces": stats.faces,
             "patches": surface.patch_count(),
             "limit_area": area,
-            "dyadic": comparison(Some(live.dyadic)),
+            "dyadic": comparison(live.dyadic),
             "random": comparison(Some(live.random)),
             "reference": comparison(reference),
         });
