@@ -207,7 +207,8 @@ fn estimates_are_within_30_percent_of_the_peak() {
 }
 
 /// The constants hold on closed meshes they were not fitted on (thin claws, a CAD part, a
-/// mechanical part, a quadrangulated character), and on an open one's surface.
+/// mechanical part, a quadrangulated character), on an open one's surface, and on a creased
+/// Catmull-Clark surface.
 #[test]
 fn estimates_hold_on_meshes_they_were_not_fitted_on() {
     let Some(data) = common::data_dir() else {
@@ -236,5 +237,10 @@ fn estimates_hold_on_meshes_they_were_not_fitted_on() {
     }
     let ogre = data.join("meshes/ogre.obj").display().to_string();
     cases.push(vec!["mesh".into(), ogre, "-r".into(), "1024".into()]);
+    // Semi-sharp creases: 280 edges of sharpness 7.9, whose quadtrees are most of the peak.
+    let rook = data.join("subd/catmark_rook.obj").display().to_string();
+    for resolution in ["256", "1024"] {
+        cases.push(vec!["subdiv".into(), rook.clone(), "-r".into(), resolution.into()]);
+    }
     all_within_30_percent(&cases, &out);
 }
