@@ -240,7 +240,12 @@ fn estimates_hold_on_meshes_they_were_not_fitted_on() {
     // Semi-sharp creases: 280 edges of sharpness 7.9, whose quadtrees are most of the peak.
     let rook = data.join("subd/catmark_rook.obj").display().to_string();
     for resolution in ["256", "1024"] {
-        cases.push(vec!["subdiv".into(), rook.clone(), "-r".into(), resolution.into()]);
+        cases.push(vec![
+            "subdiv".into(),
+            rook.clone(),
+            "-r".into(),
+            resolution.into(),
+        ]);
     }
     all_within_30_percent(&cases, &out);
 }

@@ -112,7 +112,10 @@ fn surface_points_lie_in_output_voxels_at_every_resolution() {
             // measured ratios lie between 3 and 5.5), not eightfold with the volume.
             if let Some(before) = cells_before {
                 let growth = out.stats.cells_tested as f64 / before as f64;
-                assert!((3.0..5.5).contains(&growth), "{name} {resolution}: {growth}");
+                assert!(
+                    (3.0..5.5).contains(&growth),
+                    "{name} {resolution}: {growth}"
+                );
             }
             cells_before = Some(out.stats.cells_tested);
         }

@@ -96,6 +96,20 @@ fn solid_measure_csg_and_intersect() {
     assert!(o.status.success(), "{}", text(&o));
     let curve = read_vdb_grid(dir.path().join("curve.vdb").as_path(), Some("density")).unwrap();
     assert!(curve.voxel_count() > 100);
+    // Any number of surfaces: a third operand equal to the first changes nothing.
+    let o = voxelkit(&[
+        "intersect",
+        &p("torus-s.vdb"),
+        &p("ball-s.vdb"),
+        &p("torus-s.vdb"),
+        "--resample",
+        "-o",
+        &p("curve3.vdb"),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let curve3 = read_vdb_grid(dir.path().join("curve3.vdb").as_path(), Some("density")).unwrap();
+    assert_eq!(curve3.voxel_count(), curve.voxel_count());
+    assert!(curve3.voxels().all(|c| curve.contains(c)));
     let o = voxelkit(&[
         "csg",
         "union",

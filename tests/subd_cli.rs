@@ -285,3 +285,59 @@ fn the_up_axis_turns_the_control_mesh() {
     let (kept, turned) = (extent("z"), extent("y"));
     assert_eq!([kept[0], kept[2], kept[1]], turned);
 }
+
+/// Lai & Cheng §7.3: intersection curves from the common voxels of surfaces on one grid
+/// (`subdiv A B --shared-grid`, then `intersect`). catmark_torus's tube crosses catmark_cube's
+/// limit surface in two loops. The enclosed surfaces (every voxel the limit surface touches)
+/// give whole curves, one 26-component per loop (also at 256: 2 components of 1,960 voxels);
+/// the paper's adjacency test alone leaves gaps (12 pieces at 128, 20 at 256).
+#[test]
+fn catmull_clark_surfaces_on_one_grid_meet_in_whole_curves() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    use voxelkit::grid::{Adjacency, DenseMask};
+    use voxelkit::io::vdb::read_vdb_grid;
+    let dir = tempfile::tempdir().unwrap();
+    let subd = |name: &str| data.join(format!("subd/{name}.obj")).display().to_string();
+    let components = |extra: &[&str]| {
+        let out = dir.path().join(format!("grids{}", extra.len()));
+        let mut args = vec![
+            "subdiv".to_string(),
+            subd("catmark_torus"),
+            subd("catmark_cube"),
+            "--shared-grid".into(),
+            "-r".into(),
+            "128".into(),
+            "--out-dir".into(),
+            out.display().to_string(),
+        ];
+        args.extend(extra.iter().map(|s| s.to_string()));
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = voxelkit(&refs);
+        assert!(o.status.success(), "{}", text(&o));
+        let curve = out.join("curve.vdb");
+        let o = voxelkit(&[
+            "intersect",
+            out.join("catmark_torus.vdb").to_str().unwrap(),
+            out.join("catmark_cube.vdb").to_str().unwrap(),
+            "-o",
+            curve.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        let grid = read_vdb_grid(&curve, None).unwrap();
+        let mask = DenseMask::from_grid(&grid, grid.bbox().unwrap()).unwrap();
+        (
+            grid.voxel_count(),
+            voxelkit::ops::topology::components(&mask, Adjacency::TwentySix),
+        )
+    };
+    let (voxels, pieces) = components(&["--enclose"]);
+    let (default_voxels, default_pieces) = components(&[]);
+    eprintln!(
+        "enclosed: {voxels} voxels in {pieces} pieces; default: {default_voxels} voxels in \
+         {default_pieces} pieces"
+    );
+    assert_eq!(pieces, 2, "{voxels} voxels");
+    assert!(default_pieces > pieces && default_voxels < voxels);
+}

@@ -620,19 +620,28 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
             plan_of(t, &bounds, bytes, tree.node_count() as u64)
         }
         Work::Brick(brick) => brick_plan(brick, fit)?,
-        Work::Combine { a, b, resample, .. } => {
-            // Resampled onto the first grid (only when the grids differ), each voxel of the
-            // second becomes (hb/ha)^3.
-            let scale = b.transform.voxel_size / a.transform.voxel_size;
-            let second = if *resample && !same_transform(&a.transform, &b.transform) {
-                (b.voxel_count() as f64 * scale.powi(3) / 64.0).max(b.leaf_count() as f64)
-            } else {
-                b.leaf_count() as f64
-            };
-            let leaves = a.leaf_count() as f64 + second;
-            // The result's copy of the tiles of both, and its set's growth: 1.4 tiles each
-            // (a checkerboard of 10^6 tiles in each grid: 204 MiB at the peak, estimate 189).
-            let tiles = 1.4 * (tile_bytes(a) + tile_bytes(b));
+        Work::Combine {
+            operands, resample, ..
+        } => {
+            // Resampled onto the first grid (only when the grids differ), each voxel of a
+            // later operand becomes (hb/ha)^3.
+            let a = &operands[0];
+            let later: f64 = operands[1..]
+                .iter()
+                .map(|b| {
+                    let scale = b.transform.voxel_size / a.transform.voxel_size;
+                    if *resample && !same_transform(&a.transform, &b.transform) {
+                        (b.voxel_count() as f64 * scale.powi(3) / 64.0).max(b.leaf_count() as f64)
+                    } else {
+                        b.leaf_count() as f64
+                    }
+                })
+                .sum();
+            let leaves = a.leaf_count() as f64 + later;
+            // The result's copy of the tiles of each, and its set's growth: 1.4 tiles each
+            // (a checkerboard of 10^6 tiles in each of two grids: 204 MiB at the peak,
+            // estimate 189).
+            let tiles = 1.4 * operands.iter().map(tile_bytes).sum::<f64>();
             plan_of(a.transform, &world_box(a), leaf_bytes(leaves, 0) + tiles, 1)
         }
     })

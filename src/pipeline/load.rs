@@ -81,8 +81,8 @@ pub(super) enum Work {
     CsgTree(Box<CsgTree>),
     Brick(BrickTask),
     Combine {
-        a: SparseGrid,
-        b: SparseGrid,
+        /// At least two.
+        operands: Vec<SparseGrid>,
         op: BooleanOp,
         resample: bool,
         curve: bool,
@@ -226,8 +226,7 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
             Work::Brick(brick.clone())
         }
         Task::Combine {
-            a,
-            b,
+            operands,
             grid,
             op,
             resample,
@@ -240,9 +239,14 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
                 GridSource::File(path) => read_vdb_solid(path, grid.as_deref()),
                 GridSource::Grid(g) => Ok(g.clone()),
             };
+            if operands.len() < 2 {
+                return Err(Error::InvalidArgument(format!(
+                    "a Boolean needs at least two grids, {} given",
+                    operands.len()
+                )));
+            }
             Work::Combine {
-                a: read(a)?,
-                b: read(b)?,
+                operands: operands.iter().map(read).collect::<Result<_>>()?,
                 op: *op,
                 resample: *resample,
                 curve: *curve,

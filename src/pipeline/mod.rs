@@ -183,11 +183,10 @@ pub enum Task {
     CsgTree(CsgSource),
     /// One brick of a distributed run, on the run's grid (`GridFit::Placed`).
     Brick(BrickTask),
-    /// A Boolean of two grids (from files: their grid `grid`, or the voxel set voxelkit
-    /// writes); `curve`: the intersection of two surfaces.
+    /// A Boolean of two or more grids, folded from the left (from files: their grid `grid`,
+    /// or the voxel set voxelkit writes); `curve`: the intersection of surfaces.
     Combine {
-        a: GridSource,
-        b: GridSource,
+        operands: Vec<GridSource>,
         grid: Option<String>,
         op: BooleanOp,
         resample: bool,
@@ -419,8 +418,8 @@ impl Task {
                 ..
             }
             | Task::CsgTree(CsgSource::File(p)) => vec![p.clone()],
-            Task::Combine { a, b, .. } => [a, b]
-                .into_iter()
+            Task::Combine { operands, .. } => operands
+                .iter()
                 .filter_map(|g| match g {
                     GridSource::File(p) => Some(p.clone()),
                     GridSource::Grid(_) => None,
@@ -508,7 +507,9 @@ impl Job {
                 crate::io::brick_set::brick_voxels(b.brick, b.size).min,
                 b.faces.face_count()
             ),
-            (Task::Combine { a, b, .. }, _) => format!("{} {}", grid(a), grid(b)),
+            (Task::Combine { operands, .. }, _) => {
+                operands.iter().map(grid).collect::<Vec<_>>().join(" ")
+            }
             (
                 Task::Measure {
                     source: MeasureSource::Grid(_),
@@ -673,12 +674,11 @@ impl PlannedJob {
             } => solid::measure_surface(surface, &source, *flood, *density, progress),
             Work::CsgTree(tree) => solid::csg_tree(tree, progress),
             Work::Combine {
-                a,
-                b,
+                operands,
                 op,
                 resample,
                 curve,
-            } => outcome::combine(a, b, *op, *resample, *curve, &source),
+            } => outcome::combine(operands, *op, *resample, *curve, &source),
             Work::Brick(brick) => bricks::run_brick(brick, t, progress),
         }
     }

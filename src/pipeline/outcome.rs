@@ -672,18 +672,24 @@ pub(super) fn implicit(
 }
 
 pub(super) fn combine(
-    a: &SparseGrid,
-    b: &SparseGrid,
+    operands: &[SparseGrid],
     op: BooleanOp,
     resample: bool,
     curve: bool,
     source: &str,
 ) -> Result<Outcome> {
     let start = Instant::now();
-    let grid = combine_grids(a, b, op, resample).map_err(|e| match e {
+    let named = |e| match e {
         Error::InvalidArgument(m) => Error::InvalidArgument(format!("{source}: {m}")),
         other => other,
-    })?;
+    };
+    let (first, later) = operands
+        .split_first()
+        .ok_or_else(|| Error::InvalidArgument("a Boolean needs grids".into()))?;
+    let mut grid = first.clone();
+    for b in later {
+        grid = combine_grids(&grid, b, op, resample).map_err(named)?;
+    }
     let method = if curve {
         "intersection-curve".to_string()
     } else {

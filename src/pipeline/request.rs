@@ -863,8 +863,7 @@ impl Request for CombineRequest {
 
     fn task(&self, (a, b): (GridSource, GridSource)) -> Result<Task> {
         Ok(Task::Combine {
-            a,
-            b,
+            operands: vec![a, b],
             grid: self.grid.clone(),
             op: self.op,
             resample: self.resample,

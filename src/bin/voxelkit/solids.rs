@@ -148,11 +148,13 @@ pub struct CsgArgs {
 
 #[derive(Args)]
 pub struct IntersectArgs {
-    /// First surface (.vdb).
-    a: PathBuf,
-    /// Second surface (.vdb).
-    b: PathBuf,
-    /// Resample the second grid onto the first's transform when they differ.
+    /// Surfaces (.vdb), two or more: made on one grid (`--shared-grid`), or resampled onto the
+    /// first's with --resample. Catmull-Clark surfaces made with --enclose hold every voxel
+    /// the surface touches, so that their curve is not broken where the paper's adjacency test
+    /// skips a voxel.
+    #[arg(required = true, num_args = 2..)]
+    inputs: Vec<PathBuf>,
+    /// Resample the later grids onto the first's transform where they differ.
     #[arg(long)]
     resample: bool,
     /// Output .vdb holding the voxels common to both surfaces.
@@ -232,8 +234,7 @@ pub fn measure(args: &MeasureArgs, global: &Global) -> Result<()> {
 pub fn csg(args: &CsgArgs, global: &Global) -> Result<()> {
     let task = match (args.operation, &args.a, &args.b, &args.tree) {
         (Some(op), Some(a), Some(b), None) => Task::Combine {
-            a: GridSource::File(a.clone()),
-            b: GridSource::File(b.clone()),
+            operands: vec![GridSource::File(a.clone()), GridSource::File(b.clone())],
             grid: args.grid.clone(),
             op,
             resample: args.resample,
@@ -249,8 +250,7 @@ pub fn csg(args: &CsgArgs, global: &Global) -> Result<()> {
 
 pub fn intersect(args: &IntersectArgs, global: &Global) -> Result<()> {
     let task = Task::Combine {
-        a: GridSource::File(args.a.clone()),
-        b: GridSource::File(args.b.clone()),
+        operands: args.inputs.iter().cloned().map(GridSource::File).collect(),
         grid: None,
         op: BooleanOp::Intersection,
         resample: args.resample,

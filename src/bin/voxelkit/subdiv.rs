@@ -2,12 +2,12 @@
 //! and the evaluator checked against OpenSubdiv.
 
 use crate::FitArgs;
-use crate::run::{Global, run_and_report};
+use crate::run::Global;
 use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
 use voxelkit::grid::Adjacency;
 use voxelkit::pipeline::request::SubdivRequest;
-use voxelkit::pipeline::{Job, MeshSource, SubdivisionFill, Task};
+use voxelkit::pipeline::{SubdivisionFill, Task};
 use voxelkit::subd::{ControlMesh, LimitSurface, compare_points, limit_area, read_points};
 use voxelkit::voxelize::parametric::ParametricOptions;
 use voxelkit::{Error, Result};
@@ -17,9 +17,11 @@ use voxelkit::{Error, Result};
 pub struct SubdivArgs {
     #[command(subcommand)]
     action: Option<SubdivAction>,
-    /// Catmull-Clark control mesh (.obj; quads, triangles, n-gons; closed or open).
+    /// Catmull-Clark control meshes (.obj; quads, triangles, n-gons; closed or open), with
+    /// their crease tags (`t` lines, or NAME.tags beside NAME.obj); several with --out-dir,
+    /// on one grid with --shared-grid.
     #[arg(required = true)]
-    input: Option<PathBuf>,
+    inputs: Vec<PathBuf>,
     #[command(flatten)]
     pub voxelize: SubdivVoxelizeArgs,
 }
@@ -61,8 +63,8 @@ pub struct SubdivVoxelizeArgs {
     /// Output: a .vdb (`density`, `normal` and `opposite_normals` grids; with --solid,
     /// `density`, `shell`, `interior` and `opposite_normals`), a .nvdb (the same grids for
     /// NanoVDB), or a .binvox or .vox.
-    #[arg(short, long, required = true)]
-    output: Option<PathBuf>,
+    #[command(flatten)]
+    out: crate::batch::OutputArgs,
     #[command(flatten)]
     pub write: crate::WriteArgs,
     #[command(flatten)]
@@ -109,29 +111,28 @@ pub fn run(args: &SubdivArgs, global: &Global) -> Result<()> {
             reference,
         }) => check(input, *per_patch, reference.as_deref(), json),
         Some(SubdivAction::Eval { input, points }) => eval(input, points),
-        None => {
-            let input = args.input.as_deref().expect("clap requires the input");
-            voxelize(input, &args.voxelize, global)
-        }
+        None => voxelize(&args.inputs, &args.voxelize, global),
     }
 }
 
-fn voxelize(input: &Path, args: &SubdivVoxelizeArgs, global: &Global) -> Result<()> {
-    let output = args.output.as_deref().expect("clap requires the output");
-    let task = Task::Subdivision {
-        mesh: MeshSource::File(input.to_path_buf()),
-        options: ParametricOptions {
-            adjacency: args.adjacency,
-            presplit: args.presplit,
-            enclose: args.enclose,
-        },
-        solid: args.solid.then_some(SubdivisionFill {
-            graystack: args.graystack,
-            density: args.density,
-            topology: args.topology,
-        }),
+fn voxelize(inputs: &[PathBuf], args: &SubdivVoxelizeArgs, global: &Global) -> Result<()> {
+    let options = ParametricOptions {
+        adjacency: args.adjacency,
+        presplit: args.presplit,
+        enclose: args.enclose,
     };
-    run_and_report(Job::new(task, args.fit.grid_fit()?), output, global)
+    let solid = args.solid.then_some(SubdivisionFill {
+        graystack: args.graystack,
+        density: args.density,
+        topology: args.topology,
+    });
+    crate::batch::run(inputs, &args.out, args.fit.grid_fit()?, global, |mesh| {
+        Ok(Task::Subdivision {
+            mesh,
+            options,
+            solid,
+        })
+    })
 }
 
 #[cfg(feature = "osd")]
