@@ -72,9 +72,9 @@ fn errors_point_at_the_column() {
     assert_eq!(column_of("(x + y", c), (7, "expected `)`".to_string()));
     assert!(column_of("x y", c).1.contains("after the formula"));
     assert_eq!(column_of("x # y", c).0, 3);
-    let (col, msg) = column_of("theta - 1", c);
+    let (col, msg) = column_of("psi - 1", c);
     assert_eq!(col, 1);
-    assert!(msg.contains("`theta`"), "{msg}");
+    assert!(msg.contains("`psi`"), "{msg}");
     assert!(
         column_of("sin = 2; sin", c)
             .1
@@ -88,17 +88,64 @@ fn errors_point_at_the_column() {
     );
 }
 
-/// Random formulas over x, y, z using every operation.
-fn formula() -> impl Strategy<Value = String> {
-    formula_over(["x", "y", "z"])
+/// Stolte & Kaufman blend coordinate systems in one formula: every system's variables are
+/// there in every formula, and equal the conversions of the same point.
+#[test]
+fn coordinates_blend() {
+    let mut rng = voxelkit::mesh::generate::SplitMix64(5);
+    for _ in 0..200 {
+        let p = [
+            rng.range(-2.0, 2.0),
+            rng.range(-2.0, 2.0),
+            rng.range(-2.0, 2.0),
+        ];
+        for range in [ThetaRange::Positive, ThetaRange::Symmetric] {
+            let eval = |text: &str, c: Coordinates| {
+                let f = Formula::parse_in(text, c, range).unwrap();
+                f.tape.eval(f.coordinates_of(p))
+            };
+            let spherical = Formula::parse_in("0", Coordinates::Spherical, range)
+                .unwrap()
+                .coordinates_of(p);
+            let cylindrical = Formula::parse_in("0", Coordinates::Cylindrical, range)
+                .unwrap()
+                .coordinates_of(p);
+            let close = |a: f64, b: f64, what: &str| {
+                assert!((a - b).abs() < 1e-12, "{what} at {p:?}: {a} vs {b}")
+            };
+            // r theta phi in a Cartesian formula.
+            for (k, name) in ["r", "theta", "phi"].iter().enumerate() {
+                close(eval(name, Coordinates::Cartesian), spherical[k], name);
+            }
+            // x y z in spherical and cylindrical formulas; phi in a cylindrical one.
+            for (k, name) in ["x", "y", "z"].iter().enumerate() {
+                close(eval(name, Coordinates::Spherical), p[k], name);
+                close(eval(name, Coordinates::Cylindrical), p[k], name);
+            }
+            close(
+                eval("phi", Coordinates::Cylindrical),
+                cylindrical[2].atan2(cylindrical[0]),
+                "cylindrical phi",
+            );
+            // A named sub-expression may take a blended name for itself.
+            close(
+                eval("r = 2*x; r", Coordinates::Cartesian),
+                2.0 * p[0],
+                "named r",
+            );
+        }
+    }
 }
 
-/// Random formulas over the three `variables` using every operation.
-fn formula_over(variables: [&'static str; 3]) -> impl Strategy<Value = String> {
+/// Random formulas over x, y, z (and the blended r, theta, phi) using every operation.
+fn formula() -> impl Strategy<Value = String> {
+    formula_over(&["x", "y", "z", "r", "theta", "phi"])
+}
+
+/// Random formulas over `variables` using every operation.
+fn formula_over(variables: &'static [&'static str]) -> impl Strategy<Value = String> {
     let leaf = prop_oneof![
-        Just(variables[0].to_string()),
-        Just(variables[1].to_string()),
-        Just(variables[2].to_string()),
+        prop::sample::select(variables).prop_map(str::to_string),
         (-3.0f64..3.0).prop_map(|c| format!("({c})")),
     ];
     leaf.prop_recursive(5, 40, 2, |inner| {
@@ -240,14 +287,14 @@ proptest! {
 
     /// Boxes converted to spherical coordinates enclose the coordinates of their points.
     #[test]
-    fn spherical_boxes_enclose_their_points(text in formula_over(["r", "theta", "phi"]), (lo, size, samples) in box_and_points()) {
+    fn spherical_boxes_enclose_their_points(text in formula_over(&["r", "theta", "phi", "x", "y", "z"]), (lo, size, samples) in box_and_points()) {
         check_conversion(Coordinates::Spherical, &text, lo, size, samples)?;
     }
 
     /// Formulas G(θ, φ) - r, where r is compared with G as squares: as typed (r = G, and
     /// with -r) and under the paper's substitution (r = |G|), θ in either range.
     #[test]
-    fn isolated_r_boxes_enclose_their_points(text in formula_over(["theta", "phi", "theta"]), (lo, size, samples) in box_and_points(), negative in any::<bool>(), squared in any::<bool>(), positive in any::<bool>()) {
+    fn isolated_r_boxes_enclose_their_points(text in formula_over(&["theta", "phi"]), (lo, size, samples) in box_and_points(), negative in any::<bool>(), squared in any::<bool>(), positive in any::<bool>()) {
         let theta_range = if positive { ThetaRange::Positive } else { ThetaRange::Symmetric };
         let g = Formula { theta_range, ..Formula::parse(&text, Coordinates::Spherical).unwrap() };
         let boxed: [Interval; 3] = std::array::from_fn(|k| Interval::new(lo[k], lo[k] + size[k]));
@@ -275,7 +322,7 @@ proptest! {
 
     /// The same for cylindrical coordinates.
     #[test]
-    fn cylindrical_boxes_enclose_their_points(text in formula_over(["r", "theta", "y"]), (lo, size, samples) in box_and_points()) {
+    fn cylindrical_boxes_enclose_their_points(text in formula_over(&["r", "theta", "y", "x", "z", "phi"]), (lo, size, samples) in box_and_points()) {
         check_conversion(Coordinates::Cylindrical, &text, lo, size, samples)?;
     }
 }

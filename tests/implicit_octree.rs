@@ -8,7 +8,7 @@ use voxelkit::implicit::{Coordinates, Formula, value_at};
 use voxelkit::mesh::generate::SplitMix64;
 use voxelkit::voxelize::interval_octree::{OctreeOptions, voxelize_implicit};
 
-const SURFACES: [(&str, Coordinates, &str); 3] = [
+const SURFACES: [(&str, Coordinates, &str); 5] = [
     ("sphere", Coordinates::Cartesian, "x^2 + y^2 + z^2 - 0.8^2"),
     (
         "torus",
@@ -19,6 +19,17 @@ const SURFACES: [(&str, Coordinates, &str); 3] = [
         "sinsin",
         Coordinates::Spherical,
         "sin(3*theta)*sin(4*phi) - r",
+    ),
+    // Blended coordinates: Cartesian in a spherical formula, and the other way round.
+    (
+        "blended spherical",
+        Coordinates::Spherical,
+        "r - 0.6 - 0.15*x + 0.1*sin(3*theta)",
+    ),
+    (
+        "blended cartesian",
+        Coordinates::Cartesian,
+        "r - 0.75 - 0.1*cos(2*phi) + 0.2*y*z",
     ),
 ];
 

@@ -79,11 +79,20 @@ pub struct Formula {
 impl Formula {
     /// Parses `text` (θ in the paper's [0, 2π), r as typed); errors point at the column.
     pub fn parse(text: &str, coordinates: Coordinates) -> Result<Formula> {
+        Formula::parse_in(text, coordinates, ThetaRange::default())
+    }
+
+    /// Parses `text` with θ in `theta_range` (which blended θ in a Cartesian formula follows).
+    pub fn parse_in(
+        text: &str,
+        coordinates: Coordinates,
+        theta_range: ThetaRange,
+    ) -> Result<Formula> {
         Ok(Formula {
             text: text.to_string(),
             coordinates,
-            tape: parse::parse(text, coordinates.variables())?,
-            theta_range: ThetaRange::default(),
+            tape: parse::parse(text, coordinates, theta_range)?,
+            theta_range,
             squared: false,
         })
     }

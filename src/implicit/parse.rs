@@ -11,8 +11,17 @@
 //!
 //! Functions: sqrt abs sin cos tan exp log (one argument), atan2 min max (two). `-x^2` is
 //! `-(x^2)`. Named sub-expressions are computed once and may be used by later lines.
+//!
+//! Coordinates blend, as Stolte & Kaufman's formulas do: besides its own three variables a
+//! formula may use the other systems' (`x y z` in a spherical or cylindrical formula, `r theta
+//! phi` in a Cartesian one), each computed once from its own where first used:
+//! x = r cos φ cos θ, y = r sin φ, z = r cos φ sin θ (cylindrical: x = r cos θ, z = r sin θ);
+//! r = √(x² + y² + z²), θ in the formula's range, φ = atan2(y, √(x² + z²)) (cylindrical:
+//! atan2(y, r)). The same point has the same blended coordinates whichever sign of r
+//! describes it. A named sub-expression may take such a name for itself.
 
 use super::tape::{Instr, Tape};
+use super::{Coordinates, ThetaRange};
 use crate::error::{Error, Result};
 
 #[derive(Clone, Debug, PartialEq)]
@@ -27,6 +36,8 @@ struct Parser<'a> {
     tokens: Vec<(Token, usize)>,
     at: usize,
     variables: [&'a str; 3],
+    coordinates: Coordinates,
+    theta_range: ThetaRange,
     names: Vec<(String, u32)>,
     instrs: Vec<Instr>,
     /// Nesting of signs, parentheses and function calls: bounded, so that no input can
@@ -37,13 +48,15 @@ struct Parser<'a> {
 /// Deepest nesting a formula may have.
 const MAX_DEPTH: usize = 100;
 
-/// Compiles `text` over the coordinate `variables` (in slot order).
-pub fn parse(text: &str, variables: [&str; 3]) -> Result<Tape> {
+/// Compiles `text` over the variables of `coordinates` (in slot order), θ in `theta_range`.
+pub fn parse(text: &str, coordinates: Coordinates, theta_range: ThetaRange) -> Result<Tape> {
     let mut p = Parser {
         text,
         tokens: tokenize(text)?,
         at: 0,
-        variables,
+        variables: coordinates.variables(),
+        coordinates,
+        theta_range,
         names: Vec::new(),
         instrs: Vec::new(),
         depth: 0,
@@ -331,6 +344,11 @@ impl Parser<'_> {
         if let Some(&(_, slot)) = self.names.iter().rev().find(|(n, _)| n == name) {
             return Ok(slot);
         }
+        if let Some(slot) = self.blended(name) {
+            // Computed once: later uses find it among the names.
+            self.names.insert(0, (name.to_string(), slot));
+            return Ok(slot);
+        }
         if let Some(&(_, make)) = UNARY.iter().find(|(n, _)| *n == name) {
             let args = self.arguments(name, 1)?;
             return Ok(self.push(make(args[0])));
@@ -343,10 +361,71 @@ impl Parser<'_> {
             self.text,
             column,
             format!(
-                "unknown name `{name}` (variables here: {}; functions: sqrt abs sin cos tan exp log atan2 min max)",
-                self.variables.join(" ")
+                "unknown name `{name}` (variables: x y z r theta phi; functions: sqrt abs sin cos tan exp log atan2 min max)"
             ),
         ))
+    }
+
+    /// Another system's coordinate, computed from this formula's own variables (see the
+    /// module docs); `None` when `name` is none.
+    fn blended(&mut self, name: &str) -> Option<u32> {
+        use Instr::*;
+        let var = |p: &mut Self, k: u8| p.push(Var(k));
+        let slot = match (self.coordinates, name) {
+            (Coordinates::Cartesian, "r") => {
+                let (x, y, z) = (var(self, 0), var(self, 1), var(self, 2));
+                let (x2, y2, z2) = (
+                    self.push(Pow(x, 2)),
+                    self.push(Pow(y, 2)),
+                    self.push(Pow(z, 2)),
+                );
+                let xy = self.push(Add(x2, y2));
+                let all = self.push(Add(xy, z2));
+                self.push(Sqrt(all))
+            }
+            (Coordinates::Cartesian, "theta") => {
+                let (x, z) = (var(self, 0), var(self, 2));
+                match self.theta_range {
+                    ThetaRange::Symmetric => self.push(Atan2(z, x)),
+                    ThetaRange::Positive => {
+                        let minus_x = self.push(Neg(x));
+                        let turned = self.push(Atan2(z, minus_x));
+                        let pi = self.push(Const(std::f64::consts::PI));
+                        self.push(Sub(pi, turned))
+                    }
+                }
+            }
+            (Coordinates::Cartesian, "phi") => {
+                let (x, y, z) = (var(self, 0), var(self, 1), var(self, 2));
+                let (x2, z2) = (self.push(Pow(x, 2)), self.push(Pow(z, 2)));
+                let sum = self.push(Add(x2, z2));
+                let horizontal = self.push(Sqrt(sum));
+                self.push(Atan2(y, horizontal))
+            }
+            (Coordinates::Spherical, "x" | "y" | "z") => {
+                let (r, theta, phi) = (var(self, 0), var(self, 1), var(self, 2));
+                if name == "y" {
+                    let sin_phi = self.push(Sin(phi));
+                    self.push(Mul(r, sin_phi))
+                } else {
+                    let cos_phi = self.push(Cos(phi));
+                    let horizontal = self.push(Mul(r, cos_phi));
+                    let angle = self.push(if name == "x" { Cos(theta) } else { Sin(theta) });
+                    self.push(Mul(horizontal, angle))
+                }
+            }
+            (Coordinates::Cylindrical, "x" | "z") => {
+                let (r, theta) = (var(self, 0), var(self, 1));
+                let angle = self.push(if name == "x" { Cos(theta) } else { Sin(theta) });
+                self.push(Mul(r, angle))
+            }
+            (Coordinates::Cylindrical, "phi") => {
+                let (r, y) = (var(self, 0), var(self, 2));
+                self.push(Atan2(y, r))
+            }
+            _ => return None,
+        };
+        Some(slot)
     }
 
     fn arguments(&mut self, function: &str, count: usize) -> Result<Vec<u32>> {

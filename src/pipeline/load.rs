@@ -148,9 +148,8 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
             }
             Work::Implicit {
                 formula: Formula {
-                    theta_range: *theta_range,
                     squared: *squared,
-                    ..Formula::parse(formula, *coordinates)?
+                    ..Formula::parse_in(formula, *coordinates, *theta_range)?
                 },
                 text: formula.clone(),
                 min: *min,
