@@ -1,7 +1,8 @@
-//! Mesh input on the real data (counts and volumes against the data README) and STL written
-//! here in both encodings.
+//! Mesh input on the real data (counts and volumes against the data README), STL written
+//! here in both encodings, and the attributes readers read past, named in the jobs' warnings.
 #![cfg(feature = "fixtures")]
 
+mod cli_support;
 mod common;
 
 use voxelkit::mesh::{Mesh, generate};
@@ -97,4 +98,86 @@ fn stl_in_both_encodings_welds_back_to_the_same_mesh() {
         );
         assert!((back.signed_volume() / m.signed_volume() - 1.0).abs() < 1e-9);
     }
+}
+
+/// What a reader reads past is named, so that a job can say it does not write it: OBJ
+/// texture coordinates and normals, PLY vertex properties other than position and colour.
+/// A job warns about them, and about vertex colours unless it colours its voxels with them.
+#[test]
+fn attributes_read_past_are_named_and_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let tetrahedron = "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    let obj = dir.path().join("t.obj");
+    std::fs::write(
+        &obj,
+        format!(
+            "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nv 0 0 1 1 1 1\nvt 0 0\nvn 0 0 1\n{tetrahedron}"
+        ),
+    )
+    .unwrap();
+    let m = Mesh::load(&obj).unwrap();
+    assert_eq!(m.unread, ["texture coordinates (vt)", "normals (vn)"]);
+    let plain = dir.path().join("plain.obj");
+    std::fs::write(
+        &plain,
+        format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n{tetrahedron}"),
+    )
+    .unwrap();
+    assert!(Mesh::load(&plain).unwrap().unread.is_empty());
+    let ply = dir.path().join("t.ply");
+    std::fs::write(
+        &ply,
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+         property float z\nproperty float nx\nproperty float quality\nelement face 4\n\
+         property list uchar int vertex_indices\nend_header\n0 0 0 1 5\n1 0 0 1 5\n0 1 0 1 5\n\
+         0 0 1 1 5\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n",
+    )
+    .unwrap();
+    let mut unread = Mesh::load(&ply).unwrap().unread;
+    unread.sort();
+    assert_eq!(unread, ["nx", "quality"]);
+
+    // The job's warning: everything on the separating surface, all but the colours on the
+    // projective one (which writes them as `Cd`).
+    let warnings = |method: &str| {
+        let o = cli_support::voxelkit(&[
+            "--json",
+            "mesh",
+            obj.to_str().unwrap(),
+            "--method",
+            method,
+            "-r",
+            "16",
+            "-o",
+            dir.path().join(format!("{method}.vdb")).to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", cli_support::text(&o));
+        let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        report["warnings"].to_string()
+    };
+    let separating = warnings("separating");
+    assert!(
+        separating.contains("vertex colours, texture coordinates (vt), normals (vn)"),
+        "{separating}"
+    );
+    let projective = warnings("projective");
+    assert!(
+        projective.contains("texture coordinates (vt), normals (vn)")
+            && !projective.contains("vertex colours"),
+        "{projective}"
+    );
+    // Normals come from the separating method only: the projective one refuses them.
+    let o = cli_support::voxelkit(&[
+        "mesh",
+        obj.to_str().unwrap(),
+        "--method",
+        "projective",
+        "--normals",
+        "-r",
+        "16",
+        "-o",
+        dir.path().join("n.vdb").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success() && cli_support::text(&o).contains("separating method"));
+    assert!(!dir.path().join("n.vdb").exists());
 }

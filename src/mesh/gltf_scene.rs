@@ -149,6 +149,8 @@ struct Collected {
     triangles: Vec<Vec<u32>>,
     joined: FxHashMap<[u64; 3], u32>,
     colored: bool,
+    /// Attributes besides POSITION and COLOR_0 (NORMAL, TEXCOORD_0, ...), by name.
+    unread: std::collections::BTreeSet<String>,
 }
 
 impl Collected {
@@ -186,6 +188,14 @@ impl Collected {
             &[Dimensions::Vec3],
             buffers,
         )?;
+        for (semantic, _) in primitive.attributes() {
+            if !matches!(
+                semantic,
+                ::gltf::Semantic::Positions | ::gltf::Semantic::Colors(0)
+            ) {
+                self.unread.insert(semantic.to_string());
+            }
+        }
         let colors = primitive.get(&::gltf::Semantic::Colors(0));
         if let Some(c) = &colors {
             check_accessor(
@@ -331,6 +341,7 @@ pub(super) fn load_gltf(path: &Path) -> Result<Mesh> {
         colors,
         triangles,
         colored,
+        unread,
         ..
     } = collected;
     let mut mesh = Mesh::from_polygons(path, positions, &triangles);
@@ -338,6 +349,7 @@ pub(super) fn load_gltf(path: &Path) -> Result<Mesh> {
         mesh.colors = colors;
     }
     mesh.numbered_from_zero = true;
+    mesh.unread = unread.into_iter().collect();
     Ok(mesh)
 }
 

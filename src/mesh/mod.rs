@@ -48,6 +48,10 @@ pub struct Mesh {
     /// Vertices are numbered from 0 in messages (arrays from C or Python) instead of from 1
     /// (files, as OBJ numbers them).
     pub numbered_from_zero: bool,
+    /// Per-vertex attributes the file holds that voxelkit reads past (texture coordinates,
+    /// normals, other PLY properties, glTF attributes), named as the file names them, so that
+    /// a job can say what it does not write.
+    pub unread: Vec<String>,
 }
 
 /// Axis-aligned bounding box in world space.

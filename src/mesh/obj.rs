@@ -20,6 +20,14 @@ pub(super) fn load_obj(path: &Path) -> Result<Mesh> {
         line,
         message,
     })?;
+    let unread = [
+        (parsed.texture_coordinates, "texture coordinates (vt)"),
+        (parsed.normals, "normals (vn)"),
+    ]
+    .into_iter()
+    .filter(|&(count, _)| count > 0)
+    .map(|(_, what)| what.to_string())
+    .collect();
     Ok(Mesh {
         positions: parsed.positions,
         indices: parsed.indices,
@@ -27,6 +35,7 @@ pub(super) fn load_obj(path: &Path) -> Result<Mesh> {
         colors: parsed.colors,
         polylines: parsed.polylines,
         source: path.to_path_buf(),
+        unread,
         ..Default::default()
     })
 }
@@ -58,6 +67,9 @@ struct Parsed {
     /// Where each polygon starts in `indices`, and where the last ends.
     face_starts: Vec<u32>,
     polylines: Vec<Vec<u32>>,
+    /// Texture coordinate (`vt`) and normal (`vn`) lines.
+    texture_coordinates: usize,
+    normals: usize,
 }
 
 type LineError = (usize, String);
@@ -198,6 +210,8 @@ fn parse_piece(text: &str, lines_before: usize, vertices_before: usize) -> Piece
             indices: Vec::new(),
             face_starts: Vec::new(),
             polylines: Vec::new(),
+            texture_coordinates: 0,
+            normals: 0,
         },
         first_colored: None,
         first_plain: None,
@@ -249,6 +263,8 @@ fn parse_line(
             }
             out.polylines.push(polyline);
         }
+        Some("vt") => out.texture_coordinates += 1,
+        Some("vn") => out.normals += 1,
         _ => {}
     }
     Ok(())
@@ -280,6 +296,8 @@ fn join_pieces(pieces: Vec<Piece>) -> std::result::Result<Parsed, LineError> {
         indices: vec_to_fill(total(|p| p.indices.len())),
         face_starts: vec_to_fill(total(|p| p.face_starts.len()) + 1),
         polylines: Vec::new(),
+        texture_coordinates: total(|p| p.texture_coordinates),
+        normals: total(|p| p.normals),
     };
     out.face_starts.push(0);
     for piece in pieces {

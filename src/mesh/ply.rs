@@ -171,6 +171,19 @@ pub(super) fn load_ply(path: &Path) -> Result<Mesh> {
     let mut mesh = Mesh::from_polygons(path, positions, &polygons);
     mesh.colors = colors;
     mesh.numbered_from_zero = true;
+    mesh.unread = ply
+        .header
+        .elements
+        .get("vertex")
+        .map(|element| {
+            element
+                .properties
+                .keys()
+                .filter(|name| !["x", "y", "z", "red", "green", "blue"].contains(&name.as_str()))
+                .cloned()
+                .collect()
+        })
+        .unwrap_or_default();
     Ok(mesh)
 }
 

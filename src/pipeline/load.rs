@@ -89,6 +89,45 @@ pub(super) enum Work {
     },
 }
 
+impl Work {
+    /// What the input mesh holds that this job does not write: its unread attributes, and its
+    /// vertex colours unless the job colours its voxels with them.
+    pub(super) fn unwritten_attributes(&self) -> Option<String> {
+        let (mesh, colours_kept): (&Mesh, bool) = match self {
+            Work::MeshSurface { mesh, method } => (
+                mesh,
+                matches!(
+                    method,
+                    SurfaceMethod::Projective(super::ColorChoice::FromMesh)
+                ),
+            ),
+            Work::Lines { mesh, coloring, .. } => (mesh, *coloring == Coloring::Vertex),
+            Work::DistanceBand { mesh, .. } => (mesh, false),
+            Work::SeparationCheck { mesh, .. }
+            | Work::Solid { mesh, .. }
+            | Work::MeasureMesh { mesh, .. } => (mesh, false),
+            _ => return None,
+        };
+        let mut unwritten = mesh.unread.clone();
+        let colours_dropped = !mesh.colors.is_empty() && !colours_kept;
+        if colours_dropped {
+            unwritten.insert(0, "vertex colours".into());
+        }
+        (!unwritten.is_empty()).then(|| {
+            format!(
+                "{}: its {} are not written (voxelkit writes the shape{})",
+                mesh.source.display(),
+                unwritten.join(", "),
+                if colours_dropped {
+                    ", and vertex colours as `Cd` with --method projective or `lines`"
+                } else {
+                    ""
+                }
+            )
+        })
+    }
+}
+
 /// Reads what `task` needs; mesh files are turned `up`.
 pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
     let mesh = |source: &MeshSource| source.load(false, up);

@@ -457,6 +457,7 @@ impl Job {
             }
         }
         let work = load::load(&self.task, self.up_axis)?;
+        warnings.extend(work.unwritten_attributes());
         let reading = StageTime::since("read", begun);
         let planning_begun = StageTime::now();
         let plan = estimate::price(&work, self.fit, &self.describe_input())?;

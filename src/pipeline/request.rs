@@ -733,6 +733,13 @@ impl Request for MeshRequest {
         }
         let method = match self.method {
             SurfaceKind::Separating => SurfaceMethod::Separating(self.separating()),
+            SurfaceKind::Projective if self.normals => {
+                return Err(Error::InvalidArgument(
+                    "normals are written by the separating method (the nearest face, edge or \
+                     vertex normal per voxel); the projective method writes colours"
+                        .into(),
+                ));
+            }
             SurfaceKind::Projective => {
                 SurfaceMethod::Projective(color_choice(self.colors, self.color))
             }
