@@ -171,7 +171,8 @@ vk_status vk_options_set_voxel_size(vk_options *options, double voxel_size);
 /* 6 or 26. */
 vk_status vk_options_set_separability(vk_options *options, int separability);
 vk_status vk_options_set_criterion(vk_options *options, vk_criterion criterion);
-/* Non-zero: separating surfaces carry the nearest primitive's normal per voxel. */
+/* Non-zero: separating surfaces carry the nearest primitive's normal per voxel (the projective
+ * method refuses it with VK_ERROR_INVALID_ARGUMENT). */
 vk_status vk_options_set_normals(vk_options *options, int normals);
 vk_status vk_options_set_surface_method(vk_options *options, vk_surface_method method);
 vk_status vk_options_set_fill_method(vk_options *options, vk_fill_method method);

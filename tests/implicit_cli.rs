@@ -162,8 +162,8 @@ fn bad_formulas_and_arguments_are_refused() {
             ],
         ),
         (
-            vec!["implicit", "r - 1", "-o", o],
-            vec!["unknown name `r`", "x y z"],
+            vec!["implicit", "q - 1", "-o", o],
+            vec!["unknown name `q`", "x y z r theta phi"],
         ),
         (
             vec!["implicit", "x - 1", "--bounds", "1,1", "-o", o],

@@ -159,6 +159,9 @@ int main(int argc, char **argv) {
     /* The other voxelizers. */
     vk_grid *g = NULL;
     OK(vk_options_set_surface_method(opts, VK_SURFACE_PROJECTIVE));
+    /* Normals are the separating surface's: the projective method refuses them. */
+    CHECK(vk_voxelize_mesh(mesh, opts, &g) == VK_ERROR_INVALID_ARGUMENT && g == NULL);
+    OK(vk_options_set_normals(opts, 0));
     OK(vk_voxelize_mesh(mesh, opts, &g));
     OK(vk_grid_free(g));
     OK(vk_voxelize_lines(mesh, opts, &g));
