@@ -141,6 +141,13 @@ fn levels_are_written_with_their_own_voxel_size() {
     assert_eq!(level(5).active_voxels, surface.active_voxels);
     for l in 1..=5 {
         assert!(level(l).active_voxels >= level(l - 1).active_voxels);
+        // Each level's normals beside it, on the same voxels.
+        let normals = grids
+            .iter()
+            .find(|g| g.name == format!("level_{l}_normal"))
+            .unwrap();
+        assert_eq!(normals.active_voxels, level(l).active_voxels);
+        assert_eq!(normals.value_type, "vec3s");
     }
 }
 

@@ -175,26 +175,35 @@ fn every_level_envelops_and_every_cell_has_its_parent() {
 
 #[test]
 fn normals_are_unit_gradients() {
+    // Every level's cells too ("each voxel stores the normal vector"), at their own centres;
+    // the root's centre is the sphere's, where the gradient vanishes.
     let f = Formula::parse("x^2 + y^2 + z^2 - 0.8^2", Coordinates::Cartesian).unwrap();
     let out = voxelize_implicit(
         &f,
         DVec3::splat(-1.0),
         DVec3::ONE,
-        &OctreeOptions::default(),
+        &OctreeOptions {
+            levels: true,
+            ..Default::default()
+        },
         &voxelkit::progress::Progress::none(),
     )
     .unwrap();
-    let t = out.surface.transform;
-    for leaf in out.surface.leaves() {
-        let normals = leaf.normal.as_ref().unwrap();
-        for n in leaf.offsets() {
-            let c = voxelkit::grid::offset_coord(leaf.origin, n);
-            let radial = t.index_to_world(c).normalize();
-            let normal = glam::Vec3::from_array(normals[n]).as_dvec3();
-            assert!(
-                (normal.length() - 1.0).abs() < 1e-6 && normal.dot(radial) > 0.9999,
-                "{normal} at {c:?}"
-            );
+    assert!(out.levels.len() > 5);
+    for grid in std::iter::once(&out.surface).chain(&out.levels[1..]) {
+        let t = grid.transform;
+        for leaf in grid.leaves() {
+            let normals = leaf.normal.as_ref().unwrap();
+            for n in leaf.offsets() {
+                let c = voxelkit::grid::offset_coord(leaf.origin, n);
+                let radial = t.index_to_world(c).normalize();
+                let normal = glam::Vec3::from_array(normals[n]).as_dvec3();
+                assert!(
+                    (normal.length() - 1.0).abs() < 1e-6 && normal.dot(radial) > 0.9999,
+                    "{normal} at {c:?} of the grid of voxel size {}",
+                    t.voxel_size
+                );
+            }
         }
     }
 }

@@ -174,7 +174,7 @@ pub(super) fn block_origin(key: &Key, leaf_level: bool) -> [i32; 3] {
 
 /// One grid to write.
 pub(super) struct GridOut<'g> {
-    pub name: &'g str,
+    pub name: std::borrow::Cow<'g, str>,
     pub grid: &'g SparseGrid,
     pub values: GridValues<'g>,
     /// OpenVDB's grid class (`fog volume`), when it has one.

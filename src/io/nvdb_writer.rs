@@ -658,7 +658,7 @@ pub(super) fn write_nvdb_grids(
             .map_err(io_error)?;
         let t = g.grid.transform;
         index.extend(grid_meta(
-            g.name,
+            &g.name,
             &buffer,
             t.voxel_size,
             t.origin.to_array(),

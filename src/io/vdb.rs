@@ -200,8 +200,8 @@ fn candidates<'g>(
     meta: &'g [(String, MetaValue)],
     options: &WriteOptions,
 ) -> Result<Vec<GridOut<'g>>> {
-    let grid_out = |name, grid, values, class, vector_type| GridOut {
-        name,
+    let grid_out = |name: &'g str, grid, values, class, vector_type| GridOut {
+        name: name.into(),
         grid,
         values,
         class,
@@ -243,6 +243,19 @@ fn candidates<'g>(
             for (name, mask) in masks {
                 check_voxel_size(path, mask.transform.voxel_size)?;
                 candidates.push(grid_out(name, mask, GridValues::Bool, None, None));
+                // A mask with normals (an octree level) writes them beside it.
+                if mask.channels().normal {
+                    candidates.push(GridOut {
+                        name: format!("{name}_normal").into(),
+                        ..grid_out(
+                            name,
+                            mask,
+                            GridValues::Normals,
+                            None,
+                            Some(COVARIANT_NORMALIZE),
+                        )
+                    });
+                }
             }
             Ok(candidates)
         }
@@ -306,7 +319,7 @@ fn chosen<'g>(
         .iter()
         .find(|n| !candidates.iter().any(|g| g.name == n.as_str()))
     {
-        let names: Vec<&str> = candidates.iter().map(|g| g.name).collect();
+        let names: Vec<&str> = candidates.iter().map(|g| g.name.as_ref()).collect();
         return Err(vdb_error(
             path,
             format!(
@@ -315,7 +328,7 @@ fn chosen<'g>(
             ),
         ));
     }
-    candidates.retain(|g| options.wants(g.name));
+    candidates.retain(|g| options.wants(&g.name));
     Ok(candidates)
 }
 

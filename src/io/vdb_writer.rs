@@ -98,7 +98,7 @@ pub(super) fn write_grids(
     for g in grids {
         let encoded = clocks.encode.time(|| encode_grid(path, g, encoding))?;
         let mut descriptor = Vec::new();
-        push_string(&mut descriptor, g.name);
+        push_string(&mut descriptor, &g.name);
         let mut tree_type = tree_type_of(g.values);
         if encoding.half && (g.values.value_type() != ValueType::Bool) {
             tree_type.push_str("_HalfFloat");

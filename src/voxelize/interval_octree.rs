@@ -11,7 +11,7 @@
 
 use super::Progress;
 use crate::error::{Error, Result};
-use crate::grid::{Channels, Coord, SparseGrid, Transform};
+use crate::grid::{Channels, Coord, Leaf, SparseGrid, Transform};
 use crate::implicit::{BoxTest, Dual, Formula, Interval, Split, test_box};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -199,7 +199,7 @@ impl Partial {
         };
         let levels = if run.options.levels {
             (0..=run.depth)
-                .map(|l| SparseGrid::new(run.level_transform(l), Channels::NONE))
+                .map(|l| SparseGrid::new(run.level_transform(l), channels))
                 .collect()
         } else {
             Vec::new()
@@ -215,7 +215,7 @@ impl Partial {
     }
 
     fn merge(mut self, other: Partial) -> Partial {
-        self.surface.merge_with(other.surface, |dst, src| {
+        let with_normals = |dst: &mut Leaf, src: &Leaf| {
             let (dn, sn) = (dst.normal.as_mut().unwrap(), src.normal.as_ref().unwrap());
             for n in src.offsets() {
                 dn[n] = sn[n];
@@ -223,9 +223,10 @@ impl Partial {
             for w in 0..8 {
                 dst.mask[w] |= src.mask[w];
             }
-        });
-        for (mine, theirs) in self.levels.iter_mut().zip(&other.levels) {
-            mine.union(theirs);
+        };
+        self.surface.merge_with(other.surface, with_normals);
+        for (mine, theirs) in self.levels.iter_mut().zip(other.levels) {
+            mine.merge_with(theirs, with_normals);
         }
         self.stats.cells_tested += other.stats.cells_tested;
         self.stats.axis_cells += other.stats.axis_cells;
@@ -269,7 +270,7 @@ impl Run<'_> {
     /// The kept children of a kept cell (recording them per level).
     fn children(&self, level: u32, c: Coord, part: &mut Partial) -> Vec<(u32, Coord)> {
         if level == 0 && self.options.levels {
-            part.levels[0].insert(c);
+            self.record(0, c, part);
         }
         let mut kept = Vec::new();
         for k in 0..8 {
@@ -303,17 +304,21 @@ impl Run<'_> {
         };
         if kept {
             if self.options.levels {
-                part.levels[level as usize].insert(c);
+                self.record(level, c, part);
             }
             if level == self.depth {
-                let normal = self.normal(c, &mut part.dual_slots);
-                let mut acc = part.surface.accessor();
-                let (leaf, n) = acc.leaf_mut(c);
-                leaf.set_on(n);
-                leaf.normal.as_mut().expect("surface has normals")[n] = normal;
+                let normal = self.normal(level, c, &mut part.dual_slots);
+                set_with_normal(&mut part.surface, c, normal);
             }
         }
         kept
+    }
+
+    /// Records a kept cell in its level's grid, with the normal at its centre (each voxel of
+    /// every level stores the normal vector, as the paper's octree does).
+    fn record(&self, level: u32, c: Coord, part: &mut Partial) {
+        let normal = self.normal(level, c, &mut part.dual_slots);
+        set_with_normal(&mut part.levels[level as usize], c, normal);
     }
 
     /// Whether some sub-cell of the axis cell with corner `lo` and side `size`, split
@@ -346,12 +351,22 @@ impl Run<'_> {
         }
     }
 
-    /// Unit Cartesian gradient of F at the centre of voxel `c` (zero where undefined).
-    fn normal(&self, c: Coord, slots: &mut Vec<Dual>) -> [f32; 3] {
-        let p = std::array::from_fn(|a| self.min[a] + (c[a] as f64 + 0.5) * self.h);
+    /// Unit Cartesian gradient of F at the centre of cell `c` of `level` (zero where
+    /// undefined).
+    fn normal(&self, level: u32, c: Coord, slots: &mut Vec<Dual>) -> [f32; 3] {
+        let size = self.h * f64::from(1u32 << (self.depth - level));
+        let p = std::array::from_fn(|a| self.min[a] + (c[a] as f64 + 0.5) * size);
         match self.formula.gradient_at(p, slots).try_normalize() {
             Some(n) => n.as_vec3().into(),
             None => [0.0; 3],
         }
     }
+}
+
+/// Turns voxel `c` of `grid` (which has normals) on, with `normal`.
+fn set_with_normal(grid: &mut SparseGrid, c: Coord, normal: [f32; 3]) {
+    let mut acc = grid.accessor();
+    let (leaf, n) = acc.leaf_mut(c);
+    leaf.set_on(n);
+    leaf.normal.as_mut().expect("the grid has normals")[n] = normal;
 }
