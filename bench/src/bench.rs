@@ -60,6 +60,9 @@ enum BenchKind {
     /// Planning's memory estimates against whole runs' peaks, family by family, with the
     /// factor that refits each family's constants.
     Calibrate(crate::calibrate::CalibrateArgs),
+    /// Huang et al.'s Tables 1–3 on the shared meshes: set-up, and for 6- and 26-separation
+    /// voxels, time, voxels per ms and voxels by class, beside the paper's rows.
+    Huang(crate::bench_huang::HuangBenchArgs),
     /// One OpenVDB reference run, in a process of its own (used by `whole`).
     #[command(hide = true)]
     Openvdb(crate::bench_whole::OpenVdbRunArgs),
@@ -124,6 +127,7 @@ pub fn run(args: &BenchArgs, json: bool) -> Result<()> {
         Some(BenchKind::Measure(m)) => return crate::bench_measure::run(m, json),
         Some(BenchKind::Projective(p)) => return crate::bench_projective::run(p, json),
         Some(BenchKind::Whole(w)) => return crate::bench_whole::run(w, json),
+        Some(BenchKind::Huang(h)) => return crate::bench_huang::run(h, json),
         Some(BenchKind::Openvdb(o)) => return crate::bench_whole::run_openvdb(o),
         None => {}
     }

@@ -3,6 +3,7 @@
 //! that the command line stays a thin front end.
 
 mod bench;
+mod bench_huang;
 mod bench_implicit;
 mod bench_measure;
 mod bench_projective;
@@ -24,7 +25,7 @@ use voxelkit::voxelize::separating::Criterion;
              in the same run (`whole`: the whole voxelkit process against OpenVDB; `subdiv`: the \
              Catmull-Clark voxelizer; `implicit`: the interval octree; `solid`: filled solids; \
              `measure`: volume convergence; `projective`: triangles/s; `calibrate`: memory estimates \
-             against peaks)"
+             against peaks; `huang`: the paper's Tables 1-3)"
 )]
 struct Cli {
     /// Print one JSON object instead of the tables.
