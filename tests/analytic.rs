@@ -40,10 +40,11 @@ fn check(surface: &dyn AnalyticSurface, transform: Transform, pad: i64) {
         assert!(report.separates(), "{sep:?}: {report:?}");
         // Every voxel is near the surface: within Rc (the loosest limit) plus the curvature
         // margin (at most 3k/2 voxels) of it.
-        let k = surface.max_curvature() * transform.voxel_size;
-        let limit = (sep.vertex_edge_radius() + 1.5 * k / (1.0 - k)) * transform.voxel_size;
         for c in grid.voxels() {
-            assert!(surface.nearest(transform.index_to_world(c)).distance <= limit + 1e-9);
+            let near = surface.nearest(transform.index_to_world(c), f64::INFINITY);
+            let k = near.curvature * transform.voxel_size;
+            let limit = (sep.vertex_edge_radius() + 1.5 * k / (1.0 - k)) * transform.voxel_size;
+            assert!(near.distance <= limit + 1e-9);
         }
         // Normals are unit vectors.
         for leaf in grid.leaves() {

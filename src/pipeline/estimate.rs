@@ -10,7 +10,7 @@
 //! its box.
 
 use super::load::Work;
-use super::{BrickStage, BrickTask, Fill, Plan, ShapeTask, SurfaceMethod};
+use super::{BrickStage, BrickTask, Fill, Plan, Shape, ShapeTask, SurfaceMethod};
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, MAX_DENSE_VOXELS, SparseGrid, TILE_BYTES, Transform};
 use crate::implicit::Formula;
@@ -547,8 +547,14 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
             let bbox = shape.surface().bbox();
             let t = fit_transform(&bbox, fit)?;
             let b = checked_box(&bbox, &t)?;
-            let area = shape.area() / (t.voxel_size * t.voxel_size);
-            let bytes = surface_leaf_bytes(surface_leaves(area), u32::from(*normals))
+            let leaves = match shape {
+                Shape::Formula(f) => {
+                    let resolution = ((bbox.max - bbox.min).max_element() / t.voxel_size).ceil();
+                    implicit_leaves(f.formula(), bbox.min, bbox.max, resolution as u32, false)?
+                }
+                _ => surface_leaves(shape.area() / (t.voxel_size * t.voxel_size)),
+            };
+            let bytes = surface_leaf_bytes(leaves, u32::from(*normals))
                 + cells(&b) / 512.0 * SHAPE_BLOCK_BYTES;
             plan_of(t, &bbox, bytes, (cells(&b) / 512.0).ceil() as u64)
         }

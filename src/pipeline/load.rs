@@ -152,7 +152,7 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
                 mesh,
             }
         }
-        Task::Shape(s) => Work::Shape(*s),
+        Task::Shape(s) => Work::Shape(s.clone()),
         Task::Subdivision {
             mesh,
             options,

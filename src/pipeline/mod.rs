@@ -36,6 +36,7 @@ use crate::voxelize::parametric::ParametricOptions;
 use crate::voxelize::projective::{Coloring, LineSource};
 use crate::voxelize::separating::SeparatingOptions;
 use crate::voxelize::separating_analytic::AnalyticSurface;
+use crate::voxelize::separating_formula::FormulaSurface;
 use glam::{DVec3, Vec3};
 use load::Work;
 use std::path::{Path, PathBuf};
@@ -73,11 +74,13 @@ pub enum SurfaceMethod {
 }
 
 /// An analytic surface of Huang et al. §7.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub enum Shape {
     Sphere(Sphere),
     Cylinder(Cylinder),
     Quadric(Quadric),
+    /// F = 0 of a formula, its nearest points found numerically.
+    Formula(FormulaSurface),
 }
 
 /// How a mesh's solid is found.
@@ -195,7 +198,7 @@ pub enum Task {
 }
 
 /// An analytic surface and how it is voxelized.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct ShapeTask {
     pub shape: Shape,
     pub separability: Separability,
@@ -360,6 +363,7 @@ impl Shape {
             Shape::Sphere(s) => s,
             Shape::Cylinder(c) => c,
             Shape::Quadric(q) => q,
+            Shape::Formula(f) => f,
         }
     }
 
@@ -369,6 +373,8 @@ impl Shape {
             Shape::Sphere(s) => s.area(),
             Shape::Cylinder(c) => c.area(),
             Shape::Quadric(q) => q.area(),
+            // Planned from the formula's octree instead (`estimate`).
+            Shape::Formula(_) => 0.0,
         }
     }
 
@@ -385,6 +391,7 @@ impl Shape {
                 k = q.k,
                 e = q.half_extent
             ),
+            Shape::Formula(f) => format!("{} = 0", f.formula().text),
         }
     }
 }

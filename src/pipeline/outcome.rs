@@ -5,7 +5,7 @@ use super::report::{
     Details, ImplicitDetails, ProjectiveDetails, Report, SeparatingClasses, SeparationCheckDetails,
     SubdivisionDetails, TagSummary,
 };
-use super::{ShapeTask, SurfaceMethod, on_threads};
+use super::{Shape, ShapeTask, SurfaceMethod, on_threads};
 use crate::contour::ExactSurface;
 use crate::error::{Error, Result};
 use crate::grid::{Channels, CoordBox, Leaf, SparseGrid, Transform};
@@ -32,7 +32,8 @@ use crate::voxelize::interval_octree::{OctreeOptions, voxelize_implicit};
 use crate::voxelize::parametric::{ParametricOptions, voxelize_subdivision};
 use crate::voxelize::projective::{self, Coloring, LineSource};
 use crate::voxelize::separating::{Criterion, SeparatingOptions, voxelize_mesh};
-use crate::voxelize::separating_analytic::voxelize_surface;
+use crate::voxelize::separating_analytic::{scan_region, voxelize_surface};
+use crate::voxelize::step_certificate::close_unproven_steps;
 use glam::DVec3;
 use std::path::Path;
 use std::time::Instant;
@@ -567,7 +568,7 @@ pub(super) fn shape(
         curvature_margin,
     } = task;
     let start = Instant::now();
-    let grid = voxelize_surface(
+    let mut grid = voxelize_surface(
         shape.surface(),
         t,
         separability,
@@ -575,6 +576,19 @@ pub(super) fn shape(
         curvature_margin,
         progress,
     )?;
+    let certificate_voxels = match shape {
+        Shape::Formula(f) => {
+            let region = scan_region(f, &t);
+            Some(close_unproven_steps(
+                f,
+                &mut grid,
+                region,
+                separability,
+                progress,
+            )?)
+        }
+        _ => None,
+    };
     let name = shape.describe();
     let sep = separability.adjacency();
     let method = if curvature_margin {
@@ -584,10 +598,14 @@ pub(super) fn shape(
     };
     let mut meta = provenance(method, &name, fit);
     meta.insert(1, ("separability", sep.into()));
+    if let Some(added) = certificate_voxels {
+        meta.push(("certificate_voxels", added.into()));
+    }
     let details = Details::Shape {
         shape: name,
         separability: sep,
         curvature_margin,
+        certificate_voxels,
     };
     Ok(Outcome::new(grid, meta, details).timed(start))
 }

@@ -84,6 +84,10 @@ pub enum Details {
         /// Whether the slabs carry the margin for curvature that the separation proof needs on
         /// curved surfaces (off: the paper's plain slabs, which can leave holes).
         curvature_margin: bool,
+        /// Formulas: voxels added where interval arithmetic could not prove a step between two
+        /// centres left out free of the surface (`step_certificate`).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        certificate_voxels: Option<u64>,
     },
     Subdivision(SubdivisionDetails),
     Implicit(ImplicitDetails),
@@ -392,17 +396,27 @@ impl Report {
                 shape,
                 separability,
                 curvature_margin,
+                certificate_voxels,
             } => format!(
                 "{place}: {shape}: {} voxels in {} leaves, {}, voxel size {:.6}, {timing}",
                 self.voxels,
                 self.leaves,
-                if *curvature_margin {
-                    format!("{separability}-separating")
-                } else {
-                    format!(
+                match (curvature_margin, certificate_voxels) {
+                    (_, Some(added)) => format!(
+                        "{separability}-separating (every step between two centres left out \
+                         proven free of the surface by interval arithmetic; {added} voxel(s) \
+                         added where it could not be{})",
+                        if *curvature_margin {
+                            ""
+                        } else {
+                            ", the paper's plain slabs"
+                        }
+                    ),
+                    (true, None) => format!("{separability}-separating"),
+                    (false, None) => format!(
                         "the paper's plain {separability}-separating slabs without the curvature \
                          margin (separation not guaranteed on a curved surface)"
-                    )
+                    ),
                 },
                 self.voxel_size
             ),

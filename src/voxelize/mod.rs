@@ -7,9 +7,11 @@ pub mod parametric;
 pub mod projective;
 pub mod separating;
 pub mod separating_analytic;
+pub mod separating_formula;
 mod separating_kernel;
 pub mod sign_change;
 mod sink;
+pub mod step_certificate;
 
 pub use crate::progress::Progress;
 

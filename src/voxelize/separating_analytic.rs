@@ -3,7 +3,7 @@
 //! surface point (`t6`/`t26` as for polygons), or within `Rc` of a sharp edge (the rim of
 //! a capped cylinder), exactly as edges are treated for meshes.
 //!
-//! Distances are exact: closed form for the sphere and the capped cylinder, and for
+//! Distances are exact for the closed-form shapes: for the sphere and the capped cylinder, and for
 //! `x^2 + k y + k z = 0` the cubic the Lagrange condition gives (the paper's "analytical
 //! solution"), solved by Cardano's formula and polished by a Newton step.
 //!
@@ -18,15 +18,19 @@
 //! Slabs are half-open as for polygons (`separating.rs`): `-t <= d < t` for the signed
 //! distance along the normal turned to a positive largest component.
 //!
-//! The scan visits 8^3 blocks of the shape's box and skips a block when the distance at its
-//! centre exceeds the block's radius plus `Rc`: the distance is 1-Lipschitz, so no voxel
-//! is lost by the culling.
+//! The scan visits 8^3 blocks of the shape's box and skips those the surface cannot come
+//! within reach of (`AnalyticSurface::may_come_within`: the distance at the block's centre,
+//! which is 1-Lipschitz, for the closed-form shapes; interval arithmetic for formulas, see
+//! `separating_formula`), so no voxel is lost by the culling.
+//!
+//! Formulas (`separating_formula`) give the nearest point numerically, with the curvature
+//! there; the same rule then applies voxel by voxel.
 
 use super::Progress;
 use super::Separability;
 use super::separating_kernel::{slab_bounds, turned};
 use super::sink::{nearest_channels, voxelize_parallel};
-use crate::grid::{SparseGrid, Transform};
+use crate::grid::{CoordBox, SparseGrid, Transform};
 use crate::mesh::Aabb;
 use crate::shapes::{Cylinder, Quadric, Sphere};
 use glam::DVec3;
@@ -38,39 +42,47 @@ pub struct Nearest {
     pub distance: f64,
     /// Unit normal of the surface at the nearest point.
     pub normal: DVec3,
-    /// The nearest point lies on a sharp edge (use `Rc`, not `t`).
+    /// The nearest point lies on a sharp edge (use `Rc`, not `t`); also a lower bound of the
+    /// distance where no nearest point is known (`Rc` holds for any surface).
     pub on_edge: bool,
+    /// The largest principal curvature the rule allows for around the nearest point (1 / world
+    /// length): the surface's largest anywhere for the closed-form shapes.
+    pub curvature: f64,
 }
 
 /// A surface with an exact point-to-surface distance.
 pub trait AnalyticSurface: Sync {
     /// World-space region to voxelize (the surface is clipped to it).
     fn bbox(&self) -> Aabb;
-    fn nearest(&self, p: DVec3) -> Nearest;
+    /// The nearest point of the surface to `p` where it lies within `reach` (world units);
+    /// beyond, a distance of at least `reach` may be all that is known.
+    fn nearest(&self, p: DVec3, reach: f64) -> Nearest;
     /// Negative on one side of the surface, positive on the other (used to check separation).
     fn side(&self, p: DVec3) -> f64;
-    /// The largest principal curvature anywhere on the surface (1 / world length).
-    fn max_curvature(&self) -> f64;
+    /// Whether the surface may come within `reach` of the box `[lo, hi]` (world units): false
+    /// only where it certainly does not. By the distance at the box's centre, 1-Lipschitz.
+    fn may_come_within(&self, lo: DVec3, hi: DVec3, reach: f64) -> bool {
+        let radius = 0.5 * (hi - lo).length();
+        self.nearest(0.5 * (lo + hi), radius + reach).distance <= radius + reach
+    }
 }
 
 impl AnalyticSurface for Sphere {
     fn bbox(&self) -> Aabb {
         self.bounds()
     }
-    fn nearest(&self, p: DVec3) -> Nearest {
+    fn nearest(&self, p: DVec3, _reach: f64) -> Nearest {
         let d = p - self.center;
         let len = d.length();
         Nearest {
             distance: (len - self.radius).abs(),
             normal: if len > 0.0 { d / len } else { DVec3::Z },
             on_edge: false,
+            curvature: 1.0 / self.radius,
         }
     }
     fn side(&self, p: DVec3) -> f64 {
         (p - self.center).length() - self.radius
-    }
-    fn max_curvature(&self) -> f64 {
-        1.0 / self.radius
     }
 }
 
@@ -92,7 +104,7 @@ impl AnalyticSurface for Cylinder {
     fn bbox(&self) -> Aabb {
         self.bounds()
     }
-    fn nearest(&self, p: DVec3) -> Nearest {
+    fn nearest(&self, p: DVec3, _reach: f64) -> Nearest {
         let (h, rho, dir) = cylinder_local(self, p);
         let half = 0.5 * self.height;
         let (dr, dh) = (rho - self.radius, h.abs() - half);
@@ -115,14 +127,12 @@ impl AnalyticSurface for Cylinder {
             distance,
             normal,
             on_edge,
+            curvature: 1.0 / self.radius,
         }
     }
     fn side(&self, p: DVec3) -> f64 {
         let (h, rho, _) = cylinder_local(self, p);
         (rho - self.radius).max(h.abs() - 0.5 * self.height)
-    }
-    fn max_curvature(&self) -> f64 {
-        1.0 / self.radius
     }
 }
 
@@ -150,7 +160,7 @@ impl AnalyticSurface for Quadric {
     fn bbox(&self) -> Aabb {
         self.bounds()
     }
-    fn nearest(&self, p: DVec3) -> Nearest {
+    fn nearest(&self, p: DVec3, _reach: f64) -> Nearest {
         // In the plane spanned by x and s = (y+z)/sqrt2 the surface is s = -a x^2; it is
         // constant along (y-z)/sqrt2.
         let r2 = std::f64::consts::SQRT_2;
@@ -176,14 +186,44 @@ impl AnalyticSurface for Quadric {
             distance: dist2(best).sqrt(),
             normal: n,
             on_edge: false,
+            // s = -a x^2 curves most at its vertex: 2a, with a = 1 / (k sqrt 2).
+            curvature: 2.0 / (self.k.abs() * r2),
         }
     }
     fn side(&self, p: DVec3) -> f64 {
         p.x * p.x + self.k * (p.y + p.z)
     }
-    fn max_curvature(&self) -> f64 {
-        // s = -a x^2 curves most at its vertex: 2a, with a = 1 / (k sqrt 2).
-        2.0 / (self.k.abs() * std::f64::consts::SQRT_2)
+}
+
+/// The curvature margin for a surface of largest principal curvature `k` (in voxel units,
+/// taken at most 1/2) under `separability`: `t` grows by `k'/2` (6) or `3k'/2` (26).
+fn curvature_margin(k: f64, separability: Separability) -> f64 {
+    let k = k.min(0.5);
+    let turn = k / (1.0 - k);
+    match separability {
+        Separability::Six => 0.5 * turn,
+        Separability::TwentySix => 1.5 * turn,
+    }
+}
+
+/// The farthest from the surface (voxels) a voxel can be kept: `Rc`, or `t` plus the
+/// largest margin, whichever is wider.
+pub fn keep_reach(separability: Separability, curvature_margin: bool) -> f64 {
+    let widest = if curvature_margin {
+        self::curvature_margin(0.5, separability)
+    } else {
+        0.0
+    };
+    separability.vertex_edge_radius() + widest
+}
+
+/// The voxels scanned for `surface`: its box and one voxel around, as far as its voxels
+/// reach (Rc < 1 voxel).
+pub fn scan_region(surface: &dyn AnalyticSurface, transform: &Transform) -> CoordBox {
+    let bbox = surface.bbox();
+    CoordBox {
+        min: transform.world_to_voxel(bbox.min).map(|v| v - 1),
+        max: transform.world_to_voxel(bbox.max).map(|v| v + 1),
     }
 }
 
@@ -199,42 +239,40 @@ pub fn voxelize_surface(
     curvature_margin: bool,
     progress: &Progress,
 ) -> crate::Result<SparseGrid> {
-    let bbox = surface.bbox();
-    // The surface's voxels reach up to Rc < 1 voxel beyond its box.
-    let lo = transform.world_to_voxel(bbox.min).map(|v| v - 1);
-    let hi = transform.world_to_voxel(bbox.max).map(|v| v + 1);
+    let CoordBox { min: lo, max: hi } = scan_region(surface, &transform);
     let blocks = blocks_of(lo, hi);
     let h = transform.voxel_size;
     let rc = separability.vertex_edge_radius();
-    let block_radius = 3.5 * 3f64.sqrt();
-    let k = (surface.max_curvature() * h).min(0.5);
-    let turn = k / (1.0 - k);
-    let curvature_margin = match (curvature_margin, separability) {
-        (false, _) => 0.0,
-        (true, Separability::Six) => 0.5 * turn,
-        (true, Separability::TwentySix) => 1.5 * turn,
-    };
+    let reach = (keep_reach(separability, curvature_margin) + 1e-6) * h;
     let grid = voxelize_parallel(
         &blocks,
         transform,
         nearest_channels(normals),
         progress,
         |&origin, sink| {
-            let centre = transform.index_to_world(origin) + DVec3::splat(3.5 * h);
-            if surface.nearest(centre).distance / h > block_radius + rc + curvature_margin + 1e-6 {
+            let (first, last) = (
+                transform.index_to_world(origin),
+                transform.index_to_world(origin.map(|v| v + 7)),
+            );
+            if !surface.may_come_within(first, last, reach) {
                 return;
             }
             for x in origin[0].max(lo[0])..(origin[0] + 8).min(hi[0] + 1) {
                 for y in origin[1].max(lo[1])..(origin[1] + 8).min(hi[1] + 1) {
                     for z in origin[2].max(lo[2])..(origin[2] + 8).min(hi[2] + 1) {
                         let p = transform.index_to_world([x, y, z]);
-                        let near = surface.nearest(p);
+                        let near = surface.nearest(p, reach);
                         let d = near.distance / h;
                         let kept = if near.on_edge {
                             d <= rc + 1e-9
                         } else {
+                            let margin = if curvature_margin {
+                                self::curvature_margin(near.curvature * h, separability)
+                            } else {
+                                0.0
+                            };
                             let t = separability.slab_half_thickness(near.normal);
-                            let (lo, hi) = slab_bounds(t + curvature_margin);
+                            let (lo, hi) = slab_bounds(t + margin);
                             // Normals point to where `side` is positive; the slab is
                             // half-open along the turned normal, as for polygons. The side
                             // is only asked for voxels the closed slab holds.
@@ -257,7 +295,7 @@ pub fn voxelize_surface(
 }
 
 /// Origins of the 8^3 blocks covering `lo..=hi`.
-fn blocks_of(lo: [i64; 3], hi: [i64; 3]) -> Vec<[i64; 3]> {
+pub(super) fn blocks_of(lo: [i64; 3], hi: [i64; 3]) -> Vec<[i64; 3]> {
     let mut blocks = Vec::new();
     for x in (lo[0] & !7..=hi[0]).step_by(8) {
         for y in (lo[1] & !7..=hi[1]).step_by(8) {
@@ -287,7 +325,7 @@ mod tests {
             (40.0, 40.0, -10.0),
         ] {
             let p = DVec3::new(x, y, z);
-            let got = q.nearest(p).distance;
+            let got = q.nearest(p, f64::INFINITY).distance;
             // Brute force over the parabola in the (x, s) plane.
             let (x0, s0) = (x, (y + z) / r2);
             let a = 1.0 / (10.0 * r2);
@@ -309,9 +347,9 @@ mod tests {
             radius: 2.0,
             height: 4.0,
         };
-        assert!((c.nearest(DVec3::new(3.0, 0.0, 0.0)).distance - 1.0).abs() < 1e-12);
-        assert!((c.nearest(DVec3::new(0.5, 0.0, 1.5)).distance - 0.5).abs() < 1e-12);
-        let rim = c.nearest(DVec3::new(3.0, 0.0, 3.0));
+        assert!((c.nearest(DVec3::new(3.0, 0.0, 0.0), 1.0).distance - 1.0).abs() < 1e-12);
+        assert!((c.nearest(DVec3::new(0.5, 0.0, 1.5), 1.0).distance - 0.5).abs() < 1e-12);
+        let rim = c.nearest(DVec3::new(3.0, 0.0, 3.0), 1.0);
         assert!(rim.on_edge && (rim.distance - 2f64.sqrt()).abs() < 1e-12);
     }
 }

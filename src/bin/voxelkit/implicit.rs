@@ -47,8 +47,9 @@ pub const EXAMPLES: [(&str, Coordinates, &str, &str); 5] = [
     ),
 ];
 
-#[derive(Args)]
-pub struct ImplicitArgs {
+/// A formula and the variables it is written in: what `implicit` and `shape formula` take.
+#[derive(Args, Clone)]
+pub struct FormulaArgs {
     /// The formula F; the surface is F = 0. Variables: x y z (cartesian), r theta phi
     /// (spherical: theta in the XZ plane from +X, phi from the XZ plane), r theta y
     /// (cylindrical). Operators + - * / ^ (integer powers), functions sqrt abs sin cos tan
@@ -66,6 +67,38 @@ pub struct ImplicitArgs {
     /// (r theta y).
     #[arg(long, default_value_t = ImplicitRequest::default().coords, value_parser = parse_coords)]
     coords: Coordinates,
+    /// Spherical and cylindrical: the values theta takes, `positive` (the paper's
+    /// [0, 2pi), cut along +x) or `symmetric` ((-pi, pi], cut along -x).
+    #[arg(long, default_value_t = ImplicitRequest::default().theta_range, value_parser = parse_theta_range)]
+    pub theta_range: ThetaRange,
+}
+
+impl FormulaArgs {
+    /// The formula's text and coordinates: as typed, or the named example's.
+    pub fn text_and_coordinates(&self) -> Result<(String, Coordinates)> {
+        match &self.example {
+            Some(name) => {
+                let (_, c, f, _) = EXAMPLES.iter().find(|e| e.0 == name).ok_or_else(|| {
+                    let names: Vec<&str> = EXAMPLES.iter().map(|e| e.0).collect();
+                    Error::InvalidArgument(format!(
+                        "no example `{name}`; there are {}",
+                        names.join(", ")
+                    ))
+                })?;
+                Ok((f.to_string(), *c))
+            }
+            None => Ok((
+                self.formula.clone().expect("clap requires a formula"),
+                self.coords,
+            )),
+        }
+    }
+}
+
+#[derive(Args)]
+pub struct ImplicitArgs {
+    #[command(flatten)]
+    formula: FormulaArgs,
     /// The box searched: `lo,hi` (a cube) or `x0,y0,z0,x1,y1,z1`.
     #[arg(long, default_value_t = ImplicitRequest::default().bounds, value_parser = parse_bounds, allow_hyphen_values = true, value_name = "LO,HI")]
     bounds: Bounds,
@@ -80,10 +113,6 @@ pub struct ImplicitArgs {
     /// F(-r, theta + pi, -phi) = 0 (cylindrical: F(-r, theta + pi, y) = 0).
     #[arg(long)]
     negative_r: bool,
-    /// Spherical and cylindrical: the values theta takes, `positive` (the paper's
-    /// [0, 2pi), cut along +x) or `symmetric` ((-pi, pi], cut along -x).
-    #[arg(long, default_value_t = ImplicitRequest::default().theta_range, value_parser = parse_theta_range)]
-    theta_range: ThetaRange,
     /// For F = G - r: Stolte & Kaufman's substitution [G]^2 - r^2 = 0, the surface r = |G|
     /// (lobes where G < 0 included) instead of r = G as typed.
     #[arg(long)]
@@ -110,22 +139,7 @@ pub fn parse_bounds(s: &str) -> std::result::Result<Bounds, String> {
 }
 
 pub fn run(args: &ImplicitArgs, global: &Global) -> Result<()> {
-    let (text, coordinates) = match &args.example {
-        Some(name) => {
-            let (_, c, f, _) = EXAMPLES.iter().find(|e| e.0 == name).ok_or_else(|| {
-                let names: Vec<&str> = EXAMPLES.iter().map(|e| e.0).collect();
-                Error::InvalidArgument(format!(
-                    "no example `{name}`; there are {}",
-                    names.join(", ")
-                ))
-            })?;
-            (f.to_string(), *c)
-        }
-        None => (
-            args.formula.clone().expect("clap requires a formula"),
-            args.coords,
-        ),
-    };
+    let (text, coordinates) = args.formula.text_and_coordinates()?;
     let (min, max) = args.bounds.corners();
     let task = Task::Implicit {
         formula: text,
@@ -134,7 +148,7 @@ pub fn run(args: &ImplicitArgs, global: &Global) -> Result<()> {
         max,
         levels: args.levels,
         negative_r: args.negative_r,
-        theta_range: args.theta_range,
+        theta_range: args.formula.theta_range,
         squared: args.squared,
     };
     let job = Job::new(task, GridFit::Resolution(args.resolution));

@@ -111,7 +111,7 @@ pub struct FitArgs {
     /// mesh's box]: --resolution counts voxels along its longest side and voxels whose
     /// centres lie outside it are left out.
     #[arg(long, value_parser = implicit::parse_bounds, allow_hyphen_values = true, value_name = "LO,HI")]
-    bounds: Option<voxelkit::pipeline::request::Bounds>,
+    pub bounds: Option<voxelkit::pipeline::request::Bounds>,
 }
 
 #[derive(Args, Clone, Copy)]
