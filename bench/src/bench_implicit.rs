@@ -2,11 +2,13 @@
 //! growing resolutions, as the paper computes it (θ in [0, 2π), the substitution
 //! [G]² - r² = 0, so every lobe of the surface), with the time ratio per doubling (the paper: close to 4, not 8) — and
 //! the naive reference in the same process: F at every voxel corner, voxels with a sign change.
+//! Then the paper's Fig. 7 parts (the gear, the crank) at 512^3 beside its times.
 
 use crate::bench::best_of;
 use crate::json::Json;
 use clap::Args;
 use glam::DVec3;
+use voxelkit::implicit::examples::example;
 use voxelkit::implicit::{Coordinates, Formula};
 use voxelkit::voxelize::interval_octree::{OctreeOptions, voxelize_implicit};
 use voxelkit::voxelize::sign_change::voxelize_sign_change;
@@ -33,6 +35,12 @@ pub struct ImplicitBenchArgs {
     /// Runs per measurement; the fastest is reported.
     #[arg(long, default_value_t = 1)]
     repeat: usize,
+    /// Named examples timed as the paper's Fig. 7 (none: skip them).
+    #[arg(long, value_delimiter = ',', default_value = "gear,crankshaft")]
+    examples: Vec<String>,
+    /// The resolution of the Fig. 7 rows (the paper's: 512).
+    #[arg(long, default_value_t = 512)]
+    example_resolution: u32,
 }
 
 fn parse_nm(s: &str) -> Result<(u32, u32)> {
@@ -152,8 +160,71 @@ pub fn run(args: &ImplicitBenchArgs, json: bool) -> Result<()> {
             }
         }
     }
+    let examples = figure_seven(args, &pool, json)?;
     if json {
-        println!("{}", Json::default().arr("runs", rows).render());
+        println!(
+            "{}",
+            Json::default()
+                .arr("runs", rows)
+                .arr("examples", examples)
+                .render()
+        );
     }
     Ok(())
+}
+
+/// The paper's Fig. 7 parts by interval octree (with normals, as the paper times them), one
+/// row each, beside the paper's seconds.
+fn figure_seven(
+    args: &ImplicitBenchArgs,
+    pool: &rayon::ThreadPool,
+    json: bool,
+) -> Result<Vec<Json>> {
+    let mut rows = Vec::new();
+    let res = args.example_resolution;
+    if !json && !args.examples.is_empty() {
+        println!(
+            "\nThe paper's Fig. 7 at {res}^3, {} thread(s)\n{:<12} {:>10} {:>10} {:>12} {:>14}",
+            args.threads, "example", "octree s", "voxels", "cells", "paper's s"
+        );
+    }
+    for name in args.examples.iter().filter(|n| !n.is_empty()) {
+        let e = example(name)?;
+        let formula = Formula::parse(e.formula, e.coordinates)?;
+        let options = OctreeOptions {
+            resolution: res,
+            ..Default::default()
+        };
+        let (seconds, out) = pool.install(|| {
+            best_of(args.repeat, || {
+                voxelize_implicit(
+                    &formula,
+                    DVec3::splat(-1.0),
+                    DVec3::ONE,
+                    &options,
+                    &voxelkit::progress::Progress::none(),
+                )
+            })
+        })?;
+        let paper = e
+            .paper_seconds_at_512
+            .filter(|_| res == 512)
+            .map_or("-".to_string(), |s| format!("{s}"));
+        if json {
+            rows.push(
+                Json::default()
+                    .str("example", e.name)
+                    .int("resolution", res as u64)
+                    .num("octree_seconds", seconds)
+                    .int("voxels", out.stats.voxels)
+                    .int("cells_tested", out.stats.cells_tested),
+            );
+        } else {
+            println!(
+                "{:<12} {seconds:>10.3} {:>10} {:>12} {paper:>14}",
+                e.name, out.stats.voxels, out.stats.cells_tested
+            );
+        }
+    }
+    Ok(rows)
 }

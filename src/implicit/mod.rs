@@ -4,6 +4,7 @@
 
 mod coordinates;
 mod dual;
+pub mod examples;
 pub mod formula_solid;
 mod interval;
 mod parse;

@@ -3,49 +3,12 @@
 use crate::run::{Global, run_and_report};
 use clap::Args;
 use std::path::PathBuf;
+use voxelkit::Result;
+use voxelkit::implicit::examples::example;
 use voxelkit::implicit::{Coordinates, ThetaRange};
 use voxelkit::mesh::GridFit;
 use voxelkit::pipeline::request::{Bounds, ImplicitRequest};
 use voxelkit::pipeline::{Job, Task};
-use voxelkit::{Error, Result};
-
-/// Named examples: (name, coordinates, formula, what it is).
-pub const EXAMPLES: [(&str, Coordinates, &str, &str); 5] = [
-    (
-        "sphere",
-        Coordinates::Cartesian,
-        "x^2 + y^2 + z^2 - 0.8^2",
-        "sphere of radius 0.8",
-    ),
-    (
-        "torus",
-        Coordinates::Cartesian,
-        "(sqrt(x^2 + z^2) - 0.6)^2 + y^2 - 0.25^2",
-        "torus around the y axis, radii 0.6 and 0.25",
-    ),
-    (
-        "sinsin",
-        Coordinates::Spherical,
-        "sin(3*theta)*sin(4*phi) - r",
-        "the paper's Fig. 6(a)",
-    ),
-    (
-        "gear",
-        Coordinates::Cylindrical,
-        "teeth = r - (0.8 + 0.05*sin(32*theta)); hole = 0.25 - r; slab = abs(y) - 0.15; \
-         max(max(teeth, hole), slab)",
-        "32-tooth gear with a bore: the paper's gear contour cut by a cylinder and two planes",
-    ),
-    (
-        "crankshaft",
-        Coordinates::Cartesian,
-        "shaft = max(sqrt(x^2 + z^2) - 0.12, abs(y) - 0.95); \
-         web = max(max(abs(x - 0.2) - 0.32, abs(abs(y) - 0.25) - 0.06), abs(z) - 0.18); \
-         pin = max(sqrt((x - 0.4)^2 + z^2) - 0.1, abs(y) - 0.31); \
-         min(min(shaft, web), pin)",
-        "crankshaft-like part: shaft, two webs and a crank pin (CSG by min/max)",
-    ),
-];
 
 /// A formula and the variables it is written in: what `implicit` and `shape formula` take.
 #[derive(Args, Clone)]
@@ -78,14 +41,8 @@ impl FormulaArgs {
     pub fn text_and_coordinates(&self) -> Result<(String, Coordinates)> {
         match &self.example {
             Some(name) => {
-                let (_, c, f, _) = EXAMPLES.iter().find(|e| e.0 == name).ok_or_else(|| {
-                    let names: Vec<&str> = EXAMPLES.iter().map(|e| e.0).collect();
-                    Error::InvalidArgument(format!(
-                        "no example `{name}`; there are {}",
-                        names.join(", ")
-                    ))
-                })?;
-                Ok((f.to_string(), *c))
+                let e = example(name)?;
+                Ok((e.formula.to_string(), e.coordinates))
             }
             None => Ok((
                 self.formula.clone().expect("clap requires a formula"),
