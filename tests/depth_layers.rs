@@ -6,7 +6,7 @@
 mod common;
 
 use glam::DVec3;
-use voxelkit::grid::{DenseMask, SparseGrid, Transform};
+use voxelkit::grid::{CoordBox, DenseMask, SparseGrid, Transform};
 use voxelkit::mesh::inside::inside_centres;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate, index_box};
 use voxelkit::solids::depth_layers::{
@@ -26,17 +26,25 @@ fn solid_by(
     layers: Layers,
     unclassified: Unclassified,
 ) -> DepthLayerSolid {
-    let bbox = index_box(&mesh.bbox(), t);
     let options = DepthLayerOptions {
         directions: DirectionSet::first(directions).unwrap(),
         layers,
         unclassified,
     };
+    solid_in(mesh, t, index_box(&mesh.bbox(), t), &options)
+}
+
+fn solid_in(
+    mesh: &Mesh,
+    t: &Transform,
+    bbox: CoordBox,
+    options: &DepthLayerOptions,
+) -> DepthLayerSolid {
     depth_layer_solid(
         mesh,
         t,
         bbox,
-        &options,
+        options,
         &voxelkit::progress::Progress::none(),
     )
     .unwrap()
@@ -323,14 +331,7 @@ fn user_directions_classify_exactly_and_bad_ones_are_refused() {
                 layers,
                 ..Default::default()
             };
-            let s = depth_layer_solid(
-                &mesh,
-                &t,
-                bbox,
-                &options,
-                &voxelkit::progress::Progress::none(),
-            )
-            .unwrap();
+            let s = solid_in(&mesh, &t, bbox, &options);
             assert_eq!(s.stats.per_direction.len(), list.len());
             let (wrong, unclassified) = disagreement(&mesh, &t, &s);
             eprintln!("{list:?} {layers:?}: {wrong} wrong, {unclassified} unclassified");
@@ -351,5 +352,66 @@ fn user_directions_classify_exactly_and_bad_ones_are_refused() {
     ] {
         let e = DirectionSet::given(&bad).unwrap_err().to_string();
         assert!(e.contains(why), "{bad:?}: {e}");
+    }
+}
+
+/// One tie rule (`mesh::crossings`): an L-shaped prism whose faces all lie on planes of voxel
+/// centres (and, shifted half a voxel, none does). Single layers, double layers (along the
+/// axes, and along all sixteen directions) and ray parity agree on every voxel, surface
+/// voxels included, and on the exact count: a centre is inside where the point just off it,
+/// `c + (e, e^2, e^3)`, is, so each cube of 8^3 voxels holds 512 centres however it is placed.
+#[test]
+fn single_layers_double_layers_and_parity_share_one_tie_rule() {
+    let cells = [
+        [0, 0, 0],
+        [1, 0, 0],
+        [2, 0, 0],
+        [0, 0, 1],
+        [0, 1, 0],
+        [1, 1, 0],
+        [2, 1, 0],
+        [0, 1, 1],
+    ];
+    let mesh = generate::polycube("L-prism", &cells, 8.0);
+    for offset in [0.0, 0.5] {
+        let t = Transform::new(DVec3::splat(offset), 1.0);
+        let bbox = voxelkit::ops::flood::padded(index_box(&mesh.bbox(), &t), 2);
+        let run = |layers: Layers, directions: DirectionSet| {
+            let options = DepthLayerOptions {
+                directions,
+                layers,
+                unclassified: Unclassified::NoDirection,
+            };
+            let s = solid_in(&mesh, &t, bbox, &options);
+            assert_eq!(s.stats.unclassified_voxels, 0, "{layers:?} at {offset}");
+            s.inside
+        };
+        let axes = DirectionSet::first(3).unwrap();
+        let parity = inside_centres(&mesh, &t, bbox).unwrap();
+        let expected = cells.len() as u64 * 512;
+        assert_eq!(parity.count(), expected, "parity at offset {offset}");
+        for (name, inside) in [
+            ("single layers, axes", run(Layers::Single, axes)),
+            (
+                "single layers, 16 directions",
+                run(Layers::Single, DirectionSet::ALL),
+            ),
+            ("double layers, axes", run(Layers::Double, axes)),
+            (
+                "double layers, 16 directions",
+                run(Layers::Double, DirectionSet::ALL),
+            ),
+        ] {
+            let differing = (0..inside.len())
+                .filter(|&i| inside.get_index(i) != parity.get_index(i))
+                .count();
+            assert_eq!(
+                differing,
+                0,
+                "{name} at offset {offset}: {} inside, parity {}",
+                inside.count(),
+                parity.count()
+            );
+        }
     }
 }

@@ -1,8 +1,9 @@
 //! Which voxel centres lie inside a closed mesh, by ray parity along z: every column of
 //! centres `(i, j)` casts one ray along +z (exact crossings, see `crossings`), and a centre is
-//! inside when it lies between crossings 2m and 2m+1 (sorted).
+//! inside when it lies between crossings 2m and 2m+1 (sorted); a centre on a crossing lies on
+//! the side the shared tie rule puts it (`crossings`), as depth layers put it.
 
-use super::crossings::{RayWindow, for_each_crossing};
+use super::crossings::{RayFrame, RayWindow, for_each_crossing};
 use crate::error::Result;
 use crate::grid::{CoordBox, DenseMask, Transform};
 use crate::mesh::Mesh;
@@ -14,7 +15,8 @@ use rayon::prelude::*;
 #[derive(Clone, Copy, Debug)]
 pub struct Crossing {
     key: usize,
-    pub z: f64,
+    /// The first centre above the crossing (the tie rule decides a centre on it).
+    pub after: i64,
 }
 
 impl Crossing {
@@ -40,6 +42,9 @@ pub struct ColumnCrossings {
     /// a row, the last the row's length): a column's crossings without a search.
     column_starts: Vec<u32>,
 }
+
+/// The rays of the columns: along +z, `(a, b, t) = (x, y, z)`.
+const Z_RAYS: RayFrame = RayFrame::Z;
 
 /// Triangles per parallel batch of crossings.
 const TRIANGLE_BATCH: usize = 4096;
@@ -73,16 +78,16 @@ impl ColumnCrossings {
             .par_chunks(TRIANGLE_BATCH)
             .flat_map_iter(|batch| {
                 let mut found = Vec::new();
-                for_each_crossing(&pos, batch.iter().copied(), &window, |ray, z, rising| {
+                for_each_crossing(&pos, batch.iter().copied(), &Z_RAYS, &window, |c| {
                     found.push(Crossing {
-                        key: ray << 1 | rising as usize,
-                        z,
+                        key: c.ray << 1 | c.rising as usize,
+                        after: c.after,
                     })
                 });
                 found
             })
             .collect();
-        crossings.par_sort_unstable_by(|a, b| a.ray().cmp(&b.ray()).then(a.z.total_cmp(&b.z)));
+        crossings.par_sort_unstable_by_key(|c| (c.ray(), c.after));
         let mut row_starts = vec![0usize; nx + 1];
         for c in &crossings {
             row_starts[c.ray() / ny + 1] += 1;
@@ -137,7 +142,7 @@ impl ColumnCrossings {
     pub fn spans(&self, x: i64, y: i64) -> impl Iterator<Item = (i64, i64)> + '_ {
         self.columns_of(x, y..=y)
             .chunks_exact(2)
-            .map(|pair| (pair[0].z.ceil() as i64, pair[1].z.floor() as i64))
+            .map(|pair| (pair[0].after, pair[1].after - 1))
     }
 
     /// The spans of inside centres of the `count` columns `(x, y0 + i)`, as `span(i, first z,
@@ -157,7 +162,7 @@ impl ColumnCrossings {
         {
             let i = (column[0].ray() - first) + (ys - y0) as usize;
             for pair in column.chunks_exact(2) {
-                span(i, pair[0].z.ceil() as i64, pair[1].z.floor() as i64);
+                span(i, pair[0].after, pair[1].after - 1);
             }
         }
     }
@@ -173,8 +178,8 @@ impl ColumnCrossings {
                     (
                         self.window.a0 + x as i64,
                         self.window.b0 + y as i64,
-                        pair[0].z.ceil() as i64,
-                        pair[1].z.floor() as i64,
+                        pair[0].after,
+                        pair[1].after - 1,
                     )
                 })
             })

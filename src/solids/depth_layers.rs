@@ -21,13 +21,16 @@
 //!
 //! The directions are integer vectors with a component of ±1: with `k` that component and
 //! `i, j` the others, `(a, b, t) = (p_i - t d_i, p_j - t d_j, p_k d_k)` is a unimodular change
-//! of lattice coordinates, so the rays `(a, b) = const` through voxel centres are exactly the
-//! lattice rays the crossing rasterizer walks, and voxel centres sit at integer `t`.
+//! of lattice coordinates (`RayFrame`), so the rays `(a, b) = const` through voxel centres are
+//! exactly the lattice rays the crossing rasterizer walks, and voxel centres sit at integer
+//! `t`. A centre exactly on the surface (a face on a plane of centres, a ray through an edge)
+//! is decided by the tie rule every direction and ray parity share (`mesh::crossings`): single
+//! layers, double layers and parity agree on it.
 
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, Transform};
 use crate::mesh::Mesh;
-use crate::mesh::crossings::{RayWindow, for_each_crossing};
+use crate::mesh::crossings::{RayFrame, RayWindow, for_each_crossing};
 use crate::progress::Progress;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -244,18 +247,14 @@ pub struct DepthLayerSolid {
 }
 
 /// One direction's depth buffers: the stencil count and the two nearest crossings from
-/// either end of every ray.
+/// either end of every ray, each kept as the first centre beyond it (`RayCrossing::after`).
 struct View {
-    d: [i64; 3],
-    /// The ±1 component of `d` and the other two axes.
-    k: usize,
-    i: usize,
-    j: usize,
+    frame: RayFrame,
     window: RayWindow,
     count: Vec<u16>,
-    /// Per ray: the two smallest and the two largest `t`.
-    near: Vec<[f32; 2]>,
-    far: Vec<[f32; 2]>,
+    /// Per ray: the two smallest and the two largest crossings.
+    near: Vec<[i32; 2]>,
+    far: Vec<[i32; 2]>,
 }
 
 /// What one direction says of one voxel.
@@ -270,43 +269,17 @@ enum Verdict {
 }
 
 impl View {
-    fn frame(d: [i64; 3]) -> (usize, usize, usize) {
-        let k = (0..3)
-            .rev()
-            .find(|&a| d[a].abs() == 1)
-            .expect("a ±1 component");
-        let (i, j) = match k {
-            0 => (1, 2),
-            1 => (0, 2),
-            _ => (0, 1),
-        };
-        (k, i, j)
-    }
-
-    /// `(a, b, t)` of a point given relative to the volume's first voxel.
-    #[inline]
-    fn to_ray(&self, p: DVec3) -> DVec3 {
-        let t = p[self.k] * self.d[self.k] as f64;
-        DVec3::new(
-            p[self.i] - t * self.d[self.i] as f64,
-            p[self.j] - t * self.d[self.j] as f64,
-            t,
-        )
-    }
-
     /// Ray number and `t` of the voxel at `p` (relative to the volume's first voxel).
     #[inline]
     fn voxel_ray(&self, p: [i64; 3]) -> (usize, i64) {
-        let t = p[self.k] * self.d[self.k];
-        let a = p[self.i] - t * self.d[self.i];
-        let b = p[self.j] - t * self.d[self.j];
+        let ([a, b], t) = self.frame.lattice_ray(p);
         (self.window.ray(a, b), t)
     }
 
     /// Renders the mesh (`points` relative to the first voxel, in index units) into the
     /// buffers of direction `d` over a volume of `dims` voxels.
     fn render(d: [i64; 3], dims: [usize; 3], points: &[DVec3], mesh: &Mesh) -> Result<View> {
-        let (k, i, j) = View::frame(d);
+        let frame = RayFrame::along(d);
         // The window: the (a, b) range of the volume's corners.
         let (mut lo, mut hi) = ([i64::MAX; 2], [i64::MIN; 2]);
         for corner in 0..8 {
@@ -317,8 +290,7 @@ impl View {
                     0
                 }
             });
-            let t = p[k] * d[k];
-            let ab = [p[i] - t * d[i], p[j] - t * d[j]];
+            let (ab, _) = frame.lattice_ray(p);
             for c in 0..2 {
                 lo[c] = lo[c].min(ab[c]);
                 hi[c] = hi[c].max(ab[c]);
@@ -340,23 +312,24 @@ impl View {
             });
         }
         let mut view = View {
-            d,
-            k,
-            i,
-            j,
+            frame,
             window,
             count: vec![0; rays],
-            near: vec![[f32::INFINITY; 2]; rays],
-            far: vec![[f32::NEG_INFINITY; 2]; rays],
+            near: vec![[i32::MAX; 2]; rays],
+            far: vec![[i32::MIN; 2]; rays],
         };
-        let ray_points: Vec<DVec3> = points.iter().map(|&p| view.to_ray(p)).collect();
+        let ray_points: Vec<DVec3> = points.iter().map(|&p| frame.to_ray(p)).collect();
         let (count, near, far) = (&mut view.count, &mut view.near, &mut view.far);
         for_each_crossing(
             &ray_points,
             mesh.triangles().map(|(_, t)| t),
+            &frame,
             &view.window,
-            |ray, t, _| {
-                let t = t as f32;
+            |c| {
+                let (ray, t) = (
+                    c.ray,
+                    c.after.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
+                );
                 count[ray] = count[ray].saturating_add(1);
                 let n = &mut near[ray];
                 if t < n[0] {
@@ -377,7 +350,7 @@ impl View {
 
     fn counts(&self) -> RayCounts {
         let mut c = RayCounts {
-            direction: self.d,
+            direction: self.frame.d,
             rays: self.count.len() as u64,
             ..Default::default()
         };
@@ -393,13 +366,14 @@ impl View {
         c
     }
 
-    /// The inside stretches of `ray` in `t` (closed intervals), when its count decides.
-    fn inside_spans(&self, ray: usize) -> std::result::Result<[[f32; 2]; 2], Verdict> {
-        let (n, f) = (self.near[ray], self.far[ray]);
+    /// The inside stretches of `ray` in `t` (centres `first ..= last`), when its count
+    /// decides.
+    fn inside_spans(&self, ray: usize) -> std::result::Result<[[i64; 2]; 2], Verdict> {
+        let (n, f) = (self.near[ray].map(i64::from), self.far[ray].map(i64::from));
         match self.count[ray] {
-            0 => Ok([[1.0, 0.0]; 2]),
-            // With two crossings near = [t1, t2] and far = [t2, t1]: both spans are [t1, t2].
-            2 | 4 => Ok([n, [f[1], f[0]]]),
+            0 => Ok([[1, 0]; 2]),
+            // With two crossings near = [t1, t2] and far = [t2, t1]: both spans are t1..t2.
+            2 | 4 => Ok([[n[0], n[1] - 1], [f[1], f[0] - 1]]),
             c if c % 2 == 1 => Err(Verdict::Open),
             _ => Err(Verdict::Undecided),
         }
@@ -410,7 +384,6 @@ impl View {
         let (ray, t) = self.voxel_ray(p);
         match self.inside_spans(ray) {
             Ok(spans) => {
-                let t = t as f32;
                 if spans.iter().any(|s| s[0] <= t && t <= s[1]) {
                     Verdict::Inside
                 } else {
@@ -425,8 +398,7 @@ impl View {
     #[inline]
     fn single(&self, p: [i64; 3]) -> bool {
         let (ray, t) = self.voxel_ray(p);
-        let t = t as f32;
-        self.count[ray] > 0 && self.near[ray][0] <= t && t <= self.far[ray][0]
+        self.count[ray] > 0 && i64::from(self.near[ray][0]) <= t && t < i64::from(self.far[ray][0])
     }
 }
 
@@ -523,12 +495,12 @@ pub fn depth_layer_solid(
                 if options.layers == Layers::Double
                     && !open_input
                     && options.unclassified == Unclassified::NoDirection
-                    && z_view.d == [0, 0, 1]
+                    && z_view.frame.d == [0, 0, 1]
                     && let Ok(spans) = z_view.inside_spans(ray)
                 {
                     for s in spans {
-                        let z0 = (s[0].ceil() as i64).max(0);
-                        let z1 = (s[1].floor() as i64).min(nz as i64 - 1);
+                        let z0 = s[0].max(0);
+                        let z1 = s[1].min(nz as i64 - 1);
                         if z0 <= z1 {
                             ins.push((row + z0 as usize, row + z1 as usize));
                         }

@@ -375,15 +375,15 @@ struct BlockColumn {
     ambiguous: Vec<Leaf>,
 }
 
-/// The stretches of one column between crossings: centres `first ..= last` (rounded inward;
-/// a centre on a crossing lies in both stretches) and the integer winding there.
+/// The stretches of one column between crossings: centres `first ..= last` (a centre on a
+/// crossing lies on the side the tie rule puts it) and the integer winding there.
 fn stretches(crossings: &[Crossing], orientation: i32) -> Vec<(i64, i64, i32)> {
     let mut out = Vec::with_capacity(crossings.len() + 1);
     let mut below = i64::MIN;
     let mut k = 0;
     for c in crossings {
-        out.push((below, c.z.floor() as i64, k * orientation));
-        below = c.z.ceil() as i64;
+        out.push((below, c.after - 1, k * orientation));
+        below = c.after;
         // Going up through a surface that faces down enters it.
         k -= c.direction();
     }
@@ -434,13 +434,10 @@ impl Context<'_> {
                 }
                 for (&(bz, _), block) in special.iter().zip(&mut windings) {
                     for z in bz.max(r.min[2])..=(bz + 7).min(r.max[2]) {
-                        // A centre on a crossing takes the larger winding of its two sides.
                         block[lx * 64 + ly * 8 + (z - bz) as usize] = stretches
                             .iter()
-                            .filter(|s| s.0 <= z && z <= s.1)
-                            .map(|s| s.2)
-                            .max()
-                            .unwrap_or(0);
+                            .find(|s| s.0 <= z && z <= s.1)
+                            .map_or(0, |s| s.2);
                     }
                 }
             }
