@@ -287,10 +287,11 @@ fn the_up_axis_turns_the_control_mesh() {
 }
 
 /// Lai & Cheng §7.3: intersection curves from the common voxels of surfaces on one grid
-/// (`subdiv A B --shared-grid`, then `intersect`). catmark_torus's tube crosses catmark_cube's
-/// limit surface in two loops. The enclosed surfaces (every voxel the limit surface touches)
-/// give whole curves, one 26-component per loop (also at 256: 2 components of 1,960 voxels);
-/// the paper's adjacency test alone leaves gaps (12 pieces at 128, 20 at 256).
+/// (`subdiv A B --shared-grid`, then `intersect`). The enclosed surfaces (every voxel the limit
+/// surface touches) give whole curves: one 26-component per loop of the intersection of fine
+/// tessellations of the two limit surfaces (catmark_torus's tube crosses catmark_cube's limit
+/// surface in two loops, and catmark_toroidal_tet's in two as well); the paper's adjacency test alone
+/// leaves gaps (torus and cube: 12 pieces at 128, 20 at 256).
 #[test]
 fn catmull_clark_surfaces_on_one_grid_meet_in_whole_curves() {
     let Some(data) = common::data_dir() else {
@@ -299,13 +300,13 @@ fn catmull_clark_surfaces_on_one_grid_meet_in_whole_curves() {
     use voxelkit::grid::{Adjacency, DenseMask};
     use voxelkit::io::vdb::read_vdb_grid;
     let dir = tempfile::tempdir().unwrap();
-    let subd = |name: &str| data.join(format!("subd/{name}.obj")).display().to_string();
-    let components = |extra: &[&str]| {
-        let out = dir.path().join(format!("grids{}", extra.len()));
+    let subd = |name: &str| data.join(format!("subd/{name}.obj"));
+    let components = |a: &str, b: &str, extra: &[&str]| {
+        let out = dir.path().join(format!("{a}-{b}-{}", extra.len()));
         let mut args = vec![
             "subdiv".to_string(),
-            subd("catmark_torus"),
-            subd("catmark_cube"),
+            subd(a).display().to_string(),
+            subd(b).display().to_string(),
             "--shared-grid".into(),
             "-r".into(),
             "128".into(),
@@ -319,8 +320,8 @@ fn catmull_clark_surfaces_on_one_grid_meet_in_whole_curves() {
         let curve = out.join("curve.vdb");
         let o = voxelkit(&[
             "intersect",
-            out.join("catmark_torus.vdb").to_str().unwrap(),
-            out.join("catmark_cube.vdb").to_str().unwrap(),
+            out.join(format!("{a}.vdb")).to_str().unwrap(),
+            out.join(format!("{b}.vdb")).to_str().unwrap(),
             "-o",
             curve.to_str().unwrap(),
         ]);
@@ -332,12 +333,110 @@ fn catmull_clark_surfaces_on_one_grid_meet_in_whole_curves() {
             voxelkit::ops::topology::components(&mask, Adjacency::TwentySix),
         )
     };
-    let (voxels, pieces) = components(&["--enclose"]);
-    let (default_voxels, default_pieces) = components(&[]);
-    eprintln!(
-        "enclosed: {voxels} voxels in {pieces} pieces; default: {default_voxels} voxels in \
-         {default_pieces} pieces"
-    );
-    assert_eq!(pieces, 2, "{voxels} voxels");
-    assert!(default_pieces > pieces && default_voxels < voxels);
+    let tessellation = |name: &str| {
+        let control = voxelkit::subd::ControlMesh::load(&subd(name)).unwrap();
+        voxelkit::subd::LimitSurface::new(control).tessellate(|_| 24)
+    };
+    for (a, b) in [
+        ("catmark_torus", "catmark_cube"),
+        ("catmark_torus", "catmark_toroidal_tet"),
+    ] {
+        let loops = intersection_loops(&tessellation(a), &tessellation(b));
+        let (voxels, pieces) = components(a, b, &["--enclose"]);
+        eprintln!("{a} x {b}: {loops} loops; enclosed: {voxels} voxels in {pieces} pieces");
+        assert!(loops >= 2);
+        assert_eq!(pieces, loops as u64, "{a} x {b}: {voxels} voxels");
+    }
+    let (default_voxels, default_pieces) = components("catmark_torus", "catmark_cube", &[]);
+    eprintln!("torus x cube, default: {default_voxels} voxels in {default_pieces} pieces");
+    assert!(default_pieces > 2);
+}
+
+/// The number of closed loops in which two triangle meshes meet: the segments of every pair
+/// of crossing triangles, joined where they share an end. An end is where an edge of one mesh
+/// pierces a triangle of the other, named by that edge and triangle, so the segments of
+/// neighbouring pairs join exactly (meshes in general position).
+fn intersection_loops(a: &voxelkit::mesh::Mesh, b: &voxelkit::mesh::Mesh) -> usize {
+    use glam::DVec3;
+    use std::collections::HashMap;
+    type End = (u8, u32, u32, usize);
+    let tris =
+        |m: &voxelkit::mesh::Mesh| -> Vec<[u32; 3]> { m.triangles().map(|(_, t)| t).collect() };
+    let (ta, tb) = (tris(a), tris(b));
+    // Triangles of b by the cells of a coarse lattice their boxes meet.
+    let cell = 0.05;
+    let key = |p: DVec3| (p / cell).floor().as_i64vec3().to_array();
+    let mut cells: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    for (n, t) in tb.iter().enumerate() {
+        let p = t.map(|i| b.positions[i as usize]);
+        let (lo, hi) = (key(p[0].min(p[1]).min(p[2])), key(p[0].max(p[1]).max(p[2])));
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    cells.entry([x, y, z]).or_default().push(n);
+                }
+            }
+        }
+    }
+    let mut parent: HashMap<End, End> = HashMap::new();
+    fn root(parent: &mut HashMap<End, End>, e: End) -> End {
+        let p = *parent.entry(e).or_insert(e);
+        if p == e {
+            return e;
+        }
+        let r = root(parent, p);
+        parent.insert(e, r);
+        r
+    }
+    for (na, &t) in ta.iter().enumerate() {
+        let p = t.map(|i| a.positions[i as usize]);
+        let (lo, hi) = (key(p[0].min(p[1]).min(p[2])), key(p[0].max(p[1]).max(p[2])));
+        let mut candidates = Vec::new();
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    candidates.extend(cells.get(&[x, y, z]).into_iter().flatten().copied());
+                }
+            }
+        }
+        candidates.sort_unstable();
+        candidates.dedup();
+        for nb in candidates {
+            let s = tb[nb];
+            let q = s.map(|i| b.positions[i as usize]);
+            // The points where edges of one triangle pierce the other, named by edge and
+            // triangle.
+            let mut ends: Vec<End> = Vec::new();
+            for (side, (edges_of, verts, over, tri)) in
+                [(t, p, q, nb), (s, q, p, na)].into_iter().enumerate()
+            {
+                let n = (over[1] - over[0]).cross(over[2] - over[0]);
+                for k in 0..3 {
+                    let (u, v) = (verts[k], verts[(k + 1) % 3]);
+                    let (du, dv) = (n.dot(u - over[0]), n.dot(v - over[0]));
+                    if du * dv >= 0.0 {
+                        continue;
+                    }
+                    let x = u + (v - u) * (du / (du - dv));
+                    let inside = (0..3).all(|m| {
+                        let (o0, o1) = (over[m], over[(m + 1) % 3]);
+                        (o1 - o0).cross(x - o0).dot(n) >= 0.0
+                    });
+                    if inside {
+                        let (i, j) = (edges_of[k], edges_of[(k + 1) % 3]);
+                        ends.push((side as u8, i.min(j), i.max(j), tri));
+                    }
+                }
+            }
+            if ends.len() == 2 {
+                let (r0, r1) = (root(&mut parent, ends[0]), root(&mut parent, ends[1]));
+                parent.insert(r0, r1);
+            }
+        }
+    }
+    let keys: Vec<End> = parent.keys().copied().collect();
+    let mut roots: Vec<End> = keys.into_iter().map(|e| root(&mut parent, e)).collect();
+    roots.sort_unstable();
+    roots.dedup();
+    roots.len()
 }
