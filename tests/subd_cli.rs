@@ -290,8 +290,8 @@ fn the_up_axis_turns_the_control_mesh() {
 /// (`subdiv A B --shared-grid`, then `intersect`). The enclosed surfaces (every voxel the limit
 /// surface touches) give whole curves: one 26-component per loop of the intersection of fine
 /// tessellations of the two limit surfaces (catmark_torus's tube crosses catmark_cube's limit
-/// surface in two loops, and catmark_toroidal_tet's in two as well); the paper's adjacency test alone
-/// leaves gaps (torus and cube: 12 pieces at 128, 20 at 256).
+/// surface in two loops, and catmark_toroidal_tet's in two as well); the paper's adjacency
+/// test alone leaves gaps (torus and cube: 12 pieces at 128, 20 at 256).
 #[test]
 fn catmull_clark_surfaces_on_one_grid_meet_in_whole_curves() {
     let Some(data) = common::data_dir() else {
