@@ -88,7 +88,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
             Task::Subdivision {
                 mesh: MeshSource::File(cube.to_path_buf()),
                 options: ParametricOptions::default(),
-                solid: None,
+                output: voxelkit::pipeline::SubdivisionOutput::Surface,
             },
         ),
         ("subdivision solid", subdivision_solid(cube)),
@@ -152,7 +152,7 @@ fn subdivision_solid(cube: &Path) -> Task {
     Task::Subdivision {
         mesh: MeshSource::File(cube.to_path_buf()),
         options: ParametricOptions::default(),
-        solid: Some(voxelkit::pipeline::SubdivisionFill {
+        output: voxelkit::pipeline::SubdivisionOutput::Solid(voxelkit::pipeline::SubdivisionFill {
             graystack: 1 << 10,
             density: 1.0,
             topology: true,

@@ -7,7 +7,7 @@ use std::path::Path;
 mod cli_support;
 mod common;
 
-use cli_support::{text, voxelkit};
+use cli_support::{json_field, text, voxelkit};
 use voxelkit::io::vdb::read_vdb_info;
 use voxelkit::subd::{ControlMesh, LimitSurface};
 
@@ -439,4 +439,36 @@ fn intersection_loops(a: &voxelkit::mesh::Mesh, b: &voxelkit::mesh::Mesh) -> usi
     roots.sort_unstable();
     roots.dedup();
     roots.len()
+}
+
+/// `check --subdiv`: a Catmull-Clark limit surface's voxels checked by flooding against a fine
+/// tessellation, as `check` checks a mesh's: the paper's surface blocks 6-paths, the enclosed
+/// one 26-paths; an open control mesh is refused, naming its boundary.
+#[test]
+fn check_floods_catmull_clark_surfaces() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    let spot = data.join("subd/spot_control_mesh.obj");
+    for (extra, separability) in [(None, 6.0), (Some("--enclose"), 26.0)] {
+        let mut args = vec![
+            "--json",
+            "check",
+            "--subdiv",
+            spot.to_str().unwrap(),
+            "-r",
+            "96",
+        ];
+        args.extend(extra);
+        let o = voxelkit(&args);
+        assert!(o.status.success(), "{}", text(&o));
+        let out = String::from_utf8_lossy(&o.stdout).to_string();
+        assert_eq!(json_field(&out, "separability"), separability, "{out}");
+        assert_eq!(json_field(&out, "leaked"), 0.0, "{out}");
+        assert!(json_field(&out, "inside_centres") > 10_000.0, "{out}");
+    }
+    let pawn = data.join("subd/catmark_pawn.obj");
+    let o = voxelkit(&["check", "--subdiv", pawn.to_str().unwrap(), "-r", "64"]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("24 boundary edge(s)"), "{}", text(&o));
 }

@@ -10,7 +10,9 @@
 //! its box.
 
 use super::load::Work;
-use super::{BrickStage, BrickTask, Fill, Plan, Shape, ShapeTask, SurfaceMethod};
+use super::{
+    BrickStage, BrickTask, Fill, Plan, Shape, ShapeTask, SubdivisionOutput, SurfaceMethod,
+};
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, MAX_DENSE_VOXELS, SparseGrid, TILE_BYTES, Transform};
 use crate::implicit::Formula;
@@ -558,15 +560,25 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
                 + cells(&b) / 512.0 * SHAPE_BLOCK_BYTES;
             plan_of(t, &bbox, bytes, (cells(&b) / 512.0).ceil() as u64)
         }
-        Work::Subdivision { control, solid, .. } => {
+        Work::Subdivision {
+            control, output, ..
+        } => {
             let bbox = control.bbox();
             let t = fit_transform(&bbox, fit)?;
             checked_box(&bbox, &t)?;
+            let leaves = surface_leaves(area_in_voxels(&control.polygon_mesh(), &t));
             let bytes = patch_bytes(control, &t)
-                + if solid.is_some() {
-                    subdivision_solid_bytes(control, &t)
-                } else {
-                    surface_leaves(area_in_voxels(&control.polygon_mesh(), &t)) * SUBDIV_LEAF_BYTES
+                + match output {
+                    SubdivisionOutput::Solid(_) => subdivision_solid_bytes(control, &t),
+                    SubdivisionOutput::Surface => leaves * SUBDIV_LEAF_BYTES,
+                    // The tessellation (two triangles a quad) and the flood's volumes.
+                    SubdivisionOutput::SeparationCheck => {
+                        let segments = super::outcome::check_segments(control, &t) as f64;
+                        let b = checked_box(&bbox, &t)?;
+                        leaves * (SUBDIV_LEAF_BYTES + CHECK_LEAF_BYTES)
+                            + 2.0 * control.patch_count() as f64 * segments.powi(2) * TRIANGLE_BYTES
+                            + CHECK_VOLUMES * cells(&padded(b, 3)) / 8.0
+                    }
                 };
             plan_of(t, &bbox, bytes, control.patch_count() as u64)
         }

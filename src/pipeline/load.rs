@@ -4,7 +4,7 @@
 
 use super::{
     BrickStage, BrickTask, CsgSource, Fill, GridSource, MeasureSource, MeshSource, ShapeTask,
-    SubdivisionFill, SurfaceMethod, Task, lines_source,
+    SubdivisionOutput, SurfaceMethod, Task, lines_source,
 };
 use crate::error::{Error, Result};
 use crate::grid::SparseGrid;
@@ -42,7 +42,7 @@ pub(super) enum Work {
     Subdivision {
         control: ControlMesh,
         options: ParametricOptions,
-        solid: Option<SubdivisionFill>,
+        output: SubdivisionOutput,
     },
     Implicit {
         formula: Formula,
@@ -156,7 +156,7 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
         Task::Subdivision {
             mesh,
             options,
-            solid,
+            output,
         } => Work::Subdivision {
             control: match mesh {
                 MeshSource::File(path) => {
@@ -167,7 +167,7 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
                 MeshSource::Mesh(m) => ControlMesh::from_mesh(m)?,
             },
             options: *options,
-            solid: *solid,
+            output: *output,
         },
         Task::Implicit {
             formula,

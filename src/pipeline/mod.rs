@@ -137,12 +137,12 @@ pub enum Task {
         color: ColorChoice,
     },
     Shape(ShapeTask),
-    /// A Catmull-Clark limit surface from its control mesh; with `solid`, the solid it
-    /// bounds (seeds from the limit normals, FloodingXYZ from them).
+    /// A Catmull-Clark limit surface from its control mesh, the solid it bounds (seeds from
+    /// the limit normals, FloodingXYZ from them) or the surface's separation checked.
     Subdivision {
         mesh: MeshSource,
         options: ParametricOptions,
-        solid: Option<SubdivisionFill>,
+        output: SubdivisionOutput,
     },
     /// F = 0 inside `[min, max]`, by interval octree.
     Implicit {
@@ -234,8 +234,21 @@ pub enum BrickStage {
     Winding { mesh: Mesh },
 }
 
+/// What a Catmull-Clark run makes of its limit surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SubdivisionOutput {
+    /// The surface's voxels.
+    Surface,
+    /// The solid the closed surface bounds.
+    Solid(SubdivisionFill),
+    /// The surface's voxels, checked by flooding against a tessellation far finer than a
+    /// voxel (6-paths for the paper's surface, 26-paths for the enclosed one) with the share
+    /// of simple voxels, as `check` does for meshes.
+    SeparationCheck,
+}
+
 /// How a Catmull-Clark solid is filled and weighed.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SubdivisionFill {
     /// GRAYSTACK capacity for FloodingXYZ (entries).
     pub graystack: usize,
@@ -625,12 +638,17 @@ impl PlannedJob {
             Work::Subdivision {
                 control,
                 options,
-                solid: None,
+                output: SubdivisionOutput::Surface,
             } => outcome::subdivision(control, t, options, fit, progress),
             Work::Subdivision {
                 control,
                 options,
-                solid: Some(fill),
+                output: SubdivisionOutput::SeparationCheck,
+            } => outcome::subdivision_check(control, t, options, fit, progress),
+            Work::Subdivision {
+                control,
+                options,
+                output: SubdivisionOutput::Solid(fill),
             } => solid::subdivision_solid(control, t, options, *fill, fit, progress),
             Work::Implicit {
                 formula,

@@ -8,7 +8,7 @@ use super::report::{
 use super::{Shape, ShapeTask, SurfaceMethod, on_threads};
 use crate::contour::ExactSurface;
 use crate::error::{Error, Result};
-use crate::grid::{Channels, CoordBox, Leaf, SparseGrid, Transform};
+use crate::grid::{Adjacency, Channels, CoordBox, Leaf, SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::implicit::formula_solid::FormulaSolid;
 use crate::io::atomic::check_output;
@@ -27,7 +27,7 @@ use crate::ops::minimality::simple_voxel_count;
 use crate::ops::separability::check_mesh_separation;
 use crate::progress::{Progress, StageTime};
 use crate::shapes::Cuboid;
-use crate::subd::ControlMesh;
+use crate::subd::{ControlMesh, LimitSurface};
 use crate::voxelize::interval_octree::{OctreeOptions, voxelize_implicit};
 use crate::voxelize::parametric::{ParametricOptions, voxelize_subdivision};
 use crate::voxelize::projective::{self, Coloring, LineSource};
@@ -510,6 +510,10 @@ pub(super) fn mesh_surface(
     }
 }
 
+/// Why a separation check refuses an open surface.
+const CHECK_NEEDS_CLOSED: &str = "a separation check needs a closed surface: it tells inside \
+     from outside by ray parity";
+
 pub(super) fn separation_check(
     mesh: &Mesh,
     t: Transform,
@@ -517,12 +521,25 @@ pub(super) fn separation_check(
     fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
+    mesh.require_closed(CHECK_NEEDS_CLOSED)?;
     let mut outcome = mesh_surface(mesh, t, SurfaceMethod::Separating(options), fit, progress)?;
     let adjacency = options.separability.flood_adjacency();
+    check_against(&mut outcome, mesh, adjacency, fit)?;
+    Ok(outcome)
+}
+
+/// Floods `outcome`'s surface against the closed `mesh` (`adjacency`-connected) and counts its
+/// simple voxels, into the report.
+fn check_against(
+    outcome: &mut Outcome,
+    mesh: &Mesh,
+    adjacency: Adjacency,
+    fit: GridFit,
+) -> Result<()> {
     let found = check_mesh_separation(&outcome.grid, mesh, adjacency)?;
     let simple = simple_voxel_count(&outcome.grid, adjacency)?;
     outcome.report.details = Details::SeparationCheck(SeparationCheckDetails {
-        separability: options.separability.adjacency(),
+        separability: adjacency.number(),
         inside_centres: found.inside_centres,
         exterior_voxels: found.exterior,
         leaked: found.leaked,
@@ -531,7 +548,7 @@ pub(super) fn separation_check(
         simple_share: simple as f64 / outcome.grid.voxel_count().max(1) as f64,
         resolution: fit.describe(),
     });
-    Ok(outcome)
+    Ok(())
 }
 
 pub(super) fn lines(
@@ -650,6 +667,42 @@ pub(super) fn subdivision(
             .with("opposite_normals", out.opposite)
             .timed(start),
     )
+}
+
+/// The limit surface's voxels, checked as `separation_check` checks a mesh's: the exterior
+/// flood against a tessellation far finer than a voxel (inside by its ray parity), 6-connected
+/// for the paper's surface (what §5 proves), 26-connected for the enclosed one.
+pub(super) fn subdivision_check(
+    control: &ControlMesh,
+    t: Transform,
+    options: &ParametricOptions,
+    fit: GridFit,
+    progress: &Progress,
+) -> Result<Outcome> {
+    control.polygon_mesh().require_closed(CHECK_NEEDS_CLOSED)?;
+    let mut outcome = subdivision(control, t, options, fit, progress)?;
+    let segments = check_segments(control, &t);
+    let polygons = LimitSurface::new(control.clone()).tessellate(|_| segments);
+    let adjacency = if options.enclose {
+        Adjacency::TwentySix
+    } else {
+        Adjacency::Six
+    };
+    check_against(&mut outcome, &polygons, adjacency, fit)?;
+    Ok(outcome)
+}
+
+/// Tessellation segments per voxel of a patch's side (a patch spans extent / sqrt(patches)
+/// voxels), and the most per patch side: the polygons stay far finer than a voxel.
+const TESSELLATION_PER_VOXEL: f64 = 4.0;
+const MOST_TESSELLATION_SEGMENTS: f64 = 32.0;
+
+/// The segments per patch side of the tessellation `subdivision_check` floods against.
+pub(super) fn check_segments(control: &ControlMesh, t: &Transform) -> usize {
+    let extent = (control.bbox().max - control.bbox().min).max_element() / t.voxel_size;
+    (TESSELLATION_PER_VOXEL * extent / (control.patch_count() as f64).sqrt())
+        .ceil()
+        .clamp(2.0, MOST_TESSELLATION_SEGMENTS) as usize
 }
 
 pub(super) fn implicit(

@@ -9,7 +9,7 @@
 
 use super::{
     ColorChoice, Fill, GridSource, Job, Limits, MeasureSource, MeshSource, SubdivisionFill,
-    SurfaceMethod, Task,
+    SubdivisionOutput, SurfaceMethod, Task,
 };
 use crate::choice::Choice;
 use crate::error::{Error, Result};
@@ -821,11 +821,15 @@ impl Request for SubdivRequest {
         Ok(Task::Subdivision {
             mesh,
             options: self.options()?,
-            solid: self.solid.then_some(SubdivisionFill {
-                graystack: self.graystack.max(1),
-                density: self.density,
-                topology: self.topology,
-            }),
+            output: if self.solid {
+                SubdivisionOutput::Solid(SubdivisionFill {
+                    graystack: self.graystack.max(1),
+                    density: self.density,
+                    topology: self.topology,
+                })
+            } else {
+                SubdivisionOutput::Surface
+            },
         })
     }
 }

@@ -15,9 +15,12 @@ use voxelkit::mesh::{GridFit, generate};
 use voxelkit::ops::separability::check_mesh_separation;
 use voxelkit::pipeline::request::ImplicitRequest;
 use voxelkit::pipeline::request::{Bounds, MeshRequest, Request, SurfaceKind};
-use voxelkit::pipeline::{Details, Job, MeshSource, Shape, ShapeTask, SurfaceMethod, Task};
+use voxelkit::pipeline::{
+    Details, Job, MeshSource, Shape, ShapeTask, SubdivisionOutput, SurfaceMethod, Task,
+};
 use voxelkit::shapes::{Cylinder, Quadric, Sphere};
 use voxelkit::voxelize::Separability;
+use voxelkit::voxelize::parametric::ParametricOptions;
 use voxelkit::voxelize::separating::{Criterion, SeparatingOptions};
 use voxelkit::voxelize::separating_formula::FormulaSurface;
 use voxelkit::{Error, Result};
@@ -433,10 +436,26 @@ pub fn info(file: &Path, global: &Global) -> Result<()> {
     Ok(())
 }
 
-pub fn check(input: &Path, fit: FitArgs, surface: SurfaceArgs, global: &Global) -> Result<()> {
-    let task = Task::SeparationCheck {
-        mesh: MeshSource::File(input.to_path_buf()),
-        options: surface.separating(),
+/// Checks the separation of a mesh's surface, or with `subdiv` of a Catmull-Clark limit
+/// surface's voxels, and fails when the surface leaks.
+pub fn check(
+    input: &Path,
+    fit: FitArgs,
+    surface: SurfaceArgs,
+    subdiv: Option<ParametricOptions>,
+    global: &Global,
+) -> Result<()> {
+    let mesh = MeshSource::File(input.to_path_buf());
+    let task = match subdiv {
+        Some(options) => Task::Subdivision {
+            mesh,
+            options,
+            output: SubdivisionOutput::SeparationCheck,
+        },
+        None => Task::SeparationCheck {
+            mesh,
+            options: surface.separating(),
+        },
     };
     let outcome = run_job(Job::new(task, fit.grid_fit()?), None, global)?;
     let report = &outcome.report;

@@ -7,7 +7,7 @@ use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
 use voxelkit::grid::Adjacency;
 use voxelkit::pipeline::request::SubdivRequest;
-use voxelkit::pipeline::{SubdivisionFill, Task};
+use voxelkit::pipeline::{SubdivisionFill, SubdivisionOutput, Task};
 use voxelkit::subd::{ControlMesh, LimitSurface, compare_points, limit_area, read_points};
 use voxelkit::voxelize::parametric::ParametricOptions;
 use voxelkit::{Error, Result};
@@ -26,15 +26,14 @@ pub struct SubdivArgs {
     pub voxelize: SubdivVoxelizeArgs,
 }
 
-#[derive(Args)]
-pub struct SubdivVoxelizeArgs {
+/// How the limit surface is voxelized: what `subdiv` and `check --subdiv` take.
+#[derive(Args, Clone, Copy)]
+pub struct SubdivSurfaceArgs {
     /// The adjacency the corner voxels of every final sub-patch must have: 6 gives the
     /// thickest surface, 26 the thinnest; all three block 6-paths (the paper's guarantee,
     /// checked by flooding). Use --enclose to block 26-paths as well.
     #[arg(short, long, default_value_t = SubdivRequest::default().adjacency, value_parser = parse_adjacency)]
     adjacency: Adjacency,
-    #[command(flatten)]
-    fit: FitArgs,
     /// Pre-split every patch k x k before the recursive subdivision.
     #[arg(long, default_value_t = SubdivRequest::default().presplit, value_name = "K")]
     presplit: u32,
@@ -43,6 +42,24 @@ pub struct SubdivVoxelizeArgs {
     /// paper's test alone misses voxels the surface passes through).
     #[arg(long)]
     enclose: bool,
+}
+
+impl SubdivSurfaceArgs {
+    pub fn options(&self) -> ParametricOptions {
+        ParametricOptions {
+            adjacency: self.adjacency,
+            presplit: self.presplit,
+            enclose: self.enclose,
+        }
+    }
+}
+
+#[derive(Args)]
+pub struct SubdivVoxelizeArgs {
+    #[command(flatten)]
+    surface: SubdivSurfaceArgs,
+    #[command(flatten)]
+    fit: FitArgs,
     /// Fill the closed limit surface (Lai & Cheng §6): seeds one voxel against the limit
     /// normals, the inside flooded from them by FloodingXYZ; written like `voxelkit solid`'s
     /// (`density` on the whole solid, `shell`, `interior`), with its volume and mass beside
@@ -116,21 +133,21 @@ pub fn run(args: &SubdivArgs, global: &Global) -> Result<()> {
 }
 
 fn voxelize(inputs: &[PathBuf], args: &SubdivVoxelizeArgs, global: &Global) -> Result<()> {
-    let options = ParametricOptions {
-        adjacency: args.adjacency,
-        presplit: args.presplit,
-        enclose: args.enclose,
+    let options = args.surface.options();
+    let output = if args.solid {
+        SubdivisionOutput::Solid(SubdivisionFill {
+            graystack: args.graystack,
+            density: args.density,
+            topology: args.topology,
+        })
+    } else {
+        SubdivisionOutput::Surface
     };
-    let solid = args.solid.then_some(SubdivisionFill {
-        graystack: args.graystack,
-        density: args.density,
-        topology: args.topology,
-    });
     crate::batch::run(inputs, &args.out, args.fit.grid_fit()?, global, |mesh| {
         Ok(Task::Subdivision {
             mesh,
             options,
-            solid,
+            output,
         })
     })
 }
