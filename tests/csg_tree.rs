@@ -387,3 +387,44 @@ fn placed_catmull_clark_and_grid_leaves_in_a_multi_level_tree() {
     // Nearest sampling moves the boundary by at most a voxel: a thin shell of the 112,877.
     assert!(apart < 0.02 * va, "{apart} voxels apart");
 }
+
+/// Lai & Cheng's Fig. 4 lights Boolean results by their exact normals: a tree of shapes and
+/// formulas writes `normal` on its shell voxels, the normal of the leaf surface each centre
+/// measures, pointing out of the result: up on a box's top, into the hole on a bore drilled
+/// through it (the subtracted cylinder's normal turned), and unit everywhere.
+#[test]
+fn trees_of_exact_leaves_carry_their_normals() {
+    let dir = tempfile::tempdir().unwrap();
+    let tree = r#"{ "resolution": 96, "tree": { "difference": [
+        { "box": { "min": [-1, -1, 0], "max": [1, 1, 0.5] } },
+        { "cylinder": { "base": [0, 0, -0.2], "axis": [0, 0, 1], "radius": 0.4, "height": 1 } }
+    ] } }"#;
+    tree_voxels(dir.path(), "drilled", tree);
+    let path = dir.path().join("drilled.vdb");
+    let shell = read_vdb_grid(&path, Some("shell")).unwrap();
+    let normals = read_vdb_grid(&path, Some("normal")).unwrap();
+    assert_eq!(normals.voxel_count(), shell.voxel_count());
+    let h = normals.transform.voxel_size;
+    let (mut top, mut bore) = (0, 0);
+    for leaf in normals.leaves() {
+        let values = leaf.normal.as_ref().unwrap();
+        for n in leaf.offsets() {
+            let c = voxelkit::grid::offset_coord(leaf.origin, n);
+            assert!(shell.contains(c));
+            let p = normals.transform.index_to_world(c);
+            let v = glam::Vec3::from(values[n]).as_dvec3();
+            assert!((v.length() - 1.0).abs() < 1e-5, "{p}: {v}");
+            let r = p.truncate().length();
+            if p.z > 0.5 - h && r > 0.4 + 2.0 * h && p.x.abs().max(p.y.abs()) < 1.0 - 2.0 * h {
+                assert!(v.z > 0.999, "top at {p}: {v}");
+                top += 1;
+            }
+            if r < 0.4 + h && p.z > 2.0 * h && p.z < 0.5 - 2.0 * h {
+                let into_hole = -p.truncate().extend(0.0) / r;
+                assert!(v.dot(into_hole) > 0.999, "bore at {p}: {v}");
+                bore += 1;
+            }
+        }
+    }
+    assert!(top > 1000 && bore > 500, "{top} top, {bore} bore voxels");
+}

@@ -40,6 +40,9 @@ pub const DENSITY_GRID: &str = "density";
 /// The per-voxel unit normals (Vec3S), with `--normals`.
 pub const NORMAL_GRID: &str = "normal";
 
+/// The voxels of a solid with a face towards the outside: the ones that show.
+pub const SHELL_GRID: &str = "shell";
+
 /// The per-voxel colours (Vec3S), Houdini's name.
 pub const COLOR_GRID: &str = "Cd";
 
@@ -242,6 +245,17 @@ fn candidates<'g>(
             }
             for (name, mask) in masks {
                 check_voxel_size(path, mask.transform.voxel_size)?;
+                // Normals on the voxels that show (a solid's shell) are the result's normals.
+                if *name == NORMAL_GRID && mask.channels().normal {
+                    candidates.push(grid_out(
+                        NORMAL_GRID,
+                        mask,
+                        GridValues::Normals,
+                        None,
+                        Some(COVARIANT_NORMALIZE),
+                    ));
+                    continue;
+                }
                 candidates.push(grid_out(name, mask, GridValues::Bool, None, None));
                 // A mask with normals (an octree level) writes them beside it.
                 if mask.channels().normal {

@@ -9,7 +9,7 @@ use super::{
 use crate::error::{Error, Result};
 use crate::grid::SparseGrid;
 use crate::implicit::Formula;
-use crate::io::vdb::{read_vdb_grid, read_vdb_solid};
+use crate::io::vdb::{SHELL_GRID, read_vdb_grid, read_vdb_solid};
 use crate::mesh::{Mesh, UpAxis};
 use crate::ops::csg::BooleanOp;
 use crate::solids::csg_tree::{CsgTree, parse_csg_tree, read_csg_tree};
@@ -295,5 +295,5 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
 
 /// The surface of a `.vdb` to measure: a solid's `shell` when it is one, else its voxel set.
 fn read_surface(path: &Path) -> Result<SparseGrid> {
-    read_vdb_grid(path, Some("shell")).or_else(|_| read_vdb_grid(path, None))
+    read_vdb_grid(path, Some(SHELL_GRID)).or_else(|_| read_vdb_grid(path, None))
 }

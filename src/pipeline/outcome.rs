@@ -15,9 +15,10 @@ use crate::io::atomic::check_output;
 use crate::io::binvox::write_binvox;
 use crate::io::brick_set::{BrickSet, is_brick_set};
 use crate::io::grid_export::ExportedGrid;
+use crate::io::preview::Scene;
 use crate::io::vdb::{
-    Contents, MetaValue, WriteOptions, content_grid_count, export_contents, is_nvdb, read_vdb_grid,
-    write_contents_timed,
+    Contents, MetaValue, NORMAL_GRID, SHELL_GRID, WriteOptions, content_grid_count,
+    export_contents, is_nvdb, read_vdb_grid, write_contents_timed,
 };
 use crate::io::vox::write_vox;
 use crate::mesh::{GridFit, Mesh};
@@ -162,7 +163,7 @@ impl Outcome {
             Details::Solid(d) => {
                 let m = SolidMeasures::of(
                     count("interior").unwrap_or(0),
-                    count("shell").unwrap_or(0),
+                    count(SHELL_GRID).unwrap_or(0),
                     h,
                 );
                 (d.mass_inside, d.mass_with_surface) = m.mass(d.density);
@@ -245,6 +246,20 @@ impl Outcome {
     pub(super) fn with(mut self, name: &str, grid: SparseGrid) -> Outcome {
         self.extra.push((name.to_string(), grid));
         self
+    }
+
+    /// The result as a picture shows it: its voxels, lit by their normals (the grid's own, or
+    /// a solid's on its shell) and coloured by their colours.
+    pub fn scene(&self) -> Scene<'_> {
+        let shell_normals = self
+            .extra
+            .iter()
+            .find(|(name, g)| name == NORMAL_GRID && g.channels().normal)
+            .map(|(_, g)| g);
+        Scene {
+            normals: shell_normals.or(Scene::of(&self.grid).normals),
+            ..Scene::of(&self.grid)
+        }
     }
 
     pub(super) fn timed(mut self, start: Instant) -> Outcome {

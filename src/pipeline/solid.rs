@@ -12,7 +12,7 @@ use super::{Fill, SubdivisionFill};
 use crate::contour::ExactSurface;
 use crate::error::Result;
 use crate::grid::{DenseMask, SparseGrid, Transform};
-use crate::io::vdb::MetaValue;
+use crate::io::vdb::{MetaValue, NORMAL_GRID, SHELL_GRID};
 use crate::mesh::segment_hits::MeshHits;
 use crate::mesh::{GridFit, Mesh, index_box};
 use crate::progress::Progress;
@@ -118,7 +118,7 @@ fn surface_and_inside(
     let mut details = describe(&whole, &solid)?;
     details.ambiguous_voxels = ambiguous.as_ref().map(SparseGrid::voxel_count);
     let outcome = Outcome::new(whole, meta, Details::Solid(details))
-        .with("shell", surface)
+        .with(SHELL_GRID, surface)
         .with("interior", solid.inside);
     Ok(with_ambiguous(outcome, ambiguous))
 }
@@ -142,7 +142,7 @@ fn centre_solid(
     let outer = solid.boundary();
     let interior = solid.minus(&outer).to_grid(t);
     Outcome::new(solid.to_grid(t), meta, details)
-        .with("shell", outer.to_grid(t))
+        .with(SHELL_GRID, outer.to_grid(t))
         .with("interior", interior)
 }
 
@@ -396,7 +396,17 @@ pub(super) fn csg_tree(tree: &CsgTree, progress: &Progress) -> Result<Outcome> {
         ("source_file", tree.source.display().to_string().into()),
     ];
     let mut outcome = centre_solid(&solid, t, meta, Details::Csg(details));
-    outcome.exact = ExactTree::of(tree, &t).map(|e| Arc::new(e) as Arc<dyn ExactSurface>);
+    if let Some(exact) = ExactTree::of(tree, &t) {
+        let normals = outcome
+            .extra
+            .iter()
+            .find(|(name, _)| name == SHELL_GRID)
+            .map(|(_, shell)| exact.normals_on(shell));
+        if let Some(normals) = normals {
+            outcome = outcome.with(NORMAL_GRID, normals);
+        }
+        outcome.exact = Some(Arc::new(exact) as Arc<dyn ExactSurface>);
+    }
     Ok(outcome.timed(start))
 }
 

@@ -11,12 +11,13 @@
 use super::csg_leaves::Primitive;
 use super::csg_tree::{CsgNode, CsgTree};
 use crate::contour::{ExactSurface, SegmentCrossings, crossing_of_values};
-use crate::grid::Transform;
+use crate::grid::{Channels, Leaf, SparseGrid, Transform, offset_coord};
 use crate::implicit::Formula;
 use crate::mesh::index_box;
 use crate::ops::csg::BooleanOp;
 use crate::shapes::Cuboid;
 use glam::{DAffine3, DVec2, DVec3};
+use rayon::prelude::*;
 
 pub struct ExactTree {
     root: ExactNode,
@@ -88,6 +89,32 @@ impl ExactTree {
     fn sample(&self, p: DVec3) -> (f64, DVec3) {
         let mut slots = Vec::new();
         self.root.sample(p, &mut slots)
+    }
+
+    /// The outward normal at every voxel of `voxels` (a solid's shell): the normal of the leaf
+    /// surface the tree measures at the voxel's centre, exact as the leaves are (Lai & Cheng's
+    /// Fig. 4 renders Boolean results lit by them).
+    pub fn normals_on(&self, voxels: &SparseGrid) -> SparseGrid {
+        let t = voxels.transform;
+        let channels = Channels {
+            normal: true,
+            ..Channels::NONE
+        };
+        let leaves: Vec<Leaf> = voxels
+            .leaves()
+            .par_iter()
+            .map_init(Vec::new, |slots, leaf| {
+                let mut out = Leaf::new(leaf.origin, channels);
+                out.mask = leaf.mask;
+                let normals = out.normal.as_mut().expect("a normal leaf");
+                for n in leaf.offsets() {
+                    let p = t.index_to_world(offset_coord(leaf.origin, n));
+                    normals[n] = self.root.sample(p, slots).1.as_vec3().into();
+                }
+                out
+            })
+            .collect();
+        SparseGrid::from_distinct_leaves(t, channels, leaves)
     }
 }
 

@@ -136,7 +136,7 @@ pub fn run(args: &RenderArgs, global: &Global) -> Result<()> {
 /// `--preview`: the picture beside `output` (`out.vdb` gives `out.png`), drawn from the
 /// result in memory.
 pub fn beside(
-    grid: &SparseGrid,
+    scene: &Scene,
     output: &Path,
     picture: PictureArgs,
     limit: Option<u64>,
@@ -148,6 +148,6 @@ pub fn beside(
     }
     let png = output.with_extension("png");
     check_picture_output(&png, &[output])?;
-    draw(&Scene::of(grid), picture, &png, limit)?;
+    draw(scene, picture, &png, limit)?;
     Ok(png)
 }

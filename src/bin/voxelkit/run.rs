@@ -121,7 +121,7 @@ pub fn finish_job(
         outcome.write(out, &inputs, &global.write)?;
         if global.preview {
             let limit = global.limits().max_memory;
-            let png = crate::render::beside(&outcome.grid, out, Default::default(), limit)?;
+            let png = crate::render::beside(&outcome.scene(), out, Default::default(), limit)?;
             outcome.report.preview = Some(png.display().to_string());
         }
         if let Some(mesh) = &global.mesh_out {
