@@ -428,3 +428,55 @@ fn trees_of_exact_leaves_carry_their_normals() {
     }
     assert!(top > 1000 && bore > 500, "{top} top, {bore} bore voxels");
 }
+
+/// Normals through a Boolean of two `.vdb` solids that carry them: the first operand's stay
+/// where its voxels do, and the dent a difference cuts shows the subtracted sphere's normals
+/// turned (pointing into the dent, out of the result).
+#[test]
+fn grid_booleans_carry_their_operands_normals() {
+    let dir = tempfile::tempdir().unwrap();
+    // One grid for both: the same voxel size and bounds.
+    let grid =
+        r#""voxel_size": 0.03125, "bounds": { "min": [-1.1, -1.1, -0.1], "max": [1.1, 1.1, 1.6] }"#;
+    let box_tree =
+        format!(r#"{{ {grid}, "tree": {{ "box": {{ "min": [-1, -1, 0], "max": [1, 1, 1] }} }} }}"#);
+    let ball_tree = format!(
+        r#"{{ {grid}, "tree": {{ "sphere": {{ "center": [0, 0, 1], "radius": 0.5 }} }} }}"#
+    );
+    tree_voxels(dir.path(), "box", &box_tree);
+    tree_voxels(dir.path(), "ball", &ball_tree);
+    let out = dir.path().join("dented.vdb");
+    let o = voxelkit(&[
+        "csg",
+        "difference",
+        dir.path().join("box.vdb").to_str().unwrap(),
+        dir.path().join("ball.vdb").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let result = read_vdb_grid(&out, Some("density")).unwrap();
+    let normals = read_vdb_grid(&out, Some("normal")).unwrap();
+    let h = normals.transform.voxel_size;
+    let centre = DVec3::new(0.0, 0.0, 1.0);
+    let (mut dent, mut top) = (0, 0);
+    for leaf in normals.leaves() {
+        let values = leaf.normal.as_ref().unwrap();
+        for n in leaf.offsets() {
+            let c = voxelkit::grid::offset_coord(leaf.origin, n);
+            assert!(result.contains(c));
+            let p = normals.transform.index_to_world(c);
+            let v = glam::Vec3::from(values[n]).as_dvec3();
+            if p.z < 1.0 - 2.0 * h && (p.distance(centre) - 0.5).abs() < 2.0 * h {
+                assert!(v.dot((centre - p).normalize()) > 0.95, "dent at {p}: {v}");
+                dent += 1;
+            }
+            let inner = p.x.abs().max(p.y.abs()) < 1.0 - 2.0 * h;
+            if p.z > 1.0 - h && inner && p.truncate().length() > 0.5 + 2.0 * h {
+                assert!(v.z > 0.999, "top at {p}: {v}");
+                top += 1;
+            }
+        }
+    }
+    assert!(dent > 300 && top > 1000, "{dent} dent, {top} top voxels");
+}

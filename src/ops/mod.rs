@@ -1,6 +1,7 @@
 //! Operations on voxel sets: flooding, Booleans, measures, topology, separability and minimality checks.
 
 pub mod csg;
+pub mod csg_normals;
 pub mod flood;
 pub mod flood_blocks;
 pub mod flood_linear;

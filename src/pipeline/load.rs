@@ -9,7 +9,7 @@ use super::{
 use crate::error::{Error, Result};
 use crate::grid::SparseGrid;
 use crate::implicit::Formula;
-use crate::io::vdb::{SHELL_GRID, read_vdb_grid, read_vdb_solid};
+use crate::io::vdb::{NORMAL_GRID, SHELL_GRID, read_vdb_grid, read_vdb_info, read_vdb_solid};
 use crate::mesh::{Mesh, UpAxis};
 use crate::ops::csg::BooleanOp;
 use crate::solids::csg_tree::{CsgTree, parse_csg_tree, read_csg_tree};
@@ -83,6 +83,8 @@ pub(super) enum Work {
     Combine {
         /// At least two.
         operands: Vec<SparseGrid>,
+        /// Each operand's normals, where it has them (a `normal` grid).
+        normals: Vec<Option<SparseGrid>>,
         op: BooleanOp,
         resample: bool,
         curve: bool,
@@ -283,8 +285,17 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
                     operands.len()
                 )));
             }
+            let normals = |g: &GridSource| match g {
+                GridSource::File(path) => read_vdb_info(path)?
+                    .iter()
+                    .any(|i| i.name == NORMAL_GRID && i.value_type == "vec3s")
+                    .then(|| read_vdb_grid(path, Some(NORMAL_GRID)))
+                    .transpose(),
+                GridSource::Grid(g) => Ok(g.channels().normal.then(|| g.clone())),
+            };
             Work::Combine {
                 operands: operands.iter().map(read).collect::<Result<_>>()?,
+                normals: operands.iter().map(normals).collect::<Result<_>>()?,
                 op: *op,
                 resample: *resample,
                 curve: *curve,

@@ -701,10 +701,11 @@ impl PlannedJob {
             Work::CsgTree(tree) => solid::csg_tree(tree, progress),
             Work::Combine {
                 operands,
+                normals,
                 op,
                 resample,
                 curve,
-            } => outcome::combine(operands, *op, *resample, *curve, &source),
+            } => outcome::combine(operands, normals, *op, *resample, *curve, &source),
             Work::Brick(brick) => bricks::run_brick(brick, t, progress),
         }
     }

@@ -22,7 +22,8 @@ use crate::io::vdb::{
 };
 use crate::io::vox::write_vox;
 use crate::mesh::{GridFit, Mesh};
-use crate::ops::csg::{BooleanOp, combine as combine_grids};
+use crate::ops::csg::{BooleanOp, combine as combine_grids, same_transform};
+use crate::ops::csg_normals::boolean_normals;
 use crate::ops::measure::SolidMeasures;
 use crate::ops::minimality::simple_voxel_count;
 use crate::ops::separability::check_mesh_separation;
@@ -759,6 +760,7 @@ pub(super) fn implicit(
 
 pub(super) fn combine(
     operands: &[SparseGrid],
+    normals: &[Option<SparseGrid>],
     op: BooleanOp,
     resample: bool,
     curve: bool,
@@ -772,9 +774,17 @@ pub(super) fn combine(
     let (first, later) = operands
         .split_first()
         .ok_or_else(|| Error::InvalidArgument("a Boolean needs grids".into()))?;
+    // Normals follow the Boolean on one grid (resampled operands leave theirs behind).
+    let on_one_grid = later
+        .iter()
+        .all(|b| same_transform(&first.transform, &b.transform));
     let mut grid = first.clone();
-    for b in later {
+    let mut carried = normals.first().cloned().flatten().filter(|_| on_one_grid);
+    for (b, b_normals) in later.iter().zip(normals.iter().skip(1)) {
         grid = combine_grids(&grid, b, op, resample).map_err(named)?;
+        if on_one_grid {
+            carried = boolean_normals(&grid, carried.as_ref(), b_normals.as_ref(), op);
+        }
     }
     let method = if curve {
         "intersection-curve".to_string()
@@ -782,5 +792,10 @@ pub(super) fn combine(
         format!("{op:?}").to_lowercase()
     };
     let meta = vec![("method", method.into()), ("source_file", source.into())];
-    Ok(Outcome::new(grid, meta, Details::None).timed(start))
+    let outcome = Outcome::new(grid, meta, Details::None);
+    Ok(match carried {
+        Some(normals) if !normals.is_empty() => outcome.with(NORMAL_GRID, normals),
+        _ => outcome,
+    }
+    .timed(start))
 }

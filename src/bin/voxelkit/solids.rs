@@ -139,9 +139,11 @@ pub struct CsgArgs {
     /// Resample the second grid onto the first's transform when they differ.
     #[arg(long)]
     resample: bool,
-    /// Output .vdb holding the result (`density`; `voxels` with --grids); a tree also writes
-    /// `shell` and `interior`, and when its leaves are shapes and formulas, `normal` on the
-    /// shell (the exact normal of the leaf surface each voxel lies on).
+    /// Output .vdb holding the result (`density`; `voxels` with --grids), with `normal` where
+    /// the operands carry normals on one grid (a difference's cut takes the subtracted
+    /// operand's, turned); a tree also writes `shell` and `interior`, and when its leaves are
+    /// shapes and formulas, `normal` on the shell (the exact normal of the leaf surface each
+    /// voxel lies on).
     #[arg(short, long)]
     output: PathBuf,
     #[command(flatten)]
