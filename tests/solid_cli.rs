@@ -110,6 +110,54 @@ fn solid_measure_csg_and_intersect() {
     let curve3 = read_vdb_grid(dir.path().join("curve3.vdb").as_path(), Some("density")).unwrap();
     assert_eq!(curve3.voxel_count(), curve.voxel_count());
     assert!(curve3.voxels().all(|c| curve.contains(c)));
+    // Meshes voxelized by intersect itself: on the first grid's placement they give the
+    // surfaces `mesh` gives there; on their own, one grid fitted to both, as `mesh
+    // --shared-grid` fits it.
+    let o = voxelkit(&[
+        "intersect",
+        &p("torus-s.vdb"),
+        &p("ball.obj"),
+        "-o",
+        &p("curve-mesh.vdb"),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let on_torus = read_vdb_grid(dir.path().join("curve-mesh.vdb").as_path(), None).unwrap();
+    assert!(on_torus.voxel_count() > 100);
+    let o = voxelkit(&[
+        "mesh",
+        &p("torus.obj"),
+        &p("ball.obj"),
+        "--shared-grid",
+        "-r",
+        "96",
+        "--out-dir",
+        &p("shared"),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let (shared_curve, meshes_curve) = (p("shared-curve.vdb"), p("meshes-curve.vdb"));
+    let o = voxelkit(&[
+        "intersect",
+        &p("shared/torus.vdb"),
+        &p("shared/ball.vdb"),
+        "-o",
+        &shared_curve,
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let o = voxelkit(&[
+        "intersect",
+        &p("torus.obj"),
+        &p("ball.obj"),
+        "-r",
+        "96",
+        "-o",
+        &meshes_curve,
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let read = |f: &str| read_vdb_grid(std::path::Path::new(f), None).unwrap();
+    let (a, b) = (read(&shared_curve), read(&meshes_curve));
+    assert!(a.voxel_count() > 100);
+    assert_eq!(a.transform, b.transform);
+    assert!(a.voxel_count() == b.voxel_count() && a.voxels().all(|c| b.contains(c)));
     let o = voxelkit(&[
         "csg",
         "union",

@@ -233,7 +233,8 @@ enum Command {
     /// Boolean of two voxel grids (.vdb): union, intersection or difference; or a whole CSG
     /// tree of shapes, formulas, meshes and grids from a JSON file (--tree).
     Csg(solids::CsgArgs),
-    /// The intersection curve of two voxel surfaces (.vdb): the voxels they share.
+    /// The intersection curve of voxel surfaces (.vdb grids, or meshes voxelized here on one
+    /// grid): the voxels they share.
     Intersect(solids::IntersectArgs),
     /// Volume, mass, components and genus of a mesh (its inside by --inside) or of a closed
     /// .vdb surface.

@@ -5,9 +5,14 @@ use crate::run::{Global, run_and_report, run_job};
 use clap::Args;
 use std::path::PathBuf;
 use voxelkit::Result;
+use voxelkit::io::vdb::read_vdb_grid;
+use voxelkit::mesh::GridFit;
 use voxelkit::ops::csg::BooleanOp;
+use voxelkit::pipeline::batch::shared_placement;
 use voxelkit::pipeline::request::{FillKind, FloodKind, MeasureRequest, Request, SolidRequest};
-use voxelkit::pipeline::{CsgSource, GridSource, Job, MeasureSource, MeshSource, Task};
+use voxelkit::pipeline::{
+    CsgSource, GridSource, Job, MeasureSource, MeshSource, SurfaceMethod, Task,
+};
 use voxelkit::solids::beam::BeamFill;
 use voxelkit::solids::inside_rule::InsideRule;
 
@@ -152,12 +157,18 @@ pub struct CsgArgs {
 
 #[derive(Args)]
 pub struct IntersectArgs {
-    /// Surfaces (.vdb), two or more: made on one grid (`--shared-grid`), or resampled onto the
-    /// first's with --resample. Catmull-Clark surfaces made with --enclose hold every voxel
-    /// the surface touches, so that their curve is not broken where the paper's adjacency test
-    /// skips a voxel.
+    /// Surfaces, two or more: .vdb grids made on one grid (`--shared-grid`, or resampled onto
+    /// the first's with --resample), and meshes (.obj, .stl, .ply, .off, .gltf, .glb),
+    /// voxelized here as separating surfaces (-s) on the first grid's placement, or without a
+    /// grid on one fitted to the union of their boxes (-r). Catmull-Clark surfaces made with
+    /// --enclose hold every voxel the surface touches, so that their curve is not broken where
+    /// the paper's adjacency test skips a voxel.
     #[arg(required = true, num_args = 2..)]
     inputs: Vec<PathBuf>,
+    #[command(flatten)]
+    fit: FitArgs,
+    #[command(flatten)]
+    surface: crate::SurfaceArgs,
     /// Resample the later grids onto the first's transform where they differ.
     #[arg(long)]
     resample: bool,
@@ -253,8 +264,39 @@ pub fn csg(args: &CsgArgs, global: &Global) -> Result<()> {
 }
 
 pub fn intersect(args: &IntersectArgs, global: &Global) -> Result<()> {
+    let is_grid = |p: &PathBuf| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("vdb"));
+    let meshes: Vec<PathBuf> = args
+        .inputs
+        .iter()
+        .filter(|p| !is_grid(p))
+        .cloned()
+        .collect();
+    // Meshes take the first grid's placement, or share one fitted to all of them.
+    let placement = match args.inputs.iter().find(|p| is_grid(p)) {
+        _ if meshes.is_empty() => None,
+        Some(first) => Some(GridFit::Placed(read_vdb_grid(first, None)?.transform)),
+        None => Some(shared_placement(
+            &meshes,
+            args.fit.grid_fit()?,
+            global.up_axis,
+        )?),
+    };
+    let operand = |p: &PathBuf| -> Result<GridSource> {
+        match placement {
+            Some(fit) if !is_grid(p) => {
+                let task = Task::MeshSurface {
+                    mesh: MeshSource::File(p.clone()),
+                    method: SurfaceMethod::Separating(args.surface.separating()),
+                };
+                Ok(GridSource::Grid(
+                    run_job(Job::new(task, fit), None, global)?.grid,
+                ))
+            }
+            _ => Ok(GridSource::File(p.clone())),
+        }
+    };
     let task = Task::Combine {
-        operands: args.inputs.iter().cloned().map(GridSource::File).collect(),
+        operands: args.inputs.iter().map(operand).collect::<Result<_>>()?,
         grid: None,
         op: BooleanOp::Intersection,
         resample: args.resample,
