@@ -22,6 +22,7 @@ use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
 use crate::ops::csg::same_transform;
 use crate::ops::flood::padded;
 use crate::solids::cavities::cavity_bytes;
+use crate::solids::csg_exact::ExactTree;
 use crate::solids::csg_tree::CsgNode;
 use crate::solids::exterior_flood::FloodMethod;
 use crate::solids::inside_rule::InsideRule;
@@ -247,11 +248,15 @@ fn mesh_solid_bytes(mesh: &Mesh, t: &Transform, b: &CoordBox, cost: &FillCost) -
 /// box's faces. Mesh leaves add their fill (13 KB per leaf of their surface, and their
 /// triangles), Catmull-Clark leaves their solid, grid leaves their leaves. Estimate/peak
 /// 0.89-1.15 on the flange, a union of shapes and a mesh minus a slab at 256-1024 (was
-/// 1.2-9.5).
+/// 1.2-9.5). A tree of shapes and formulas also keeps its shell's normals: 512 of them and a
+/// mask per shell leaf, 15.5 KB per leaf the faces' estimate counts (the shell crosses about
+/// 2.5 leaves for each of those; flange 256-1024: estimate/peak 1.01-1.12, 0.38 at 1024
+/// without them).
 const CSG_VOLUMES: f64 = 1.2;
 const CSG_FACE_AREA_PER_LEAF: f64 = 92.0;
 const CSG_LEAF_BYTES: f64 = 3000.0;
 const CSG_MESH_LEAF_BYTES: f64 = 13000.0;
+const CSG_NORMAL_LEAF_BYTES: f64 = 15500.0;
 
 /// Peak bytes of evaluating the CSG tree `root` over the box `b`.
 fn csg_tree_bytes(root: &CsgNode, t: &Transform, b: &CoordBox) -> f64 {
@@ -634,12 +639,19 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
         Work::CsgTree(tree) => {
             let (t, bounds) = tree.transform()?;
             let b = checked_box(&bounds, &t)?;
-            let bytes = csg_tree_bytes(&tree.root, &t, &b);
+            let normals = match ExactTree::of(tree, &t) {
+                Some(_) => face_cells(&b) / CSG_FACE_AREA_PER_LEAF * CSG_NORMAL_LEAF_BYTES,
+                None => 0.0,
+            };
+            let bytes = csg_tree_bytes(&tree.root, &t, &b) + normals;
             plan_of(t, &bounds, bytes, tree.node_count() as u64)
         }
         Work::Brick(brick) => brick_plan(brick, fit)?,
         Work::Combine {
-            operands, resample, ..
+            operands,
+            normals,
+            resample,
+            ..
         } => {
             // Resampled onto the first grid (only when the grids differ), each voxel of a
             // later operand becomes (hb/ha)^3.
@@ -660,7 +672,19 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
             // (a checkerboard of 10^6 tiles in each of two grids: 204 MiB at the peak,
             // estimate 189).
             let tiles = 1.4 * operands.iter().map(tile_bytes).sum::<f64>();
-            plan_of(a.transform, &world_box(a), leaf_bytes(leaves, 0) + tiles, 1)
+            // The operands' normals, and as many again carried into the result.
+            let normal_leaves: f64 = normals
+                .iter()
+                .flatten()
+                .map(|g| g.leaf_count() as f64)
+                .sum();
+            let normals = 2.0 * normal_leaves * CSG_NORMAL_LEAF_BYTES;
+            plan_of(
+                a.transform,
+                &world_box(a),
+                leaf_bytes(leaves, 0) + tiles + normals,
+                1,
+            )
         }
     })
 }
