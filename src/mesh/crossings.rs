@@ -11,7 +11,7 @@
 //! evaluated from its lower-numbered vertex, so both triangles at an edge see the same answer
 //! and a closed mesh is crossed an exact, even number of times along every ray; triangles seen
 //! edge-on are missed. A centre exactly on a crossing lies on the side its perturbed `t` falls
-//! (`Crossing::after`): a centre on a face lies inside or outside as a point just off it, in the
+//! (`RayCrossing::after`): a centre on a face lies inside or outside as a point just off it, in the
 //! same place whichever direction looks at it, so the methods agree on surface voxels too.
 
 use glam::{DVec2, DVec3};
@@ -50,9 +50,9 @@ impl RayWindow {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RayFrame {
     pub d: [i64; 3],
-    pub k: usize,
-    pub i: usize,
-    pub j: usize,
+    k: usize,
+    i: usize,
+    j: usize,
     alpha: [f64; 3],
     beta: [f64; 3],
     tau: [f64; 3],

@@ -3,9 +3,9 @@
 //! surface point (`t6`/`t26` as for polygons), or within `Rc` of a sharp edge (the rim of
 //! a capped cylinder), exactly as edges are treated for meshes.
 //!
-//! Distances are exact for the closed-form shapes: for the sphere and the capped cylinder, and for
-//! `x^2 + k y + k z = 0` the cubic the Lagrange condition gives (the paper's "analytical
-//! solution"), solved by Cardano's formula and polished by a Newton step.
+//! Distances are exact for the closed-form shapes: for the sphere and the capped cylinder,
+//! and for `x^2 + k y + k z = 0` the cubic the Lagrange condition gives (the paper's
+//! "analytical solution"), solved by Cardano's formula and polished by a Newton step.
 //!
 //! Correction for curvature (the paper proves planes only, and on a sphere of radius 61.4
 //! voxels its plain `t6` leaves 6-holes where two neighbours both miss by 1e-4 voxels): a
