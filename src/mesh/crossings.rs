@@ -59,17 +59,6 @@ pub struct RayFrame {
 }
 
 impl RayFrame {
-    /// Rays along +z: `(a, b, t) = (x, y, z)`.
-    pub const Z: RayFrame = RayFrame {
-        d: [0, 0, 1],
-        k: 2,
-        i: 0,
-        j: 1,
-        alpha: [1.0, 0.0, 0.0],
-        beta: [0.0, 1.0, 0.0],
-        tau: [0.0, 0.0, 1.0],
-    };
-
     /// Rays along `d`, which must have a component of ±1 (the last such is `k`).
     pub fn along(d: [i64; 3]) -> RayFrame {
         let k = (0..3)

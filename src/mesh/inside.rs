@@ -43,9 +43,6 @@ pub struct ColumnCrossings {
     column_starts: Vec<u32>,
 }
 
-/// The rays of the columns: along +z, `(a, b, t) = (x, y, z)`.
-const Z_RAYS: RayFrame = RayFrame::Z;
-
 /// Triangles per parallel batch of crossings.
 const TRIANGLE_BATCH: usize = 4096;
 
@@ -74,11 +71,13 @@ impl ColumnCrossings {
             width: nx,
             height: ny,
         };
+        // Columns along +z: `(a, b, t) = (x, y, z)`.
+        let z_rays = RayFrame::along([0, 0, 1]);
         let mut crossings: Vec<Crossing> = triangles
             .par_chunks(TRIANGLE_BATCH)
             .flat_map_iter(|batch| {
                 let mut found = Vec::new();
-                for_each_crossing(&pos, batch.iter().copied(), &Z_RAYS, &window, |c| {
+                for_each_crossing(&pos, batch.iter().copied(), &z_rays, &window, |c| {
                     found.push(Crossing {
                         key: c.ray << 1 | c.rising as usize,
                         after: c.after,

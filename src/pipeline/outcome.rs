@@ -37,6 +37,7 @@ use crate::voxelize::separating::{Criterion, SeparatingOptions, voxelize_mesh};
 use crate::voxelize::separating_analytic::{scan_region, voxelize_surface};
 use crate::voxelize::step_certificate::close_unproven_steps;
 use glam::DVec3;
+use std::borrow::Cow;
 use std::path::Path;
 use std::time::Instant;
 
@@ -252,15 +253,15 @@ impl Outcome {
     /// The result as a picture shows it: its voxels, lit by their normals (the grid's own, or
     /// a solid's on its shell) and coloured by their colours.
     pub fn scene(&self) -> Scene<'_> {
-        let shell_normals = self
+        let mut scene = Scene::of(&self.grid);
+        if let Some((_, shell_normals)) = self
             .extra
             .iter()
             .find(|(name, g)| name == NORMAL_GRID && g.channels().normal)
-            .map(|(_, g)| g);
-        Scene {
-            normals: shell_normals.or(Scene::of(&self.grid).normals),
-            ..Scene::of(&self.grid)
+        {
+            scene.normals = Some(shell_normals);
         }
+        scene
     }
 
     pub(super) fn timed(mut self, start: Instant) -> Outcome {
@@ -779,11 +780,16 @@ pub(super) fn combine(
         .iter()
         .all(|b| same_transform(&first.transform, &b.transform));
     let mut grid = first.clone();
-    let mut carried = normals.first().cloned().flatten().filter(|_| on_one_grid);
+    let mut carried = normals
+        .first()
+        .and_then(Option::as_ref)
+        .filter(|_| on_one_grid)
+        .map(Cow::Borrowed);
     for (b, b_normals) in later.iter().zip(normals.iter().skip(1)) {
         grid = combine_grids(&grid, b, op, resample).map_err(named)?;
         if on_one_grid {
-            carried = boolean_normals(&grid, carried.as_ref(), b_normals.as_ref(), op);
+            carried =
+                boolean_normals(&grid, carried.as_deref(), b_normals.as_ref(), op).map(Cow::Owned);
         }
     }
     let method = if curve {
@@ -794,7 +800,7 @@ pub(super) fn combine(
     let meta = vec![("method", method.into()), ("source_file", source.into())];
     let outcome = Outcome::new(grid, meta, Details::None);
     Ok(match carried {
-        Some(normals) if !normals.is_empty() => outcome.with(NORMAL_GRID, normals),
+        Some(normals) if !normals.is_empty() => outcome.with(NORMAL_GRID, normals.into_owned()),
         _ => outcome,
     }
     .timed(start))

@@ -30,6 +30,12 @@ const MOST_STEPS: usize = 64;
 /// Halvings of the reach tried for a certified lower bound of the distance.
 const LOWER_BOUND_HALVINGS: i32 = 10;
 
+thread_local! {
+    /// Scratch slots of the interval tape evaluations.
+    static BOX_SLOTS: std::cell::RefCell<(Vec<Interval>, Vec<Split>)> =
+        const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
+}
+
 /// The surface F = 0 of a formula inside a box.
 #[derive(Clone, Debug)]
 pub struct FormulaSurface {
@@ -59,12 +65,15 @@ impl FormulaSurface {
     /// Whether interval arithmetic proves F != 0 over the box `[lo, hi]`.
     pub fn box_is_empty(&self, lo: DVec3, hi: DVec3) -> bool {
         let b = [0, 1, 2].map(|a| Interval::new(lo[a], hi[a]));
-        let test = if self.formula.tape.divides() {
-            test_box::<Split>(&self.formula, b, false, true, &mut Vec::new())
-        } else {
-            test_box::<Interval>(&self.formula, b, false, true, &mut Vec::new())
-        };
-        test == BoxTest::Empty
+        // Asked once a voxel and once a step piece: the tape's slots are kept per thread.
+        BOX_SLOTS.with_borrow_mut(|(intervals, splits)| {
+            let test = if self.formula.tape.divides() {
+                test_box::<Split>(&self.formula, b, false, true, splits)
+            } else {
+                test_box::<Interval>(&self.formula, b, false, true, intervals)
+            };
+            test == BoxTest::Empty
+        })
     }
 
     /// The point of F = 0 that Newton steps along the gradient reach from `x`, with the
