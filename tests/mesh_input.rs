@@ -100,9 +100,10 @@ fn stl_in_both_encodings_welds_back_to_the_same_mesh() {
     }
 }
 
-/// What a reader reads past is named, so that a job can say it does not write it: OBJ
-/// texture coordinates and normals, PLY vertex properties other than position and colour.
-/// A job warns about them, and about vertex colours unless it colours its voxels with them.
+/// What a reader reads is named, and what it reads past, so that a job can say what it does
+/// not write: OBJ texture coordinates and normals that not every face corner names, PLY list
+/// properties. A job warns about them, about attributes it does not write, and about vertex
+/// colours unless it colours its voxels with them.
 #[test]
 fn attributes_read_past_are_named_and_warned_about() {
     let dir = tempfile::tempdir().unwrap();
@@ -116,7 +117,25 @@ fn attributes_read_past_are_named_and_warned_about() {
     )
     .unwrap();
     let m = Mesh::load(&obj).unwrap();
-    assert_eq!(m.unread, ["texture coordinates (vt)", "normals (vn)"]);
+    assert_eq!(
+        m.unread,
+        [
+            "texture coordinates (vt) (line 7: a face corner names none)",
+            "normals (vn) (line 7: a face corner names none)"
+        ]
+    );
+    assert!(m.attributes.is_empty());
+    let cornered = dir.path().join("c.obj");
+    std::fs::write(
+        &cornered,
+        "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nv 0 0 1 1 1 1\nvt 0 0\nvn 0 0 1\n\
+         f 1/1/1 3/1/1 2/1/1\nf 1/1/1 2/1/1 4/1/1\nf 2/1/1 3/1/1 4/1/1\nf 3/1/1 1/1/1 4/1/1\n",
+    )
+    .unwrap();
+    let m = Mesh::load(&cornered).unwrap();
+    let names: Vec<&str> = m.attributes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["uv", "vertex_normal"]);
+    assert!(m.unread.is_empty());
     let plain = dir.path().join("plain.obj");
     std::fs::write(
         &plain,
@@ -133,13 +152,14 @@ fn attributes_read_past_are_named_and_warned_about() {
          0 0 1 1 5\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n",
     )
     .unwrap();
-    let mut unread = Mesh::load(&ply).unwrap().unread;
-    unread.sort();
-    assert_eq!(unread, ["nx", "quality"]);
+    let m = Mesh::load(&ply).unwrap();
+    let names: Vec<&str> = m.attributes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["nx", "quality"], "a lone `nx` is a scalar");
+    assert!(m.unread.is_empty());
 
     // The job's warning: everything on the separating surface, all but the colours on the
     // projective one (which writes them as `Cd`).
-    let warnings = |method: &str| {
+    let warnings = |obj: &std::path::Path, method: &str| {
         let o = cli_support::voxelkit(&[
             "--json",
             "mesh",
@@ -155,14 +175,19 @@ fn attributes_read_past_are_named_and_warned_about() {
         let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
         report["warnings"].to_string()
     };
-    let separating = warnings("separating");
+    let separating = warnings(&cornered, "separating");
     assert!(
-        separating.contains("vertex colours, texture coordinates (vt), normals (vn)"),
+        separating.contains("vertex colours, `uv`, `vertex_normal` are not written"),
         "{separating}"
     );
-    let projective = warnings("projective");
+    assert_eq!(
+        warnings(&cornered, "projective"),
+        "null",
+        "projective writes them all"
+    );
+    let projective = warnings(&obj, "projective");
     assert!(
-        projective.contains("texture coordinates (vt), normals (vn)")
+        projective.contains("texture coordinates (vt) (line 7")
             && !projective.contains("vertex colours"),
         "{projective}"
     );

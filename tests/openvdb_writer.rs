@@ -10,6 +10,7 @@ mod common;
 use std::path::Path;
 use voxelkit::io::vdb::{Compression, WriteOptions};
 use voxelkit::mesh::GridFit;
+use voxelkit::mesh::attributes::AttributeChoice;
 use voxelkit::pipeline::{Job, MeshSource, Outcome, SurfaceMethod, Task};
 use voxelkit::progress::Unobserved;
 use voxelkit::solids::exterior_flood::FloodMethod;
@@ -98,6 +99,7 @@ fn openvdbs_writer_and_the_native_one_write_the_same_grids() {
                 normals: true,
                 ..Default::default()
             }),
+            attributes: AttributeChoice::None,
         },
         160,
     );
@@ -118,6 +120,7 @@ fn openvdbs_writer_and_the_native_one_write_the_same_grids() {
             band: 3.0,
             signed: true,
             inside: InsideRule::Winding,
+            attributes: AttributeChoice::None,
         },
         400,
     );

@@ -10,6 +10,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 use voxelkit::Error;
 use voxelkit::implicit::Coordinates;
+use voxelkit::mesh::attributes::AttributeChoice;
 use voxelkit::mesh::{GridFit, generate};
 use voxelkit::pipeline::{
     ColorChoice, CsgSource, Fill, Job, MeasureSource, MeshSource, Shape, ShapeTask, SurfaceMethod,
@@ -54,6 +55,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
             Task::MeshSurface {
                 mesh: mesh(),
                 method: SurfaceMethod::Separating(SeparatingOptions::default()),
+                attributes: AttributeChoice::None,
             },
         ),
         (
@@ -61,6 +63,7 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
             Task::MeshSurface {
                 mesh: mesh(),
                 method: SurfaceMethod::Projective(ColorChoice::FromMesh),
+                attributes: AttributeChoice::None,
             },
         ),
         (
@@ -345,6 +348,7 @@ fn every_stage_of_a_fill_is_heard_and_counted_to_its_total() {
                 band: 3.0,
                 signed: true,
                 inside: InsideRule::Winding,
+                attributes: AttributeChoice::None,
             },
             vec!["distances and inside"],
         ),

@@ -9,6 +9,7 @@ use glam::DVec3;
 use proptest::prelude::*;
 use std::path::Path;
 use voxelkit::implicit::{Coordinates, Formula};
+use voxelkit::mesh::attributes::AttributeChoice;
 use voxelkit::mesh::{GridFit, Mesh, generate};
 use voxelkit::pipeline::{Fill, Job, MeshSource, SurfaceMethod, Task};
 use voxelkit::progress::Unobserved;
@@ -66,6 +67,7 @@ fn read_mesh(dir: &Path, name: &str, bytes: &[u8]) -> Result<(), TestCaseError> 
                 Task::MeshSurface {
                     mesh: mesh.clone(),
                     method: SurfaceMethod::Separating(Default::default()),
+                    attributes: AttributeChoice::None,
                 },
                 Task::Solid {
                     mesh,

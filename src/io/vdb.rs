@@ -17,6 +17,7 @@ use super::vdb_writer::{Encoding, write_grids};
 use crate::contour::{Meaning, ScalarField};
 use crate::error::{Error, Result};
 use crate::grid::{Channels, LEAF_VOXELS, Leaf, SparseGrid, Transform};
+use crate::mesh::attributes::{AttributeGrid, AttributeKind};
 use crate::progress::{StageClock, StageTime};
 use glam::DVec3;
 use std::path::Path;
@@ -88,17 +89,20 @@ pub fn write_vdb_as(
     let contents = Contents::Voxels {
         grid,
         masks: masks.to_vec(),
+        attributes: &[],
     };
     write_contents(path, &contents, metadata, options)
 }
 
-/// What a write holds: a voxel set with bool grids beside it, or a band of distances.
+/// What a write holds: a voxel set with bool grids beside it, or a band of distances; each
+/// with the mesh attributes carried onto its voxels, a grid per attribute after the others.
 pub enum Contents<'a> {
     /// `density` (and `voxels`), `normal` and `Cd` when the grid has them, then one bool
     /// grid per `(name, mask)`.
     Voxels {
         grid: &'a SparseGrid,
         masks: Vec<(&'a str, &'a SparseGrid)>,
+        attributes: &'a [AttributeGrid],
     },
     /// Distances in world units on the grid's voxels, `background` elsewhere. With its
     /// `interior`, signed distances: the fog volume `density` and the LEVEL_SET grid `surface`
@@ -108,7 +112,18 @@ pub enum Contents<'a> {
         grid: &'a SparseGrid,
         background: f32,
         interior: Option<&'a SparseGrid>,
+        attributes: &'a [AttributeGrid],
     },
+}
+
+impl<'a> Contents<'a> {
+    fn attributes(&self) -> &'a [AttributeGrid] {
+        match *self {
+            Contents::Voxels { attributes, .. } | Contents::Distances { attributes, .. } => {
+                attributes
+            }
+        }
+    }
 }
 
 /// Writes `contents` to `path` (`.vdb` or `.nvdb`), every grid with `metadata` plus
@@ -196,8 +211,35 @@ pub fn content_grid_count(
     Ok(chosen(what, candidates(what, contents, &[], options)?, options)?.len())
 }
 
-/// Every grid `contents` can write, before `options` choose among them.
+/// Every grid `contents` can write, before `options` choose among them: its own, then its
+/// attributes' (scalars as FloatGrids, texture coordinates and normals as Vec3SGrids).
 fn candidates<'g>(
+    path: &Path,
+    contents: &Contents<'g>,
+    meta: &'g [(String, MetaValue)],
+    options: &WriteOptions,
+) -> Result<Vec<GridOut<'g>>> {
+    let mut grids = content_candidates(path, contents, meta, options)?;
+    for a in contents.attributes() {
+        let (values, vector_type) = match a.kind {
+            AttributeKind::Scalar => (GridValues::Distances { background: 0.0 }, None),
+            AttributeKind::TextureCoordinates => (GridValues::Colors, Some("invariant")),
+            AttributeKind::Normal => (GridValues::Colors, Some(COVARIANT_NORMALIZE)),
+        };
+        grids.push(GridOut {
+            name: a.name.as_str().into(),
+            grid: &a.grid,
+            values,
+            class: None,
+            vector_type,
+            metadata: meta,
+        });
+    }
+    Ok(grids)
+}
+
+/// The grids of `contents` itself.
+fn content_candidates<'g>(
     path: &Path,
     contents: &Contents<'g>,
     meta: &'g [(String, MetaValue)],
@@ -212,7 +254,9 @@ fn candidates<'g>(
         metadata: meta,
     };
     match *contents {
-        Contents::Voxels { grid, ref masks } => {
+        Contents::Voxels {
+            grid, ref masks, ..
+        } => {
             check_voxel_size(path, grid.transform.voxel_size)?;
             let mut candidates = vec![
                 grid_out(
@@ -277,6 +321,7 @@ fn candidates<'g>(
             grid,
             background,
             interior,
+            ..
         } => {
             check_voxel_size(path, grid.transform.voxel_size)?;
             if grid.leaves().iter().any(|l| l.value.is_none()) {
@@ -400,6 +445,7 @@ pub fn write_distance_band(
         grid,
         background,
         interior,
+        attributes: &[],
     };
     write_contents(path, &contents, metadata, options)
 }

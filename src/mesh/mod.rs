@@ -2,6 +2,7 @@
 //! validation,
 //! measurement, fitting to a grid, and the project's own generated fixtures.
 
+pub mod attributes;
 pub mod boundary_caps;
 mod closed;
 pub mod crossings;
@@ -11,6 +12,7 @@ pub mod generate;
 mod gltf_scene;
 pub mod inside;
 pub mod key_groups;
+pub mod nearest_attributes;
 mod obj;
 mod off;
 mod ply;
@@ -48,9 +50,11 @@ pub struct Mesh {
     /// Vertices are numbered from 0 in messages (arrays from C or Python) instead of from 1
     /// (files, as OBJ numbers them).
     pub numbered_from_zero: bool,
-    /// Per-vertex attributes the file holds that voxelkit reads past (texture coordinates,
-    /// normals, other PLY properties, glTF attributes), named as the file names them, so that
-    /// a job can say what it does not write.
+    /// Texture coordinates, normals and named scalars of the vertices or face corners.
+    pub attributes: Vec<attributes::VertexAttribute>,
+    /// Per-vertex attributes the file holds that voxelkit reads past (glTF attributes, PLY
+    /// list properties, OBJ texture coordinates on some faces only), named as the file names
+    /// them, so that a job can say what it does not write.
     pub unread: Vec<String>,
 }
 
@@ -145,13 +149,14 @@ impl Mesh {
     }
 
     /// Checks what every algorithm relies on: a face, finite positions, indices in range,
-    /// at least three corners per face.
+    /// at least three corners per face, attributes with a value for every corner.
     pub fn validate(&self) -> Result<()> {
         if self.face_count() == 0 {
             return Err(self.empty_error());
         }
         self.validate_positions()?;
-        self.validate_faces()
+        self.validate_faces()?;
+        self.validate_attributes()
     }
 
     fn empty_error(&self) -> Error {
@@ -233,8 +238,18 @@ impl Mesh {
     /// Fan triangulation of face `f`.
     #[inline]
     pub fn fan(&self, f: usize) -> impl Iterator<Item = [u32; 3]> + '_ {
-        let face = self.face(f);
-        (1..face.len() - 1).map(move |k| [face[0], face[k], face[k + 1]])
+        self.fan_corners(f)
+            .map(move |slots| slots.map(|s| self.indices[s]))
+    }
+
+    /// Fan triangulation of face `f` as positions of its corners in `indices`.
+    #[inline]
+    pub fn fan_corners(&self, f: usize) -> impl Iterator<Item = [usize; 3]> + use<> {
+        let (start, end) = (
+            self.face_starts[f] as usize,
+            self.face_starts[f + 1] as usize,
+        );
+        (start + 1..end - 1).map(move |k| [start, k, k + 1])
     }
 
     /// Number of triangles in the fan triangulation.

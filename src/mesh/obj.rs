@@ -1,10 +1,12 @@
 //! OBJ input: `v` (with an optional `r g b` colour), `f` and `l` (polyline) statements,
 //! polygons kept, vertices numbered exactly as in the file (so errors can name the file's
-//! vertex, and unused vertices stay visible to the checks that refuse them). Texture and
-//! normal indices of corners are read past; other statements (groups, materials, points)
-//! are ignored.
+//! vertex, and unused vertices stay visible to the checks that refuse them). Texture
+//! coordinates (`vt`) and normals (`vn`) become the attributes `uv` and `vertex_normal` when
+//! every face corner names one (`f v/vt/vn`); otherwise they are reported unread, with the
+//! first line that lacks one. Other statements (groups, materials, points) are ignored.
 
 use super::Mesh;
+use super::attributes::{AttributeKind, VertexAttribute};
 use crate::error::{Error, Result};
 use crate::huge_pages::vec_to_fill;
 use glam::{DVec3, Vec3};
@@ -20,14 +22,25 @@ pub(super) fn load_obj(path: &Path) -> Result<Mesh> {
         line,
         message,
     })?;
-    let unread = [
-        (parsed.texture_coordinates, "texture coordinates (vt)"),
-        (parsed.normals, "normals (vn)"),
-    ]
-    .into_iter()
-    .filter(|&(count, _)| count > 0)
-    .map(|(_, what)| what.to_string())
-    .collect();
+    let mut attributes = Vec::new();
+    let mut unread = Vec::new();
+    for (stream, name, kind) in [
+        (parsed.texture, "uv", AttributeKind::TextureCoordinates),
+        (parsed.normals, "vertex_normal", AttributeKind::Normal),
+    ] {
+        let every_corner = stream.corners.len() == parsed.indices.len();
+        match stream.trouble {
+            _ if stream.values.is_empty() || parsed.indices.is_empty() => {}
+            None if every_corner => attributes.push(VertexAttribute {
+                name: name.into(),
+                kind,
+                values: stream.values,
+                corners: stream.corners,
+            }),
+            Some((line, why)) => unread.push(format!("{} (line {line}: {why})", stream.what)),
+            None => unread.push(stream.what.to_string()),
+        }
+    }
     Ok(Mesh {
         positions: parsed.positions,
         indices: parsed.indices,
@@ -35,6 +48,7 @@ pub(super) fn load_obj(path: &Path) -> Result<Mesh> {
         colors: parsed.colors,
         polylines: parsed.polylines,
         source: path.to_path_buf(),
+        attributes,
         unread,
         ..Default::default()
     })
@@ -67,9 +81,75 @@ struct Parsed {
     /// Where each polygon starts in `indices`, and where the last ends.
     face_starts: Vec<u32>,
     polylines: Vec<Vec<u32>>,
-    /// Texture coordinate (`vt`) and normal (`vn`) lines.
-    texture_coordinates: usize,
+    /// `vt` and `vn` values and the face corners' indices into them.
+    texture: CornerValues,
+    normals: CornerValues,
+}
+
+/// Values a face corner may name after its vertex (`f v/vt/vn`): `vt` or `vn` lines.
+#[derive(Debug, Default)]
+struct CornerValues {
+    /// What the statements are, for messages.
+    what: &'static str,
+    values: Vec<Vec3>,
+    /// One index per face corner while every corner names one.
+    corners: Vec<u32>,
+    /// The first line where a face corner names none or a bad one, and why: the values are
+    /// then not read.
+    trouble: Option<(usize, String)>,
+}
+
+impl CornerValues {
+    fn new(what: &'static str) -> Self {
+        CornerValues {
+            what,
+            ..Default::default()
+        }
+    }
+
+    /// Takes a face corner's index `text` (empty: none) into values of which `defined` are
+    /// defined so far.
+    fn take(&mut self, text: Option<&str>, defined: i64, line: usize) {
+        if self.trouble.is_some() {
+            return;
+        }
+        match text
+            .filter(|t| !t.is_empty())
+            .map(|t| resolve(t, defined, self.what))
+        {
+            Some(Ok(i)) => self.corners.push(i),
+            Some(Err(why)) => self.trouble = Some((line, why)),
+            None => self.trouble = Some((line, "a face corner names none".into())),
+        }
+    }
+
+    /// Appends a later piece's values and corners.
+    fn join(&mut self, later: CornerValues) {
+        self.values.extend(later.values);
+        self.corners.extend(later.corners);
+        self.trouble = self.trouble.take().or(later.trouble);
+    }
+}
+
+/// How many lines, and of each vertex statement, come before a piece of text.
+#[derive(Clone, Copy, Debug, Default)]
+struct Counts {
+    lines: usize,
+    positions: usize,
+    texture: usize,
     normals: usize,
+}
+
+impl std::ops::Add for Counts {
+    type Output = Counts;
+    fn add(self, o: Counts) -> Counts {
+        Counts {
+            lines: self.lines + o.lines,
+            positions: self.positions + o.positions,
+            texture: self.texture + o.texture,
+            normals: self.normals + o.normals,
+        }
+    }
 }
 
 type LineError = (usize, String);
@@ -94,32 +174,48 @@ fn numbers<'a, const N: usize>(
     Ok(out)
 }
 
-/// Appends the 0-based vertex indices of an `f` or `l` statement's corners to `out`.
+/// The 0-based index an OBJ index `text` names among `defined` values (`noun`): 1-based,
+/// negative counting back from the last.
+fn resolve(text: &str, defined: i64, noun: &str) -> std::result::Result<u32, String> {
+    let i = match text.parse::<i64>() {
+        Ok(0) => return Err("index 0 (OBJ indices start at 1)".into()),
+        Ok(i) if i < 0 => defined + i,
+        Ok(i) => i - 1,
+        Err(_) => return Err(format!("cannot read index `{text}`")),
+    };
+    if i < 0 || i >= defined {
+        return Err(format!(
+            "index {text} is out of range: {defined} {noun} are defined before this line"
+        ));
+    }
+    Ok(i as u32)
+}
+
+/// Appends the 0-based vertex indices of an `f` or `l` statement's corners to `out`, and a
+/// face's texture and normal indices to `corner_values`.
 fn corners<'a>(
     words: impl Iterator<Item = &'a str>,
-    vertices: i64,
+    defined: Counts,
     what: &str,
     line: usize,
     out: &mut Vec<u32>,
+    mut corner_values: Option<(&mut CornerValues, &mut CornerValues)>,
 ) -> std::result::Result<(), LineError> {
     for corner in words {
-        let index = corner.split('/').next().unwrap_or("");
-        let i = match index.parse::<i64>() {
-            Ok(0) => return Err((line, format!("{what} index 0 (OBJ indices start at 1)"))),
-            // Negative indices count back from the last vertex read so far.
-            Ok(i) if i < 0 => vertices + i,
-            Ok(i) => i - 1,
-            Err(_) => return Err((line, format!("cannot read {what} corner `{corner}`"))),
-        };
-        if i < 0 || i >= vertices {
-            return Err((
-                line,
-                format!(
-                    "{what} index {index} is out of range: {vertices} vertices are defined before this line"
-                ),
-            ));
+        let mut parts = corner.split('/');
+        let index = parts.next().unwrap_or("");
+        let i = resolve(index, defined.positions as i64, "vertices").map_err(|why| {
+            if index.parse::<i64>().is_err() {
+                (line, format!("cannot read {what} corner `{corner}`"))
+            } else {
+                (line, format!("{what} {why}"))
+            }
+        })?;
+        out.push(i);
+        if let Some((texture, normals)) = corner_values.as_mut() {
+            texture.take(parts.next(), defined.texture as i64, line);
+            normals.take(parts.next(), defined.normals as i64, line);
         }
-        out.push(i as u32);
     }
     Ok(())
 }
@@ -128,8 +224,9 @@ fn corners<'a>(
 const PIECE_BYTES: usize = 1 << 20;
 
 /// Parses OBJ text, or names the first bad line: `(1-based line, message)`. The text is
-/// parsed in pieces of whole lines on all threads, each told how many lines and vertices
-/// come before it (negative indices count back from there), and the pieces joined in order.
+/// parsed in pieces of whole lines on all threads, each told how many lines and vertex
+/// statements come before it (negative indices count back from there), and the pieces
+/// joined in order.
 fn parse_obj(text: &str) -> std::result::Result<Parsed, LineError> {
     parse_in_pieces(text, PIECE_BYTES)
 }
@@ -137,18 +234,17 @@ fn parse_obj(text: &str) -> std::result::Result<Parsed, LineError> {
 /// `parse_obj` with pieces of about `piece_bytes`.
 fn parse_in_pieces(text: &str, piece_bytes: usize) -> std::result::Result<Parsed, LineError> {
     let pieces = whole_line_pieces(text, piece_bytes);
-    let counts: Vec<(usize, usize)> = pieces.par_iter().map(|p| line_counts(p)).collect();
-    let mut before = Vec::with_capacity(pieces.len());
-    let (mut lines, mut vertices) = (0, 0);
-    for &(l, v) in &counts {
-        before.push((lines, vertices));
-        lines += l;
-        vertices += v;
-    }
+    let counts: Vec<Counts> = pieces.par_iter().map(|p| line_counts(p)).collect();
+    let before = counts.iter().scan(Counts::default(), |sum, &c| {
+        let at = *sum;
+        *sum = *sum + c;
+        Some(at)
+    });
+    let before: Vec<Counts> = before.collect();
     let parsed: Vec<Piece> = pieces
         .par_iter()
         .zip(before)
-        .map(|(text, (lines, vertices))| parse_piece(text, lines, vertices))
+        .map(|(text, before)| parse_piece(text, before))
         .collect();
     join_pieces(parsed)
 }
@@ -175,21 +271,28 @@ fn whole_line_pieces(text: &str, piece_bytes: usize) -> Vec<&str> {
     pieces
 }
 
-/// The lines of `text` and how many of them are `v` statements.
-fn line_counts(text: &str) -> (usize, usize) {
-    let (mut lines, mut vertices) = (0, 0);
+/// The lines of `text` and how many of them are `v`, `vt` and `vn` statements.
+fn line_counts(text: &str) -> Counts {
+    let mut counts = Counts::default();
     for line in text.lines() {
-        lines += 1;
+        counts.lines += 1;
         let b = line.as_bytes();
-        let vertex = match b {
+        let statement = match b {
             // The common forms, decided without splitting the line.
-            [b'v', next, ..] if next.is_ascii_whitespace() => true,
-            [first, ..] if first.is_ascii_graphic() => false,
-            _ => line.split_whitespace().next() == Some("v"),
+            [b'v', next, ..] if next.is_ascii_whitespace() => "v",
+            [b'v', b't', next, ..] if next.is_ascii_whitespace() => "vt",
+            [b'v', b'n', next, ..] if next.is_ascii_whitespace() => "vn",
+            [first, ..] if first.is_ascii_graphic() => "",
+            _ => line.split_whitespace().next().unwrap_or(""),
         };
-        vertices += usize::from(vertex);
+        match statement {
+            "v" => counts.positions += 1,
+            "vt" => counts.texture += 1,
+            "vn" => counts.normals += 1,
+            _ => {}
+        }
     }
-    (lines, vertices)
+    counts
 }
 
 /// A piece of a file parsed: what it holds, the first colour and plain vertex lines, and
@@ -201,8 +304,8 @@ struct Piece {
     error: Option<LineError>,
 }
 
-/// Parses the lines of a piece, after `lines_before` lines and `vertices_before` vertices.
-fn parse_piece(text: &str, lines_before: usize, vertices_before: usize) -> Piece {
+/// Parses the lines of a piece, after the lines and vertex statements of `before`.
+fn parse_piece(text: &str, before: Counts) -> Piece {
     let mut piece = Piece {
         parsed: Parsed {
             positions: Vec::new(),
@@ -210,16 +313,16 @@ fn parse_piece(text: &str, lines_before: usize, vertices_before: usize) -> Piece
             indices: Vec::new(),
             face_starts: Vec::new(),
             polylines: Vec::new(),
-            texture_coordinates: 0,
-            normals: 0,
+            texture: CornerValues::new("texture coordinates (vt)"),
+            normals: CornerValues::new("normals (vn)"),
         },
         first_colored: None,
         first_plain: None,
         error: None,
     };
     for (n, raw) in text.lines().enumerate() {
-        let line = lines_before + n + 1;
-        if let Err(e) = parse_line(raw, line, vertices_before, &mut piece) {
+        let line = before.lines + n + 1;
+        if let Err(e) = parse_line(raw, line, before, &mut piece) {
             piece.error = Some(e);
             break;
         }
@@ -231,11 +334,18 @@ fn parse_piece(text: &str, lines_before: usize, vertices_before: usize) -> Piece
 fn parse_line(
     raw: &str,
     line: usize,
-    vertices_before: usize,
+    before: Counts,
     piece: &mut Piece,
 ) -> std::result::Result<(), LineError> {
     let out = &mut piece.parsed;
     let mut words = raw.split_whitespace();
+    // What is defined up to this line, for the corners' indices.
+    let defined = Counts {
+        lines: line,
+        positions: before.positions + out.positions.len(),
+        texture: before.texture + out.texture.values.len(),
+        normals: before.normals + out.normals.values.len(),
+    };
     match words.next() {
         Some("v") => {
             out.positions
@@ -250,24 +360,46 @@ fn parse_line(
             }
         }
         Some("f") => {
-            let vertices = (vertices_before + out.positions.len()) as i64;
-            corners(words, vertices, "face", line, &mut out.indices)?;
+            let streams = Some((&mut out.texture, &mut out.normals));
+            corners(words, defined, "face", line, &mut out.indices, streams)?;
             out.face_starts.push(out.indices.len() as u32);
         }
         Some("l") => {
             let mut polyline = Vec::new();
-            let vertices = (vertices_before + out.positions.len()) as i64;
-            corners(words, vertices, "line", line, &mut polyline)?;
+            corners(words, defined, "line", line, &mut polyline, None)?;
             if polyline.len() < 2 {
                 return Err((line, "a line needs 2 or more vertices".into()));
             }
             out.polylines.push(polyline);
         }
-        Some("vt") => out.texture_coordinates += 1,
-        Some("vn") => out.normals += 1,
+        // `vt u [v [w]]`: v defaults to 0; w is dropped. A bad value spoils the attribute,
+        // not the shape.
+        Some("vt") => {
+            let uv: Vec<f64> = words.take(2).map_while(|w| w.parse().ok()).collect();
+            let value = match uv[..] {
+                [u] => Vec3::new(u as f32, 0.0, 0.0),
+                [u, v] => Vec3::new(u as f32, v as f32, 0.0),
+                _ => Vec3::NAN,
+            };
+            vertex_value(&mut out.texture, value, line);
+        }
+        Some("vn") => {
+            let n = numbers::<3>(&mut words, "normal", line).map_or(Vec3::NAN, |n| {
+                DVec3::from_array(n).normalize_or_zero().as_vec3()
+            });
+            vertex_value(&mut out.normals, n, line);
+        }
         _ => {}
     }
     Ok(())
+}
+
+/// Adds a `vt` or `vn` value; one that is not finite spoils its attribute.
+fn vertex_value(stream: &mut CornerValues, value: Vec3, line: usize) {
+    if !value.is_finite() && stream.trouble.is_none() {
+        stream.trouble = Some((line, "not a finite value".into()));
+    }
+    stream.values.push(value);
 }
 
 /// The pieces in file order as one file, or its first bad line. A file must not mix vertices
@@ -296,8 +428,8 @@ fn join_pieces(pieces: Vec<Piece>) -> std::result::Result<Parsed, LineError> {
         indices: vec_to_fill(total(|p| p.indices.len())),
         face_starts: vec_to_fill(total(|p| p.face_starts.len()) + 1),
         polylines: Vec::new(),
-        texture_coordinates: total(|p| p.texture_coordinates),
-        normals: total(|p| p.normals),
+        texture: CornerValues::new("texture coordinates (vt)"),
+        normals: CornerValues::new("normals (vn)"),
     };
     out.face_starts.push(0);
     for piece in pieces {
@@ -309,6 +441,8 @@ fn join_pieces(pieces: Vec<Piece>) -> std::result::Result<Parsed, LineError> {
         out.face_starts
             .extend(p.face_starts.iter().map(|s| s + shift));
         out.polylines.extend(p.polylines);
+        out.texture.join(p.texture);
+        out.normals.join(p.normals);
     }
     Ok(out)
 }
@@ -340,6 +474,8 @@ mod tests {
             "v 0 0 0 1 0 0\n# comment\nv 1 0 0 0 1 0\nvt 0 0\nv 0 1 0\nf 1 2 3\n",
             "v 0 0 0\nv 1 nan 0\nv 0 0 0 1 1 1\n",
             "\u{a0}v 0 0 0\nv\t1 0 0\nv 0 1 0\nf 1 2 3",
+            "v 0 0 0\nv 1 0 0\nvt 0 0\nvt 1 0\nvn 0 0 1\nv 0 1 0\nvt 0 1\nf 1/1/1 2/-2/1 3/-1/-1\n",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 1 2 3\nf 1/4 2/1 3/1\n",
         ] {
             same_in_pieces(text);
         }
@@ -365,6 +501,28 @@ mod tests {
         assert_eq!(parsed.indices, vec![0, 2, 3]);
         assert_eq!(parsed.face_starts, vec![0, 3]);
         assert!(parsed.colors.is_empty());
+    }
+
+    #[test]
+    fn corner_texture_coordinates_and_normals_are_read() {
+        // A seam: vertex 1 takes uv 1 in the first face and uv 3 in the second.
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0.5 0.5\nvt 0 1\n\
+                    vn 0 0 2\nf 1/1/1 2/2/1 3/4/1\nf 2/-2/-1 4/-1/1 3/-1/1\n";
+        let parsed = parse_obj(text).unwrap();
+        assert_eq!(parsed.texture.values.len(), 4);
+        assert_eq!(parsed.texture.corners, vec![0, 1, 3, 2, 3, 3]);
+        assert_eq!(parsed.normals.values, vec![Vec3::Z]);
+        assert_eq!(parsed.normals.corners, vec![0; 6]);
+        assert!(parsed.texture.trouble.is_none() && parsed.normals.trouble.is_none());
+        // A face without texture coordinates, or with a bad index, spoils them (not the
+        // shape), naming the line.
+        let parsed =
+            parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 1 2 3\n").unwrap();
+        assert_eq!(parsed.texture.trouble.as_ref().map(|t| t.0), Some(6));
+        let parsed = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n").unwrap();
+        let (line, why) = parsed.texture.trouble.unwrap();
+        assert_eq!(line, 5);
+        assert!(why.contains("out of range"), "{why}");
     }
 
     #[test]

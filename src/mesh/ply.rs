@@ -1,10 +1,13 @@
 //! PLY input, ASCII and binary (either byte order), through `ply-rs-bw`: the `vertex`
 //! element's `x y z` (any numeric type) and, when present, `red green blue` (0..255 integers
-//! or 0..1 floats) as the mesh's vertex colours (`Cd`), and the `face` element's
-//! `vertex_indices` (or `vertex_index`) lists. Vertices are numbered from 0, as PLY numbers
-//! them; errors name the file and the element.
+//! or 0..1 floats) as the mesh's vertex colours (`Cd`), `nx ny nz` as `vertex_normal`, `u v`
+//! (or `s t`, `texture_u texture_v`) as `uv`, every other numeric property as a scalar
+//! attribute of its own name, and the `face` element's `vertex_indices` (or `vertex_index`)
+//! lists. Vertices are numbered from 0, as PLY numbers them; errors name the file and the
+//! element.
 
 use super::Mesh;
+use super::attributes::{AttributeKind, VertexAttribute};
 use crate::error::{Error, Result};
 use glam::{DVec3, Vec3};
 use ply_rs_bw::parser::Parser;
@@ -171,20 +174,91 @@ pub(super) fn load_ply(path: &Path) -> Result<Mesh> {
     let mut mesh = Mesh::from_polygons(path, positions, &polygons);
     mesh.colors = colors;
     mesh.numbered_from_zero = true;
-    mesh.unread = ply
+    let names: Vec<String> = ply
         .header
         .elements
         .get("vertex")
-        .map(|element| {
-            element
-                .properties
-                .keys()
-                .filter(|name| !["x", "y", "z", "red", "green", "blue"].contains(&name.as_str()))
-                .cloned()
-                .collect()
-        })
+        .map(|element| element.properties.keys().cloned().collect())
         .unwrap_or_default();
+    (mesh.attributes, mesh.unread) = vertex_attributes(path, &names, vertices)?;
     Ok(mesh)
+}
+
+/// Vertex properties read as vectors: each is a name and its properties' names.
+const VECTORS: [(&str, AttributeKind, [&str; 3]); 4] = [
+    ("vertex_normal", AttributeKind::Normal, ["nx", "ny", "nz"]),
+    ("uv", AttributeKind::TextureCoordinates, ["u", "v", ""]),
+    ("uv", AttributeKind::TextureCoordinates, ["s", "t", ""]),
+    (
+        "uv",
+        AttributeKind::TextureCoordinates,
+        ["texture_u", "texture_v", ""],
+    ),
+];
+
+/// The vertex properties besides position and colour, named `names` in the header's order:
+/// vectors (normals, texture coordinates) where all their parts are present, scalars
+/// otherwise; list properties are reported unread.
+fn vertex_attributes(
+    path: &Path,
+    names: &[String],
+    vertices: &[DefaultElement],
+) -> Result<(Vec<VertexAttribute>, Vec<String>)> {
+    let has = |n: &str| names.iter().any(|m| m == n);
+    let mut taken: Vec<&str> = vec!["x", "y", "z", "red", "green", "blue"];
+    let mut attributes: Vec<VertexAttribute> = Vec::new();
+    let mut unread = Vec::new();
+    let component = |k: usize, v: &DefaultElement, name: &str| {
+        v.get(name).and_then(scalar).ok_or_else(|| {
+            parse_error(path, format!("vertex {k} has no numeric `{name}` property"))
+        })
+    };
+    for (name, kind, parts) in VECTORS {
+        let parts: Vec<&str> = parts.into_iter().filter(|p| !p.is_empty()).collect();
+        let named_already = attributes.iter().any(|a| a.name == name);
+        if named_already || !parts.iter().all(|p| has(p)) {
+            continue;
+        }
+        let values = vertices
+            .iter()
+            .enumerate()
+            .map(|(k, v)| {
+                let mut x = [0.0f32; 3];
+                for (i, p) in parts.iter().enumerate() {
+                    x[i] = component(k, v, p)? as f32;
+                }
+                Ok(Vec3::from_array(x))
+            })
+            .collect::<Result<Vec<Vec3>>>()?;
+        taken.extend(parts);
+        attributes.push(VertexAttribute {
+            name: name.into(),
+            kind,
+            values,
+            corners: Vec::new(),
+        });
+    }
+    for name in names.iter().filter(|n| !taken.contains(&n.as_str())) {
+        let numeric = vertices
+            .first()
+            .is_some_and(|v| v.get(name).and_then(scalar).is_some());
+        if !numeric {
+            unread.push(name.clone());
+            continue;
+        }
+        let values = vertices
+            .iter()
+            .enumerate()
+            .map(|(k, v)| Ok(Vec3::new(component(k, v, name)? as f32, 0.0, 0.0)))
+            .collect::<Result<Vec<Vec3>>>()?;
+        attributes.push(VertexAttribute {
+            name: name.clone(),
+            kind: AttributeKind::Scalar,
+            values,
+            corners: Vec::new(),
+        });
+    }
+    Ok((attributes, unread))
 }
 
 impl Mesh {

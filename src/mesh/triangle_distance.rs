@@ -36,6 +36,39 @@ pub fn triangle_distance_squared(p: DVec3, [a, b, c]: [DVec3; 3]) -> f64 {
         .min(segment_distance_squared(p, c, a))
 }
 
+/// The point of triangle `abc` nearest to `p`, as barycentric weights of `a`, `b` and `c`:
+/// the foot on its plane where `p` projects inside it, else the nearest point of the
+/// nearest edge (as `triangle_distance_squared` measures).
+pub fn nearest_on_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> DVec3 {
+    let n = (b - a).cross(c - a);
+    let n2 = n.length_squared();
+    let areas = [(b, c), (c, a), (a, b)].map(|(u, v)| (v - u).cross(p - u).dot(n));
+    if n2 > 0.0 && areas.iter().all(|&w| w >= 0.0) {
+        return DVec3::from_array(areas) / n2;
+    }
+    // The edge `(from, to)` between corners `i` and `j`, at parameter t from `from`.
+    let along = |u: DVec3, v: DVec3| {
+        let d = v - u;
+        let t = if d.length_squared() > 0.0 {
+            ((p - u).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (t, (u + d * t).distance_squared(p))
+    };
+    let mut best = (f64::INFINITY, DVec3::ZERO);
+    for (i, j, u, v) in [(0, 1, a, b), (1, 2, b, c), (2, 0, c, a)] {
+        let (t, d2) = along(u, v);
+        if d2 < best.0 {
+            let mut w = DVec3::ZERO;
+            w[i] = 1.0 - t;
+            w[j] = t;
+            best = (d2, w);
+        }
+    }
+    best.1
+}
+
 /// The distance from `p` to the triangle `abc`.
 pub fn triangle_distance(p: DVec3, t: [DVec3; 3]) -> f64 {
     triangle_distance_squared(p, t).sqrt()
@@ -43,6 +76,28 @@ pub fn triangle_distance(p: DVec3, t: [DVec3; 3]) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn nearest_points_lie_at_the_distance() {
+        use super::*;
+        let mut random = crate::random::SplitMix64(7);
+        for _ in 0..2000 {
+            let mut point = || {
+                DVec3::new(
+                    random.range(-1.0, 1.0),
+                    random.range(-1.0, 1.0),
+                    random.range(-1.0, 1.0),
+                )
+            };
+            let t = [point(), point(), point()];
+            let p = point() * 2.0;
+            let w = nearest_on_triangle(p, t);
+            assert!((w.element_sum() - 1.0).abs() < 1e-12 && w.min_element() >= -1e-12);
+            let q = w.x * t[0] + w.y * t[1] + w.z * t[2];
+            let d = triangle_distance(p, t);
+            assert!((q.distance(p) - d).abs() < 1e-9 * (1.0 + d), "{p} {t:?}");
+        }
+    }
+
     use super::*;
 
     #[test]

@@ -2,13 +2,21 @@
 //! the imported mesh.
 
 use super::Mesh;
+use super::attributes::AttributeKind;
 pub use crate::grid::UpAxis;
 
 impl Mesh {
-    /// The mesh with its `up` axis turned to +z.
+    /// The mesh with its `up` axis turned to +z, its normals with it.
     pub fn with_up_axis(mut self, up: UpAxis) -> Mesh {
         for p in &mut self.positions {
             *p = up.turn(*p);
+        }
+        for a in &mut self.attributes {
+            if a.kind == AttributeKind::Normal {
+                for n in &mut a.values {
+                    *n = up.turn(n.as_dvec3()).as_vec3();
+                }
+            }
         }
         self
     }

@@ -8,7 +8,9 @@
 //! change away from the surface, from its rim alone.
 
 use super::Mesh;
-use super::triangle_distance::{segment_distance, triangle_distance, triangle_distance_squared};
+use super::triangle_distance::{
+    nearest_on_triangle, segment_distance, triangle_distance, triangle_distance_squared,
+};
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
@@ -141,6 +143,8 @@ struct Node {
 /// 1/2 must be decided by the exact `winding_number`.
 pub struct WindingTree {
     corners: Vec<[DVec3; 3]>,
+    /// The place of each of `corners` in the triangles the tree was built of.
+    ids: Vec<u32>,
     nodes: Vec<Node>,
 }
 
@@ -154,27 +158,29 @@ impl WindingTree {
     }
 
     /// The tree over triangles given by their corners.
-    pub fn of_triangles(mut corners: Vec<[DVec3; 3]>) -> WindingTree {
+    pub fn of_triangles(corners: Vec<[DVec3; 3]>) -> WindingTree {
         let mut tree = WindingTree {
             corners: Vec::new(),
+            ids: Vec::new(),
             nodes: Vec::new(),
         };
-        if !corners.is_empty() {
-            let n = corners.len();
-            tree.build(&mut corners, 0, n);
+        let mut numbered: Vec<([DVec3; 3], u32)> = corners.into_iter().zip(0..).collect();
+        if !numbered.is_empty() {
+            let n = numbered.len();
+            tree.build(&mut numbered, 0, n);
         }
-        tree.corners = corners;
+        (tree.corners, tree.ids) = numbered.into_iter().unzip();
         tree
     }
 
-    /// Builds the node over `corners[first..last]` (reordering them) and returns its index.
-    fn build(&mut self, corners: &mut [[DVec3; 3]], first: usize, last: usize) -> usize {
-        let part = &mut corners[first..last];
+    /// Builds the node over `triangles[first..last]` (reordering them) and returns its index.
+    fn build(&mut self, triangles: &mut [([DVec3; 3], u32)], first: usize, last: usize) -> usize {
+        let part = &mut triangles[first..last];
         let mut area = DVec3::ZERO;
         let mut weighted = DVec3::ZERO;
         let mut total = 0.0;
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        for [a, b, c] in part.iter() {
+        for ([a, b, c], _) in part.iter() {
             let n = 0.5 * (*b - *a).cross(*c - *a);
             let weight = n.length();
             area += n;
@@ -188,14 +194,14 @@ impl WindingTree {
         } else {
             0.5 * (lo + hi)
         };
-        let moment = part.iter().fold(DMat3::ZERO, |m, [a, b, c]| {
+        let moment = part.iter().fold(DMat3::ZERO, |m, ([a, b, c], _)| {
             let n = 0.5 * (*b - *a).cross(*c - *a);
             let offset = (*a + *b + *c) / 3.0 - centre;
             m + DMat3::from_cols(offset * n.x, offset * n.y, offset * n.z)
         });
         let radius = part
             .iter()
-            .flatten()
+            .flat_map(|(t, _)| t)
             .map(|p| p.distance(centre))
             .fold(0.0, f64::max);
         let index = self.nodes.len();
@@ -214,11 +220,11 @@ impl WindingTree {
         if last - first > LEAF_TRIANGLES {
             // Split at the median centroid along the box's longest axis.
             let axis = (hi - lo).max_position();
-            let key = |t: &[DVec3; 3]| (t[0][axis] + t[1][axis] + t[2][axis]) / 3.0;
+            let key = |(t, _): &([DVec3; 3], u32)| (t[0][axis] + t[1][axis] + t[2][axis]) / 3.0;
             let middle = (last - first) / 2;
             part.select_nth_unstable_by(middle, |x, y| key(x).total_cmp(&key(y)));
-            let left = self.build(corners, first, first + middle);
-            let right = self.build(corners, first + middle, last);
+            let left = self.build(triangles, first, first + middle);
+            let right = self.build(triangles, first + middle, last);
             self.nodes[index].children = Some([left, right]);
         }
         index
@@ -287,9 +293,25 @@ impl WindingTree {
         }
     }
 
-    /// The distance from `p` to the nearest triangle, exactly: clusters nearer first, none
-    /// whose box lies farther than the nearest triangle found.
+    /// The distance from `p` to the nearest triangle, exactly.
     pub fn distance(&self, p: DVec3) -> f64 {
+        self.nearest(p).map_or(f64::INFINITY, |(_, d2)| d2.sqrt())
+    }
+
+    /// The triangle nearest to `p` (its place in the triangles the tree was built of) and its
+    /// point nearest to `p` as barycentric weights of its corners.
+    pub fn nearest_point(&self, p: DVec3) -> Option<(usize, DVec3)> {
+        let (slot, _) = self.nearest(p)?;
+        Some((
+            self.ids[slot] as usize,
+            nearest_on_triangle(p, self.corners[slot]),
+        ))
+    }
+
+    /// The slot in `corners` of the triangle nearest to `p`, and its squared distance,
+    /// exactly: clusters nearer first, none whose box lies farther than the nearest triangle
+    /// found.
+    fn nearest(&self, p: DVec3) -> Option<(usize, f64)> {
         // The squared distance to a cluster's box: no triangle of it lies nearer.
         let lower = |i: usize| {
             let node = &self.nodes[i];
@@ -298,13 +320,13 @@ impl WindingTree {
                 .max(DVec3::ZERO)
                 .length_squared()
         };
-        let mut best = f64::INFINITY;
+        let mut best = (usize::MAX, f64::INFINITY);
         let mut stack = Vec::with_capacity(64);
         if !self.nodes.is_empty() {
             stack.push((0usize, lower(0)));
         }
         while let Some((i, bound)) = stack.pop() {
-            if bound >= best {
+            if bound >= best.1 {
                 continue;
             }
             let node = &self.nodes[i];
@@ -319,13 +341,16 @@ impl WindingTree {
                     }
                 }
                 None => {
-                    for &t in &self.corners[node.first..node.last] {
-                        best = best.min(triangle_distance_squared(p, t));
+                    for slot in node.first..node.last {
+                        let d2 = triangle_distance_squared(p, self.corners[slot]);
+                        if d2 < best.1 {
+                            best = (slot, d2);
+                        }
                     }
                 }
             }
         }
-        best.sqrt()
+        (best.0 != usize::MAX).then_some(best)
     }
 
     /// Whether a triangle comes within `reach` of `p` (clusters skipped by their balls).

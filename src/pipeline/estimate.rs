@@ -18,6 +18,7 @@ use crate::grid::{CoordBox, MAX_DENSE_VOXELS, SparseGrid, TILE_BYTES, Transform}
 use crate::implicit::Formula;
 use crate::io::brick_set::brick_voxels;
 use crate::io::vdb::check_voxel_size;
+use crate::mesh::attributes::AttributeChoice;
 use crate::mesh::{Aabb, GridFit, Mesh, fit_transform, index_box};
 use crate::ops::csg::same_transform;
 use crate::ops::flood::padded;
@@ -203,6 +204,23 @@ const SHAPE_BLOCK_BYTES: f64 = 20.0;
 /// Leaves crossed by a surface of `area` voxels^2.
 fn surface_leaves(area: f64) -> f64 {
     area / MESH_AREA_PER_LEAF + 1.0
+}
+
+/// A tree over the triangles with their corner places, per triangle, for attributes carried
+/// from the nearest point.
+const NEAREST_TRIANGLE_BYTES: f64 = 180.0;
+
+/// The attributes `chosen` writes of `mesh`: each a grid with a value and a vector channel.
+fn attribute_count(mesh: &Mesh, chosen: &AttributeChoice) -> u32 {
+    chosen.select(mesh).map_or(0, |a| a.len() as u32)
+}
+
+/// The nearest-point tree of `mesh` when `carried` attributes are taken from it.
+fn nearest_tree_bytes(mesh: &Mesh, carried: u32, by_nearest: bool) -> f64 {
+    if carried == 0 || !by_nearest {
+        return 0.0;
+    }
+    mesh.triangle_count() as f64 * NEAREST_TRIANGLE_BYTES
 }
 
 /// Peak bytes of `leaves` surface leaves with `vector_channels` normal or colour channels.
@@ -492,7 +510,11 @@ fn mesh_plan(mesh: &Mesh, fit: GridFit) -> Result<(Transform, CoordBox)> {
 /// Places the grid of `work` and prices it; `what` names the input in errors.
 pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
     Ok(match work {
-        Work::MeshSurface { mesh, method } => {
+        Work::MeshSurface {
+            mesh,
+            method,
+            attributes,
+        } => {
             let (t, _) = mesh_plan(mesh, fit)?;
             let (channels, items) = match method {
                 SurfaceMethod::Separating(o) => {
@@ -503,11 +525,21 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
                     (u32::from(colour), mesh.face_count() as u64)
                 }
             };
-            let bytes = mesh_surface_bytes(mesh, &t, channels);
+            let carried = attribute_count(mesh, attributes);
+            let bytes = mesh_surface_bytes(mesh, &t, channels + carried)
+                + nearest_tree_bytes(
+                    mesh,
+                    carried,
+                    matches!(method, SurfaceMethod::Separating(_)),
+                );
             plan_of(t, &mesh.bbox(), bytes, items)
         }
         Work::DistanceBand {
-            mesh, band, signed, ..
+            mesh,
+            band,
+            signed,
+            attributes,
+            ..
         } => {
             let (t, _) = mesh_plan(mesh, fit)?;
             // A band 2w+1 voxels thick crosses about that many eighths of each leaf it meets.
@@ -517,7 +549,11 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
             } else {
                 UNSIGNED_BAND_LEAF_BYTES
             };
-            let bytes = leaves * per_leaf + mesh.triangle_count() as f64 * BAND_TRIANGLE_BYTES;
+            let carried = attribute_count(mesh, attributes);
+            let bytes = leaves * per_leaf
+                + mesh.triangle_count() as f64 * BAND_TRIANGLE_BYTES
+                + surface_leaf_bytes(leaves, carried)
+                + nearest_tree_bytes(mesh, carried, true);
             plan_of(t, &mesh.bbox(), bytes, separating::work_items(mesh))
         }
         Work::SeparationCheck { mesh, options } => {

@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use crate::grid::SparseGrid;
 use crate::implicit::Formula;
 use crate::io::vdb::{NORMAL_GRID, SHELL_GRID, read_vdb_grid, read_vdb_info, read_vdb_solid};
+use crate::mesh::attributes::AttributeChoice;
 use crate::mesh::{Mesh, UpAxis};
 use crate::ops::csg::BooleanOp;
 use crate::solids::csg_tree::{CsgTree, parse_csg_tree, read_csg_tree};
@@ -28,6 +29,7 @@ pub(super) enum Work {
     MeshSurface {
         mesh: Mesh,
         method: SurfaceMethod,
+        attributes: AttributeChoice,
     },
     SeparationCheck {
         mesh: Mesh,
@@ -58,6 +60,7 @@ pub(super) enum Work {
         band: f64,
         signed: bool,
         inside: InsideRule,
+        attributes: AttributeChoice,
     },
     Solid {
         mesh: Mesh,
@@ -92,36 +95,57 @@ pub(super) enum Work {
 }
 
 impl Work {
-    /// What the input mesh holds that this job does not write: its unread attributes, and its
-    /// vertex colours unless the job colours its voxels with them.
+    /// What the input mesh holds that this job does not write: its unread attributes, those
+    /// it does not choose, and its vertex colours unless the job colours its voxels with them.
     pub(super) fn unwritten_attributes(&self) -> Option<String> {
-        let (mesh, colours_kept): (&Mesh, bool) = match self {
-            Work::MeshSurface { mesh, method } => (
+        let none = AttributeChoice::None;
+        let (mesh, colours_kept, chosen): (&Mesh, bool, &AttributeChoice) = match self {
+            Work::MeshSurface {
+                mesh,
+                method,
+                attributes,
+            } => (
                 mesh,
                 matches!(
                     method,
                     SurfaceMethod::Projective(super::ColorChoice::FromMesh)
                 ),
+                attributes,
             ),
-            Work::Lines { mesh, coloring, .. } => (mesh, *coloring == Coloring::Vertex),
-            Work::DistanceBand { mesh, .. } => (mesh, false),
+            Work::Lines { mesh, coloring, .. } => (mesh, *coloring == Coloring::Vertex, &none),
+            Work::DistanceBand {
+                mesh, attributes, ..
+            } => (mesh, false, attributes),
             Work::SeparationCheck { mesh, .. }
             | Work::Solid { mesh, .. }
-            | Work::MeasureMesh { mesh, .. } => (mesh, false),
+            | Work::MeasureMesh { mesh, .. } => (mesh, false, &none),
             _ => return None,
         };
-        let mut unwritten = mesh.unread.clone();
+        let written = chosen.select(mesh).unwrap_or_default();
+        let mut unwritten: Vec<String> = mesh
+            .attributes
+            .iter()
+            .filter(|a| !written.iter().any(|w| w.name == a.name))
+            .map(|a| format!("`{}`", a.name))
+            .collect();
+        let attributes_dropped = !unwritten.is_empty();
+        unwritten.extend(mesh.unread.iter().cloned());
         let colours_dropped = !mesh.colors.is_empty() && !colours_kept;
         if colours_dropped {
             unwritten.insert(0, "vertex colours".into());
         }
         (!unwritten.is_empty()).then(|| {
             format!(
-                "{}: its {} are not written (voxelkit writes the shape{})",
+                "{}: its {} are not written (voxelkit writes the shape{}{})",
                 mesh.source.display(),
                 unwritten.join(", "),
                 if colours_dropped {
-                    ", and vertex colours as `Cd` with --method projective or `lines`"
+                    ", vertex colours as `Cd` with --method projective or `lines`"
+                } else {
+                    ""
+                },
+                if attributes_dropped {
+                    ", and vertex attributes with `mesh --attributes all` (or their names)"
                 } else {
                     ""
                 }
@@ -130,13 +154,24 @@ impl Work {
     }
 }
 
+/// `mesh`, refused before any work when it lacks an attribute `chosen` names.
+fn with_attributes(mesh: Mesh, chosen: &AttributeChoice) -> Result<Mesh> {
+    chosen.select(&mesh)?;
+    Ok(mesh)
+}
+
 /// Reads what `task` needs; mesh files are turned `up`.
 pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
     let mesh = |source: &MeshSource| source.load(false, up);
     Ok(match task {
-        Task::MeshSurface { mesh: m, method } => Work::MeshSurface {
-            mesh: mesh(m)?,
+        Task::MeshSurface {
+            mesh: m,
+            method,
+            attributes,
+        } => Work::MeshSurface {
+            mesh: with_attributes(mesh(m)?, attributes)?,
             method: *method,
+            attributes: attributes.clone(),
         },
         Task::SeparationCheck { mesh: m, options } => Work::SeparationCheck {
             mesh: mesh(m)?,
@@ -204,11 +239,13 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
             band,
             signed,
             inside,
+            attributes,
         } => Work::DistanceBand {
-            mesh: Arc::new(mesh(m)?),
+            mesh: Arc::new(with_attributes(mesh(m)?, attributes)?),
             band: *band,
             signed: *signed,
             inside: *inside,
+            attributes: attributes.clone(),
         },
         Task::Solid {
             mesh: m,

@@ -4,6 +4,7 @@
 //! allocated; `PlannedJob::run` does the work under an `Observer` (progress, cancellation)
 //! and returns an `Outcome`: the grids, their `.vdb` metadata and the report.
 
+mod attribute_grids;
 pub mod batch;
 pub mod brick_exterior;
 pub mod bricks;
@@ -23,6 +24,7 @@ pub use report::*;
 use crate::error::{Error, Result};
 use crate::grid::{SparseGrid, Transform};
 use crate::implicit::{Coordinates, ThetaRange};
+use crate::mesh::attributes::AttributeChoice;
 use crate::mesh::{GridFit, Mesh, UpAxis};
 use crate::ops::csg::BooleanOp;
 use crate::progress::{Observer, Progress, StageTime};
@@ -123,6 +125,8 @@ pub enum Task {
     MeshSurface {
         mesh: MeshSource,
         method: SurfaceMethod,
+        /// The mesh's vertex attributes written beside the voxels.
+        attributes: AttributeChoice,
     },
     /// The separating surface of a closed mesh, checked: the inside centres an exterior flood
     /// reaches through it (none when it separates) and its simple (removable) voxels.
@@ -181,6 +185,8 @@ pub enum Task {
         band: f64,
         signed: bool,
         inside: InsideRule,
+        /// The mesh's vertex attributes written on the band's voxels.
+        attributes: AttributeChoice,
     },
     /// A CSG tree in JSON (see `ops::csg_tree`); the tree sets the grid.
     CsgTree(CsgSource),
@@ -623,9 +629,11 @@ impl PlannedJob {
         let fit = self.job.fit;
         let source = self.job.describe_input();
         match &self.work {
-            Work::MeshSurface { mesh, method } => {
-                outcome::mesh_surface(mesh, t, *method, fit, progress)
-            }
+            Work::MeshSurface {
+                mesh,
+                method,
+                attributes,
+            } => outcome::mesh_surface(mesh, t, *method, attributes, fit, progress),
             Work::SeparationCheck { mesh, options } => {
                 outcome::separation_check(mesh, t, *options, fit, progress)
             }
@@ -671,7 +679,16 @@ impl PlannedJob {
                 band,
                 signed,
                 inside,
-            } => solid::distance_band(mesh, t, *band, *signed, *inside, fit, progress),
+                attributes,
+            } => {
+                let band = solid::BandAsked {
+                    band: *band,
+                    signed: *signed,
+                    inside: *inside,
+                    attributes,
+                };
+                solid::distance_band(mesh, t, band, fit, progress)
+            }
             Work::Solid {
                 mesh,
                 fill,

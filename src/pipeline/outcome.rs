@@ -1,6 +1,7 @@
 //! What a job returns: the main grid, the grids written beside it, the `.vdb` metadata and
 //! the report; and the surface tasks that make them.
 
+use super::attribute_grids::{Carry, add_attributes};
 use super::report::{
     Details, ImplicitDetails, ProjectiveDetails, Report, SeparatingClasses, SeparationCheckDetails,
     SubdivisionDetails, TagSummary,
@@ -21,6 +22,7 @@ use crate::io::vdb::{
     export_contents, is_nvdb, read_vdb_grid, write_contents_timed,
 };
 use crate::io::vox::write_vox;
+use crate::mesh::attributes::{AttributeChoice, AttributeGrid};
 use crate::mesh::{GridFit, Mesh};
 use crate::ops::csg::{BooleanOp, combine as combine_grids, same_transform};
 use crate::ops::csg_normals::boolean_normals;
@@ -48,6 +50,8 @@ pub struct Outcome {
     /// Bool grids written beside it (`shell`, `interior`, `unclassified`,
     /// `opposite_normals`, `level_0` ..), by name.
     pub extra: Vec<(String, SparseGrid)>,
+    /// The input mesh's attributes on the voxels (`uv`, `vertex_normal`, PLY scalars).
+    pub attributes: Vec<AttributeGrid>,
     /// The metadata every written grid carries (`method`, `source_file`, ...).
     pub metadata: Vec<(String, MetaValue)>,
     pub report: Report,
@@ -133,6 +137,7 @@ impl Outcome {
         Outcome {
             grid,
             extra: Vec::new(),
+            attributes: Vec::new(),
             metadata: metadata
                 .into_iter()
                 .map(|(k, v)| (k.to_string(), v))
@@ -150,6 +155,7 @@ impl Outcome {
         let before = self.grid.voxel_count();
         self.grid.clip(keep);
         self.extra.iter_mut().for_each(|(_, g)| g.clip(keep));
+        self.attributes.iter_mut().for_each(|a| a.grid.clip(keep));
         if let Some(interior) = self.distances.as_mut().and_then(|d| d.interior.as_mut()) {
             interior.clip(keep);
         }
@@ -236,6 +242,7 @@ impl Outcome {
         Outcome {
             grid,
             extra: Vec::new(),
+            attributes: Vec::new(),
             metadata: parent.metadata.clone(),
             report,
             distances: None,
@@ -356,10 +363,12 @@ impl Outcome {
                 grid: &self.grid,
                 background: d.background,
                 interior: d.interior.as_ref(),
+                attributes: &self.attributes,
             },
             None => Contents::Voxels {
                 grid: &self.grid,
                 masks: self.extra.iter().map(|(n, g)| (n.as_str(), g)).collect(),
+                attributes: &self.attributes,
             },
         }
     }
@@ -474,14 +483,32 @@ fn projective_outcome(
     Outcome::new(grid, meta, Details::Projective(details))
 }
 
+/// `mesh`'s surface by `method`, with the attributes `chosen` on its voxels.
 pub(super) fn mesh_surface(
+    mesh: &Mesh,
+    t: Transform,
+    method: SurfaceMethod,
+    chosen: &AttributeChoice,
+    fit: GridFit,
+    progress: &Progress,
+) -> Result<Outcome> {
+    let start = Instant::now();
+    let mut outcome = bare_mesh_surface(mesh, t, method, fit, progress)?;
+    let carry = match method {
+        SurfaceMethod::Separating(_) => Carry::Nearest,
+        SurfaceMethod::Projective(_) => Carry::Interpolated,
+    };
+    add_attributes(&mut outcome, mesh, chosen, carry, progress)?;
+    Ok(outcome.timed(start))
+}
+
+fn bare_mesh_surface(
     mesh: &Mesh,
     t: Transform,
     method: SurfaceMethod,
     fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
-    let start = Instant::now();
     let source = mesh.source.display().to_string();
     match method {
         SurfaceMethod::Separating(options) => {
@@ -516,13 +543,13 @@ pub(super) fn mesh_surface(
                     s.degenerate_faces
                 ));
             }
-            Ok(out.timed(start))
+            Ok(out)
         }
         SurfaceMethod::Projective(color) => {
             let coloring = color.coloring(mesh);
             let (grid, s) = projective::voxelize_triangles(mesh, t, coloring, progress)?;
             let meta = provenance("projective-triangles", &source, fit);
-            Ok(projective_outcome(grid, meta, &s, coloring).timed(start))
+            Ok(projective_outcome(grid, meta, &s, coloring))
         }
     }
 }
@@ -539,7 +566,9 @@ pub(super) fn separation_check(
     progress: &Progress,
 ) -> Result<Outcome> {
     mesh.require_closed(CHECK_NEEDS_CLOSED)?;
-    let mut outcome = mesh_surface(mesh, t, SurfaceMethod::Separating(options), fit, progress)?;
+    let method = SurfaceMethod::Separating(options);
+    let none = AttributeChoice::None;
+    let mut outcome = mesh_surface(mesh, t, method, &none, fit, progress)?;
     let adjacency = options.separability.flood_adjacency();
     check_against(&mut outcome, mesh, adjacency, fit)?;
     Ok(outcome)

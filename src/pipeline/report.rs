@@ -51,6 +51,9 @@ pub struct Report {
     pub voxels_outside_bounds: Option<u64>,
     #[serde(flatten)]
     pub details: Details,
+    /// The mesh attributes written as grids: name, how they were carried, voxels.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub attributes: Vec<String>,
     /// What the user should know although the job succeeded.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
@@ -514,6 +517,9 @@ impl Report {
             text.push_str(&format!(
                 "\nwithin bounds: voxels {lo:?} to {hi:?} kept, {out} outside left out"
             ));
+        }
+        if !self.attributes.is_empty() {
+            text.push_str(&format!("\nattributes: {}", self.attributes.join(", ")));
         }
         for w in &self.warnings {
             text.push_str(&format!("\nwarning: {w}"));

@@ -16,6 +16,7 @@ use crate::error::{Error, Result};
 use crate::grid::Adjacency;
 use crate::implicit::{Coordinates, ThetaRange};
 use crate::io::vdb::{Compression, WriteOptions};
+use crate::mesh::attributes::AttributeChoice;
 use crate::mesh::{Aabb, DEFAULT_RESOLUTION, GridFit, UpAxis};
 use crate::ops::csg::BooleanOp;
 use crate::ops::flood_xyz::DEFAULT_GRAYSTACK;
@@ -395,6 +396,12 @@ request! {
         normals: bool = false,
         /// Projective: carry the mesh's vertex colours into a `Cd` grid.
         colors: bool = true,
+        /// The mesh's vertex attributes to write, each as a grid of its name (`uv`,
+        /// `vertex_normal`, a PLY property's name): `["all"]`, `["none"]` or names (none:
+        /// all with the projective method, none otherwise). The projective method
+        /// interpolates them across each triangle; separating surfaces and distance bands
+        /// take each voxel's value at the mesh's nearest point.
+        attributes: Option<Vec<String>> = None,
         /// Projective: one (r, g, b) colour for every voxel instead.
         color: Option<[f32; 3]> = None,
         /// Exact signed distances (a level set) within `band`, signed by `inside`.
@@ -605,13 +612,20 @@ fn color_choice(colors: bool, color: Option<[f32; 3]>) -> ColorChoice {
     }
 }
 
-fn distance_band(mesh: MeshSource, band: f64, signed: bool, inside: InsideRule) -> Result<Task> {
+fn distance_band(
+    mesh: MeshSource,
+    band: f64,
+    signed: bool,
+    inside: InsideRule,
+    attributes: AttributeChoice,
+) -> Result<Task> {
     positive("band", band)?;
     Ok(Task::DistanceBand {
         mesh,
         band,
         signed,
         inside,
+        attributes,
     })
 }
 
@@ -709,6 +723,13 @@ macro_rules! fitted {
 }
 
 impl MeshRequest {
+    /// The attributes asked for, or `default` when none are named.
+    fn attributes_or(&self, default: AttributeChoice) -> AttributeChoice {
+        self.attributes
+            .as_deref()
+            .map_or(default, AttributeChoice::of_names)
+    }
+
     pub fn separating(&self) -> SeparatingOptions {
         SeparatingOptions {
             separability: self.separability,
@@ -729,7 +750,8 @@ impl Request for MeshRequest {
             ));
         }
         if self.sdf || self.udf {
-            return distance_band(mesh, self.band, self.sdf, self.inside);
+            let attributes = self.attributes_or(AttributeChoice::None);
+            return distance_band(mesh, self.band, self.sdf, self.inside, attributes);
         }
         let method = match self.method {
             SurfaceKind::Separating => SurfaceMethod::Separating(self.separating()),
@@ -744,7 +766,15 @@ impl Request for MeshRequest {
                 SurfaceMethod::Projective(color_choice(self.colors, self.color))
             }
         };
-        Ok(Task::MeshSurface { mesh, method })
+        let attributes = self.attributes_or(match method {
+            SurfaceMethod::Projective(_) => AttributeChoice::All,
+            SurfaceMethod::Separating(_) => AttributeChoice::None,
+        });
+        Ok(Task::MeshSurface {
+            mesh,
+            method,
+            attributes,
+        })
     }
 }
 
@@ -764,7 +794,7 @@ impl Request for SolidRequest {
 
     fn task(&self, mesh: MeshSource) -> Result<Task> {
         if self.sdf {
-            return distance_band(mesh, self.band, true, self.inside);
+            return distance_band(mesh, self.band, true, self.inside, AttributeChoice::None);
         }
         positive("density", self.density)?;
         let fill = match self.method {

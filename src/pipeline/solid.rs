@@ -2,6 +2,7 @@
 //! distance band, measure a mesh or a `.vdb` surface, evaluate a CSG tree; with volumes,
 //! mass, components and genus.
 
+use super::attribute_grids::{Carry, add_attributes};
 use super::outcome::{Distances, Outcome};
 use super::outcome::{provenance, tag_metadata};
 use super::report::{
@@ -13,6 +14,7 @@ use crate::contour::ExactSurface;
 use crate::error::Result;
 use crate::grid::{DenseMask, SparseGrid, Transform};
 use crate::io::vdb::{MetaValue, NORMAL_GRID, SHELL_GRID};
+use crate::mesh::attributes::AttributeChoice;
 use crate::mesh::segment_hits::MeshHits;
 use crate::mesh::{GridFit, Mesh, index_box};
 use crate::progress::Progress;
@@ -257,16 +259,29 @@ pub(super) fn mesh_solid(
     Ok(outcome.timed(start))
 }
 
+/// What a distance band job asks for.
+pub(super) struct BandAsked<'a> {
+    /// Half width in voxels.
+    pub band: f64,
+    pub signed: bool,
+    pub inside: InsideRule,
+    pub attributes: &'a AttributeChoice,
+}
+
 pub(super) fn distance_band(
     mesh: &Arc<Mesh>,
     t: Transform,
-    band: f64,
-    signed: bool,
-    inside: InsideRule,
+    asked: BandAsked,
     fit: GridFit,
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
+    let BandAsked {
+        band,
+        signed,
+        inside,
+        attributes,
+    } = asked;
     let (grid, interior, choice, ambiguous) = if signed {
         let choice = choose_inside(inside, mesh, SIGN_NEEDS_CLOSED)?;
         let set = level_set(mesh, t, band, &choice.inside, progress)?;
@@ -310,6 +325,7 @@ pub(super) fn distance_band(
         background: background as f32,
         interior,
     });
+    add_attributes(&mut outcome, mesh, attributes, Carry::Nearest, progress)?;
     Ok(with_ambiguous(outcome, ambiguous).timed(start))
 }
 

@@ -1,8 +1,9 @@
 //! Projective voxelization (Jegathese, Painkras & Prakash, "Fundamental Algorithms for
 //! Projective Voxelization"): lines by marching their dominant axis (`line`), triangles by
 //! scan-lines in the plane of their dominant normal component (`triangle`), polyhedra as the
-//! beam of voxels between front and back faces (`beam`), each carrying an attribute (colour)
-//! by the same increments as the coordinates.
+//! beam of voxels between front and back faces (`beam`), each carrying an attribute (a
+//! colour, or a vertex attribute of the mesh: `interpolate_attribute`) by the same increments
+//! as the coordinates.
 //!
 //! Every primitive is scanned on its own, in parallel chunks into thread-local grids; where
 //! several primitives reach a voxel, its colour is the one of the sample nearest to the voxel
@@ -21,6 +22,7 @@ use super::sink::{Sink, voxelize_indexed, voxelize_parallel};
 use crate::error::{Error, Result};
 use crate::grid::{Channels, SparseGrid, Transform};
 use crate::mesh::Mesh;
+use crate::mesh::attributes::{AttributeGrid, VertexAttribute};
 use attribute::Attribute;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -130,15 +132,12 @@ pub fn voxelize_triangles(
     let pos = index_positions(mesh, &transform);
     let degenerate = AtomicU64::new(0);
     let grid = match vertex_colors(mesh, coloring)? {
-        None => scan_faces(
-            mesh,
-            &pos,
-            &vec![(); pos.len()],
-            transform,
-            &degenerate,
-            progress,
-        ),
-        Some(colors) => scan_faces(mesh, &pos, &colors, transform, &degenerate, progress),
+        None => scan_faces(mesh, &pos, |_| [(); 3], transform, &degenerate, progress),
+        Some(colors) => {
+            let corner = |s: usize| colors[mesh.indices[s] as usize];
+            let values = |slots: [usize; 3]| slots.map(corner);
+            scan_faces(mesh, &pos, values, transform, &degenerate, progress)
+        }
     };
     progress.check()?;
     let stats = ProjectiveStats {
@@ -149,12 +148,31 @@ pub fn voxelize_triangles(
     Ok((grid, stats))
 }
 
-/// Scans the fan triangles of every face, counting those without area in `degenerate`;
+/// Interpolates `attribute` of `mesh` across every triangle by the scan that voxelizes it
+/// (the triangle's affine interpolant at each voxel's projection along its dominant axis);
+/// where several triangles reach a voxel, the value of the sample nearest its centre.
 /// `progress` counts faces.
+pub fn interpolate_attribute(
+    mesh: &Mesh,
+    transform: Transform,
+    attribute: &VertexAttribute,
+    progress: &Progress,
+) -> Result<AttributeGrid> {
+    let pos = index_positions(mesh, &transform);
+    let values = |slots: [usize; 3]| mesh.attribute_corners(attribute, slots);
+    let degenerate = AtomicU64::new(0);
+    let grid = scan_faces(mesh, &pos, values, transform, &degenerate, progress);
+    progress.check()?;
+    Ok(AttributeGrid::finished(attribute, grid))
+}
+
+/// Scans the fan triangles of every face, each with the values `corner_values` gives its
+/// corners (by their positions in `Mesh::indices`), counting triangles without area in
+/// `degenerate`; `progress` counts faces.
 fn scan_faces<A: Deposit>(
     mesh: &Mesh,
     pos: &[DVec3],
-    attrs: &[A],
+    corner_values: impl Fn([usize; 3]) -> [A; 3] + Sync,
     transform: Transform,
     degenerate: &AtomicU64,
     progress: &Progress,
@@ -165,10 +183,10 @@ fn scan_faces<A: Deposit>(
         A::channels(),
         progress,
         |f, sink| {
-            for t in mesh.fan(f) {
+            for slots in mesh.fan_corners(f) {
                 let flat = triangle::voxelize_triangle(
-                    t.map(|i| pos[i as usize]),
-                    t.map(|i| attrs[i as usize]),
+                    slots.map(|s| pos[mesh.indices[s] as usize]),
+                    corner_values(slots),
                     |v, d, a: A| a.deposit(sink, v, d),
                 );
                 if flat {

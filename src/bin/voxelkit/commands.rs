@@ -11,6 +11,7 @@ use voxelkit::grid::{CoordBox, Transform};
 use voxelkit::implicit::Formula;
 use voxelkit::io::brick_set::{BrickSet, is_brick_set};
 use voxelkit::io::vdb::{DENSITY_GRID, VOXELS_GRID, read_vdb_info};
+use voxelkit::mesh::attributes::AttributeChoice;
 use voxelkit::mesh::{GridFit, generate};
 use voxelkit::ops::separability::check_mesh_separation;
 use voxelkit::pipeline::request::ImplicitRequest;
@@ -167,6 +168,7 @@ fn surface_job(mesh: MeshSource, fit: FitArgs, surface: SurfaceArgs) -> Result<J
         Task::MeshSurface {
             mesh,
             method: SurfaceMethod::Separating(surface.separating()),
+            attributes: AttributeChoice::None,
         },
         fit.grid_fit()?,
     ))
@@ -178,6 +180,7 @@ pub fn mesh(
     inputs: &[PathBuf],
     projective: bool,
     color: &crate::projective::ColorArgs,
+    attributes: Option<Vec<String>>,
     distance: &DistanceArgs,
     fit: FitArgs,
     surface: SurfaceArgs,
@@ -198,6 +201,7 @@ pub fn mesh(
         },
         colors,
         color,
+        attributes,
         sdf: distance.sdf,
         udf: distance.udf,
         band: distance.band,

@@ -165,6 +165,14 @@ enum Command {
         method: SurfaceKind,
         #[command(flatten)]
         color: projective::ColorArgs,
+        /// The mesh's vertex attributes to write, each as a grid of its name: `all`, `none`
+        /// or names, comma-separated (`uv,vertex_normal`): OBJ `vt` as `uv` and `vn` as
+        /// `vertex_normal`, PLY normals and texture coordinates the same, other PLY vertex
+        /// properties by their names. --method projective interpolates them across each
+        /// triangle; the separating surface and --sdf/--udf take each voxel's value at the
+        /// mesh's nearest point [default: all with --method projective, none otherwise]
+        #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+        attributes: Option<Vec<String>>,
         #[command(flatten)]
         distance: commands::DistanceArgs,
         #[command(flatten)]
@@ -309,6 +317,7 @@ fn main() -> ExitCode {
             inputs,
             method,
             color,
+            attributes,
             distance,
             fit,
             surface,
@@ -318,6 +327,7 @@ fn main() -> ExitCode {
             &inputs,
             method == SurfaceKind::Projective,
             &color,
+            attributes,
             &distance,
             fit,
             surface,

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use voxelkit::Result;
 use voxelkit::io::vdb::read_vdb_grid;
 use voxelkit::mesh::GridFit;
+use voxelkit::mesh::attributes::AttributeChoice;
 use voxelkit::ops::csg::BooleanOp;
 use voxelkit::pipeline::batch::shared_placement;
 use voxelkit::pipeline::request::{FillKind, FloodKind, MeasureRequest, Request, SolidRequest};
@@ -287,6 +288,7 @@ pub fn intersect(args: &IntersectArgs, global: &Global) -> Result<()> {
                 let task = Task::MeshSurface {
                     mesh: MeshSource::File(p.clone()),
                     method: SurfaceMethod::Separating(args.surface.separating()),
+                    attributes: AttributeChoice::None,
                 };
                 Ok(GridSource::Grid(
                     run_job(Job::new(task, fit), None, global)?.grid,

@@ -5,6 +5,8 @@ use glam::DVec3;
 
 /// A value interpolated linearly along lines and across triangles.
 pub trait Attribute: Copy + Send + Sync {
+    /// Whether values are carried: which of several samples of a voxel is kept then matters.
+    const CARRIED: bool = true;
     fn add(self, d: Self) -> Self;
     fn sub(self, o: Self) -> Self;
     fn scale(self, s: f64) -> Self;
@@ -17,6 +19,7 @@ pub trait Attribute: Copy + Send + Sync {
 
 /// No attribute: the scan compiles down to coordinates only.
 impl Attribute for () {
+    const CARRIED: bool = false;
     #[inline]
     fn add(self, _: Self) -> Self {}
     #[inline]

@@ -17,7 +17,11 @@
 //!   both emit its voxels (the grid keeps one, with the attribute of the nearer sample). Nothing
 //!   between them is left uncovered.
 //! - The attribute is the triangle's affine interpolant at the voxel's projection onto the
-//!   plane along the dominant axis, held within the range of the vertex values.
+//!   plane along the dominant axis, held within the range of the vertex values. Where several
+//!   triangles reach a voxel, the grid keeps the sample nearest the voxel's centre: how far the
+//!   plane lies along the dominant axis (before it is held within the triangle's range), plus
+//!   how far the projection lies outside the triangle, so that a triangle's own value beats a
+//!   neighbour's extrapolated one.
 //! - A triangle without area (the sine of an angle below 1e-9) is voxelized as its longest edge.
 
 use super::attribute::Attribute;
@@ -68,6 +72,7 @@ fn scan<const W: usize, A: Attribute>(
     let gradient = attribute_gradient(p, c, u, v);
     let (c_lo, c_hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
     let q = p.map(|x| [x[u], x[v]]);
+    let outside = A::CARRIED.then(|| Outside::new(q));
     let (j0, j1) = (
         round(q[0][1].min(q[1][1]).min(q[2][1])),
         round(q[0][1].max(q[1][1]).max(q[2][1])),
@@ -95,9 +100,10 @@ fn scan<const W: usize, A: Attribute>(
             voxel[u] = i;
             voxel[v] = j;
             voxel[W] = k;
+            let beyond = outside.as_ref().map_or(0.0, |o| o.at(i as f64, j as f64));
             emit(
                 voxel,
-                (held - k as f64).abs(),
+                (depth - k as f64).abs() + beyond,
                 attr.clamp_between(c_lo, c_hi),
             );
             depth += dw_du;
@@ -166,6 +172,38 @@ impl Sides {
             right = right.max(m[0]);
         }
         (left, right)
+    }
+}
+
+/// How far a point of the projection plane lies outside the projected triangle: the largest
+/// distance beyond one of its edges' lines (0 inside).
+struct Outside {
+    /// Per edge: its inward unit normal `(nu, nv)` and offset, `nu * u + nv * v + offset`
+    /// being the signed distance inside.
+    edges: [[f64; 3]; 3],
+}
+
+impl Outside {
+    #[inline]
+    fn new(q: [[f64; 2]; 3]) -> Self {
+        let area =
+            (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]);
+        let sign = area.signum();
+        let edges = [(0, 1), (1, 2), (2, 0)].map(|(a, b)| {
+            let (du, dv) = (q[b][0] - q[a][0], q[b][1] - q[a][1]);
+            let length = du.hypot(dv).max(f64::MIN_POSITIVE);
+            let (nu, nv) = (-dv * sign / length, du * sign / length);
+            [nu, nv, -(nu * q[a][0] + nv * q[a][1])]
+        });
+        Outside { edges }
+    }
+
+    #[inline]
+    fn at(&self, u: f64, v: f64) -> f64 {
+        self.edges
+            .iter()
+            .map(|[nu, nv, c]| -(nu * u + nv * v + c))
+            .fold(0.0, f64::max)
     }
 }
 

@@ -1,0 +1,70 @@
+//! The input mesh's vertex attributes on a job's voxels: interpolated by the projective scan,
+//! or taken from the mesh's nearest point (separating surfaces, distance bands), each written
+//! as a grid of its own name, renamed `vertex_NAME` where that name is one of the job's own.
+
+use super::Outcome;
+use crate::error::Result;
+use crate::io::vdb::{
+    COLOR_GRID, DENSITY_GRID, DISTANCE_GRID, LEVEL_SET_GRID, NORMAL_GRID, VOXELS_GRID,
+};
+use crate::mesh::Mesh;
+use crate::mesh::attributes::AttributeChoice;
+use crate::mesh::nearest_attributes::carry_nearest;
+use crate::progress::Progress;
+use crate::voxelize::projective::interpolate_attribute;
+
+/// How attribute values reach the voxels.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Carry {
+    /// Across each triangle by the projective scan.
+    Interpolated,
+    /// From the point of the mesh nearest each voxel's centre.
+    Nearest,
+}
+
+/// Grid names a job writes of its own.
+const OWN_GRIDS: [&str; 6] = [
+    DENSITY_GRID,
+    VOXELS_GRID,
+    NORMAL_GRID,
+    COLOR_GRID,
+    LEVEL_SET_GRID,
+    DISTANCE_GRID,
+];
+
+/// Adds the attributes of `mesh` that `chosen` names to `outcome`, on its voxels.
+pub(super) fn add_attributes(
+    outcome: &mut Outcome,
+    mesh: &Mesh,
+    chosen: &AttributeChoice,
+    carry: Carry,
+    progress: &Progress,
+) -> Result<()> {
+    let attributes = chosen.select(mesh)?;
+    if attributes.is_empty() {
+        return Ok(());
+    }
+    let grids = match carry {
+        Carry::Interpolated => attributes
+            .iter()
+            .map(|a| interpolate_attribute(mesh, outcome.grid.transform, a, progress))
+            .collect::<Result<Vec<_>>>()?,
+        Carry::Nearest => carry_nearest(mesh, &outcome.grid, &attributes, progress)?,
+    };
+    let how = match carry {
+        Carry::Interpolated => "interpolated across triangles",
+        Carry::Nearest => "from the nearest point",
+    };
+    for mut grid in grids {
+        if OWN_GRIDS.contains(&grid.name.as_str()) {
+            grid.name = format!("vertex_{}", grid.name);
+        }
+        outcome.report.attributes.push(format!(
+            "{} ({how}, {} voxels)",
+            grid.name,
+            grid.grid.voxel_count()
+        ));
+        outcome.attributes.push(grid);
+    }
+    Ok(())
+}
