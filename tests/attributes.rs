@@ -300,6 +300,25 @@ fn files_attributes_reach_their_grids_and_openvdb_reads_them() {
         .collect();
     assert!(values.iter().all(|v| (1.0..=4.0).contains(v)));
     assert!(values.iter().any(|&v| v < 1.5) && values.iter().any(|&v| v > 3.5));
+    // Vertex colours travel to the separating surface as `Cd`, from the nearest point.
+    let coloured = dir.path().join("coloured.obj");
+    std::fs::write(
+        &coloured,
+        "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nv 0 0 1 1 1 1\n\
+         f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n",
+    )
+    .unwrap();
+    let (colours, summary) = written(&coloured, "coloured.vdb", &["--attributes", "Cd"]);
+    assert!(
+        summary.contains("Cd (from the nearest point") && !summary.contains("warning"),
+        "{summary}"
+    );
+    let cd = voxelkit::io::vdb::read_vdb_grid(&colours, Some("Cd")).unwrap();
+    assert!(cd.voxel_count() > 1000);
+    assert!(cd.leaves().iter().all(|l| l.offsets().all(|n| {
+        let c = l.color.as_ref().unwrap()[n];
+        c.iter().all(|v| (0.0..=1.0).contains(v)) && c.iter().sum::<f32>() >= 1.0 - 1e-5
+    })));
     #[cfg(feature = "vdb")]
     for (file, grid) in [
         (&seam, "uv"),

@@ -223,7 +223,9 @@ fn candidates<'g>(
     for a in contents.attributes() {
         let (values, vector_type) = match a.kind {
             AttributeKind::Scalar => (GridValues::Distances { background: 0.0 }, None),
-            AttributeKind::TextureCoordinates => (GridValues::Colors, Some("invariant")),
+            AttributeKind::TextureCoordinates | AttributeKind::Color => {
+                (GridValues::Colors, Some("invariant"))
+            }
             AttributeKind::Normal => (GridValues::Colors, Some(COVARIANT_NORMALIZE)),
         };
         grids.push(GridOut {

@@ -8,6 +8,7 @@ use super::Mesh;
 use crate::error::{Error, Result};
 use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 
 /// How an attribute's values are written and turned.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -18,7 +19,12 @@ pub enum AttributeKind {
     TextureCoordinates,
     /// Unit normals, renormalized after interpolation (a Vec3SGrid of covariant normals).
     Normal,
+    /// Vertex colours (a Vec3SGrid `Cd`, as the projective method writes its own).
+    Color,
 }
+
+/// The name vertex colours take as an attribute carried from the nearest point.
+pub const COLOR_ATTRIBUTE: &str = "Cd";
 
 /// One attribute: its values, and which value each face corner takes.
 #[derive(Clone, Debug, PartialEq)]
@@ -76,33 +82,43 @@ impl AttributeChoice {
         }
     }
 
-    /// The attributes of `mesh` chosen; a name the mesh does not carry is refused, naming the
-    /// file and what it carries.
-    pub fn select<'m>(&self, mesh: &'m Mesh) -> Result<Vec<&'m VertexAttribute>> {
+    /// The attributes of `mesh` chosen, its vertex colours among them (as `Cd`) when
+    /// `colours`; a name the mesh does not carry is refused, naming the file and what it
+    /// carries.
+    pub fn select<'m>(
+        &self,
+        mesh: &'m Mesh,
+        colours: bool,
+    ) -> Result<Vec<Cow<'m, VertexAttribute>>> {
+        let colour = colours.then(|| mesh.color_attribute()).flatten();
+        let carried: Vec<Cow<VertexAttribute>> = mesh
+            .attributes
+            .iter()
+            .map(Cow::Borrowed)
+            .chain(colour.map(Cow::Owned))
+            .collect();
         match self {
             AttributeChoice::None => Ok(Vec::new()),
-            AttributeChoice::All => Ok(mesh.attributes.iter().collect()),
-            AttributeChoice::Named(names) => names
-                .iter()
-                .map(|name| {
-                    mesh.attributes
-                        .iter()
-                        .find(|a| &a.name == name)
-                        .ok_or_else(|| {
-                            let carried: Vec<&str> =
-                                mesh.attributes.iter().map(|a| a.name.as_str()).collect();
-                            Error::InvalidArgument(format!(
-                                "{}: the mesh carries no attribute `{name}`; it carries {}",
-                                mesh.source.display(),
-                                if carried.is_empty() {
-                                    "none".to_string()
-                                } else {
-                                    carried.join(", ")
-                                }
-                            ))
-                        })
-                })
-                .collect(),
+            AttributeChoice::All => Ok(carried),
+            AttributeChoice::Named(names) => {
+                let mut chosen = Vec::new();
+                for name in names {
+                    let Some(a) = carried.iter().find(|a| &a.name == name) else {
+                        let names: Vec<&str> = carried.iter().map(|a| a.name.as_str()).collect();
+                        return Err(Error::InvalidArgument(format!(
+                            "{}: the mesh carries no attribute `{name}`; it carries {}",
+                            mesh.source.display(),
+                            if names.is_empty() {
+                                "none".to_string()
+                            } else {
+                                names.join(", ")
+                            }
+                        )));
+                    };
+                    chosen.push(a.clone());
+                }
+                Ok(chosen)
+            }
         }
     }
 }
@@ -140,6 +156,16 @@ impl Mesh {
             }
         }
         Ok(())
+    }
+
+    /// The vertex colours as an attribute, when the mesh has them.
+    pub fn color_attribute(&self) -> Option<VertexAttribute> {
+        (!self.colors.is_empty()).then(|| VertexAttribute {
+            name: COLOR_ATTRIBUTE.into(),
+            kind: AttributeKind::Color,
+            values: self.colors.clone(),
+            corners: Vec::new(),
+        })
     }
 
     /// The values of attribute `a` at the corners of fan triangle `slots` (positions in

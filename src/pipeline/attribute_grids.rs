@@ -1,14 +1,15 @@
 //! The input mesh's vertex attributes on a job's voxels: interpolated by the projective scan,
 //! or taken from the mesh's nearest point (separating surfaces, distance bands), each written
 //! as a grid of its own name, renamed `vertex_NAME` where that name is one of the job's own.
+//! Vertex colours travel as the attribute `Cd` where the job does not write them itself.
 
-use super::Outcome;
+use super::{Outcome, SurfaceMethod};
 use crate::error::Result;
 use crate::io::vdb::{
     COLOR_GRID, DENSITY_GRID, DISTANCE_GRID, LEVEL_SET_GRID, NORMAL_GRID, VOXELS_GRID,
 };
 use crate::mesh::Mesh;
-use crate::mesh::attributes::AttributeChoice;
+use crate::mesh::attributes::{AttributeChoice, AttributeKind, VertexAttribute};
 use crate::mesh::nearest_attributes::carry_nearest;
 use crate::progress::Progress;
 use crate::voxelize::projective::interpolate_attribute;
@@ -20,6 +21,22 @@ pub(super) enum Carry {
     Interpolated,
     /// From the point of the mesh nearest each voxel's centre.
     Nearest,
+}
+
+impl Carry {
+    /// How `method` carries attributes.
+    pub(super) fn of(method: &SurfaceMethod) -> Carry {
+        match method {
+            SurfaceMethod::Separating(_) => Carry::Nearest,
+            SurfaceMethod::Projective(_) => Carry::Interpolated,
+        }
+    }
+
+    /// Whether vertex colours travel as an attribute (`Cd`): the projective method writes them
+    /// as its own colour grid instead.
+    pub(super) fn carries_colours(self) -> bool {
+        self == Carry::Nearest
+    }
 }
 
 /// Grid names a job writes of its own.
@@ -40,7 +57,7 @@ pub(super) fn add_attributes(
     carry: Carry,
     progress: &Progress,
 ) -> Result<()> {
-    let attributes = chosen.select(mesh)?;
+    let attributes = chosen.select(mesh, carry.carries_colours())?;
     if attributes.is_empty() {
         return Ok(());
     }
@@ -49,14 +66,18 @@ pub(super) fn add_attributes(
             .iter()
             .map(|a| interpolate_attribute(mesh, outcome.grid.transform, a, progress))
             .collect::<Result<Vec<_>>>()?,
-        Carry::Nearest => carry_nearest(mesh, &outcome.grid, &attributes, progress)?,
+        Carry::Nearest => {
+            let attributes: Vec<&VertexAttribute> = attributes.iter().map(|a| &**a).collect();
+            carry_nearest(mesh, &outcome.grid, &attributes, progress)?
+        }
     };
     let how = match carry {
         Carry::Interpolated => "interpolated across triangles",
         Carry::Nearest => "from the nearest point",
     };
     for mut grid in grids {
-        if OWN_GRIDS.contains(&grid.name.as_str()) {
+        let own = grid.kind != AttributeKind::Color && OWN_GRIDS.contains(&grid.name.as_str());
+        if own {
             grid.name = format!("vertex_{}", grid.name);
         }
         outcome.report.attributes.push(format!(

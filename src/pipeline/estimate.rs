@@ -9,6 +9,7 @@
 //! A surface of area A (in voxels) crosses about A/32 leaves; a solid is assumed to fill half
 //! its box.
 
+use super::attribute_grids::Carry;
 use super::load::Work;
 use super::{
     BrickStage, BrickTask, Fill, Plan, Shape, ShapeTask, SubdivisionOutput, SurfaceMethod,
@@ -211,8 +212,10 @@ fn surface_leaves(area: f64) -> f64 {
 const NEAREST_TRIANGLE_BYTES: f64 = 180.0;
 
 /// The attributes `chosen` writes of `mesh`: each a grid with a value and a vector channel.
-fn attribute_count(mesh: &Mesh, chosen: &AttributeChoice) -> u32 {
-    chosen.select(mesh).map_or(0, |a| a.len() as u32)
+fn attribute_count(mesh: &Mesh, chosen: &AttributeChoice, carry: Carry) -> u32 {
+    chosen
+        .select(mesh, carry.carries_colours())
+        .map_or(0, |a| a.len() as u32)
 }
 
 /// The nearest-point tree of `mesh` when `carried` attributes are taken from it.
@@ -525,7 +528,7 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
                     (u32::from(colour), mesh.face_count() as u64)
                 }
             };
-            let carried = attribute_count(mesh, attributes);
+            let carried = attribute_count(mesh, attributes, Carry::of(method));
             let bytes = mesh_surface_bytes(mesh, &t, channels + carried)
                 + nearest_tree_bytes(
                     mesh,
@@ -549,7 +552,7 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
             } else {
                 UNSIGNED_BAND_LEAF_BYTES
             };
-            let carried = attribute_count(mesh, attributes);
+            let carried = attribute_count(mesh, attributes, Carry::Nearest);
             let bytes = leaves * per_leaf
                 + mesh.triangle_count() as f64 * BAND_TRIANGLE_BYTES
                 + surface_leaf_bytes(leaves, carried)

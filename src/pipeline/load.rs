@@ -2,6 +2,7 @@
 //! grids), each kept beside the options that act on it, so that pricing and running match
 //! one enum and never a task against what was loaded for it.
 
+use super::attribute_grids::Carry;
 use super::{
     BrickStage, BrickTask, CsgSource, Fill, GridSource, MeasureSource, MeshSource, ShapeTask,
     SubdivisionOutput, SurfaceMethod, Task, lines_source,
@@ -10,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::grid::SparseGrid;
 use crate::implicit::Formula;
 use crate::io::vdb::{NORMAL_GRID, SHELL_GRID, read_vdb_grid, read_vdb_info, read_vdb_solid};
-use crate::mesh::attributes::AttributeChoice;
+use crate::mesh::attributes::{AttributeChoice, AttributeKind};
 use crate::mesh::{Mesh, UpAxis};
 use crate::ops::csg::BooleanOp;
 use crate::solids::csg_tree::{CsgTree, parse_csg_tree, read_csg_tree};
@@ -99,7 +100,8 @@ impl Work {
     /// it does not choose, and its vertex colours unless the job colours its voxels with them.
     pub(super) fn unwritten_attributes(&self) -> Option<String> {
         let none = AttributeChoice::None;
-        let (mesh, colours_kept, chosen): (&Mesh, bool, &AttributeChoice) = match self {
+        let (mesh, colours_kept, chosen, carry): (&Mesh, bool, &AttributeChoice, Carry) = match self
+        {
             Work::MeshSurface {
                 mesh,
                 method,
@@ -111,17 +113,26 @@ impl Work {
                     SurfaceMethod::Projective(super::ColorChoice::FromMesh)
                 ),
                 attributes,
+                Carry::of(method),
             ),
-            Work::Lines { mesh, coloring, .. } => (mesh, *coloring == Coloring::Vertex, &none),
+            Work::Lines { mesh, coloring, .. } => (
+                mesh,
+                *coloring == Coloring::Vertex,
+                &none,
+                Carry::Interpolated,
+            ),
             Work::DistanceBand {
                 mesh, attributes, ..
-            } => (mesh, false, attributes),
+            } => (mesh, false, attributes, Carry::Nearest),
             Work::SeparationCheck { mesh, .. }
             | Work::Solid { mesh, .. }
-            | Work::MeasureMesh { mesh, .. } => (mesh, false, &none),
+            | Work::MeasureMesh { mesh, .. } => (mesh, false, &none, Carry::Nearest),
             _ => return None,
         };
-        let written = chosen.select(mesh).unwrap_or_default();
+        let written = chosen
+            .select(mesh, carry.carries_colours())
+            .unwrap_or_default();
+        let colours_kept = colours_kept || written.iter().any(|a| a.kind == AttributeKind::Color);
         let mut unwritten: Vec<String> = mesh
             .attributes
             .iter()
@@ -140,7 +151,7 @@ impl Work {
                 mesh.source.display(),
                 unwritten.join(", "),
                 if colours_dropped {
-                    ", vertex colours as `Cd` with --method projective or `lines`"
+                    ", vertex colours as `Cd` with --method projective, `lines` or `mesh --attributes Cd`"
                 } else {
                     ""
                 },
@@ -156,7 +167,7 @@ impl Work {
 
 /// `mesh`, refused before any work when it lacks an attribute `chosen` names.
 fn with_attributes(mesh: Mesh, chosen: &AttributeChoice) -> Result<Mesh> {
-    chosen.select(&mesh)?;
+    chosen.select(&mesh, true)?;
     Ok(mesh)
 }
 

@@ -494,11 +494,7 @@ pub(super) fn mesh_surface(
 ) -> Result<Outcome> {
     let start = Instant::now();
     let mut outcome = bare_mesh_surface(mesh, t, method, fit, progress)?;
-    let carry = match method {
-        SurfaceMethod::Separating(_) => Carry::Nearest,
-        SurfaceMethod::Projective(_) => Carry::Interpolated,
-    };
-    add_attributes(&mut outcome, mesh, chosen, carry, progress)?;
+    add_attributes(&mut outcome, mesh, chosen, Carry::of(&method), progress)?;
     Ok(outcome.timed(start))
 }
 

@@ -397,7 +397,8 @@ request! {
         /// Projective: carry the mesh's vertex colours into a `Cd` grid.
         colors: bool = true,
         /// The mesh's vertex attributes to write, each as a grid of its name (`uv`,
-        /// `vertex_normal`, a PLY property's name): `["all"]`, `["none"]` or names (none:
+        /// `vertex_normal`, a PLY property's name, `Cd` for vertex colours where the method
+        /// does not colour its voxels itself): `["all"]`, `["none"]` or names (none:
         /// all with the projective method, none otherwise). The projective method
         /// interpolates them across each triangle; separating surfaces and distance bands
         /// take each voxel's value at the mesh's nearest point.

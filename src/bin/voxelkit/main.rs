@@ -168,7 +168,8 @@ enum Command {
         /// The mesh's vertex attributes to write, each as a grid of its name: `all`, `none`
         /// or names, comma-separated (`uv,vertex_normal`): OBJ `vt` as `uv` and `vn` as
         /// `vertex_normal`, PLY normals and texture coordinates the same, other PLY vertex
-        /// properties by their names. --method projective interpolates them across each
+        /// properties by their names, vertex colours as `Cd` (--method projective writes
+        /// those by its colour options). --method projective interpolates them across each
         /// triangle; the separating surface and --sdf/--udf take each voxel's value at the
         /// mesh's nearest point [default: all with --method projective, none otherwise]
         #[arg(long, value_delimiter = ',', value_name = "NAMES")]
