@@ -224,3 +224,46 @@ fn shape_formula_on_the_command_line_equals_shape_sphere() {
     assert!(!bad.status.success());
     assert!(text(&bad).contains("column"), "{}", text(&bad));
 }
+
+/// `intersect --formula A --formula B`: the common voxels of two formula surfaces made on one
+/// grid, a sphere of radius 0.8 and the plane z = 0.3x, form one closed curve (a single
+/// 26-component) whose voxels all lie near both surfaces.
+#[test]
+fn two_formula_surfaces_meet_in_one_curve() {
+    use voxelkit::grid::{Adjacency, DenseMask};
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("circle.vdb");
+    let o = voxelkit(&[
+        "intersect",
+        "--formula",
+        "sqrt(x^2 + y^2 + z^2) - 0.8",
+        "--formula",
+        "z - 0.3*x",
+        "-r",
+        "96",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let grid = voxelkit::io::vdb::read_vdb_grid(&out, None).unwrap();
+    let mask = DenseMask::from_grid(&grid, grid.bbox().unwrap()).unwrap();
+    assert_eq!(
+        voxelkit::ops::topology::components(&mask, Adjacency::TwentySix),
+        1
+    );
+    let h = grid.transform.voxel_size;
+    // The circle is 2 pi 0.8 long: at least one voxel per voxel of length.
+    assert!(grid.voxel_count() as f64 > 2.0 * std::f64::consts::PI * 0.8 / h);
+    for leaf in grid.leaves() {
+        for c in leaf.coords() {
+            let p = grid.transform.index_to_world(c);
+            assert!((p.length() - 0.8).abs() < h, "{p} off the sphere");
+            assert!(
+                (p.z - 0.3 * p.x).abs() / 1.09f64.sqrt() < h,
+                "{p} off the plane"
+            );
+        }
+    }
+    let o = voxelkit(&["intersect", "--formula", "x", "-o", out.to_str().unwrap()]);
+    assert!(!o.status.success() && text(&o).contains("two or more surfaces"));
+}

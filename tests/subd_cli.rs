@@ -347,6 +347,27 @@ fn catmull_clark_surfaces_on_one_grid_meet_in_whole_curves() {
         assert!(loops >= 2);
         assert_eq!(pieces, loops as u64, "{a} x {b}: {voxels} voxels");
     }
+    // `intersect --subdiv` makes the enclosed surfaces on one grid itself: the same curve.
+    let direct = dir.path().join("direct.vdb");
+    let o = voxelkit(&[
+        "intersect",
+        "--subdiv",
+        subd("catmark_torus").to_str().unwrap(),
+        subd("catmark_cube").to_str().unwrap(),
+        "-r",
+        "128",
+        "-o",
+        direct.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let two_steps = dir.path().join("catmark_torus-catmark_cube-1/curve.vdb");
+    let coords = |p: &std::path::Path| {
+        let g = read_vdb_grid(p, None).unwrap();
+        let mut c: Vec<[i64; 3]> = g.leaves().iter().flat_map(|l| l.coords()).collect();
+        c.sort();
+        c
+    };
+    assert_eq!(coords(&direct), coords(&two_steps));
     let (default_voxels, default_pieces) = components("catmark_torus", "catmark_cube", &[]);
     eprintln!("torus x cube, default: {default_voxels} voxels in {default_pieces} pieces");
     assert!(default_pieces > 2);

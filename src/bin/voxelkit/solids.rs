@@ -4,18 +4,24 @@ use crate::FitArgs;
 use crate::run::{Global, run_and_report, run_job};
 use clap::Args;
 use std::path::PathBuf;
-use voxelkit::Result;
+use voxelkit::implicit::{Coordinates, Formula, ThetaRange};
 use voxelkit::io::vdb::read_vdb_grid;
 use voxelkit::mesh::GridFit;
 use voxelkit::mesh::attributes::AttributeChoice;
+use voxelkit::mesh::fit_transform;
 use voxelkit::ops::csg::BooleanOp;
 use voxelkit::pipeline::batch::shared_placement;
+use voxelkit::pipeline::request::ImplicitRequest;
 use voxelkit::pipeline::request::{FillKind, FloodKind, MeasureRequest, Request, SolidRequest};
 use voxelkit::pipeline::{
-    CsgSource, GridSource, Job, MeasureSource, MeshSource, SurfaceMethod, Task,
+    CsgSource, GridSource, Job, MeasureSource, MeshSource, Shape, ShapeTask, SubdivisionOutput,
+    SurfaceMethod, Task,
 };
 use voxelkit::solids::beam::BeamFill;
 use voxelkit::solids::inside_rule::InsideRule;
+use voxelkit::voxelize::parametric::ParametricOptions;
+use voxelkit::voxelize::separating_formula::FormulaSurface;
+use voxelkit::{Error, Result};
 
 /// How the exterior is flooded.
 #[derive(Args, Clone, Copy)]
@@ -158,14 +164,23 @@ pub struct CsgArgs {
 
 #[derive(Args)]
 pub struct IntersectArgs {
-    /// Surfaces, two or more: .vdb grids made on one grid (`--shared-grid`, or resampled onto
-    /// the first's with --resample), and meshes (.obj, .stl, .ply, .off, .gltf, .glb),
-    /// voxelized here as separating surfaces (-s) on the first grid's placement, or without a
-    /// grid on one fitted to the union of their boxes (-r). Catmull-Clark surfaces made with
-    /// --enclose hold every voxel the surface touches, so that their curve is not broken where
-    /// the paper's adjacency test skips a voxel.
-    #[arg(required = true, num_args = 2..)]
+    /// Surfaces (two or more with the --formula ones): .vdb grids made on one grid
+    /// (`--shared-grid`, or resampled onto the first's with --resample), and meshes (.obj,
+    /// .stl, .ply, .off, .gltf, .glb), voxelized here as separating surfaces (-s) on the first
+    /// grid's placement, or without a grid on one fitted to the union of their boxes (-r).
+    /// Catmull-Clark surfaces made with --enclose hold every voxel the surface touches, so that
+    /// their curve is not broken where the paper's adjacency test skips a voxel.
+    #[arg(num_args = 0..)]
     inputs: Vec<PathBuf>,
+    /// Read the .obj inputs as Catmull-Clark control meshes (with their crease tags), their
+    /// limit surfaces voxelized here enclosed (every voxel the surface touches).
+    #[arg(long)]
+    subdiv: bool,
+    /// A formula surface F = 0 (x y z, r theta phi blended; see `implicit`), voxelized here
+    /// by Huang's criterion (-s) within --bounds [default: -1,1] on the same grid; repeat for
+    /// several.
+    #[arg(long = "formula", value_name = "F", allow_hyphen_values = true)]
+    formulas: Vec<String>,
     #[command(flatten)]
     fit: FitArgs,
     #[command(flatten)]
@@ -265,6 +280,11 @@ pub fn csg(args: &CsgArgs, global: &Global) -> Result<()> {
 }
 
 pub fn intersect(args: &IntersectArgs, global: &Global) -> Result<()> {
+    if args.inputs.len() + args.formulas.len() < 2 {
+        return Err(Error::InvalidArgument(
+            "intersect needs two or more surfaces: files and --formula ones".into(),
+        ));
+    }
     let is_grid = |p: &PathBuf| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("vdb"));
     let meshes: Vec<PathBuf> = args
         .inputs
@@ -272,33 +292,68 @@ pub fn intersect(args: &IntersectArgs, global: &Global) -> Result<()> {
         .filter(|p| !is_grid(p))
         .cloned()
         .collect();
-    // Meshes take the first grid's placement, or share one fitted to all of them.
+    let bounds = args.fit.bounds.unwrap_or(ImplicitRequest::default().bounds);
+    // Surfaces made here take the first grid's placement, or share one fitted to all the
+    // meshes (a control mesh's box holds its limit surface), or to the formulas' bounds.
     let placement = match args.inputs.iter().find(|p| is_grid(p)) {
-        _ if meshes.is_empty() => None,
+        _ if meshes.is_empty() && args.formulas.is_empty() => None,
         Some(first) => Some(GridFit::Placed(read_vdb_grid(first, None)?.transform)),
+        None if meshes.is_empty() => Some(GridFit::Placed(fit_transform(
+            &bounds.aabb(),
+            args.fit.grid_fit()?,
+        )?)),
         None => Some(shared_placement(
             &meshes,
             args.fit.grid_fit()?,
             global.up_axis,
         )?),
     };
-    let operand = |p: &PathBuf| -> Result<GridSource> {
-        match placement {
-            Some(fit) if !is_grid(p) => {
-                let task = Task::MeshSurface {
-                    mesh: MeshSource::File(p.clone()),
-                    method: SurfaceMethod::Separating(args.surface.separating()),
-                    attributes: AttributeChoice::None,
-                };
-                Ok(GridSource::Grid(
-                    run_job(Job::new(task, fit), None, global)?.grid,
-                ))
-            }
-            _ => Ok(GridSource::File(p.clone())),
-        }
+    let made_here = |task: Task, fit: GridFit| -> Result<GridSource> {
+        Ok(GridSource::Grid(
+            run_job(Job::new(task, fit), None, global)?.grid,
+        ))
     };
+    let operand = |p: &PathBuf| -> Result<GridSource> {
+        let Some(fit) = placement.filter(|_| !is_grid(p)) else {
+            return Ok(GridSource::File(p.clone()));
+        };
+        let mesh = MeshSource::File(p.clone());
+        let task = if args.subdiv {
+            Task::Subdivision {
+                mesh,
+                options: ParametricOptions {
+                    enclose: true,
+                    ..ParametricOptions::default()
+                },
+                output: SubdivisionOutput::Surface,
+            }
+        } else {
+            Task::MeshSurface {
+                mesh,
+                method: SurfaceMethod::Separating(args.surface.separating()),
+                attributes: AttributeChoice::None,
+            }
+        };
+        made_here(task, fit)
+    };
+    let formula = |text: &String| -> Result<GridSource> {
+        let parsed = Formula::parse_in(text, Coordinates::Cartesian, ThetaRange::default())?;
+        let task = Task::Shape(ShapeTask {
+            shape: Shape::Formula(FormulaSurface::new(parsed, bounds.aabb())),
+            separability: args.surface.separating().separability,
+            normals: false,
+            curvature_margin: true,
+        });
+        made_here(task, placement.expect("formulas are placed"))
+    };
+    let operands = args
+        .inputs
+        .iter()
+        .map(operand)
+        .chain(args.formulas.iter().map(formula))
+        .collect::<Result<_>>()?;
     let task = Task::Combine {
-        operands: args.inputs.iter().map(operand).collect::<Result<_>>()?,
+        operands,
         grid: None,
         op: BooleanOp::Intersection,
         resample: args.resample,
