@@ -402,3 +402,89 @@ fn shared_meshes_carry_their_texture_coordinates_and_normals() {
         "{error}"
     );
 }
+
+/// glTF `NORMAL` (turned with the node) and `TEXCOORD_0` reach the mesh per triangle corner:
+/// two primitives share an edge's positions (joined into one vertex) with different texture
+/// coordinates, which stay apart.
+#[test]
+fn gltf_normals_and_texture_coordinates_are_read_per_corner() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut bin: Vec<u8> = Vec::new();
+    let mut floats = |v: &[f32]| {
+        let at = bin.len();
+        bin.extend(v.iter().flat_map(|f| f.to_le_bytes()));
+        at
+    };
+    // Two unit squares side by side in z = 0: [0,1]x[0,1] and [1,2]x[0,1].
+    let left = floats(&[0., 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0.]);
+    let right = floats(&[1., 0., 0., 2., 0., 0., 2., 1., 0., 1., 1., 0.]);
+    let normals = floats(&[0., 0., 1., 0., 0., 1., 0., 0., 1., 0., 0., 1.]);
+    let uv_left = floats(&[0., 0., 0.5, 0., 0.5, 1., 0., 1.]);
+    let uv_right = floats(&[0.6, 0., 1., 0., 1., 1., 0.6, 1.]);
+    let indices = bin.len();
+    bin.extend([0u16, 1, 2, 0, 2, 3].iter().flat_map(|i| i.to_le_bytes()));
+    std::fs::write(dir.path().join("squares.bin"), &bin).unwrap();
+    let view = |offset: usize, length: usize| serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": length});
+    let accessor = |view: usize, kind: &str, count: usize, component: u32| serde_json::json!({"bufferView": view, "componentType": component, "count": count, "type": kind});
+    let mut position = accessor(0, "VEC3", 4, 5126);
+    position["min"] = serde_json::json!([0, 0, 0]);
+    position["max"] = serde_json::json!([1, 1, 0]);
+    let mut position_right = accessor(1, "VEC3", 4, 5126);
+    position_right["min"] = serde_json::json!([1, 0, 0]);
+    position_right["max"] = serde_json::json!([2, 1, 0]);
+    let half = std::f32::consts::FRAC_1_SQRT_2;
+    let gltf = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "buffers": [{"uri": "squares.bin", "byteLength": bin.len()}],
+        "bufferViews": [view(left, 48), view(right, 48), view(normals, 48), view(uv_left, 32), view(uv_right, 32), view(indices, 12)],
+        "accessors": [position, position_right, accessor(2, "VEC3", 4, 5126), accessor(3, "VEC2", 4, 5126), accessor(4, "VEC2", 4, 5126), accessor(5, "SCALAR", 6, 5123)],
+        "meshes": [{"primitives": [
+            {"attributes": {"POSITION": 0, "NORMAL": 2, "TEXCOORD_0": 3}, "indices": 5},
+            {"attributes": {"POSITION": 1, "NORMAL": 2, "TEXCOORD_0": 4}, "indices": 5}
+        ]}],
+        // A quarter turn about x: z = 0 becomes y = 0, the normal +z becomes -y.
+        "nodes": [{"mesh": 0, "rotation": [half, 0.0, 0.0, half]}],
+        "scenes": [{"nodes": [0]}],
+        "scene": 0
+    });
+    let path = dir.path().join("squares.gltf");
+    std::fs::write(&path, gltf.to_string()).unwrap();
+    let mesh = Mesh::load(&path).unwrap();
+    assert_eq!(
+        mesh.positions.len(),
+        6,
+        "the shared edge's positions are joined"
+    );
+    assert!(mesh.unread.is_empty(), "{:?}", mesh.unread);
+    let uv = mesh.attributes.iter().find(|a| a.name == "uv").unwrap();
+    let normal = mesh
+        .attributes
+        .iter()
+        .find(|a| a.name == "vertex_normal")
+        .unwrap();
+    for v in &normal.values {
+        assert!(v.distance(Vec3::new(0.0, -1.0, 0.0)) < 1e-6, "{v}");
+    }
+    // The corners at x = 1 take u = 0.5 in the left square's faces and 0.6 in the right's.
+    let mut seen = std::collections::BTreeSet::new();
+    for f in 0..mesh.face_count() {
+        for slots in mesh.fan_corners(f) {
+            for s in slots {
+                let p = mesh.positions[mesh.indices[s] as usize];
+                if (p.x - 1.0).abs() < 1e-9 {
+                    let u = uv.at_corner(&mesh.indices, s).x;
+                    let left_face = mesh
+                        .face(f)
+                        .iter()
+                        .any(|&v| mesh.positions[v as usize].x < 0.5);
+                    assert!(
+                        (u - if left_face { 0.5 } else { 0.6 }).abs() < 1e-6,
+                        "u {u}"
+                    );
+                    seen.insert(left_face);
+                }
+            }
+        }
+    }
+    assert_eq!(seen.len(), 2);
+}

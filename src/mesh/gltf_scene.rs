@@ -1,6 +1,8 @@
 //! glTF 2.0 input (`.gltf` with its buffers, embedded or beside it, and `.glb`), through the
 //! `gltf` crate: every triangle primitive of the default scene (else the first), placed by
-//! its nodes' transforms, with `COLOR_0` as the mesh's vertex colours (`Cd`).
+//! its nodes' transforms, with `COLOR_0` as the mesh's vertex colours (`Cd`), `NORMAL` (turned
+//! with the nodes) as the attribute `vertex_normal` and `TEXCOORD_0` as `uv`, per triangle
+//! corner so that the values on both sides of a seam stay apart.
 //!
 //! glTF splits vertices wherever an attribute changes (UV seams, hard normals), so a closed
 //! model arrives as open patches; positions equal after placement are joined into one vertex,
@@ -8,6 +10,7 @@
 //! its buffer before it is read: the crate trusts the file's offsets and strides.
 
 use super::Mesh;
+use super::attributes::{AttributeKind, VertexAttribute};
 use crate::error::{Error, Result};
 use crate::io::references::read_referenced;
 use ::gltf::accessor::{DataType, Dimensions};
@@ -141,7 +144,8 @@ fn check_accessor(
     }
 }
 
-/// What the scene adds up to: joined positions, their colours and the triangles.
+/// What the scene adds up to: joined positions, their colours, the triangles and the corner
+/// attributes.
 #[derive(Default)]
 struct Collected {
     positions: Vec<DVec3>,
@@ -149,8 +153,50 @@ struct Collected {
     triangles: Vec<Vec<u32>>,
     joined: FxHashMap<[u64; 3], u32>,
     colored: bool,
-    /// Attributes besides POSITION and COLOR_0 (NORMAL, TEXCOORD_0, ...), by name.
+    normals: CornerAttribute,
+    texture: CornerAttribute,
+    /// Attributes besides POSITION, COLOR_0, NORMAL and TEXCOORD_0, by name, and those some
+    /// primitives lack.
     unread: std::collections::BTreeSet<String>,
+}
+
+/// A glTF vertex attribute gathered per triangle corner over the primitives.
+#[derive(Default)]
+struct CornerAttribute {
+    values: Vec<Vec3>,
+    corners: Vec<u32>,
+    /// A primitive lacked it: it is not read.
+    incomplete: bool,
+}
+
+impl CornerAttribute {
+    /// Takes a primitive's `values` (one per vertex; none when it lacks them), returning where
+    /// they start.
+    fn add(&mut self, values: Option<Vec<Vec3>>) -> u32 {
+        let start = self.values.len() as u32;
+        match values {
+            Some(v) => self.values.extend(v),
+            None => self.incomplete = true,
+        }
+        start
+    }
+
+    /// The attribute over `corner_count` corners, when every primitive carried it.
+    fn finish(
+        self,
+        name: &str,
+        kind: AttributeKind,
+        corner_count: usize,
+    ) -> Option<VertexAttribute> {
+        (!self.incomplete && !self.values.is_empty() && self.corners.len() == corner_count).then(
+            || VertexAttribute {
+                name: name.into(),
+                kind,
+                values: self.values,
+                corners: self.corners,
+            },
+        )
+    }
 }
 
 impl Collected {
@@ -191,9 +237,37 @@ impl Collected {
         for (semantic, _) in primitive.attributes() {
             if !matches!(
                 semantic,
-                ::gltf::Semantic::Positions | ::gltf::Semantic::Colors(0)
+                ::gltf::Semantic::Positions
+                    | ::gltf::Semantic::Colors(0)
+                    | ::gltf::Semantic::Normals
+                    | ::gltf::Semantic::TexCoords(0)
             ) {
                 self.unread.insert(semantic.to_string());
+            }
+        }
+        for (semantic, name, types, dims) in [
+            (
+                ::gltf::Semantic::Normals,
+                "NORMAL",
+                &[DataType::F32][..],
+                &[Dimensions::Vec3][..],
+            ),
+            (
+                ::gltf::Semantic::TexCoords(0),
+                "TEXCOORD_0",
+                &[DataType::F32, DataType::U8, DataType::U16][..],
+                &[Dimensions::Vec2][..],
+            ),
+        ] {
+            if let Some(a) = primitive.get(&semantic) {
+                check_accessor(&a, name, types, dims, buffers)?;
+                if a.count() != positions.count() {
+                    return Err(format!(
+                        "{name} has {} items for {} positions",
+                        a.count(),
+                        positions.count()
+                    ));
+                }
             }
         }
         let colors = primitive.get(&::gltf::Semantic::Colors(0));
@@ -223,6 +297,20 @@ impl Collected {
             )?;
         }
         let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+        // Normals turn with the inverse transpose of the placement.
+        let turn = to_world.inverse().transpose();
+        let normals = reader.read_normals().map(|n| {
+            n.map(|n| {
+                turn.transform_vector3(Vec3::from(n).as_dvec3())
+                    .normalize_or_zero()
+                    .as_vec3()
+            })
+            .collect()
+        });
+        let texture = reader
+            .read_tex_coords(0)
+            .map(|t| t.into_f32().map(|[u, v]| Vec3::new(u, v, 0.0)).collect());
+        let (normals_from, texture_from) = (self.normals.add(normals), self.texture.add(texture));
         let mut read_colors = reader.read_colors(0).map(|c| c.into_rgb_f32());
         self.colored |= read_colors.is_some();
         let placed: Vec<u32> = reader
@@ -250,12 +338,15 @@ impl Collected {
         // A mirroring transform turns the faces inside out; keep them facing outward.
         let mirrored = to_world.determinant() < 0.0;
         let mut push = |a: u32, b: u32, c: u32| {
-            let [a, b, c] = [a, b, c].map(|i| placed[i as usize]);
-            self.triangles.push(if mirrored {
-                vec![a, c, b]
-            } else {
-                vec![a, b, c]
-            });
+            let corners = if mirrored { [a, c, b] } else { [a, b, c] };
+            self.triangles
+                .push(corners.map(|i| placed[i as usize]).to_vec());
+            for (attribute, from) in [
+                (&mut self.normals, normals_from),
+                (&mut self.texture, texture_from),
+            ] {
+                attribute.corners.extend(corners.map(|i| from + i));
+            }
         };
         match corners {
             Mode::Triangles => order.chunks_exact(3).for_each(|t| push(t[0], t[1], t[2])),
@@ -341,7 +432,9 @@ pub(super) fn load_gltf(path: &Path) -> Result<Mesh> {
         colors,
         triangles,
         colored,
-        unread,
+        normals,
+        texture,
+        mut unread,
         ..
     } = collected;
     let mut mesh = Mesh::from_polygons(path, positions, &triangles);
@@ -349,6 +442,25 @@ pub(super) fn load_gltf(path: &Path) -> Result<Mesh> {
         mesh.colors = colors;
     }
     mesh.numbered_from_zero = true;
+    let corner_count = mesh.indices.len();
+    for (attribute, semantic, name, kind) in [
+        (normals, "NORMAL", "vertex_normal", AttributeKind::Normal),
+        (
+            texture,
+            "TEXCOORD_0",
+            "uv",
+            AttributeKind::TextureCoordinates,
+        ),
+    ] {
+        let lacking = attribute.incomplete && !attribute.values.is_empty();
+        match attribute.finish(name, kind, corner_count) {
+            Some(a) => mesh.attributes.push(a),
+            None if lacking => {
+                unread.insert(format!("{semantic} (some primitives lack it)"));
+            }
+            None => {}
+        }
+    }
     mesh.unread = unread.into_iter().collect();
     Ok(mesh)
 }
