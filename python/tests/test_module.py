@@ -352,3 +352,24 @@ def test_a_grid_draws_a_png(data, tmp_path):
     with pytest.raises(ValueError, match=".png"):
         grid.render(tmp_path / "a.jpg")
     assert not (tmp_path / "a.png").exists()
+
+
+def test_vertex_attributes_as_arrays(data, tmp_path):
+    """A mesh's texture coordinates and normals are arrays in the order of ``ijk``: spot's
+    ``uv`` interpolated by the projective method, bunny-closed's ``vertex_normal`` taken from
+    the nearest point of the separating surface, close to the exact nearest-feature normal."""
+    spot = voxelkit.mesh(data / "meshes" / "spot_triangulated.obj", resolution=64, method="projective")
+    uv = spot.values("uv")
+    assert uv.shape == (len(spot), 3) and not np.isnan(uv).any()
+    assert uv[:, :2].min() > -0.06 and uv[:, :2].max() < 1.01 and (uv[:, 2] == 0).all()
+    bunny = voxelkit.mesh(
+        data / "meshes" / "bunny-closed.obj", resolution=64, normals=True, attributes=["vertex_normal"]
+    )
+    vertex = bunny.values("vertex_normal")
+    assert np.allclose(np.linalg.norm(vertex, axis=1), 1, atol=1e-5)
+    agree = (np.sum(vertex * bunny.values("normal"), axis=1) > 0.8).mean()
+    assert agree > 0.95
+    with pytest.raises(KeyError):
+        bunny.values("uv")
+    with pytest.raises(ValueError, match="no attribute `uv`"):
+        voxelkit.mesh(data / "meshes" / "bunny-closed.obj", resolution=32, attributes=["uv"])

@@ -62,7 +62,7 @@ def mesh(
     criterion = 'huang' (one of huang, clipped): huang: the paper's full vertex spheres and edge cylinders; clipped: the same clipped to the face slabs (still separating, far fewer redundant voxels).
     normals = False: Also keep a `normal` grid (nearest face, edge or vertex normal per voxel).
     colors = True: Projective: carry the mesh's vertex colours into a `Cd` grid.
-    attributes = None: The mesh's vertex attributes to write, each as a grid of its name (`uv`, `vertex_normal`, a PLY property's name): `["all"]`, `["none"]` or names (none: all with the projective method, none otherwise). The projective method interpolates them across each triangle; separating surfaces and distance bands take each voxel's value at the mesh's nearest point.
+    attributes = None: The mesh's vertex attributes to write, each as a grid of its name (`uv`, `vertex_normal`, a PLY property's name, `Cd` for vertex colours where the method does not colour its voxels itself): `["all"]`, `["none"]` or names (none: all with the projective method, none otherwise). The projective method interpolates them across each triangle; separating surfaces and distance bands take each voxel's value at the mesh's nearest point.
     color = None: Projective: one (r, g, b) colour for every voxel instead.
     sdf = False: Exact signed distances (a level set) within `band`, signed by `inside`.
     udf = False: Exact unsigned distances within `band` (open meshes too).

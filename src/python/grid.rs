@@ -9,6 +9,7 @@ use crate::io::vdb::{COLOR_GRID, DISTANCE_GRID, LEVEL_SET_GRID, NORMAL_GRID};
 
 use crate::io::mesh_out::MeshFormat;
 use crate::mesh::UpAxis;
+use crate::mesh::attributes::{AttributeGrid, AttributeKind};
 use crate::pipeline::Outcome;
 use crate::pipeline::request::WriteRequest;
 use crate::pipeline::to_mesh::check_mesh_output;
@@ -76,16 +77,26 @@ impl Grid {
                 self.channel_names()
             )));
         }
-        Ok(if name == self.value_name() { 1 } else { 3 })
+        let scalar = |a: &AttributeGrid| a.name == name && a.kind == AttributeKind::Scalar;
+        let one = name == self.value_name() || self.outcome.attributes.iter().any(scalar);
+        Ok(if one { 1 } else { 3 })
     }
 
     /// Channel `name` of the voxel at leaf `leaf`, offset `n` (width floats).
     fn channel_at<'a>(
-        &self,
+        &'a self,
         name: &str,
         leaf: &'a crate::grid::Leaf,
         n: usize,
     ) -> Option<&'a [f32]> {
+        if let Some(a) = self.outcome.attributes.iter().find(|a| a.name == name) {
+            let at = a.grid.leaf(leaf.origin).filter(|l| l.is_on(n))?;
+            return if a.kind == AttributeKind::Scalar {
+                at.value.as_ref().map(|v| &v[n..n + 1])
+            } else {
+                at.color.as_ref().map(|v| &v[n][..])
+            };
+        }
         if name == self.value_name() {
             leaf.value.as_ref().map(|v| &v[n..n + 1])
         } else if name == NORMAL_GRID {
@@ -97,10 +108,10 @@ impl Grid {
 
     /// A channel per active voxel, `width` floats each, NaN on whole tiles (which carry
     /// no channels).
-    fn channel(
-        &self,
+    fn channel<'a>(
+        &'a self,
         width: usize,
-        get: impl Fn(&crate::grid::Leaf, usize) -> Option<&[f32]>,
+        get: impl Fn(&'a crate::grid::Leaf, usize) -> Option<&'a [f32]>,
     ) -> Vec<f32> {
         let grid = &self.outcome.grid;
         let mut out = Vec::with_capacity(grid.voxel_count() as usize * width);
@@ -117,8 +128,9 @@ impl Grid {
         out
     }
 
-    /// The names `values` accepts for this grid.
-    fn channel_names(&self) -> Vec<&'static str> {
+    /// The names `values` accepts for this grid: its channels, then the mesh attributes
+    /// carried onto its voxels.
+    fn channel_names(&self) -> Vec<&str> {
         let c = self.outcome.grid.channels();
         [
             (c.value, self.value_name()),
@@ -127,6 +139,7 @@ impl Grid {
         ]
         .into_iter()
         .filter_map(|(on, name)| on.then_some(name))
+        .chain(self.outcome.attributes.iter().map(|a| a.name.as_str()))
         .collect()
     }
 }
@@ -146,7 +159,8 @@ impl Grid {
 
     /// A channel in the order of `ijk`, named as the file names its grid: `"surface"` (N,) for
     /// a level set (`sdf`), `"distance"` (N,) for unsigned distances (`udf`, world units) and
-    /// the separating voxelizer's `normals=True` (voxels); `"normal"` and `"Cd"` (N, 3).
+    /// the separating voxelizer's `normals=True` (voxels); `"normal"` and `"Cd"` (N, 3); a
+    /// mesh attribute (`attributes=`): `"uv"`, `"vertex_normal"` (N, 3), a PLY scalar (N,).
     /// Whole tiles give NaN.
     fn values<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
         let width = self.channel_width(name)?;
