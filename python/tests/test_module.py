@@ -373,3 +373,12 @@ def test_vertex_attributes_as_arrays(data, tmp_path):
         bunny.values("uv")
     with pytest.raises(ValueError, match="no attribute `uv`"):
         voxelkit.mesh(data / "meshes" / "bunny-closed.obj", resolution=32, attributes=["uv"])
+
+
+def test_names_given_as_one_string(data, tmp_path):
+    """Options that take names take one comma-separated string too, as the command line does."""
+    bunny = voxelkit.mesh(data / "meshes" / "bunny-closed.obj", resolution=32, attributes="all")
+    assert bunny.values("vertex_normal").shape == (len(bunny), 3)
+    out = tmp_path / "b.vdb"
+    bunny.write(out, grids="density,vertex_normal")
+    assert voxelkit.read_vdb(out, grid="vertex_normal") is not None

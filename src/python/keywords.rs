@@ -49,6 +49,23 @@ fn to_json(v: &Bound<'_, PyAny>) -> Result<Value, String> {
     ))
 }
 
+/// A field that takes names (`grids`, `attributes`) given one string: its comma-separated
+/// names, as the command line reads them (`grids="density,Cd"`, `attributes="all"`).
+fn names_of_one_string<R: Schema>(key: &str, json: Value) -> Value {
+    let names = ["Sequence[str]", "Optional[Sequence[str]]"];
+    let takes_names = R::fields()
+        .iter()
+        .any(|f| f.name == key && names.contains(&f.python_type.as_str()));
+    match json {
+        Value::String(s) if takes_names => Value::Array(
+            s.split(',')
+                .map(|n| Value::String(n.trim().into()))
+                .collect(),
+        ),
+        other => other,
+    }
+}
+
 /// One call's request, limits and progress function, from its keyword arguments.
 pub(super) struct Keywords<R> {
     pub(super) request: R,
@@ -84,6 +101,7 @@ impl<R: Schema> Keywords<R> {
                 continue;
             }
             let json = to_json(&value).map_err(|e| PyValueError::new_err(format!("{key}: {e}")))?;
+            let json = names_of_one_string::<R>(&key, json);
             into.insert(key, json);
         }
         Ok(Keywords {
