@@ -415,3 +415,68 @@ fn single_layers_double_layers_and_parity_share_one_tie_rule() {
         }
     }
 }
+
+/// Depth layers on formula sources (`implicit --depth-layers`): every ray's crossings of
+/// F = 0 isolated by interval arithmetic, so the solid is exactly the centres where F < 0
+/// within the bounds, for Cartesian, spherical and cylindrical formulas, a genus-2 surface,
+/// a solid the bounds cut, and a plane through a row of centres (F = 0 there: outside, by the
+/// tie rule; the rays lying in it are left undecided, and the z rays decide).
+#[test]
+fn formula_depth_layers_are_the_centres_where_f_is_negative() {
+    use voxelkit::implicit::{Formula, value_at};
+    use voxelkit::pipeline::request::{ImplicitRequest, Request};
+    use voxelkit::progress::Unobserved;
+    let genus_two = "((x^2 + y^2)^2 - x^2 + y^2)^2 + z^2 - 0.01";
+    let cases = [
+        ("torus", "", 64, [-1.0, 1.0]),
+        ("gear", "", 64, [-1.0, 1.0]),
+        ("", genus_two, 64, [-1.2, 1.2]),
+        ("", "x^2 + y^2 + z^2 - 1.2", 48, [-1.0, 1.0]),
+        ("", "z - 0.015625", 64, [-1.0, 1.0]),
+    ];
+    for (example, text, resolution, [lo, hi]) in cases {
+        let (text, coords) = match voxelkit::implicit::examples::EXAMPLES
+            .iter()
+            .find(|e| e.name == example)
+        {
+            Some(e) => (e.formula.to_string(), e.coordinates),
+            None => (text.to_string(), voxelkit::implicit::Coordinates::Cartesian),
+        };
+        let request = ImplicitRequest {
+            coords,
+            bounds: voxelkit::pipeline::request::Bounds::Cube([lo, hi]),
+            resolution,
+            depth_layers: true,
+            ..ImplicitRequest::default()
+        };
+        let job = request.job(text.clone(), &Default::default()).unwrap();
+        let outcome = job.plan().unwrap().run(&Unobserved).unwrap();
+        let t = outcome.grid.transform;
+        let formula = Formula::parse_in(&text, coords, Default::default()).unwrap();
+        let mut expected = Vec::new();
+        for i in 0..resolution as i64 {
+            for j in 0..resolution as i64 {
+                for k in 0..resolution as i64 {
+                    let p = t.index_to_world([i, j, k]);
+                    if value_at(&formula, p.to_array(), false) < 0.0 {
+                        expected.push([i, j, k]);
+                    }
+                }
+            }
+        }
+        let mut got: Vec<[i64; 3]> = outcome.grid.voxels().collect();
+        got.sort();
+        expected.sort();
+        assert_eq!(got.len(), expected.len(), "{text}");
+        assert!(
+            got == expected,
+            "{text}: the solid differs from F < 0 at the centres"
+        );
+        let unclassified = outcome
+            .extra
+            .iter()
+            .find(|(n, _)| n == "unclassified")
+            .map_or(0, |(_, g)| g.voxel_count());
+        assert_eq!(unclassified, 0, "{text}");
+    }
+}

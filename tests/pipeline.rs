@@ -47,6 +47,21 @@ fn fixtures(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
 }
 
 /// Every kind of task on the fixtures.
+/// A sphere formula's surface, or its solid by depth layers.
+fn implicit(depth_layers: bool) -> Task {
+    Task::Implicit {
+        formula: "x^2 + y^2 + z^2 - 0.5".into(),
+        coordinates: Coordinates::Cartesian,
+        min: DVec3::splat(-1.0),
+        max: DVec3::splat(1.0),
+        levels: false,
+        negative_r: false,
+        theta_range: Default::default(),
+        squared: false,
+        depth_layers,
+    }
+}
+
 fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
     let mesh = || MeshSource::File(torus.to_path_buf());
     vec![
@@ -95,19 +110,8 @@ fn tasks(torus: &Path, cube: &Path) -> Vec<(&'static str, Task)> {
             },
         ),
         ("subdivision solid", subdivision_solid(cube)),
-        (
-            "implicit",
-            Task::Implicit {
-                formula: "x^2 + y^2 + z^2 - 0.5".into(),
-                coordinates: Coordinates::Cartesian,
-                min: DVec3::splat(-1.0),
-                max: DVec3::splat(1.0),
-                levels: false,
-                negative_r: false,
-                theta_range: Default::default(),
-                squared: false,
-            },
-        ),
+        ("implicit", implicit(false)),
+        ("implicit depth layers", implicit(true)),
         (
             "solid flood",
             Task::Solid {
@@ -178,7 +182,7 @@ fn every_task_refuses_an_impossible_grid_at_planning() {
                 Err(e @ Error::TooLarge { .. }) => {
                     assert!(e.to_string().contains("MiB"), "{name}: {e}")
                 }
-                Err(Error::InvalidArgument(m)) if name == "implicit" => {
+                Err(Error::InvalidArgument(m)) if name.starts_with("implicit") => {
                     assert!(m.contains("65536"), "{name}: {m}")
                 }
                 Err(e) => panic!("{name} at {fit:?}: refused with the wrong error: {e}"),

@@ -168,6 +168,7 @@ def implicit(
     negative_r: bool = False,
     theta_range: Literal["positive", "symmetric"] = 'positive',
     squared: bool = False,
+    depth_layers: bool = False,
     threads: Optional[int] = None,
     max_memory_mib: Optional[int] = None,
     progress: Optional[Progress] = None,
@@ -183,6 +184,7 @@ def implicit(
     negative_r = False: Spherical and cylindrical: the surface where r < 0 too.
     theta_range = 'positive' (one of positive, symmetric): positive (the paper's [0, 2pi)) or symmetric ((-pi, pi]).
     squared = False: The paper's [G]^2 - r^2 = 0 for F = G - r (the surface r = |G|).
+    depth_layers = False: The solid F < 0 within the bounds instead of the surface, by Passalis et al.'s double depth layers along z, x and y, each ray's crossings of F = 0 isolated by interval arithmetic.
     threads = None: Worker threads (none or 0: every core; at most 256).
     max_memory_mib = None: Refuse work estimated above this many MiB before it starts (none or 0: the memory available).
     progress: f(stage, done, total), called a few times a second (raising cancels)"""

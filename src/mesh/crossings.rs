@@ -103,6 +103,16 @@ impl RayFrame {
         )
     }
 
+    /// The index-space point of `(a, b, t)`.
+    #[inline]
+    pub fn from_ray(&self, r: DVec3) -> DVec3 {
+        let mut p = DVec3::ZERO;
+        p[self.k] = r.z * self.d[self.k] as f64;
+        p[self.i] = r.x + r.z * self.d[self.i] as f64;
+        p[self.j] = r.y + r.z * self.d[self.j] as f64;
+        p
+    }
+
     /// Ray `(a, b)` and `t` of an integer index-space point.
     #[inline]
     pub fn lattice_ray(&self, p: [i64; 3]) -> ([i64; 2], i64) {

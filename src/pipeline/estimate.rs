@@ -207,6 +207,19 @@ fn surface_leaves(area: f64) -> f64 {
     area / MESH_AREA_PER_LEAF + 1.0
 }
 
+/// Depth buffers per ray (count and four depths) and the crossings found on it while its
+/// direction renders (a list each).
+const FORMULA_RAY_BYTES: f64 = 18.0 + 120.0;
+
+/// A formula's depth-layer solid: the inside and unclassified masks (a bit per voxel each) and
+/// the three directions' rays, about a face of the box each.
+fn formula_depth_layer_bytes(min: DVec3, max: DVec3, t: &Transform) -> f64 {
+    let n = ((max - min) / t.voxel_size).ceil() + 2.0;
+    let cells = n.x * n.y * n.z;
+    let rays = n.x * n.y + n.y * n.z + n.x * n.z;
+    cells / 4.0 + rays * FORMULA_RAY_BYTES
+}
+
 /// A tree over the triangles with their corner places, per triangle, for attributes carried
 /// from the nearest point.
 const NEAREST_TRIANGLE_BYTES: f64 = 180.0;
@@ -632,6 +645,7 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
             max,
             levels,
             negative_r,
+            depth_layers,
             ..
         } => {
             let resolution = octree_resolution(fit, *min, *max)?;
@@ -647,7 +661,11 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
             // Every level holds about a quarter of the one below it.
             let levels = if *levels { 4.0 / 3.0 } else { 1.0 };
             let leaves = implicit_leaves(formula, *min, *max, resolution, *negative_r)?;
-            let bytes = (leaves + 1.0) * IMPLICIT_LEAF_BYTES * levels;
+            let bytes = if *depth_layers {
+                formula_depth_layer_bytes(*min, *max, &t)
+            } else {
+                (leaves + 1.0) * IMPLICIT_LEAF_BYTES * levels
+            };
             let options = crate::voxelize::interval_octree::OctreeOptions {
                 resolution,
                 ..Default::default()

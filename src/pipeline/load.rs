@@ -54,6 +54,7 @@ pub(super) enum Work {
         max: DVec3,
         levels: bool,
         negative_r: bool,
+        depth_layers: bool,
     },
     DistanceBand {
         /// Shared with the outcome, whose meshes take their crossings from it.
@@ -226,6 +227,7 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
             negative_r,
             theta_range,
             squared,
+            depth_layers,
         } => {
             let size = *max - *min;
             if !(size.max_element().is_finite() && size.min_element() > 0.0) {
@@ -243,6 +245,7 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
                 max: *max,
                 levels: *levels,
                 negative_r: *negative_r,
+                depth_layers: *depth_layers,
             }
         }
         Task::DistanceBand {

@@ -160,6 +160,8 @@ pub enum Task {
         theta_range: ThetaRange,
         /// The paper's substitution [G]² - r² = 0 for F = G - r (r = |G|).
         squared: bool,
+        /// The solid F < 0 by depth layers instead of the surface.
+        depth_layers: bool,
     },
     Solid {
         mesh: MeshSource,
@@ -663,8 +665,23 @@ impl PlannedJob {
                 text,
                 min,
                 max,
+                depth_layers: true,
+                ..
+            } => {
+                let bounds = crate::mesh::Aabb {
+                    min: *min,
+                    max: *max,
+                };
+                solid::formula_depth_layers(formula, text, bounds, t, progress)
+            }
+            Work::Implicit {
+                formula,
+                text,
+                min,
+                max,
                 levels,
                 negative_r,
+                ..
             } => {
                 let options = crate::voxelize::interval_octree::OctreeOptions {
                     resolution: estimate::octree_resolution(fit, *min, *max)?,

@@ -297,7 +297,9 @@ pub struct DepthLayerDetails {
     pub volume_with_unclassified: f64,
     pub density: f64,
     pub mass: f64,
-    pub mesh_signed_volume: f64,
+    /// A mesh's signed volume (none for a formula).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mesh_signed_volume: Option<f64>,
     pub directions: Vec<DirectionCounts>,
 }
 
@@ -578,7 +580,7 @@ fn solid_summary(place: &str, s: &SolidDetails, timing: &str) -> String {
 
 fn depth_layer_summary(place: &str, method: &str, d: &DepthLayerDetails, timing: &str) -> String {
     let mut t = format!(
-        "{place}: {method}: {} inside, {} unclassifiable voxels; volume {:.6} (inside centres){}; mass {:.6} at density {}; mesh signed volume {:.6}",
+        "{place}: {method}: {} inside, {} unclassifiable voxels; volume {:.6} (inside centres){}; mass {:.6} at density {}{}",
         d.inside_voxels,
         d.unclassified_voxels,
         d.volume,
@@ -593,6 +595,8 @@ fn depth_layer_summary(place: &str, method: &str, d: &DepthLayerDetails, timing:
         d.mass,
         d.density,
         d.mesh_signed_volume
+            .map(|v| format!("; mesh signed volume {v:.6}"))
+            .unwrap_or_default()
     );
     t.push_str("\n  rays by crossings     0          2          4         >4        odd");
     for c in &d.directions {

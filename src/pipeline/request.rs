@@ -507,6 +507,10 @@ request! {
         theta_range: ThetaRange = ThetaRange::default(),
         /// The paper's [G]^2 - r^2 = 0 for F = G - r (the surface r = |G|).
         squared: bool = false,
+        /// The solid F < 0 within the bounds instead of the surface, by Passalis et al.'s
+        /// double depth layers along z, x and y, each ray's crossings of F = 0 isolated by
+        /// interval arithmetic.
+        depth_layers: bool = false,
     }
 }
 
@@ -874,6 +878,12 @@ impl Request for ImplicitRequest {
 
     fn task(&self, formula: String) -> Result<Task> {
         let (min, max) = self.bounds.corners();
+        if self.depth_layers && (self.squared || self.negative_r || self.levels) {
+            return Err(Error::InvalidArgument(
+                "depth_layers makes the solid F < 0: it takes neither squared, negative_r nor levels"
+                    .into(),
+            ));
+        }
         Ok(Task::Implicit {
             formula,
             coordinates: self.coords,
@@ -883,6 +893,7 @@ impl Request for ImplicitRequest {
             negative_r: self.negative_r,
             theta_range: self.theta_range,
             squared: self.squared,
+            depth_layers: self.depth_layers,
         })
     }
 }

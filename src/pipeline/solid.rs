@@ -11,9 +11,11 @@ use super::report::{
 };
 use super::{Fill, SubdivisionFill};
 use crate::contour::ExactSurface;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::grid::{DenseMask, SparseGrid, Transform};
+use crate::implicit::Formula;
 use crate::io::vdb::{MetaValue, NORMAL_GRID, SHELL_GRID};
+use crate::mesh::Aabb;
 use crate::mesh::attributes::AttributeChoice;
 use crate::mesh::segment_hits::MeshHits;
 use crate::mesh::{GridFit, Mesh, index_box};
@@ -21,9 +23,12 @@ use crate::progress::Progress;
 use crate::solids::beam::{BeamFill, beam_solid};
 use crate::solids::csg_exact::ExactTree;
 use crate::solids::csg_tree::CsgTree;
-use crate::solids::depth_layers::{Layers, depth_layer_solid};
+use crate::solids::depth_layers::{
+    DepthLayerOptions, DepthLayerSolid, DepthLayerStats, Layers, depth_layer_solid, depth_layers_of,
+};
 use crate::solids::exterior_flood::{FloodMethod, Solid};
 use crate::solids::flooded_mesh::{self, FLOOD_NEEDS_CLOSED, SurfaceAndInside};
+use crate::solids::formula_rays::FormulaRays;
 use crate::solids::inside_rule::{Inside, InsideChoice, InsideRule, choose_inside};
 use crate::solids::level_set::{SIGN_NEEDS_CLOSED, level_set, unsigned_distance};
 use crate::subd::ControlMesh;
@@ -210,53 +215,106 @@ pub(super) fn mesh_solid(
             let edges = mesh.edge_counts();
             let region = index_box(&mesh.bbox(), &t);
             let solid = depth_layer_solid(mesh, &t, region, &options, progress)?;
-            let s = &solid.stats;
-            let cell = t.voxel_size.powi(3);
-            let volume = s.inside_voxels as f64 * cell;
-            let details = DepthLayerDetails {
-                inside_voxels: s.inside_voxels,
-                unclassified_voxels: s.unclassified_voxels,
-                unclassified_on_odd_rays: s.open_voxels,
-                odd_rays: s.odd_rays(),
-                boundary_edges: edges.boundary,
-                non_manifold_edges: edges.non_manifold,
-                volume,
-                volume_with_unclassified: (s.inside_voxels + s.unclassified_voxels) as f64 * cell,
-                density,
-                mass: volume * density,
-                mesh_signed_volume: mesh.signed_volume(),
-                directions: s
-                    .per_direction
-                    .iter()
-                    .map(|c| DirectionCounts {
-                        direction: c.direction,
-                        rays: c.rays,
-                        crossed_0: c.none,
-                        crossed_2: c.two,
-                        crossed_4: c.four,
-                        crossed_more: c.more,
-                        crossed_odd: c.odd,
-                    })
-                    .collect(),
-            };
-            let method = format!(
-                "depth-layers ({}, {} directions)",
-                match options.layers {
-                    Layers::Double => "double layers + stencil",
-                    Layers::Single => "single layer",
-                },
-                options.directions.len()
-            );
-            centre_solid(
-                &solid.inside,
-                t,
-                meta(&method),
-                Details::DepthLayers(details),
-            )
-            .with("unclassified", solid.unclassified.to_grid(t))
+            let mut details = depth_layer_details(&solid.stats, t, density);
+            details.boundary_edges = edges.boundary;
+            details.non_manifold_edges = edges.non_manifold;
+            details.mesh_signed_volume = Some(mesh.signed_volume());
+            depth_layer_outcome(solid, t, meta(&depth_layer_method(&options)), details)
         }
     };
     Ok(outcome.timed(start))
+}
+
+/// The report of a depth-layer solid (the input's edges and volume left to the caller).
+fn depth_layer_details(s: &DepthLayerStats, t: Transform, density: f64) -> DepthLayerDetails {
+    let cell = t.voxel_size.powi(3);
+    let volume = s.inside_voxels as f64 * cell;
+    DepthLayerDetails {
+        inside_voxels: s.inside_voxels,
+        unclassified_voxels: s.unclassified_voxels,
+        unclassified_on_odd_rays: s.open_voxels,
+        odd_rays: s.odd_rays(),
+        boundary_edges: 0,
+        non_manifold_edges: 0,
+        volume,
+        volume_with_unclassified: (s.inside_voxels + s.unclassified_voxels) as f64 * cell,
+        density,
+        mass: volume * density,
+        mesh_signed_volume: None,
+        directions: s
+            .per_direction
+            .iter()
+            .map(|c| DirectionCounts {
+                direction: c.direction,
+                rays: c.rays,
+                crossed_0: c.none,
+                crossed_2: c.two,
+                crossed_4: c.four,
+                crossed_more: c.more,
+                crossed_odd: c.odd,
+            })
+            .collect(),
+    }
+}
+
+/// The method name of depth layers with `options`.
+fn depth_layer_method(options: &DepthLayerOptions) -> String {
+    format!(
+        "depth-layers ({}, {} directions)",
+        match options.layers {
+            Layers::Double => "double layers + stencil",
+            Layers::Single => "single layer",
+        },
+        options.directions.len()
+    )
+}
+
+/// A depth-layer solid as an outcome: its inside voxels, shell, interior and unclassifiable
+/// voxels.
+fn depth_layer_outcome(
+    solid: DepthLayerSolid,
+    t: Transform,
+    meta: Vec<(&str, MetaValue)>,
+    details: DepthLayerDetails,
+) -> Outcome {
+    centre_solid(&solid.inside, t, meta, Details::DepthLayers(details))
+        .with("unclassified", solid.unclassified.to_grid(t))
+}
+
+/// A formula's solid, F < 0 within `[min, max]`, by double depth layers along z, x and y, each
+/// ray's crossings isolated by interval arithmetic (`solids::formula_rays`).
+pub(super) fn formula_depth_layers(
+    formula: &Formula,
+    text: &str,
+    bounds: Aabb,
+    t: Transform,
+    progress: &Progress,
+) -> Result<Outcome> {
+    let start = Instant::now();
+    if formula.squared {
+        return Err(Error::InvalidArgument(
+            "the squared substitution's sign does not say inside: depth layers take the formula as typed"
+                .into(),
+        ));
+    }
+    let region = index_box(&bounds, &t);
+    let options = DepthLayerOptions::default();
+    let rays = FormulaRays {
+        formula,
+        transform: t,
+        first: region.min,
+        bounds,
+    };
+    let solid = depth_layers_of(&rays, region, &options, progress)?;
+    let details = depth_layer_details(&solid.stats, t, 1.0);
+    let method = depth_layer_method(&options);
+    let coordinates = format!("{:?}", formula.coordinates).to_lowercase();
+    let meta = vec![
+        ("method", method.as_str().into()),
+        ("formula", text.into()),
+        ("coordinates", coordinates.as_str().into()),
+    ];
+    Ok(depth_layer_outcome(solid, t, meta, details).timed(start))
 }
 
 /// What a distance band job asks for.

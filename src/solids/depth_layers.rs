@@ -30,7 +30,7 @@
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, DenseMask, Transform};
 use crate::mesh::Mesh;
-use crate::mesh::crossings::{RayFrame, RayWindow, for_each_crossing};
+use crate::mesh::crossings::{RayCrossing, RayFrame, RayWindow, for_each_crossing};
 use crate::progress::Progress;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -276,9 +276,8 @@ impl View {
         (self.window.ray(a, b), t)
     }
 
-    /// Renders the mesh (`points` relative to the first voxel, in index units) into the
-    /// buffers of direction `d` over a volume of `dims` voxels.
-    fn render(d: [i64; 3], dims: [usize; 3], points: &[DVec3], mesh: &Mesh) -> Result<View> {
+    /// Renders `surface` into the buffers of direction `d` over a volume of `dims` voxels.
+    fn render(d: [i64; 3], dims: [usize; 3], surface: &dyn RaySurface) -> Result<View> {
         let frame = RayFrame::along(d);
         // The window: the (a, b) range of the volume's corners.
         let (mut lo, mut hi) = ([i64::MAX; 2], [i64::MIN; 2]);
@@ -318,33 +317,26 @@ impl View {
             near: vec![[i32::MAX; 2]; rays],
             far: vec![[i32::MIN; 2]; rays],
         };
-        let ray_points: Vec<DVec3> = points.iter().map(|&p| frame.to_ray(p)).collect();
         let (count, near, far) = (&mut view.count, &mut view.near, &mut view.far);
-        for_each_crossing(
-            &ray_points,
-            mesh.triangles().map(|(_, t)| t),
-            &frame,
-            &view.window,
-            |c| {
-                let (ray, t) = (
-                    c.ray,
-                    c.after.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
-                );
-                count[ray] = count[ray].saturating_add(1);
-                let n = &mut near[ray];
-                if t < n[0] {
-                    *n = [t, n[0]];
-                } else if t < n[1] {
-                    n[1] = t;
-                }
-                let f = &mut far[ray];
-                if t > f[0] {
-                    *f = [t, f[0]];
-                } else if t > f[1] {
-                    f[1] = t;
-                }
-            },
-        );
+        surface.crossings(&frame, &view.window, &mut |c| {
+            let (ray, t) = (
+                c.ray,
+                c.after.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
+            );
+            count[ray] = count[ray].saturating_add(1);
+            let n = &mut near[ray];
+            if t < n[0] {
+                *n = [t, n[0]];
+            } else if t < n[1] {
+                n[1] = t;
+            }
+            let f = &mut far[ray];
+            if t > f[0] {
+                *f = [t, f[0]];
+            } else if t > f[1] {
+                f[1] = t;
+            }
+        });
         Ok(view)
     }
 
@@ -443,6 +435,26 @@ fn push_voxel(runs: &mut Vec<(usize, usize)>, index: usize) {
     }
 }
 
+/// What the rays of the depth buffers cross: a surface that reports every crossing of the
+/// rays of a window, in index units relative to the volume's first voxel.
+pub trait RaySurface: Sync {
+    fn crossings(&self, frame: &RayFrame, window: &RayWindow, cross: &mut dyn FnMut(RayCrossing));
+}
+
+/// A mesh's triangles, their corners relative to the volume's first voxel.
+struct MeshRays<'m> {
+    points: Vec<DVec3>,
+    mesh: &'m Mesh,
+}
+
+impl RaySurface for MeshRays<'_> {
+    fn crossings(&self, frame: &RayFrame, window: &RayWindow, cross: &mut dyn FnMut(RayCrossing)) {
+        let ray_points: Vec<DVec3> = self.points.iter().map(|&p| frame.to_ray(p)).collect();
+        let triangles = self.mesh.triangles().map(|(_, t)| t);
+        for_each_crossing(&ray_points, triangles, frame, window, cross);
+    }
+}
+
 /// The solid of `mesh` on `transform` over `bbox`: depth buffers along `options.directions`,
 /// classified with single or double layers; `progress` counts the directions
 /// rendered, then the x slabs classified (two stages).
@@ -453,21 +465,31 @@ pub fn depth_layer_solid(
     options: &DepthLayerOptions,
     progress: &Progress,
 ) -> Result<DepthLayerSolid> {
-    let mut inside = DenseMask::new(bbox)?;
-    let mut unclassified = DenseMask::new(bbox)?;
-    let dims = inside.dims();
     let origin = DVec3::from_array(bbox.min.map(|v| v as f64));
-    let points: Vec<DVec3> = mesh
+    let points = mesh
         .positions
         .iter()
         .map(|&p| transform.world_to_index(p) - origin)
         .collect();
+    depth_layers_of(&MeshRays { points, mesh }, bbox, options, progress)
+}
+
+/// The solid `surface` bounds over `bbox`, as `depth_layer_solid`.
+pub fn depth_layers_of(
+    surface: &dyn RaySurface,
+    bbox: CoordBox,
+    options: &DepthLayerOptions,
+    progress: &Progress,
+) -> Result<DepthLayerSolid> {
+    let mut inside = DenseMask::new(bbox)?;
+    let mut unclassified = DenseMask::new(bbox)?;
+    let dims = inside.dims();
     let directions = options.directions.to_vec();
     progress.stage("depth buffers", directions.len() as u64);
     let views = directions
         .par_iter()
         .map(|&d| {
-            let view = View::render(d, dims, &points, mesh);
+            let view = View::render(d, dims, surface);
             progress.advance(1);
             view
         })

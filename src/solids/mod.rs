@@ -13,6 +13,7 @@ pub mod csg_tree;
 pub mod depth_layers;
 pub mod exterior_flood;
 pub mod flooded_mesh;
+pub mod formula_rays;
 pub mod inside_rule;
 pub mod level_set;
 pub mod point_queries;

@@ -7,8 +7,9 @@ use voxelkit::Result;
 use voxelkit::implicit::examples::example;
 use voxelkit::implicit::{Coordinates, ThetaRange};
 use voxelkit::mesh::GridFit;
+use voxelkit::pipeline::Job;
+use voxelkit::pipeline::request::Request;
 use voxelkit::pipeline::request::{Bounds, ImplicitRequest};
-use voxelkit::pipeline::{Job, Task};
 
 /// A formula and the variables it is written in: what `implicit` and `shape formula` take.
 #[derive(Args, Clone)]
@@ -74,6 +75,11 @@ pub struct ImplicitArgs {
     /// (lobes where G < 0 included) instead of r = G as typed.
     #[arg(long)]
     squared: bool,
+    /// Write the solid F < 0 within the bounds instead of the surface: Passalis et al.'s
+    /// double depth layers along z, x and y, each ray's crossings of F = 0 isolated by
+    /// interval arithmetic (`density`, `shell`, `interior`, `unclassified`).
+    #[arg(long, conflicts_with_all = ["levels", "negative_r", "squared"])]
+    depth_layers: bool,
     /// Output: a .vdb (`density`, `normal`, and the levels), a .nvdb (the same grids for
     /// NanoVDB), or a .binvox or .vox (the voxels alone).
     #[arg(short, long)]
@@ -97,17 +103,16 @@ pub fn parse_bounds(s: &str) -> std::result::Result<Bounds, String> {
 
 pub fn run(args: &ImplicitArgs, global: &Global) -> Result<()> {
     let (text, coordinates) = args.formula.text_and_coordinates()?;
-    let (min, max) = args.bounds.corners();
-    let task = Task::Implicit {
-        formula: text,
-        coordinates,
-        min,
-        max,
+    let request = ImplicitRequest {
+        coords: coordinates,
+        bounds: args.bounds,
+        resolution: args.resolution,
         levels: args.levels,
         negative_r: args.negative_r,
         theta_range: args.formula.theta_range,
         squared: args.squared,
+        depth_layers: args.depth_layers,
     };
-    let job = Job::new(task, GridFit::Resolution(args.resolution));
+    let job = Job::new(request.task(text)?, GridFit::Resolution(args.resolution));
     run_and_report(job, &args.output, global)
 }
