@@ -2,6 +2,7 @@
 //! whole 8^3 and 128^3 blocks, a cached write accessor, Boolean operations block by block,
 //! and the index-to-world transform.
 
+pub mod attribute_grid;
 pub(crate) mod bits;
 mod coord;
 mod leaf;

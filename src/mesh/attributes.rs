@@ -6,22 +6,10 @@
 
 use super::Mesh;
 use crate::error::{Error, Result};
+pub use crate::grid::attribute_grid::{ATTRIBUTE_CHANNELS, AttributeGrid, AttributeKind};
 use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
-
-/// How an attribute's values are written and turned.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum AttributeKind {
-    /// One number per vertex (a FloatGrid).
-    Scalar,
-    /// Texture coordinates `(u, v, 0)` (a Vec3SGrid whose vectors do not turn with the grid).
-    TextureCoordinates,
-    /// Unit normals, renormalized after interpolation (a Vec3SGrid of covariant normals).
-    Normal,
-    /// Vertex colours (a Vec3SGrid `Cd`, as the projective method writes its own).
-    Color,
-}
 
 /// The name vertex colours take as an attribute carried from the nearest point.
 pub const COLOR_ATTRIBUTE: &str = "Cd";
@@ -176,25 +164,13 @@ impl Mesh {
     }
 }
 
-/// An attribute on a job's voxels: its values in the grid's colour channel (a scalar in its
-/// value channel), written as a grid of the attribute's name.
-pub struct AttributeGrid {
-    pub name: String,
-    pub kind: AttributeKind,
-    pub grid: crate::grid::SparseGrid,
-}
-
-/// The channels an attribute grid holds.
-pub const ATTRIBUTE_CHANNELS: crate::grid::Channels = crate::grid::Channels {
-    value: true,
-    normal: false,
-    color: true,
-};
-
 impl AttributeGrid {
     /// The grid of `attribute` from interpolated values in `grid`'s colour channel: normals
     /// back to unit length, a scalar copied into the value channel.
-    pub fn finished(attribute: &VertexAttribute, mut grid: crate::grid::SparseGrid) -> Self {
+    pub fn finished(
+        attribute: &VertexAttribute,
+        mut grid: crate::grid::SparseGrid,
+    ) -> AttributeGrid {
         use rayon::prelude::*;
         grid.leaves_mut().par_iter_mut().for_each(|leaf| {
             let offsets: Vec<usize> = leaf.offsets().collect();
