@@ -8,7 +8,6 @@ use super::Mesh;
 use crate::error::{Error, Result};
 pub use crate::grid::attribute_grid::{ATTRIBUTE_CHANNELS, AttributeGrid, AttributeKind};
 use glam::{DVec3, Vec3};
-use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 
 /// The name vertex colours take as an attribute carried from the nearest point.
@@ -51,7 +50,7 @@ impl VertexAttribute {
 }
 
 /// Which attributes a job writes.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub enum AttributeChoice {
     #[default]
     None,

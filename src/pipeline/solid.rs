@@ -304,6 +304,7 @@ pub(super) fn formula_depth_layers(
         transform: t,
         first: region.min,
         bounds,
+        progress,
     };
     let solid = depth_layers_of(&rays, region, &options, progress)?;
     let details = depth_layer_details(&solid.stats, t, 1.0);

@@ -16,6 +16,7 @@ use crate::grid::Transform;
 use crate::implicit::{BoxTest, Formula, Interval, test_box, value_at};
 use crate::mesh::Aabb;
 use crate::mesh::crossings::{RayCrossing, RayFrame, RayWindow};
+use crate::progress::Progress;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -27,19 +28,23 @@ const BUDGET: usize = 50_000;
 const UNDECIDED_CROSSINGS: usize = 6;
 
 /// F < 0 within `bounds`, on the grid `transform`, for the volume whose first voxel is
-/// `first`.
-pub struct FormulaRays<'f> {
+/// `first`; once `progress` is stopped, the remaining rays are skipped (the caller checks).
+pub struct FormulaRays<'f, 'p> {
     pub formula: &'f Formula,
     pub transform: Transform,
     pub first: [i64; 3],
     pub bounds: Aabb,
+    pub progress: &'f Progress<'p>,
 }
 
-impl RaySurface for FormulaRays<'_> {
+impl RaySurface for FormulaRays<'_, '_> {
     fn crossings(&self, frame: &RayFrame, window: &RayWindow, cross: &mut dyn FnMut(RayCrossing)) {
         let per_ray: Vec<Vec<RayCrossing>> = (0..window.len())
             .into_par_iter()
             .map_init(Vec::new, |slots, ray| {
+                if self.progress.stopped() {
+                    return Vec::new();
+                }
                 let (a, b) = (
                     window.a0 + (ray / window.height) as i64,
                     window.b0 + (ray % window.height) as i64,
@@ -51,7 +56,7 @@ impl RaySurface for FormulaRays<'_> {
     }
 }
 
-impl FormulaRays<'_> {
+impl FormulaRays<'_, '_> {
     /// The world point at `t` along ray `ab`.
     fn world(&self, frame: &RayFrame, ab: [i64; 2], t: f64) -> DVec3 {
         let p = frame.from_ray(DVec3::new(ab[0] as f64, ab[1] as f64, t));
