@@ -3,15 +3,23 @@
 
 use glam::DVec3;
 
-/// The squared distance from `p` to the segment `ab`.
-pub fn segment_distance_squared(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+/// The point of segment `ab` nearest to `p`, as its parameter `t` in [0, 1] from `a`, and
+/// its squared distance to `p`.
+#[inline]
+pub fn nearest_on_segment(p: DVec3, a: DVec3, b: DVec3) -> (f64, f64) {
     let d = b - a;
     let t = if d.length_squared() > 0.0 {
         ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
     } else {
         0.0
     };
-    (a + d * t).distance_squared(p)
+    (t, (a + d * t).distance_squared(p))
+}
+
+/// The squared distance from `p` to the segment `ab`.
+#[inline]
+pub fn segment_distance_squared(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    nearest_on_segment(p, a, b).1
 }
 
 /// The distance from `p` to the segment `ab`.
@@ -46,19 +54,9 @@ pub fn nearest_on_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> DVec3 {
     if n2 > 0.0 && areas.iter().all(|&w| w >= 0.0) {
         return DVec3::from_array(areas) / n2;
     }
-    // The edge `(from, to)` between corners `i` and `j`, at parameter t from `from`.
-    let along = |u: DVec3, v: DVec3| {
-        let d = v - u;
-        let t = if d.length_squared() > 0.0 {
-            ((p - u).dot(d) / d.length_squared()).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        (t, (u + d * t).distance_squared(p))
-    };
     let mut best = (f64::INFINITY, DVec3::ZERO);
     for (i, j, u, v) in [(0, 1, a, b), (1, 2, b, c), (2, 0, c, a)] {
-        let (t, d2) = along(u, v);
+        let (t, d2) = nearest_on_segment(p, u, v);
         if d2 < best.0 {
             let mut w = DVec3::ZERO;
             w[i] = 1.0 - t;

@@ -12,7 +12,7 @@ use crate::mesh::Mesh;
 use crate::mesh::attributes::{AttributeChoice, AttributeKind, VertexAttribute};
 use crate::mesh::nearest_attributes::carry_nearest;
 use crate::progress::Progress;
-use crate::voxelize::projective::interpolate_attribute;
+use crate::voxelize::projective::interpolate_attributes;
 
 /// How attribute values reach the voxels.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -61,13 +61,17 @@ pub(super) fn add_attributes(
     if attributes.is_empty() {
         return Ok(());
     }
+    let attributes: Vec<&VertexAttribute> = attributes.iter().map(|a| &**a).collect();
+    // A stage of its own: the interpolation scans the faces once per attribute, the nearest
+    // point is found once per leaf of the result.
     let grids = match carry {
-        Carry::Interpolated => attributes
-            .iter()
-            .map(|a| interpolate_attribute(mesh, outcome.grid.transform, a, progress))
-            .collect::<Result<Vec<_>>>()?,
+        Carry::Interpolated => {
+            let faces = (mesh.face_count() * attributes.len()) as u64;
+            progress.stage("attributes", faces);
+            interpolate_attributes(mesh, outcome.grid.transform, &attributes, progress)?
+        }
         Carry::Nearest => {
-            let attributes: Vec<&VertexAttribute> = attributes.iter().map(|a| &**a).collect();
+            progress.stage("attributes", outcome.grid.leaf_count() as u64);
             carry_nearest(mesh, &outcome.grid, &attributes, progress)?
         }
     };

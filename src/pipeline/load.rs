@@ -229,6 +229,14 @@ pub(super) fn load(task: &Task, up: UpAxis) -> Result<Work> {
             squared,
             depth_layers,
         } => {
+            // The sign of the squared substitution or of F at negative r does not say inside.
+            if *depth_layers && (*squared || *negative_r || *levels) {
+                return Err(Error::InvalidArgument(
+                    "depth layers make the solid F < 0: they take neither the squared \
+                     substitution, negative r nor the octree's levels"
+                        .into(),
+                ));
+            }
             let size = *max - *min;
             if !(size.max_element().is_finite() && size.min_element() > 0.0) {
                 return Err(Error::InvalidArgument(format!(

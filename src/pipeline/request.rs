@@ -878,12 +878,6 @@ impl Request for ImplicitRequest {
 
     fn task(&self, formula: String) -> Result<Task> {
         let (min, max) = self.bounds.corners();
-        if self.depth_layers && (self.squared || self.negative_r || self.levels) {
-            return Err(Error::InvalidArgument(
-                "depth_layers makes the solid F < 0: it takes neither squared, negative_r nor levels"
-                    .into(),
-            ));
-        }
         Ok(Task::Implicit {
             formula,
             coordinates: self.coords,

@@ -11,7 +11,7 @@ use super::report::{
 };
 use super::{Fill, SubdivisionFill};
 use crate::contour::ExactSurface;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::grid::{DenseMask, SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::io::vdb::{MetaValue, NORMAL_GRID, SHELL_GRID};
@@ -291,12 +291,6 @@ pub(super) fn formula_depth_layers(
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
-    if formula.squared {
-        return Err(Error::InvalidArgument(
-            "the squared substitution's sign does not say inside: depth layers take the formula as typed"
-                .into(),
-        ));
-    }
     let region = index_box(&bounds, &t);
     let options = DepthLayerOptions::default();
     let rays = FormulaRays {

@@ -148,22 +148,27 @@ pub fn voxelize_triangles(
     Ok((grid, stats))
 }
 
-/// Interpolates `attribute` of `mesh` across every triangle by the scan that voxelizes it
-/// (the triangle's affine interpolant at each voxel's projection along its dominant axis);
-/// where several triangles reach a voxel, the value of the sample nearest its centre.
-/// `progress` counts faces.
-pub fn interpolate_attribute(
+/// Interpolates each of `attributes` of `mesh` across every triangle by the scan that
+/// voxelizes it (the triangle's affine interpolant at each voxel's projection along its
+/// dominant axis); where several triangles reach a voxel, the value of the sample nearest its
+/// centre. `progress` counts faces, once per attribute.
+pub fn interpolate_attributes(
     mesh: &Mesh,
     transform: Transform,
-    attribute: &VertexAttribute,
+    attributes: &[&VertexAttribute],
     progress: &Progress,
-) -> Result<AttributeGrid> {
+) -> Result<Vec<AttributeGrid>> {
     let pos = index_positions(mesh, &transform);
-    let values = |slots: [usize; 3]| mesh.attribute_corners(attribute, slots);
     let degenerate = AtomicU64::new(0);
-    let grid = scan_faces(mesh, &pos, values, transform, &degenerate, progress);
-    progress.check()?;
-    Ok(AttributeGrid::finished(attribute, grid))
+    attributes
+        .iter()
+        .map(|&attribute| {
+            let values = |slots: [usize; 3]| mesh.attribute_corners(attribute, slots);
+            let grid = scan_faces(mesh, &pos, values, transform, &degenerate, progress);
+            progress.check()?;
+            Ok(AttributeGrid::finished(attribute, grid))
+        })
+        .collect()
 }
 
 /// Scans the fan triangles of every face, each with the values `corner_values` gives its

@@ -78,7 +78,7 @@ pub struct ImplicitArgs {
     /// Write the solid F < 0 within the bounds instead of the surface: Passalis et al.'s
     /// double depth layers along z, x and y, each ray's crossings of F = 0 isolated by
     /// interval arithmetic (`density`, `shell`, `interior`, `unclassified`).
-    #[arg(long, conflicts_with_all = ["levels", "negative_r", "squared"])]
+    #[arg(long)]
     depth_layers: bool,
     /// Output: a .vdb (`density`, `normal`, and the levels), a .nvdb (the same grids for
     /// NanoVDB), or a .binvox or .vox (the voxels alone).
