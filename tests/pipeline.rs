@@ -160,6 +160,7 @@ fn subdivision_solid(cube: &Path) -> Task {
         mesh: MeshSource::File(cube.to_path_buf()),
         options: ParametricOptions::default(),
         output: voxelkit::pipeline::SubdivisionOutput::Solid(voxelkit::pipeline::SubdivisionFill {
+            depth_layers: false,
             graystack: 1 << 10,
             density: 1.0,
             topology: true,

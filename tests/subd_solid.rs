@@ -2,7 +2,10 @@
 //! the exact limit volume (Gauss quadrature, divergence theorem) against a fine tessellation;
 //! the seeds-and-FloodingXYZ solid at 64, 128 and 256 against the exterior flood of the same
 //! surface (identical) and against the limit volume (within area x h); inward-oriented control
-//! meshes fill the same; open ones are refused; and CSG trees over subdivision solids.
+//! meshes fill the same; open ones are refused; CSG trees over subdivision solids; and the
+//! depth-layer solid (Passalis et al. on the parametric surface): its certified tessellation
+//! closed and within its tolerance of the limit surface, its inside the centres a fine
+//! tessellation's winding number puts inside.
 #![cfg(all(feature = "vdb", feature = "fixtures"))]
 
 mod common;
@@ -11,7 +14,10 @@ use std::path::Path;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform};
 use voxelkit::progress::Progress;
 use voxelkit::solids::exterior_flood::{FloodMethod, solid_from_surface};
-use voxelkit::solids::subdivision::{SubdivisionSolid, subdivision_solid};
+use voxelkit::solids::subdivision::{
+    Filled, SubdivisionSolid, TESSELLATION_TOLERANCE, subdivision_depth_layer_solid,
+    subdivision_solid,
+};
 use voxelkit::subd::{ControlMesh, LimitSurface, limit_volume};
 
 /// Every closed control mesh of the data folder.
@@ -89,14 +95,19 @@ fn seeded_solids_hold_the_limit_volume_and_equal_the_exterior_flood() {
             let (made, h) = solid_at(&control, resolution);
             let m = made.solid.measures;
             let exact = made.limit_volume;
+            let Filled::Seeds {
+                seeds,
+                outside_seeds,
+            } = made.filled
+            else {
+                panic!("a seeded solid");
+            };
             eprintln!(
                 "{name} {resolution}: limit volume {exact:.6} in {:.6} .. {:.6} (area x h {:.6}); \
-                 {} seeds, {} outside",
+                 {seeds} seeds, {outside_seeds} outside",
                 m.volume_inside,
                 m.volume_with_surface,
                 area * h,
-                made.seeds,
-                made.outside_seeds
             );
             assert!(m.volume_inside <= exact && exact <= m.volume_with_surface);
             assert!(exact - m.volume_inside <= area * h, "{name} {resolution}");
@@ -203,4 +214,145 @@ fn csg_trees_take_subdivision_leaves() {
         ControlMesh::load(&data.join("subd/catmark_torus.obj")).unwrap(),
     ));
     assert!((va - exact).abs() <= area * h, "{va} vs {exact}");
+}
+
+/// The certified tessellation depth layers run on: closed and consistently oriented (every
+/// edge in two triangles, once each way), every limit point sampled at random within its
+/// tolerance of it, and its volume within area x tolerance of the limit volume.
+#[test]
+fn certified_tessellations_are_closed_and_within_their_tolerance() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    use voxelkit::mesh::winding::WindingTree;
+    use voxelkit::subd::certified_tessellation;
+    for name in CLOSED_CONTROL_MESHES {
+        let control = load(&data, name);
+        let b = control.bbox();
+        let tolerance = TESSELLATION_TOLERANCE * (b.max - b.min).max_element() / 128.0;
+        let surface = LimitSurface::new(control);
+        let t = certified_tessellation(&surface, tolerance, u64::MAX, &Progress::none()).unwrap();
+        let mesh = &t.mesh;
+        let mut edges = std::collections::HashMap::new();
+        for (_, [a, b, c]) in mesh.triangles() {
+            for (p, q) in [(a, b), (b, c), (c, a)] {
+                *edges.entry((p, q)).or_insert(0u32) += 1;
+            }
+        }
+        let unmatched = edges
+            .iter()
+            .filter(|&(&(p, q), &n)| n != 1 || edges.get(&(q, p)) != Some(&1))
+            .count();
+        assert_eq!(
+            unmatched, 0,
+            "{name}: {unmatched} edges not shared once each way"
+        );
+        let tree = WindingTree::new(mesh);
+        let mut farthest = 0.0f64;
+        for (face, u, v) in surface.random_parameters(64, 7) {
+            let p = surface.evaluate(face, u, v).unwrap().position;
+            farthest = farthest.max(tree.distance(p));
+        }
+        let exact = limit_volume(&surface);
+        let area = voxelkit::subd::limit_area(&surface);
+        let volume_error = (mesh.signed_volume() - exact).abs();
+        eprintln!(
+            "{name}: {} triangles, level {} at most; limit points within {:.3} of the \
+             tolerance; volume off by {:.3} of area x tolerance",
+            mesh.triangle_count(),
+            t.deepest,
+            farthest / tolerance,
+            volume_error / (area * tolerance)
+        );
+        assert!(farthest < tolerance, "{name}: {farthest} > {tolerance}");
+        assert!(volume_error < area * tolerance, "{name}");
+    }
+}
+
+/// The depth-layer solid of every closed control mesh at 64 (some at 128) holds exactly the centres
+/// off the enclosing surface that the winding number of a fine tessellation (not the
+/// certified one) puts inside, plus the surface; the seeded flood's solid holds them too,
+/// with at most pockets of outside centres the enclosing surface walls in.
+#[test]
+fn depth_layer_solids_are_the_centres_inside_the_limit_surface() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    use voxelkit::mesh::winding::WindingTree;
+    for name in CLOSED_CONTROL_MESHES {
+        let control = load(&data, name);
+        let surface = LimitSurface::new(control.clone());
+        let segments = (512.0 / (surface.patch_count() as f64).sqrt()).clamp(4.0, 64.0) as usize;
+        let reference = WindingTree::new(&surface.tessellate(|_| segments));
+        // 128 as well where creases and extraordinary corners crowd the tessellation.
+        let resolutions: &[u32] = match name {
+            "spot_control_mesh" | "catmark_cube_creases1" | "beast" => &[64, 128],
+            _ => &[64],
+        };
+        for &resolution in resolutions {
+            let t = fit_transform(
+                &control.polygon_mesh().bbox(),
+                GridFit::Resolution(resolution),
+            )
+            .unwrap();
+            let made = subdivision_depth_layer_solid(
+                &control,
+                t,
+                &Default::default(),
+                u64::MAX,
+                &Progress::none(),
+            )
+            .unwrap();
+            let Filled::DepthLayers {
+                triangles,
+                by_winding_number,
+                ..
+            } = made.filled
+            else {
+                panic!("a depth-layer solid");
+            };
+            let shell = &made.surface.surface;
+            let bbox = shell.bbox().unwrap();
+            let mut expected = 0u64;
+            let mut wrong = Vec::new();
+            for x in bbox.min[0]..=bbox.max[0] {
+                for y in bbox.min[1]..=bbox.max[1] {
+                    for z in bbox.min[2]..=bbox.max[2] {
+                        let c = [x, y, z];
+                        if shell.contains(c) {
+                            continue;
+                        }
+                        let w = reference.winding_number(t.index_to_world(c)).abs();
+                        let inside = w >= 0.5;
+                        expected += u64::from(inside);
+                        if inside != made.solid.inside.contains(c) {
+                            wrong.push((c, w));
+                        }
+                    }
+                }
+            }
+            let (seeded, _) = solid_at(&control, resolution);
+            let walled_in =
+                seeded.solid.inside.voxel_count() as i64 - made.solid.inside.voxel_count() as i64;
+            eprintln!(
+                "{name} {resolution}: {} inside ({expected} by the winding number), {triangles} \
+                 triangles, {by_winding_number} undecided by the layers; the seeded flood \
+                 holds {walled_in} more",
+                made.solid.inside.voxel_count()
+            );
+            assert!(
+                wrong.is_empty(),
+                "{name} {resolution}: {:?}",
+                &wrong[..wrong.len().min(5)]
+            );
+            assert!(
+                made.solid
+                    .inside
+                    .voxels()
+                    .all(|c| seeded.solid.inside.contains(c)),
+                "{name} {resolution}"
+            );
+            assert!(walled_in >= 0, "{name} {resolution}");
+        }
+    }
 }

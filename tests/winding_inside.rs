@@ -225,7 +225,13 @@ fn solids_level_sets_and_measures_agree_with_the_exact_winding_number() {
             min: solid.grid.bbox().unwrap().min.map(|v| v - 2),
             max: solid.grid.bbox().unwrap().max.map(|v| v + 2),
         };
-        let leaf = csg_leaves::mesh_solid(mesh, &t, bbox, &csg_leaves::ALL_DIRECTIONS).unwrap();
+        let leaf = csg_leaves::mesh_solid(
+            mesh,
+            &t,
+            bbox,
+            &voxelkit::solids::depth_layers::DepthLayerOptions::ALL_DIRECTIONS,
+        )
+        .unwrap();
         agrees(
             "a CSG mesh leaf",
             mesh,

@@ -65,11 +65,17 @@ fn leaf_bytes(leaves: f64, vector_channels: u32) -> f64 {
 /// How many leaves with `vector_channels` channels fit in `limit` (default: the memory
 /// available), for work whose size is only known as it runs.
 pub(super) fn leaf_budget(limit: Option<u64>, vector_channels: u32) -> u64 {
+    let per_leaf = LEAF_BYTES + f64::from(vector_channels) * VECTOR_LEAF_BYTES;
+    (memory_budget(limit) as f64 / per_leaf) as u64
+}
+
+/// Bytes that work whose size is only known as it runs may take under `limit` (default: the
+/// memory available).
+pub(super) fn memory_budget(limit: Option<u64>) -> u64 {
     let available = limit
         .or_else(crate::system::available_memory_bytes)
         .unwrap_or(u64::MAX) as f64;
-    let per_leaf = LEAF_BYTES + f64::from(vector_channels) * VECTOR_LEAF_BYTES;
-    ((available - BASE_BYTES).max(0.0) / per_leaf) as u64
+    (available - BASE_BYTES).max(0.0) as u64
 }
 
 /// Peak bytes of a surface of `area` voxels^2.

@@ -258,6 +258,8 @@ pub enum SubdivisionOutput {
 /// How a Catmull-Clark solid is filled and weighed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SubdivisionFill {
+    /// By depth layers on a certified tessellation instead of seeds and FloodingXYZ.
+    pub depth_layers: bool,
     /// GRAYSTACK capacity for FloodingXYZ (entries).
     pub graystack: usize,
     /// Mass per unit volume.
@@ -659,7 +661,10 @@ impl PlannedJob {
                 control,
                 options,
                 output: SubdivisionOutput::Solid(fill),
-            } => solid::subdivision_solid(control, t, options, *fill, fit, progress),
+            } => {
+                let memory = estimate::memory_budget(self.job.limits.max_memory);
+                solid::subdivision_solid(control, t, options, *fill, fit, memory, progress)
+            }
             Work::Implicit {
                 formula,
                 text,

@@ -480,6 +480,10 @@ request! {
         presplit: u32 = ParametricOptions::default().presplit,
         /// The solid of the closed limit surface, with its volume and mass.
         solid: bool = false,
+        /// With `solid`: fill by Passalis et al.'s double depth layers along z, x and y on a
+        /// tessellation certified within 0.45 voxel of the limit surface, united with the
+        /// enclosing surface, instead of seeds and FloodingXYZ (every pocket filled).
+        depth_layers: bool = false,
         /// GRAYSTACK capacity of FloodingXYZ (entries).
         graystack: usize = DEFAULT_GRAYSTACK,
         /// Mass per unit volume.
@@ -852,12 +856,17 @@ impl Request for SubdivRequest {
     fn task(&self, mesh: MeshSource) -> Result<Task> {
         if self.solid {
             positive("density", self.density)?;
+        } else if self.depth_layers {
+            return Err(Error::InvalidArgument(
+                "depth_layers fills the solid: set solid as well".into(),
+            ));
         }
         Ok(Task::Subdivision {
             mesh,
             options: self.options()?,
             output: if self.solid {
                 SubdivisionOutput::Solid(SubdivisionFill {
+                    depth_layers: self.depth_layers,
                     graystack: self.graystack.max(1),
                     density: self.density,
                     topology: self.topology,

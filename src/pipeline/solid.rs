@@ -31,6 +31,7 @@ use crate::solids::flooded_mesh::{self, FLOOD_NEEDS_CLOSED, SurfaceAndInside};
 use crate::solids::formula_rays::FormulaRays;
 use crate::solids::inside_rule::{Inside, InsideChoice, InsideRule, choose_inside};
 use crate::solids::level_set::{SIGN_NEEDS_CLOSED, level_set, unsigned_distance};
+use crate::solids::subdivision::{self, Filled};
 use crate::subd::ControlMesh;
 use crate::voxelize::parametric::ParametricOptions;
 use rayon::prelude::*;
@@ -487,39 +488,67 @@ pub(super) fn subdivision_solid(
     options: &ParametricOptions,
     fill: SubdivisionFill,
     fit: GridFit,
+    memory: u64,
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
-    let made = crate::solids::subdivision::subdivision_solid(
-        control,
-        t,
-        options,
-        fill.graystack.max(1),
-        progress,
-    )?;
-    let method = "lai-cheng-parametric-enclosed+seeds+flooding-xyz";
+    let made = if fill.depth_layers {
+        subdivision::subdivision_depth_layer_solid(control, t, options, memory, progress)?
+    } else {
+        subdivision::subdivision_solid(control, t, options, fill.graystack.max(1), progress)?
+    };
+    let method = match made.filled {
+        Filled::Seeds { .. } => "lai-cheng-parametric-enclosed+seeds+flooding-xyz",
+        Filled::DepthLayers { .. } => {
+            "lai-cheng-parametric-enclosed+depth-layers-on-certified-tessellation"
+        }
+    };
     let mut meta = provenance(method, &control.source.display().to_string(), fit);
     meta.push(("adjacency", options.adjacency.number().into()));
     meta.push(("limit_volume", made.limit_volume.into()));
     meta.push(("limit_area", made.limit_area.into()));
-    meta.push(("seeds", made.seeds.into()));
-    // Steps along tilted normals can leave the solid; their floods reach the border and are
-    // dropped (`solids::subdivision`).
-    meta.push(("outside_seeds", made.outside_seeds.into()));
+    let mut rule = SUBDIVISION_RULE.to_string();
+    match made.filled {
+        Filled::Seeds {
+            seeds,
+            outside_seeds,
+        } => {
+            meta.push(("seeds", seeds.into()));
+            // Steps along tilted normals can leave the solid; their floods reach the border
+            // and are dropped (`solids::subdivision`).
+            meta.push(("outside_seeds", outside_seeds.into()));
+        }
+        Filled::DepthLayers {
+            triangles,
+            deepest,
+            stats,
+            by_winding_number,
+        } => {
+            meta.push(("tessellation_triangles", triangles.into()));
+            meta.push(("tessellation_deepest_level", deepest.into()));
+            meta.push((
+                "tessellation_tolerance_voxels",
+                subdivision::TESSELLATION_TOLERANCE.into(),
+            ));
+            meta.push(("odd_rays", stats.odd_rays().into()));
+            meta.push(("decided_by_winding_number", by_winding_number.into()));
+            rule = format!(
+                "inside = the centres double depth layers along {} directions put inside, on a \
+                 tessellation within {} voxel of the limit surface ({triangles} triangles), \
+                 {by_winding_number} of them settled by its winding number where no direction \
+                 decided; and the enclosing surface",
+                stats.per_direction.len(),
+                subdivision::TESSELLATION_TOLERANCE
+            );
+        }
+    }
     let tags = TagSummary::of(&control.tags);
     tag_metadata(&mut meta, &tags);
     let (limit_volume, limit_area) = (made.limit_volume, made.limit_area);
     let opposite = made.surface.opposite;
     let parts = SurfaceAndInside::of(made.surface.surface, made.solid);
     let outcome = surface_and_inside(parts, meta, |whole, solid| {
-        let mut details = solid_details(
-            whole,
-            solid,
-            fill.density,
-            SUBDIVISION_RULE,
-            None,
-            fill.topology,
-        )?;
+        let mut details = solid_details(whole, solid, fill.density, &rule, None, fill.topology)?;
         details.limit_volume = Some(limit_volume);
         details.mesh_area = Some(limit_area);
         details.tags = tags.clone();

@@ -13,7 +13,7 @@ use crate::ops::csg::{resample, same_transform};
 use crate::ops::flood_xyz::DEFAULT_GRAYSTACK;
 use crate::progress::Progress;
 use crate::shapes::{Cuboid, Cylinder, Sphere};
-use crate::solids::depth_layers::{DepthLayerOptions, Layers, depth_layer_solid};
+use crate::solids::depth_layers::{DepthLayerOptions, depth_layer_solid};
 use crate::solids::inside_rule::{Inside, InsideRule, choose_inside};
 use crate::solids::winding_inside::winding_inside;
 use glam::{DAffine3, DVec3};
@@ -142,13 +142,6 @@ pub fn formula_solid(
         },
     )
 }
-
-/// Depth layers over all directions, the most that can be decided.
-pub const ALL_DIRECTIONS: DepthLayerOptions = DepthLayerOptions {
-    directions: crate::solids::depth_layers::DirectionSet::ALL,
-    layers: Layers::Double,
-    unclassified: crate::solids::depth_layers::Unclassified::NoDirection,
-};
 
 /// A mesh's centres inside it by the automatic inside rule: its winding number, or where its
 /// orientation is inconsistent, depth layers (voxels they cannot decide are an error naming

@@ -30,7 +30,7 @@
 //! `{"mesh": {"file": "cow.obj", "place": {"translate": [2, 0, 0]}}}`.
 
 use super::csg_leaves::{
-    ALL_DIRECTIONS, Primitive, formula_solid, grid_bounds, grid_solid, mesh_solid, primitive_solid,
+    Primitive, formula_solid, grid_bounds, grid_solid, mesh_solid, primitive_solid,
     subdivision_leaf,
 };
 use super::csg_placement::{PlaceSpec, placed_box, to_world};
@@ -527,7 +527,12 @@ impl CsgNode {
             ),
             CsgNode::Mesh(m) => (
                 format!("mesh {}", m.source.display()),
-                mesh_solid(m, transform, bbox, &ALL_DIRECTIONS)?,
+                mesh_solid(
+                    m,
+                    transform,
+                    bbox,
+                    &crate::solids::depth_layers::DepthLayerOptions::ALL_DIRECTIONS,
+                )?,
             ),
             CsgNode::Subdivision(c) => (
                 format!("subdiv {}", c.source.display()),

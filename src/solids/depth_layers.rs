@@ -198,6 +198,15 @@ pub struct DepthLayerOptions {
     pub unclassified: Unclassified,
 }
 
+impl DepthLayerOptions {
+    /// Double layers over all directions, the most that can be decided.
+    pub const ALL_DIRECTIONS: DepthLayerOptions = DepthLayerOptions {
+        directions: DirectionSet::ALL,
+        layers: Layers::Double,
+        unclassified: Unclassified::NoDirection,
+    };
+}
+
 impl Default for DepthLayerOptions {
     fn default() -> Self {
         DepthLayerOptions {

@@ -16,31 +16,63 @@
 //!   through a part thinner than a voxel, can land outside: a seed whose flood reaches the
 //!   border of the box lay outside, and its flood is dropped and counted (`outside_seeds`);
 //!   later seeds in that region are skipped. If no seed stays inside, the solid is refused.
+//!
+//! Or, as Passalis et al. offer for parametric surfaces, by depth layers: double layers along
+//! the 16 directions of `depth_layers::DIRECTIONS` run on a tessellation certified within `TESSELLATION_TOLERANCE` voxel of
+//! the limit surface (`subd::certified_tessellation`), so every centre they decide wrongly lies
+//! within that distance of the limit surface, inside its voxel's half-voxel ball: a voxel the
+//! surface touches, which the enclosing surface holds. The solid is the centres the layers put
+//! inside, united with the enclosing surface: no seeds, no flood, every pocket filled. The
+//! rare centre off the surface that every direction crosses more than four times is settled by
+//! the closed tessellation's winding number.
 
 use crate::error::{Error, Result};
 use crate::grid::{Coord, DenseMask, Transform};
+use crate::mesh::winding::WindingTree;
 use crate::ops::flood::padded;
 use crate::ops::flood_xyz::{FloodXyzStats, flood_xyz};
 use crate::ops::measure::SolidMeasures;
 use crate::ops::seed::seeds_from_normals;
 use crate::progress::Progress;
+use crate::solids::depth_layers::{DepthLayerOptions, DepthLayerStats, depth_layer_solid};
 use crate::solids::exterior_flood::Solid;
-use crate::subd::{ControlMesh, LimitSurface, limit_volume_and_area};
+use crate::subd::{
+    ControlMesh, LimitSurface, TESSELLATION_TRIANGLE_BYTES, certified_tessellation,
+    limit_volume_and_area,
+};
 use crate::voxelize::parametric::{ParametricOptions, ParametricOutput, voxelize_subdivision};
+use rayon::prelude::*;
+
+/// How far (voxels) the tessellation depth layers run on may stray from the limit surface:
+/// below half a voxel, with room for rounding.
+pub const TESSELLATION_TOLERANCE: f64 = 0.45;
 
 /// A Catmull-Clark solid and what made it.
 pub struct SubdivisionSolid {
     /// The voxelized limit surface (with normals) and its opposite-normal voxels.
     pub surface: ParametricOutput,
     pub solid: Solid,
-    /// Seeds the rule gave, and those whose flood reached the border (dropped).
-    pub seeds: u64,
-    pub outside_seeds: u64,
+    pub filled: Filled,
     /// The exact volume the limit surface encloses (Gauss quadrature), in world units: its
     /// sign tells which way the normals face.
     pub limit_volume: f64,
     /// The limit surface's exact area, from the same quadrature.
     pub limit_area: f64,
+}
+
+/// How the inside was found.
+pub enum Filled {
+    /// Seeds the rule gave, and those whose flood reached the border (dropped).
+    Seeds { seeds: u64, outside_seeds: u64 },
+    /// Depth layers on a certified tessellation: its triangles, the deepest quadtree level a
+    /// patch took, the layers' ray counts, and the voxels off the surface no direction decided
+    /// (settled by the tessellation's winding number).
+    DepthLayers {
+        triangles: u64,
+        deepest: u32,
+        stats: DepthLayerStats,
+        by_winding_number: u64,
+    },
 }
 
 /// Why a solid needs a closed control mesh.
@@ -55,18 +87,8 @@ pub fn subdivision_solid(
     capacity: usize,
     progress: &Progress,
 ) -> Result<SubdivisionSolid> {
-    if !control.is_closed() {
-        return Err(Error::InvalidArgument(format!(
-            "{}: {SOLID_NEEDS_CLOSED}",
-            control.source.display()
-        )));
-    }
-    let options = ParametricOptions {
-        enclose: true,
-        ..*options
-    };
-    let surface = voxelize_subdivision(control, transform, &options, progress)?;
-    let (limit_volume, limit_area) = limit_volume_and_area(&LimitSurface::new(control.clone()));
+    let (surface, limit) = enclosing_surface(control, transform, options, progress)?;
+    let (limit_volume, limit_area) = limit_volume_and_area(&limit);
     let outward = limit_volume < 0.0;
     let seeds: Vec<Coord> = seeds_from_normals(&surface.surface, &surface.opposite, outward)
         .map(|choice| choice.seed)
@@ -123,8 +145,101 @@ pub fn subdivision_solid(
             measures,
             xyz_stats: Some(stats),
         },
-        seeds: seeds.len() as u64,
-        outside_seeds,
+        filled: Filled::Seeds {
+            seeds: seeds.len() as u64,
+            outside_seeds,
+        },
+        limit_volume: limit_volume.abs(),
+        limit_area,
+    })
+}
+
+/// The enclosing voxelization of the closed limit surface of `control`, and the surface.
+fn enclosing_surface(
+    control: &ControlMesh,
+    transform: Transform,
+    options: &ParametricOptions,
+    progress: &Progress,
+) -> Result<(ParametricOutput, LimitSurface)> {
+    if !control.is_closed() {
+        return Err(Error::InvalidArgument(format!(
+            "{}: {SOLID_NEEDS_CLOSED}",
+            control.source.display()
+        )));
+    }
+    let options = ParametricOptions {
+        enclose: true,
+        ..*options
+    };
+    let surface = voxelize_subdivision(control, transform, &options, progress)?;
+    Ok((surface, LimitSurface::new(control.clone())))
+}
+
+/// The solid of the closed limit surface of `control` by double depth layers along all
+/// directions on a tessellation within `TESSELLATION_TOLERANCE` voxel of it, united with the
+/// enclosing surface; the tessellation may take `memory` bytes at most.
+pub fn subdivision_depth_layer_solid(
+    control: &ControlMesh,
+    transform: Transform,
+    options: &ParametricOptions,
+    memory: u64,
+    progress: &Progress,
+) -> Result<SubdivisionSolid> {
+    let (surface, limit) = enclosing_surface(control, transform, options, progress)?;
+    let Some(bbox) = surface.surface.bbox() else {
+        return Err(Error::InvalidArgument(format!(
+            "{}: the limit surface has no voxels",
+            control.source.display()
+        )));
+    };
+    let tessellation = certified_tessellation(
+        &limit,
+        TESSELLATION_TOLERANCE * transform.voxel_size,
+        memory / TESSELLATION_TRIANGLE_BYTES,
+        progress,
+    )?;
+    let bbox = padded(bbox, 1);
+    let layers = depth_layer_solid(
+        &tessellation.mesh,
+        &transform,
+        bbox,
+        &DepthLayerOptions::ALL_DIRECTIONS,
+        progress,
+    )?;
+    let on_surface = DenseMask::from_grid(&surface.surface, bbox)?;
+    let mut inside = layers.inside.minus(&on_surface);
+    // The tessellation is closed: its winding number settles the few centres that every
+    // direction's rays cross more than four times.
+    let undecided: Vec<usize> = layers.unclassified.minus(&on_surface).ones().collect();
+    if !undecided.is_empty() {
+        let tree = WindingTree::new(&tessellation.mesh);
+        let settled: Vec<usize> = undecided
+            .par_iter()
+            .copied()
+            .filter(|&i| {
+                let centre = transform.index_to_world(inside.coord(i));
+                tree.winding_number(centre).abs() >= 0.5
+            })
+            .collect();
+        for i in settled {
+            inside.set_index(i);
+        }
+    }
+    let (limit_volume, limit_area) = limit_volume_and_area(&limit);
+    let measures = SolidMeasures::of(inside.count(), on_surface.count(), transform.voxel_size);
+    Ok(SubdivisionSolid {
+        surface,
+        solid: Solid {
+            inside: inside.to_grid(transform),
+            measures,
+            xyz_stats: None,
+        },
+        filled: Filled::DepthLayers {
+            triangles: tessellation.mesh.triangle_count() as u64,
+            deepest: tessellation.deepest,
+            stats: layers.stats,
+            by_winding_number: undecided.len() as u64,
+        },
         limit_volume: limit_volume.abs(),
         limit_area,
     })

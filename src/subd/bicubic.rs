@@ -87,6 +87,29 @@ impl Bicubic {
         (p, pu, pv)
     }
 
+    /// A bound on `|S_uu| + 2 |S_uv| + |S_vv|` over the patch: each second derivative is a
+    /// convex combination (B-spline weights) of the net's second differences, so its length is
+    /// at most theirs.
+    pub fn second_derivative_bound(&self) -> f64 {
+        let p = &self.p;
+        let mut along_u = 0.0f64;
+        let mut along_v = 0.0f64;
+        let mut mixed = 0.0f64;
+        for a in 0..4 {
+            for b in 0..2 {
+                along_u = along_u.max((p[b][a] - 2.0 * p[b + 1][a] + p[b + 2][a]).length());
+                along_v = along_v.max((p[a][b] - 2.0 * p[a][b + 1] + p[a][b + 2]).length());
+            }
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                let twist = p[i + 1][j + 1] - p[i + 1][j] - p[i][j + 1] + p[i][j];
+                mixed = mixed.max(twist.length());
+            }
+        }
+        along_u + 2.0 * mixed + along_v
+    }
+
     /// Bounding box of the piece over `[u0,u1] x [v0,v1]`: the box of its 16 Bezier control
     /// points, which contain the piece (convex hull property).
     pub fn bound(&self, u0: f64, u1: f64, v0: f64, v1: f64) -> (DVec3, DVec3) {
@@ -140,6 +163,29 @@ mod tests {
             let fv = (b.eval(u, v + h).0 - b.eval(u, v - h).0) / (2.0 * h);
             assert!((pu - fu).length() < 1e-8 && (pv - fv).length() < 1e-8);
         }
+    }
+
+    #[test]
+    fn second_derivatives_stay_within_the_bound() {
+        let b = sample_patch();
+        let bound = b.second_derivative_bound();
+        let h = 1e-4;
+        let mut largest = 0.0f64;
+        for a in 0..=10 {
+            for c in 0..=10 {
+                let (u, v) = (0.05 + 0.09 * a as f64, 0.05 + 0.09 * c as f64);
+                let f = |du: f64, dv: f64| b.eval(u + du, v + dv).0;
+                let uu = (f(h, 0.0) - 2.0 * f(0.0, 0.0) + f(-h, 0.0)) / (h * h);
+                let vv = (f(0.0, h) - 2.0 * f(0.0, 0.0) + f(0.0, -h)) / (h * h);
+                let uv = (f(h, h) - f(h, -h) - f(-h, h) + f(-h, -h)) / (4.0 * h * h);
+                largest = largest.max(uu.length() + 2.0 * uv.length() + vv.length());
+            }
+        }
+        assert!(largest <= bound * (1.0 + 1e-6), "{largest} > {bound}");
+        assert!(
+            largest > 0.3 * bound,
+            "the bound is loose: {largest} against {bound}"
+        );
     }
 
     #[test]

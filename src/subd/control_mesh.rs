@@ -224,6 +224,11 @@ impl ControlMesh {
         self.mesh.face_len(f)
     }
 
+    /// The vertices of face `f`, counter-clockwise.
+    pub fn face_vertices(&self, f: usize) -> &[u32] {
+        self.mesh.face(f)
+    }
+
     /// Patches of the limit surface: one per quad, n per n-gon.
     pub fn patch_count(&self) -> usize {
         (0..self.face_count())

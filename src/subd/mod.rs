@@ -3,6 +3,7 @@
 
 mod area;
 mod bicubic;
+mod certified_tessellation;
 mod compare;
 mod control_mesh;
 mod crease;
@@ -18,6 +19,9 @@ mod surface;
 mod tags;
 
 pub use area::{limit_area, limit_volume, limit_volume_and_area};
+pub use certified_tessellation::{
+    CertifiedTessellation, TESSELLATION_TRIANGLE_BYTES, certified_tessellation,
+};
 pub use compare::{Comparison, angle_between, compare_points};
 pub use control_mesh::{ControlMesh, ControlStats};
 pub use patch::LimitSample;

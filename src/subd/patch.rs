@@ -136,6 +136,39 @@ impl PatchNode {
         }
     }
 
+    /// Whether triangles spanning any points of the piece over the square `[u0,u1] x [v0,v1]`
+    /// lie within `tolerance` of the piece at the same parameters. On a bicubic leaf, whose own
+    /// parameters give the square a side `h`, linear interpolation is within
+    /// `h^2/2 (|S_uu| + 2 |S_uv| + |S_vv|)` (Taylor's remainder; the linear terms cancel in a
+    /// convex combination); a square spanning several leaves of the quadtree (towards an
+    /// extraordinary corner) passes when its box, which holds the piece and so the triangles,
+    /// has a diagonal below `tolerance`.
+    pub fn within_tolerance(&self, u0: f64, u1: f64, v0: f64, v1: f64, tolerance: f64) -> bool {
+        match self {
+            PatchNode::Regular(b) => {
+                let side = (u1 - u0).max(v1 - v0);
+                0.5 * side * side * b.second_derivative_bound() < tolerance
+            }
+            PatchNode::Irregular(p) => {
+                let i = usize::from(u0 >= 0.5);
+                let j = usize::from(v0 >= 0.5);
+                let within =
+                    |lo: f64, hi: f64, k: usize| if k == 0 { hi <= 0.5 } else { lo >= 0.5 };
+                if within(u0, u1, i) && within(v0, v1, j) {
+                    return p.children()[quadrant_index(i, j)].within_tolerance(
+                        2.0 * u0 - i as f64,
+                        2.0 * u1 - i as f64,
+                        2.0 * v0 - j as f64,
+                        2.0 * v1 - j as f64,
+                        tolerance,
+                    );
+                }
+                let (lo, hi) = self.bound(u0, u1, v0, v1);
+                (hi - lo).length() < tolerance
+            }
+        }
+    }
+
     /// A box containing the piece of the patch over `[u0,u1] x [v0,v1]`.
     pub fn bound(&self, u0: f64, u1: f64, v0: f64, v1: f64) -> (DVec3, DVec3) {
         match self {

@@ -104,6 +104,18 @@ impl LimitSurface {
         self.patches[pid].bound(s0, s1, t0, t1)
     }
 
+    /// See `PatchNode::within_tolerance`.
+    pub fn within_tolerance(&self, pid: usize, [s0, s1, t0, t1]: [f64; 4], tolerance: f64) -> bool {
+        self.patches[pid].within_tolerance(s0, s1, t0, t1, tolerance)
+    }
+
+    /// The face patch `pid` belongs to, and its place among the face's patches (an n-gon's
+    /// sub-face number; 0 for a quad).
+    pub fn patch_of_face(&self, pid: usize) -> (usize, usize) {
+        let face = self.patch_face[pid] as usize;
+        (face, pid - self.first_patch[face] as usize)
+    }
+
     /// Whether patch `pid` is one polynomial over `[s0,s1] x [t0,t1]` (see
     /// `PatchNode::polynomial_on`).
     pub fn polynomial_on(&self, pid: usize, s0: f64, s1: f64, t0: f64, t1: f64) -> bool {

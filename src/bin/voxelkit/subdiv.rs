@@ -67,6 +67,11 @@ pub struct SubdivVoxelizeArgs {
     /// refines it, so that no gap lets the inside flood out.
     #[arg(long)]
     solid: bool,
+    /// --solid: fill by Passalis et al.'s double depth layers along z, x and y, run on a
+    /// tessellation certified within 0.45 voxel of the limit surface and united with the
+    /// enclosing surface, instead of seeds and FloodingXYZ: no seeds to miss a pocket.
+    #[arg(long, requires = "solid")]
+    depth_layers: bool,
     /// --solid: GRAYSTACK capacity of FloodingXYZ (entries; when full, sweeps resume the
     /// flood).
     #[arg(long, default_value_t = SubdivRequest::default().graystack, requires = "solid")]
@@ -136,6 +141,7 @@ fn voxelize(inputs: &[PathBuf], args: &SubdivVoxelizeArgs, global: &Global) -> R
     let options = args.surface.options();
     let output = if args.solid {
         SubdivisionOutput::Solid(SubdivisionFill {
+            depth_layers: args.depth_layers,
             graystack: args.graystack,
             density: args.density,
             topology: args.topology,
