@@ -940,7 +940,8 @@ pub extern "C" fn vk_options_set_flood(
             FloodKind::Blocks
         };
         o.solid.graystack = graystack;
-        // The subdivision solid always floods by FloodingXYZ: it takes the stack when given.
+        // The subdivision solid floods by FloodingXYZ (unless it takes depth layers): it takes
+        // the stack when given.
         o.subdivision.graystack = if xyz {
             graystack
         } else {

@@ -242,6 +242,59 @@ fn subdiv_solid_writes_the_filled_limit_surface() {
     let count = |name: &str| grids.iter().find(|g| g.name == name).unwrap().active_voxels;
     assert_eq!(grids[0].name, "density");
     assert_eq!(count("density"), count("shell") + count("interior"));
+    // Depth layers on the certified tessellation fill the same voxels (no pocket walls an
+    // outside centre in on the cube) and say how.
+    let layered = dir.path().join("layered.vdb");
+    let o = voxelkit(&[
+        "subdiv",
+        &input,
+        "--solid",
+        "--depth-layers",
+        "-r",
+        "48",
+        "-o",
+        layered.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(
+        text(&o).contains("tessellation within 0.45 voxel"),
+        "{}",
+        text(&o)
+    );
+    let layered_grids = read_vdb_info(&layered).unwrap();
+    let density = &layered_grids[0];
+    assert_eq!(density.active_voxels, count("density"));
+    let meta = |key: &str| {
+        density
+            .metadata
+            .iter()
+            .find(|m| m.key == key)
+            .map(|m| m.value.clone())
+    };
+    assert_eq!(
+        meta("method").as_deref(),
+        Some("lai-cheng-parametric-enclosed+depth-layers-on-certified-tessellation")
+    );
+    assert_eq!(meta("odd_rays").as_deref(), Some("0"));
+    assert!(
+        meta("tessellation_triangles")
+            .unwrap()
+            .parse::<u64>()
+            .unwrap()
+            > 100
+    );
+    let o = voxelkit(&[
+        "subdiv",
+        &input,
+        "--depth-layers",
+        "-o",
+        layered.to_str().unwrap(),
+    ]);
+    assert!(
+        !o.status.success() && text(&o).contains("--solid"),
+        "{}",
+        text(&o)
+    );
     // One face fewer: an open control mesh.
     let open = CUBE.rsplit_once("f 4 1 5 8\n").unwrap().0;
     let open = write(dir.path(), "open.obj", open);

@@ -68,6 +68,10 @@ def test_subdiv_solid_equals_cli(data, cli, tmp_path):
     r = grid.report
     assert r["volume_inside"] <= r["limit_volume"] <= r["volume_with_surface"]
     assert set(grid.extras) >= {"shell", "interior"}
+    # Depth layers on the certified tessellation: the CLI's voxels, and the flood's here.
+    layered = voxelkit.subdiv(path, resolution=64, solid=True, depth_layers=True)
+    assert voxel_set(layered.ijk) == expected
+    assert "depth layers" in layered.report["inside_rule"]
 
 
 def test_implicit_equals_cli(cli, tmp_path):

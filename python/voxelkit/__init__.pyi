@@ -131,6 +131,7 @@ def subdiv(
     enclose: bool = False,
     presplit: int = 8,
     solid: bool = False,
+    depth_layers: bool = False,
     graystack: int = 1048576,
     density: float = 1.0,
     topology: bool = False,
@@ -151,6 +152,7 @@ def subdiv(
     enclose = False: Every voxel the surface touches (an enveloping voxelization).
     presplit = 8: Each face's patch split K x K before the adaptive subdivision.
     solid = False: The solid of the closed limit surface, with its volume and mass.
+    depth_layers = False: With `solid`: fill by Passalis et al.'s double depth layers along z, x and y on a tessellation certified within 0.45 voxel of the limit surface, united with the enclosing surface, instead of seeds and FloodingXYZ (every pocket filled).
     graystack = 1048576: GRAYSTACK capacity of FloodingXYZ (entries).
     density = 1.0: Mass per unit volume.
     topology = False: Also count components and genus.

@@ -43,8 +43,36 @@ pub struct ColumnCrossings {
     column_starts: Vec<u32>,
 }
 
-/// Triangles per parallel batch of crossings.
+/// Triangles per parallel batch of crossings at most, and about how many crossings.
 const TRIANGLE_BATCH: usize = 4096;
+const CROSSING_BATCH: f64 = (1 << 20) as f64;
+
+/// Consecutive runs of `triangles` (over `pos`, index units) for parallel batches: up to
+/// `TRIANGLE_BATCH` triangles or about `CROSSING_BATCH` crossings each, with room for the
+/// crossings of each run. A triangle crosses at most its area on the xy plane plus half its
+/// perimeter plus one columns (lattice points of a polygon), so each run's crossings fit
+/// without the vector growing: a few large triangles (a CAD model's faces) neither leave one
+/// thread all the work nor make the peak depend on when vectors doubled.
+fn crossing_batches(pos: &[DVec3], triangles: &[[u32; 3]]) -> Vec<(std::ops::Range<usize>, usize)> {
+    let room: Vec<f64> = triangles
+        .par_iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| pos[v as usize].truncate());
+            let perimeter = a.distance(b) + b.distance(c) + c.distance(a);
+            0.5 * (b - a).perp_dot(c - a).abs() + 0.5 * perimeter + 1.0
+        })
+        .collect();
+    let mut batches = Vec::new();
+    let (mut start, mut sum) = (0, 0.0);
+    for (i, r) in room.iter().enumerate() {
+        sum += r;
+        if i + 1 - start == TRIANGLE_BATCH || sum >= CROSSING_BATCH || i + 1 == room.len() {
+            batches.push((start..i + 1, sum.ceil() as usize));
+            (start, sum) = (i + 1, 0.0);
+        }
+    }
+    batches
+}
 
 impl ColumnCrossings {
     /// The crossings of the closed `mesh` (world units) with the columns of `bbox`.
@@ -73,11 +101,12 @@ impl ColumnCrossings {
         };
         // Columns along +z: `(a, b, t) = (x, y, z)`.
         let z_rays = RayFrame::along([0, 0, 1]);
-        let mut crossings: Vec<Crossing> = triangles
-            .par_chunks(TRIANGLE_BATCH)
-            .flat_map_iter(|batch| {
-                let mut found = Vec::new();
-                for_each_crossing(&pos, batch.iter().copied(), &z_rays, &window, |c| {
+        let batches: Vec<Vec<Crossing>> = crossing_batches(&pos, triangles)
+            .into_par_iter()
+            .map(|(run, room)| {
+                let mut found = Vec::with_capacity(room);
+                let batch = triangles[run].iter().copied();
+                for_each_crossing(&pos, batch, &z_rays, &window, |c| {
                     found.push(Crossing {
                         key: c.ray << 1 | c.rising as usize,
                         after: c.after,
@@ -86,6 +115,10 @@ impl ColumnCrossings {
                 found
             })
             .collect();
+        let mut crossings = Vec::with_capacity(batches.iter().map(Vec::len).sum());
+        for batch in batches {
+            crossings.extend_from_slice(&batch);
+        }
         crossings.par_sort_unstable_by_key(|c| (c.ray(), c.after));
         let mut row_starts = vec![0usize; nx + 1];
         for c in &crossings {

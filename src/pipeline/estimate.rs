@@ -339,6 +339,20 @@ fn subdivision_solid_bytes(control: &ControlMesh, t: &Transform) -> f64 {
         + control.irregular_corner_count() as f64 * IRREGULAR_CORNER_BYTES
 }
 
+/// Triangles per leaf of a certified tessellation at most: two, or a fan where finer leaves
+/// meet it (2.0-3.2 on the shared control meshes at 64-1024).
+const TESSELLATION_TRIANGLES_PER_LEAF: f64 = 3.5;
+
+/// The certified tessellation depth layers run on: its leaves are counted exactly (the
+/// split alone, a fraction of a second), each triangle at its cost while built and rendered.
+fn tessellation_bytes(control: &ControlMesh, t: &Transform) -> f64 {
+    let surface = crate::subd::LimitSurface::new(control.clone());
+    let tolerance = crate::solids::subdivision::TESSELLATION_TOLERANCE * t.voxel_size;
+    crate::subd::certified_leaf_count(&surface, tolerance) as f64
+        * TESSELLATION_TRIANGLES_PER_LEAF
+        * crate::subd::TESSELLATION_TRIANGLE_BYTES as f64
+}
+
 /// A distance band's leaf with its values and encoded buffers: 2.4 KB; a level set's also
 /// holds its interior's leaf and the fog volume's buffers, 3 KB. Each triangle 150 bytes
 /// (its corners, the bins). Fitted on bunny-closed (`--sdf`) and igea (`--udf`) at 1024; the
@@ -641,7 +655,14 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
             let leaves = surface_leaves(area_in_voxels(&control.polygon_mesh(), &t));
             let bytes = patch_bytes(control, &t)
                 + match output {
-                    SubdivisionOutput::Solid(_) => subdivision_solid_bytes(control, &t),
+                    SubdivisionOutput::Solid(fill) => {
+                        subdivision_solid_bytes(control, &t)
+                            + if fill.depth_layers {
+                                tessellation_bytes(control, &t)
+                            } else {
+                                0.0
+                            }
+                    }
                     SubdivisionOutput::Surface => leaves * SUBDIV_LEAF_BYTES,
                     // The tessellation (two triangles a quad) and the flood's volumes.
                     SubdivisionOutput::SeparationCheck => {
@@ -783,10 +804,12 @@ fn solid_plan(mesh: &Mesh, fit: GridFit, fill: Fill) -> Result<Plan> {
 }
 
 /// The winding number's inside gathers every crossing of a column's ray with the mesh and its
-/// caps (16 bytes each, gathered in batches that grow as they fill): 36 bytes a crossing at
-/// the peak beside the surface and the solid's grids. Estimate/peak 0.86-1.19 on bunny-closed,
-/// igea, armadillo, skull, horse, spot, scorpion, fandisk and rocker-arm at 1024.
-const WINDING_CROSSING_BYTES: f64 = 36.0;
+/// caps (16 bytes each, gathered in batches sized for them, then copied into one sorted
+/// array): 32 bytes a crossing at the peak beside the surface and the solid's grids.
+/// Estimate/peak 0.83-1.23 on bunny-closed, igea, armadillo, skull, horse, spot, scorpion,
+/// fandisk and rocker-arm at 1024, the same from run to run (batches that grew by doubling
+/// made fandisk's 1.19-1.31).
+const WINDING_CROSSING_BYTES: f64 = 32.0;
 
 /// A solid or a measure at `cost` (its grids, no flood) whose inside the winding number
 /// decides: the crossings added.

@@ -203,7 +203,7 @@ pub fn subdivision_depth_layer_solid(
         &tessellation.mesh,
         &transform,
         bbox,
-        &DepthLayerOptions::ALL_DIRECTIONS,
+        &DepthLayerOptions::default(),
         progress,
     )?;
     let on_surface = DenseMask::from_grid(&surface.surface, bbox)?;

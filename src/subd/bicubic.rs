@@ -95,10 +95,10 @@ impl Bicubic {
         let mut along_u = 0.0f64;
         let mut along_v = 0.0f64;
         let mut mixed = 0.0f64;
-        for a in 0..4 {
+        for (a, row) in p.iter().enumerate() {
             for b in 0..2 {
                 along_u = along_u.max((p[b][a] - 2.0 * p[b + 1][a] + p[b + 2][a]).length());
-                along_v = along_v.max((p[a][b] - 2.0 * p[a][b + 1] + p[a][b + 2]).length());
+                along_v = along_v.max((row[b] - 2.0 * row[b + 1] + row[b + 2]).length());
             }
         }
         for i in 0..3 {

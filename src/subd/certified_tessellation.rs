@@ -94,12 +94,12 @@ struct Side {
 }
 
 impl Side {
-    fn to_curve(&self, sigma: i64) -> i64 {
+    fn curve_at(self, sigma: i64) -> i64 {
         (self.offset + self.slope * sigma) / 2
     }
 
     /// The side parameter of curve parameter `c`, if the side reaches it.
-    fn from_curve(&self, c: i64) -> Option<i64> {
+    fn side_at(self, c: i64) -> Option<i64> {
         let scaled = 2 * c - self.offset;
         (scaled % self.slope == 0)
             .then_some(scaled / self.slope)
@@ -368,7 +368,7 @@ impl PatchMesh {
             for (&(x, y), &sigma) in along.iter().zip(&self.sides[k]) {
                 index.entry((x, y)).or_insert_with(|| {
                     let side = &self.curves[k];
-                    keys.push(side.curve.point(side.to_curve(sigma)));
+                    keys.push(side.curve.point(side.curve_at(sigma)));
                     points.push(at(x, y));
                     points.len() as u32 - 1
                 });
@@ -408,6 +408,17 @@ impl PatchMesh {
             triangles,
         }
     }
+}
+
+/// The leaves the tessellation within `tolerance` splits `surface`'s patches into, counted
+/// before any triangle is made (a memory plan's count; a patch that cannot be split counts
+/// what it reached).
+pub fn certified_leaf_count(surface: &LimitSurface, tolerance: f64) -> u64 {
+    let budget = AtomicI64::new(i64::MAX);
+    (0..surface.patch_count())
+        .into_par_iter()
+        .map(|pid| leaves(surface, pid, tolerance, &budget).map_or(0, |l| l.len() as u64))
+        .sum()
 }
 
 /// Tessellates the closed limit surface `surface` within `tolerance` (world units) of it, in
@@ -463,7 +474,7 @@ pub fn certified_tessellation(
                 on_curve
                     .entry(sides[k].curve)
                     .or_default()
-                    .push(sides[k].to_curve(sigma));
+                    .push(sides[k].curve_at(sigma));
             };
             if q.y == 0 {
                 put(0, q.x);
@@ -494,7 +505,7 @@ pub fn certified_tessellation(
                 sorted(
                     on_curve[&s.curve]
                         .iter()
-                        .filter_map(|&c| s.from_curve(c))
+                        .filter_map(|&c| s.side_at(c))
                         .collect(),
                 )
             };

@@ -20,7 +20,8 @@ mod tags;
 
 pub use area::{limit_area, limit_volume, limit_volume_and_area};
 pub use certified_tessellation::{
-    CertifiedTessellation, TESSELLATION_TRIANGLE_BYTES, certified_tessellation,
+    CertifiedTessellation, TESSELLATION_TRIANGLE_BYTES, certified_leaf_count,
+    certified_tessellation,
 };
 pub use compare::{Comparison, angle_between, compare_points};
 pub use control_mesh::{ControlMesh, ControlStats};

@@ -57,7 +57,9 @@ impl FormulaArgs {
 pub struct ImplicitArgs {
     #[command(flatten)]
     formula: FormulaArgs,
-    /// The box searched: `lo,hi` (a cube) or `x0,y0,z0,x1,y1,z1`.
+    /// The box searched: `lo,hi` (a cube) or `x0,y0,z0,x1,y1,z1`. Formulas run with the same
+    /// bounds and resolution share one grid (their voxels align, as --shared-grid aligns
+    /// meshes'), so their outputs combine voxel for voxel (`voxelkit intersect`, `csg`).
     #[arg(long, default_value_t = ImplicitRequest::default().bounds, value_parser = parse_bounds, allow_hyphen_values = true, value_name = "LO,HI")]
     bounds: Bounds,
     /// Voxels along the longest side of the bounds.
