@@ -25,7 +25,7 @@ def client(dask):
     from dask.distributed import Client, LocalCluster
 
     cluster = LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
         env={"RAYON_NUM_THREADS": "1"},
     )
     client = Client(cluster)

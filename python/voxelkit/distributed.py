@@ -145,12 +145,16 @@ def _client(scheduler, workers, threads):
 
     if scheduler:
         return _connect(Client, scheduler), None
+    # The scheduler's HTTP server starts even without a dashboard: on a free port, so that a
+    # taken 8787 prints no warning. Workers log nothing below critical: a brick's failure comes
+    # back to the client with its name, and a run stopped by a signal ends with one line, not
+    # the heartbeat tracebacks of workers whose scheduler went first.
     cluster = LocalCluster(
         n_workers=workers,
         threads_per_worker=1,
         processes=True,
-        dashboard_address=None,
-        env={"RAYON_NUM_THREADS": str(threads)},
+        dashboard_address=":0",
+        env={"RAYON_NUM_THREADS": str(threads), "DASK_LOGGING__DISTRIBUTED": "critical"},
     )
     return Client(cluster), cluster
 
