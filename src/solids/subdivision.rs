@@ -18,13 +18,13 @@
 //!   later seeds in that region are skipped. If no seed stays inside, the solid is refused.
 //!
 //! Or, as Passalis et al. offer for parametric surfaces, by depth layers: double layers along
-//! the 16 directions of `depth_layers::DIRECTIONS` run on a tessellation certified within `TESSELLATION_TOLERANCE` voxel of
-//! the limit surface (`subd::certified_tessellation`), so every centre they decide wrongly lies
+//! z, x and y run on a tessellation certified within `TESSELLATION_TOLERANCE` voxel of the
+//! limit surface (`subd::certified_tessellation`), so every centre they decide wrongly lies
 //! within that distance of the limit surface, inside its voxel's half-voxel ball: a voxel the
 //! surface touches, which the enclosing surface holds. The solid is the centres the layers put
 //! inside, united with the enclosing surface: no seeds, no flood, every pocket filled. The
-//! rare centre off the surface that every direction crosses more than four times is settled by
-//! the closed tessellation's winding number.
+//! rare centre off the surface that all three directions cross more than four times is settled
+//! by the closed tessellation's winding number.
 
 use crate::error::{Error, Result};
 use crate::grid::{Coord, DenseMask, Transform};
@@ -175,8 +175,8 @@ fn enclosing_surface(
     Ok((surface, LimitSurface::new(control.clone())))
 }
 
-/// The solid of the closed limit surface of `control` by double depth layers along all
-/// directions on a tessellation within `TESSELLATION_TOLERANCE` voxel of it, united with the
+/// The solid of the closed limit surface of `control` by double depth layers along z, x and
+/// y on a tessellation within `TESSELLATION_TOLERANCE` voxel of it, united with the
 /// enclosing surface; the tessellation may take `memory` bytes at most.
 pub fn subdivision_depth_layer_solid(
     control: &ControlMesh,
