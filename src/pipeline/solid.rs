@@ -497,51 +497,53 @@ pub(super) fn subdivision_solid(
     } else {
         subdivision::subdivision_solid(control, t, options, fill.graystack.max(1), progress)?
     };
-    let method = match made.filled {
-        Filled::Seeds { .. } => "lai-cheng-parametric-enclosed+seeds+flooding-xyz",
-        Filled::DepthLayers { .. } => {
-            "lai-cheng-parametric-enclosed+depth-layers-on-certified-tessellation"
-        }
-    };
-    let mut meta = provenance(method, &control.source.display().to_string(), fit);
-    meta.push(("adjacency", options.adjacency.number().into()));
-    meta.push(("limit_volume", made.limit_volume.into()));
-    meta.push(("limit_area", made.limit_area.into()));
-    let mut rule = SUBDIVISION_RULE.to_string();
-    match made.filled {
+    // How the inside was found names the method, its metadata and the summary's rule.
+    let (method, filled_meta, rule): (_, Vec<(&str, MetaValue)>, _) = match made.filled {
         Filled::Seeds {
             seeds,
             outside_seeds,
-        } => {
-            meta.push(("seeds", seeds.into()));
+        } => (
+            "lai-cheng-parametric-enclosed+seeds+flooding-xyz",
             // Steps along tilted normals can leave the solid; their floods reach the border
             // and are dropped (`solids::subdivision`).
-            meta.push(("outside_seeds", outside_seeds.into()));
-        }
+            vec![
+                ("seeds", seeds.into()),
+                ("outside_seeds", outside_seeds.into()),
+            ],
+            SUBDIVISION_RULE.to_string(),
+        ),
         Filled::DepthLayers {
             triangles,
             deepest,
             stats,
             by_winding_number,
-        } => {
-            meta.push(("tessellation_triangles", triangles.into()));
-            meta.push(("tessellation_deepest_level", deepest.into()));
-            meta.push((
-                "tessellation_tolerance_voxels",
-                subdivision::TESSELLATION_TOLERANCE.into(),
-            ));
-            meta.push(("odd_rays", stats.odd_rays().into()));
-            meta.push(("decided_by_winding_number", by_winding_number.into()));
-            rule = format!(
+        } => (
+            "lai-cheng-parametric-enclosed+depth-layers-on-certified-tessellation",
+            vec![
+                ("tessellation_triangles", triangles.into()),
+                ("tessellation_deepest_level", deepest.into()),
+                (
+                    "tessellation_tolerance_voxels",
+                    subdivision::TESSELLATION_TOLERANCE.into(),
+                ),
+                ("odd_rays", stats.odd_rays().into()),
+                ("decided_by_winding_number", by_winding_number.into()),
+            ],
+            format!(
                 "inside = the centres double depth layers along {} directions put inside, on a \
                  tessellation within {} voxel of the limit surface ({triangles} triangles), \
                  {by_winding_number} of them settled by its winding number where no direction \
                  decided; and the enclosing surface",
                 stats.per_direction.len(),
                 subdivision::TESSELLATION_TOLERANCE
-            );
-        }
-    }
+            ),
+        ),
+    };
+    let mut meta = provenance(method, &control.source.display().to_string(), fit);
+    meta.push(("adjacency", options.adjacency.number().into()));
+    meta.push(("limit_volume", made.limit_volume.into()));
+    meta.push(("limit_area", made.limit_area.into()));
+    meta.extend(filled_meta);
     let tags = TagSummary::of(&control.tags);
     tag_metadata(&mut meta, &tags);
     let (limit_volume, limit_area) = (made.limit_volume, made.limit_area);

@@ -27,7 +27,7 @@
 //! by the closed tessellation's winding number.
 
 use crate::error::{Error, Result};
-use crate::grid::{Coord, DenseMask, Transform};
+use crate::grid::{Coord, CoordBox, DenseMask, Transform};
 use crate::mesh::winding::WindingTree;
 use crate::ops::flood::padded;
 use crate::ops::flood_xyz::{FloodXyzStats, flood_xyz};
@@ -87,8 +87,13 @@ pub fn subdivision_solid(
     capacity: usize,
     progress: &Progress,
 ) -> Result<SubdivisionSolid> {
-    let (surface, limit) = enclosing_surface(control, transform, options, progress)?;
-    let (limit_volume, limit_area) = limit_volume_and_area(&limit);
+    let Enclosed {
+        surface,
+        bbox,
+        limit_volume,
+        limit_area,
+        ..
+    } = enclosed(control, transform, options, progress)?;
     let outward = limit_volume < 0.0;
     let seeds: Vec<Coord> = seeds_from_normals(&surface.surface, &surface.opposite, outward)
         .map(|choice| choice.seed)
@@ -99,13 +104,6 @@ pub fn subdivision_solid(
             control.source.display()
         )));
     }
-    let Some(bbox) = surface.surface.bbox() else {
-        return Err(Error::InvalidArgument(format!(
-            "{}: the limit surface has no voxels",
-            control.source.display()
-        )));
-    };
-    let bbox = padded(bbox, 1);
     let blocked = DenseMask::from_grid(&surface.surface, bbox)?;
     let mut inside = DenseMask::new(bbox)?;
     let mut outside = DenseMask::new(bbox)?;
@@ -154,13 +152,23 @@ pub fn subdivision_solid(
     })
 }
 
-/// The enclosing voxelization of the closed limit surface of `control`, and the surface.
-fn enclosing_surface(
+/// The enclosing voxelization of a closed limit surface, the surface itself, the voxelization's
+/// box grown by a voxel, and the limit volume (signed: its sign says which way the normals
+/// face) and area.
+struct Enclosed {
+    surface: ParametricOutput,
+    limit: LimitSurface,
+    bbox: CoordBox,
+    limit_volume: f64,
+    limit_area: f64,
+}
+
+fn enclosed(
     control: &ControlMesh,
     transform: Transform,
     options: &ParametricOptions,
     progress: &Progress,
-) -> Result<(ParametricOutput, LimitSurface)> {
+) -> Result<Enclosed> {
     if !control.is_closed() {
         return Err(Error::InvalidArgument(format!(
             "{}: {SOLID_NEEDS_CLOSED}",
@@ -172,7 +180,21 @@ fn enclosing_surface(
         ..*options
     };
     let surface = voxelize_subdivision(control, transform, &options, progress)?;
-    Ok((surface, LimitSurface::new(control.clone())))
+    let Some(bbox) = surface.surface.bbox() else {
+        return Err(Error::InvalidArgument(format!(
+            "{}: the limit surface has no voxels",
+            control.source.display()
+        )));
+    };
+    let limit = LimitSurface::new(control.clone());
+    let (limit_volume, limit_area) = limit_volume_and_area(&limit);
+    Ok(Enclosed {
+        surface,
+        limit,
+        bbox: padded(bbox, 1),
+        limit_volume,
+        limit_area,
+    })
 }
 
 /// The solid of the closed limit surface of `control` by double depth layers along z, x and
@@ -185,20 +207,19 @@ pub fn subdivision_depth_layer_solid(
     memory: u64,
     progress: &Progress,
 ) -> Result<SubdivisionSolid> {
-    let (surface, limit) = enclosing_surface(control, transform, options, progress)?;
-    let Some(bbox) = surface.surface.bbox() else {
-        return Err(Error::InvalidArgument(format!(
-            "{}: the limit surface has no voxels",
-            control.source.display()
-        )));
-    };
+    let Enclosed {
+        surface,
+        limit,
+        bbox,
+        limit_volume,
+        limit_area,
+    } = enclosed(control, transform, options, progress)?;
     let tessellation = certified_tessellation(
         &limit,
         TESSELLATION_TOLERANCE * transform.voxel_size,
         memory / TESSELLATION_TRIANGLE_BYTES,
         progress,
     )?;
-    let bbox = padded(bbox, 1);
     let layers = depth_layer_solid(
         &tessellation.mesh,
         &transform,
@@ -225,7 +246,6 @@ pub fn subdivision_depth_layer_solid(
             inside.set_index(i);
         }
     }
-    let (limit_volume, limit_area) = limit_volume_and_area(&limit);
     let measures = SolidMeasures::of(inside.count(), on_surface.count(), transform.voxel_size);
     Ok(SubdivisionSolid {
         surface,

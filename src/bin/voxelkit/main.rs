@@ -346,10 +346,10 @@ fn main() -> ExitCode {
             subdiv,
             subdiv_surface,
             ..
-        } => {
-            let subdiv = subdiv.then(|| subdiv_surface.options());
-            commands::check(&input, fit, surface, subdiv, &global)
-        }
+        } => subdiv
+            .then(|| subdiv_surface.request().options())
+            .transpose()
+            .and_then(|subdiv| commands::check(&input, fit, surface, subdiv, &global)),
         Command::Demo {
             output, resolution, ..
         } => commands::demo(&output, resolution, &global),

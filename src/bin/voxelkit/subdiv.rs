@@ -6,10 +6,9 @@ use crate::run::Global;
 use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
 use voxelkit::grid::Adjacency;
+use voxelkit::pipeline::request::Request;
 use voxelkit::pipeline::request::SubdivRequest;
-use voxelkit::pipeline::{SubdivisionFill, SubdivisionOutput, Task};
 use voxelkit::subd::{ControlMesh, LimitSurface, compare_points, limit_area, read_points};
-use voxelkit::voxelize::parametric::ParametricOptions;
 use voxelkit::{Error, Result};
 
 #[derive(Args)]
@@ -45,11 +44,13 @@ pub struct SubdivSurfaceArgs {
 }
 
 impl SubdivSurfaceArgs {
-    pub fn options(&self) -> ParametricOptions {
-        ParametricOptions {
+    /// The request these flags fill; the library checks and completes it.
+    pub fn request(&self) -> SubdivRequest {
+        SubdivRequest {
             adjacency: self.adjacency,
             presplit: self.presplit,
             enclose: self.enclose,
+            ..SubdivRequest::default()
         }
     }
 }
@@ -138,23 +139,16 @@ pub fn run(args: &SubdivArgs, global: &Global) -> Result<()> {
 }
 
 fn voxelize(inputs: &[PathBuf], args: &SubdivVoxelizeArgs, global: &Global) -> Result<()> {
-    let options = args.surface.options();
-    let output = if args.solid {
-        SubdivisionOutput::Solid(SubdivisionFill {
-            depth_layers: args.depth_layers,
-            graystack: args.graystack,
-            density: args.density,
-            topology: args.topology,
-        })
-    } else {
-        SubdivisionOutput::Surface
+    let request = SubdivRequest {
+        solid: args.solid,
+        depth_layers: args.depth_layers,
+        graystack: args.graystack,
+        density: args.density,
+        topology: args.topology,
+        ..args.surface.request()
     };
     crate::batch::run(inputs, &args.out, args.fit.grid_fit()?, global, |mesh| {
-        Ok(Task::Subdivision {
-            mesh,
-            options,
-            output,
-        })
+        request.task(mesh)
     })
 }
 
