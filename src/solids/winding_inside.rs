@@ -10,8 +10,12 @@
 //! centres are decided together from a proven range of c over each (`WindingTree::bounds`,
 //! Barill et al.'s hierarchy with its error bounded): where no integer lies within `AMBIGUOUS`
 //! of c + 1/2 over a block, one integer threshold decides all its centres from the crossings
-//! alone; only blocks a cap's w = 1/2 sheet passes through are evaluated centre by centre,
-//! and there a bound too loose to decide falls back to the exact sum over the caps. A closed,
+//! alone. Blocks a cap's w = 1/2 sheet passes through are split into cubes: away from the mesh
+//! w is smooth, and its second-order Taylor model around a cube's middle (gradient and Hessian
+//! exact from the rim, the remainder bounded by the rim's third derivatives) settles every
+//! centre it leaves clear of 1/2; beside the mesh the caps' range settles what it can; the
+//! rest are evaluated centre by centre, where a bound too loose to decide falls back to the
+//! exact sum over the caps. A closed,
 //! consistently oriented mesh has no caps: every block's threshold is 1 and the answer is ray
 //! crossings alone, as fast as parity and equal to it wherever the mesh does not overlap itself.
 
@@ -65,7 +69,7 @@ enum Block {
     Near { low: f64, high: f64 },
 }
 
-/// How far from the region's centres the mesh's own surface is asked about: `continuous_sign`
+/// How far from the region's centres the mesh's own surface is asked about: `settle_by_model`
 /// asks about balls of radius at most 4 sqrt(3) (half an 8^3 block's diagonal) around them.
 /// The caps are asked about within `TOP_BLOCK` sqrt(3) of the region: every ball `Caps::range`
 /// asks about lies in the circumsphere of a block that meets the region.
@@ -391,6 +395,13 @@ fn stretches(crossings: &[Crossing], orientation: i32) -> Vec<(i64, i64, i32)> {
     out
 }
 
+/// The smallest cube a model is made for: on smaller ones it settles too few
+/// centres to pay for itself.
+const MODEL_SIZE: i64 = 4;
+
+/// A model's middle centre this close to a cap is not used (voxels).
+const ON_CAP: f64 = 1e-9;
+
 /// The winding of a centre outside the region: never inside.
 const OUTSIDE_REGION: i32 = i32::MIN;
 
@@ -455,7 +466,7 @@ impl Context<'_> {
                     }
                 }
                 Block::Near { low, high } => {
-                    self.resolve(origin, origin, 8, Some((low, high)), k, &mut decided);
+                    self.resolve(origin, 8, Some((low, high)), k, &mut decided);
                 }
             }
             *masks.entry(bz).or_default() = decided.inside;
@@ -478,101 +489,131 @@ impl Context<'_> {
         out
     }
 
-    /// Decides the centres of the cube at `origin` of edge `size` inside the 8^3 block at
-    /// `block` (integer windings `k`, by leaf offset), given the caps' range over the cube
-    /// (none: unknown): centres whose winding the range decides at once, the rest by the
-    /// cube's eighths, down to single centres.
+    /// Decides the centres of the cube at `origin` of edge `size` inside an 8^3 block
+    /// (integer windings `k`, by leaf offset): those the caps' range over the cube
+    /// decides from their integer winding alone (`known`, or bounded here), those the winding
+    /// number's model around the cube's middle decides, the rest by the cube's eighths, down to
+    /// single centres. Inside the caps, where ranges fail, the model comes first; beside the
+    /// mesh, where models fail, the range.
     fn resolve(
         &self,
-        block: Coord,
         origin: Coord,
         size: i64,
-        range: Option<(f64, f64)>,
+        known: Option<(f64, f64)>,
         k: &[i32; 512],
         decided: &mut Decided,
     ) {
-        let (low, high) = range.unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
-        let offsets = || {
-            (0..size).flat_map(move |x| {
-                (0..size).flat_map(move |y| {
-                    (0..size).map(move |z| {
-                        let l = [0, 1, 2].map(|a| (origin[a] - block[a]) as usize);
-                        (l[0] + x as usize) * 64 + (l[1] + y as usize) * 8 + l[2] + z as usize
-                    })
-                })
-            })
+        let pending = match known {
+            Some(range) => self.settle_by_range(origin, size, range, k, decided),
+            None => cube_centres(origin, size)
+                .map(crate::grid::leaf_offset)
+                .any(|n| k[n] != OUTSIDE_REGION && !decided.is_settled(n)),
         };
-        let open = |k: i32| {
-            let k = k as f64;
-            k != OUTSIDE_REGION as f64 && k <= high + 0.5 + AMBIGUOUS && k >= low + 0.5 - AMBIGUOUS
-        };
-        let undecided = offsets().any(|n| open(k[n]));
-        if undecided
-            && size > 1
-            && range.is_none()
-            && let Some(inside) = self.continuous_sign(origin, size, k)
-        {
-            for n in offsets() {
-                if inside && k[n] != OUTSIDE_REGION {
-                    decided.inside[n / 64] |= 1 << (n % 64);
-                }
-            }
+        if !pending {
             return;
         }
-        if size > 1 && undecided {
+        if size >= MODEL_SIZE && self.settle_by_model(origin, size, k, decided) {
+            return;
+        }
+        if size > 1 && known.is_none() {
+            let half = (size - 1) as f64 / 2.0;
+            let centre = DVec3::from_array(origin.map(|v| v as f64)) + half;
+            if let Some(range) = self.caps.range(centre, half * 3f64.sqrt())
+                && !self.settle_by_range(origin, size, range, k, decided)
+            {
+                return;
+            }
+        }
+        if size > 1 {
             let h = size / 2;
             for corner in 0..8 {
                 let child = [0, 1, 2].map(|a| origin[a] + if corner >> a & 1 == 1 { h } else { 0 });
-                let half = (h - 1) as f64 / 2.0;
-                let centre = DVec3::from_array(child.map(|v| v as f64)) + half;
-                // A single centre is evaluated as it is: its range would cost as much.
-                let range = (h > 1)
-                    .then(|| self.caps.range(centre, half * 3f64.sqrt()))
-                    .flatten();
-                self.resolve(block, child, h, range, k, decided);
+                self.resolve(child, h, None, k, decided);
             }
             return;
         }
-        for n in offsets() {
-            let kn = k[n];
-            if kn == OUTSIDE_REGION {
-                continue;
-            }
-            let (inside, near) = if !open(kn) {
-                (kn as f64 > high + 0.5, false)
-            } else {
-                let c = crate::grid::offset_coord(block, n);
-                self.evaluate(kn, DVec3::from_array(c.map(|v| v as f64)))
-            };
-            if inside {
-                decided.inside[n / 64] |= 1 << (n % 64);
-            }
-            if near {
-                decided.ambiguous[n / 64] |= 1 << (n % 64);
-            }
+        let n = crate::grid::leaf_offset(origin);
+        if k[n] != OUTSIDE_REGION && !decided.is_settled(n) {
+            let (inside, near) = self.evaluate(k[n], DVec3::from_array(origin.map(|v| v as f64)));
+            decided.settle(n, inside, near);
         }
     }
 
-    /// Whether every centre of the cube at `origin` of edge `size` (integer windings `k`, by
-    /// offset in its block) is inside, or every one outside, where no centre lies near 1/2:
-    /// none where the mesh passes through the cube or its middle centre cannot tell. The
-    /// winding number is continuous across the caps and changes off the mesh no faster than
-    /// its rim allows, so one centre's value and that rate decide the whole cube.
-    fn continuous_sign(&self, origin: Coord, size: i64, k: &[i32; 512]) -> Option<bool> {
+    /// Settles the centres of the cube at `origin` of edge `size` whose integer winding `k`
+    /// the caps' range [low, high] over the cube decides; returns whether any is left.
+    fn settle_by_range(
+        &self,
+        origin: Coord,
+        size: i64,
+        (low, high): (f64, f64),
+        k: &[i32; 512],
+        decided: &mut Decided,
+    ) -> bool {
+        let mut pending = false;
+        for n in cube_centres(origin, size).map(crate::grid::leaf_offset) {
+            let kn = k[n];
+            if kn == OUTSIDE_REGION || decided.is_settled(n) {
+                continue;
+            }
+            let kf = kn as f64;
+            if kf <= high + 0.5 + AMBIGUOUS && kf >= low + 0.5 - AMBIGUOUS {
+                pending = true;
+            } else {
+                decided.settle(n, kf > high + 0.5, false);
+            }
+        }
+        pending
+    }
+
+    /// Settles the centres of the cube at `origin` of edge `size` (integer windings `k`, by
+    /// offset in its block) that the winding number's second-order model around the cube's
+    /// middle centre q decides: where the mesh does not pass within the cube's ball, w is
+    /// smooth there and w(q + d) lies within |d|^3 / 6 times the rim's bound on its third
+    /// derivatives of w(q) + grad w(q) . d + d . H d / 2, gradient and Hessian exact (the rim's
+    /// Biot-Savart integral and its derivative). Returns whether every centre is settled.
+    fn settle_by_model(
+        &self,
+        origin: Coord,
+        size: i64,
+        k: &[i32; 512],
+        decided: &mut Decided,
+    ) -> bool {
         let middle = origin.map(|v| v + size / 2);
         let kq = k[crate::grid::leaf_offset(middle)];
         if kq == OUTSIDE_REGION {
-            return None;
+            return false;
         }
         let q = DVec3::from_array(middle.map(|v| v as f64));
         let reach = (size / 2) as f64 * 3f64.sqrt();
-        if self.surface.comes_within(q, reach) {
-            return None;
+        // On a cap the integer winding's tie rule and the caps' number need not agree.
+        if self.surface.comes_within(q, reach) || self.caps.tree.comes_within(q, ON_CAP) {
+            return false;
         }
+        let third = self.caps.rim.third_derivative(q, reach) / 6.0;
+        if !third.is_finite() {
+            return false;
+        }
+        let o = self.caps.orientation as f64;
         let bounds = self.caps.fans.bounds(q);
-        let d = kq as f64 - self.caps.orientation as f64 * bounds.value - 0.5;
-        let margin = d.abs() - bounds.spread - reach * self.caps.rim.gradient(q, reach);
-        (margin > AMBIGUOUS).then_some(d > 0.0)
+        let value = kq as f64 - o * bounds.value - 0.5;
+        let (gradient, hessian) = self.caps.rim.winding_derivatives(q);
+        let (gradient, half_hessian) = (-o * gradient, hessian * (-0.5 * o));
+        let mut all = true;
+        for c in cube_centres(origin, size) {
+            let n = crate::grid::leaf_offset(c);
+            if k[n] == OUTSIDE_REGION || decided.is_settled(n) {
+                continue;
+            }
+            let d = DVec3::from_array(c.map(|v| v as f64)) - q;
+            let from_half = value + gradient.dot(d) + d.dot(half_hessian * d);
+            let error = bounds.spread + third * d.length_squared() * d.length();
+            if from_half.abs() > error + AMBIGUOUS {
+                decided.settle(n, from_half > 0.0, false);
+            } else {
+                all = false;
+            }
+        }
+        all
     }
 
     /// Whether the centre `p` of integer winding `k` is inside, and whether its winding number
@@ -592,9 +633,36 @@ impl Context<'_> {
     }
 }
 
+/// The centres of the cube at `origin` of edge `size`.
+fn cube_centres(origin: Coord, size: i64) -> impl Iterator<Item = Coord> {
+    (0..size).flat_map(move |x| {
+        (0..size).flat_map(move |y| {
+            (0..size).map(move |z| [origin[0] + x, origin[1] + y, origin[2] + z])
+        })
+    })
+}
+
 /// The centres of one 8^3 block decided one by one, by leaf offset.
 #[derive(Default)]
 struct Decided {
+    settled: [u64; 8],
     inside: [u64; 8],
     ambiguous: [u64; 8],
+}
+
+impl Decided {
+    fn is_settled(&self, n: usize) -> bool {
+        self.settled[n / 64] >> (n % 64) & 1 == 1
+    }
+
+    fn settle(&mut self, n: usize, inside: bool, ambiguous: bool) {
+        let bit = 1u64 << (n % 64);
+        self.settled[n / 64] |= bit;
+        if inside {
+            self.inside[n / 64] |= bit;
+        }
+        if ambiguous {
+            self.ambiguous[n / 64] |= bit;
+        }
+    }
 }
