@@ -5,6 +5,11 @@
 //! boundary, so their winding number is an integer everywhere, counted exactly by ray
 //! crossings, and the mesh's own winding number is that integer less the caps' (Jacobson et al.
 //! 2013 split it the same way around a hole). Caps are small: one triangle per rim edge.
+//!
+//! Edges cancel by position, not by vertex number: a seam whose two sides repeat their vertices
+//! (a mesh exported in parts, as the Utah teapot is) is no hole, and capping each side would lay
+//! two opposite caps on top of each other, whose numbers cancel but whose jumps every query near
+//! them must resolve. Where welding would make orientations disagree, the vertices stay apart.
 
 use super::Mesh;
 use glam::DVec3;
@@ -19,6 +24,8 @@ pub struct BoundaryCaps {
     pub loops: usize,
     /// Edges two faces use in the same direction: where the orientation is inconsistent.
     pub inconsistent_edges: u64,
+    /// Each mesh vertex's first vertex at the same position, where vertices were welded so.
+    pub welded: Option<Vec<u32>>,
 }
 
 impl BoundaryCaps {
@@ -26,13 +33,59 @@ impl BoundaryCaps {
     pub fn is_empty(&self) -> bool {
         self.triangles.is_empty()
     }
+
+    /// The mesh's triangles over the vertices the caps were made for (welded ones by their
+    /// first vertex at the same place): with the caps, a surface without boundary whose shared
+    /// edges are numbered alike, so that ray crossings see both sides of every edge the same way.
+    pub fn mesh_triangles(&self, mesh: &Mesh) -> Vec<[u32; 3]> {
+        match &self.welded {
+            Some(first) => mesh
+                .triangles()
+                .map(|(_, t)| t.map(|v| first[v as usize]))
+                .collect(),
+            None => mesh.triangles().map(|(_, t)| t).collect(),
+        }
+    }
 }
 
-/// The caps of `mesh`'s fan triangles.
+/// The caps of `mesh`'s fan triangles, its vertices welded by position unless that makes
+/// orientations disagree that agreed apart.
 pub fn boundary_caps(mesh: &Mesh) -> BoundaryCaps {
+    let apart = caps_over(mesh, None);
+    let Some(first) = first_at_same_position(mesh) else {
+        return apart;
+    };
+    let welded = caps_over(mesh, Some(first));
+    if welded.inconsistent_edges > apart.inconsistent_edges {
+        apart
+    } else {
+        welded
+    }
+}
+
+/// Each vertex's first vertex at the same position, if any two share one.
+fn first_at_same_position(mesh: &Mesh) -> Option<Vec<u32>> {
+    let mut seen: HashMap<[u64; 3], u32> = HashMap::with_capacity(mesh.positions.len());
+    let mut shared = false;
+    let first: Vec<u32> = (0..mesh.positions.len() as u32)
+        .map(|v| {
+            // 0.0 and -0.0 are one place.
+            let key = mesh.p(v).to_array().map(|c| (c + 0.0).to_bits());
+            let f = *seen.entry(key).or_insert(v);
+            shared |= f != v;
+            f
+        })
+        .collect();
+    shared.then_some(first)
+}
+
+/// The caps of `mesh`'s triangles with each vertex taken as `first` names it.
+fn caps_over(mesh: &Mesh, first: Option<Vec<u32>>) -> BoundaryCaps {
+    let id = |v: u32| first.as_ref().map_or(v, |f| f[v as usize]);
     // Each undirected edge's uses from its lower to its upper vertex, less the reverse uses.
     let mut net: HashMap<(u32, u32), i32> = HashMap::new();
     for (_, t) in mesh.triangles() {
+        let t = t.map(id);
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
             if a != b {
@@ -63,6 +116,7 @@ pub fn boundary_caps(mesh: &Mesh) -> BoundaryCaps {
         triangles: Vec::new(),
         loops: 0,
         inconsistent_edges,
+        welded: None,
     };
     let base = mesh.positions.len() as u32;
     for &(start, _) in &rims {
@@ -86,6 +140,7 @@ pub fn boundary_caps(mesh: &Mesh) -> BoundaryCaps {
             .extend(rim.windows(2).map(|edge| [c, edge[1], edge[0]]));
         caps.loops += 1;
     }
+    caps.welded = first;
     caps
 }
 
@@ -122,6 +177,39 @@ mod tests {
             }
         }
         assert!(net.values().all(|&n| n == 0));
+    }
+
+    /// A cube whose first face has vertices of its own at the same places: a seam all round
+    /// it, closed once welded; with the face also flipped, welding would make its edges
+    /// inconsistent, so the vertices stay apart and the seam is capped.
+    #[test]
+    fn a_seam_of_repeated_vertices_is_welded_unless_orientations_then_disagree() {
+        let cube = generate::cuboid(DVec3::ZERO, DVec3::ONE);
+        let mut positions = cube.positions.clone();
+        let copies: Vec<u32> = cube
+            .face(0)
+            .iter()
+            .map(|&v| {
+                positions.push(cube.p(v));
+                (positions.len() - 1) as u32
+            })
+            .collect();
+        let seamed = |flip: bool| {
+            let mut faces: Vec<Vec<u32>> = (0..cube.face_count())
+                .map(|f| cube.face(f).to_vec())
+                .collect();
+            faces[0] = copies.clone();
+            if flip {
+                faces[0].reverse();
+            }
+            Mesh::from_polygons("seamed", positions.clone(), &faces)
+        };
+        let welded = boundary_caps(&seamed(false));
+        assert!(welded.is_empty() && welded.welded.is_some());
+        assert_eq!(welded.inconsistent_edges, 0);
+        let apart = boundary_caps(&seamed(true));
+        assert!(apart.welded.is_none());
+        assert_eq!((apart.loops, apart.inconsistent_edges), (2, 0));
     }
 
     #[test]

@@ -224,7 +224,7 @@ pub fn winding_inside(
 pub fn closed_by_caps(mesh: &Mesh, caps: &BoundaryCaps) -> (Vec<DVec3>, Vec<[u32; 3]>) {
     let mut points = mesh.positions.clone();
     points.extend_from_slice(&caps.points);
-    let mut triangles: Vec<[u32; 3]> = mesh.triangles().map(|(_, t)| t).collect();
+    let mut triangles = caps.mesh_triangles(mesh);
     triangles.extend_from_slice(&caps.triangles);
     (points, triangles)
 }
