@@ -515,7 +515,8 @@ impl Context<'_> {
         if size >= MODEL_SIZE && self.settle_by_model(origin, size, k, decided) {
             return;
         }
-        if size > 1 && known.is_none() {
+        // Below the models' size, the caps' range alone (cheaper).
+        if size > 1 && size < MODEL_SIZE && known.is_none() {
             let half = (size - 1) as f64 / 2.0;
             let centre = DVec3::from_array(origin.map(|v| v as f64)) + half;
             if let Some(range) = self.caps.range(centre, half * 3f64.sqrt())
@@ -566,11 +567,14 @@ impl Context<'_> {
     }
 
     /// Settles the centres of the cube at `origin` of edge `size` (integer windings `k`, by
-    /// offset in its block) that the winding number's second-order model around the cube's
-    /// middle centre q decides: where the mesh does not pass within the cube's ball, w is
-    /// smooth there and w(q + d) lies within |d|^3 / 6 times the rim's bound on its third
-    /// derivatives of w(q) + grad w(q) . d + d . H d / 2, gradient and Hessian exact (the rim's
-    /// Biot-Savart integral and its derivative). Returns whether every centre is settled.
+    /// offset in its block) that a second-order model around the cube's middle centre q
+    /// decides. The caps' number c has its gradient and Hessian exactly from the rim (its
+    /// Biot-Savart integral and that integral's derivative), and wherever c is smooth along
+    /// q + d it lies within |d|^3 / 6 times the rim's bound on its third derivatives of
+    /// c(q) + grad c . d + d . H d / 2. Where no cap passes within the cube's ball, c is smooth
+    /// there and each centre's own integer winding k gives w = k - c; where the mesh does not
+    /// pass, w = k(q) - c is smooth, continuing c smoothly across the caps. Returns whether
+    /// every centre is settled.
     fn settle_by_model(
         &self,
         origin: Coord,
@@ -585,8 +589,12 @@ impl Context<'_> {
         }
         let q = DVec3::from_array(middle.map(|v| v as f64));
         let reach = (size / 2) as f64 * 3f64.sqrt();
+        let caps_smooth = !self.caps.tree.comes_within(q, reach);
         // On a cap the integer winding's tie rule and the caps' number need not agree.
-        if self.surface.comes_within(q, reach) || self.caps.tree.comes_within(q, ON_CAP) {
+        let winding_smooth = !caps_smooth
+            && !self.surface.comes_within(q, reach)
+            && !self.caps.tree.comes_within(q, ON_CAP);
+        if !caps_smooth && !winding_smooth {
             return false;
         }
         let third = self.caps.rim.third_derivative(q, reach) / 6.0;
@@ -595,9 +603,8 @@ impl Context<'_> {
         }
         let o = self.caps.orientation as f64;
         let bounds = self.caps.fans.bounds(q);
-        let value = kq as f64 - o * bounds.value - 0.5;
         let (gradient, hessian) = self.caps.rim.winding_derivatives(q);
-        let (gradient, half_hessian) = (-o * gradient, hessian * (-0.5 * o));
+        let half_hessian = hessian * 0.5;
         let mut all = true;
         for c in cube_centres(origin, size) {
             let n = crate::grid::leaf_offset(c);
@@ -605,7 +612,9 @@ impl Context<'_> {
                 continue;
             }
             let d = DVec3::from_array(c.map(|v| v as f64)) - q;
-            let from_half = value + gradient.dot(d) + d.dot(half_hessian * d);
+            let caps = bounds.value + gradient.dot(d) + d.dot(half_hessian * d);
+            let integer = if caps_smooth { k[n] } else { kq };
+            let from_half = integer as f64 - o * caps - 0.5;
             let error = bounds.spread + third * d.length_squared() * d.length();
             if from_half.abs() > error + AMBIGUOUS {
                 decided.settle(n, from_half > 0.0, false);
