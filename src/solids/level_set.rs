@@ -59,11 +59,6 @@ pub fn level_set(
         || winding_inside(mesh, caps, transform, columns_box, progress),
     );
     let (mut grid, inside) = (grid?, inside?);
-    let h = transform.voxel_size as f32;
-    let centres = inside.grid(transform);
-    grid.leaves_mut().par_iter_mut().for_each(|leaf| {
-        sign_leaf(leaf, &centres.block_mask(leaf.origin), h);
-    });
     // Band leaves stay leaves, even wholly inside: the level set writes its tiles.
     let (full_band, full_free): (Vec<Coord>, Vec<Coord>) = inside
         .full_blocks
@@ -77,6 +72,10 @@ pub fn level_set(
     }));
     let mut interior = SparseGrid::from_distinct_leaves(transform, Channels::NONE, leaves);
     interior.fill_leaf_blocks(full_free);
+    let h = transform.voxel_size as f32;
+    grid.leaves_mut().par_iter_mut().for_each(|leaf| {
+        sign_leaf(leaf, &interior.block_mask(leaf.origin), h);
+    });
     Ok(LevelSet {
         band: grid,
         interior,

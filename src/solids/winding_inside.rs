@@ -414,7 +414,10 @@ impl Context<'_> {
             .collect();
         let is_special = |bz: i64| special.binary_search_by_key(&bz, |s| s.0).is_ok();
         let r = self.region;
-        let mut masks: BTreeMap<i64, [u64; 8]> = BTreeMap::new();
+        // The inside of each 8^3 block of the column, by its place along z.
+        let z0 = r.min[2] & !7;
+        let mut masks = vec![[0u64; 8]; ((r.max[2] - z0) / 8 + 1) as usize];
+        let slot = |bz: i64| ((bz - z0) / 8) as usize;
         // The integer winding of every centre of the special blocks, by leaf offset.
         let mut windings = vec![[OUTSIDE_REGION; 512]; special.len()];
         let mut out = BlockColumn::default();
@@ -438,7 +441,7 @@ impl Context<'_> {
                         let end = last.min(bz + 7);
                         if !is_special(bz) {
                             let run = (1u64 << (end - z + 1)) - 1;
-                            masks.entry(bz).or_default()[lx] |= run << (ly * 8 + (z - bz) as usize);
+                            masks[slot(bz)][lx] |= run << (ly * 8 + (z - bz) as usize);
                         }
                         z = end + 1;
                     }
@@ -469,14 +472,14 @@ impl Context<'_> {
                     self.resolve(origin, 8, Some((low, high)), k, &mut decided);
                 }
             }
-            *masks.entry(bz).or_default() = decided.inside;
+            masks[slot(bz)] = decided.inside;
             if decided.ambiguous.iter().any(|&w| w != 0) {
                 let mut leaf = Leaf::new(origin, Channels::NONE);
                 leaf.mask = decided.ambiguous;
                 ambiguous.push(leaf);
             }
         }
-        for (bz, mask) in masks {
+        for (bz, mask) in (z0..).step_by(8).zip(masks) {
             if mask.iter().all(|&w| w == u64::MAX) {
                 out.full_blocks.push([bx, by, bz]);
             } else if mask.iter().any(|&w| w != 0) {
