@@ -10,12 +10,12 @@
 //! centres are decided together from a proven range of c over each (`WindingTree::bounds`,
 //! Barill et al.'s hierarchy with its error bounded): where no integer lies within `AMBIGUOUS`
 //! of c + 1/2 over a block, one integer threshold decides all its centres from the crossings
-//! alone. Blocks a cap's w = 1/2 sheet passes through are split into cubes: away from the mesh
-//! w is smooth, and its second-order Taylor model around a cube's middle (gradient and Hessian
-//! exact from the rim, the remainder bounded by the rim's third derivatives) settles every
-//! centre it leaves clear of 1/2; beside the mesh the caps' range settles what it can; the
-//! rest are evaluated centre by centre, where a bound too loose to decide falls back to the
-//! exact sum over the caps. A closed,
+//! alone. Blocks a cap's w = 1/2 sheet passes through are split into cubes: where the mesh does
+//! not pass through a cube, w is smooth there, and where no cap does, c is; a second-order
+//! Taylor model around the cube's middle (gradient and Hessian exact from the rim, the
+//! remainder bounded by the rim's third derivatives) then settles every centre it leaves clear
+//! of 1/2. The rest, mostly beside a hole's rim, are evaluated centre by centre, where a bound
+//! too loose to decide falls back to the exact sum over the caps. A closed,
 //! consistently oriented mesh has no caps: every block's threshold is 1 and the answer is ray
 //! crossings alone, as fast as parity and equal to it wherever the mesh does not overlap itself.
 
@@ -493,11 +493,10 @@ impl Context<'_> {
     }
 
     /// Decides the centres of the cube at `origin` of edge `size` inside an 8^3 block
-    /// (integer windings `k`, by leaf offset): those the caps' range over the cube
-    /// decides from their integer winding alone (`known`, or bounded here), those the winding
-    /// number's model around the cube's middle decides, the rest by the cube's eighths, down to
-    /// single centres. Inside the caps, where ranges fail, the model comes first; beside the
-    /// mesh, where models fail, the range.
+    /// (integer windings `k`, by leaf offset): those the caps' range `known` decides from their
+    /// integer winding alone, those the second-order model around the cube's middle decides
+    /// (cubes of `MODEL_SIZE` and more; on smaller ones the caps' range over the cube instead),
+    /// the rest by the cube's eighths, down to single centres.
     fn resolve(
         &self,
         origin: Coord,
