@@ -52,6 +52,10 @@ impl BoundaryCaps {
 /// orientations disagree that agreed apart.
 pub fn boundary_caps(mesh: &Mesh) -> BoundaryCaps {
     let apart = caps_over(mesh, None);
+    // Closed as numbered: nothing to weld.
+    if apart.is_empty() {
+        return apart;
+    }
     let Some(first) = first_at_same_position(mesh) else {
         return apart;
     };
