@@ -317,7 +317,9 @@ pub(super) fn run_brick(task: &BrickTask, t: Transform, progress: &Progress) -> 
             let region = index_box(&mesh.bbox(), &t).intersection(&voxels);
             let mut whole = match region {
                 Some(region) => {
-                    winding_inside(mesh, &boundary_caps(mesh), t, region, progress)?.grid(t)
+                    winding_inside(mesh, &boundary_caps(mesh), t, region, progress)?
+                        .into_grids(t)
+                        .0
                 }
                 None => SparseGrid::new(t, surface.channels()),
             };

@@ -156,8 +156,8 @@ pub fn mesh_solid(
     if let Inside::Winding(caps) = &choice.inside {
         return match index_box(&mesh.bbox(), transform).intersection(&bbox) {
             Some(region) => {
-                let grid = winding_inside(mesh, caps, *transform, region, &Progress::none())?
-                    .grid(*transform);
+                let (grid, _) = winding_inside(mesh, caps, *transform, region, &Progress::none())?
+                    .into_grids(*transform);
                 DenseMask::from_grid(&grid, bbox)
             }
             None => DenseMask::new(bbox),

@@ -95,11 +95,10 @@ pub fn flooded_mesh(
             || flood_surface(mesh, t, progress),
             || winding_inside(mesh, caps, t, region, progress),
         );
-        let centres = centres?;
-        let parts = SurfaceAndInside::with_inside(surface?, centres.grid(t));
+        let (centres, ambiguous) = centres?.into_grids(t);
         return Ok(SurfaceAndInside {
-            ambiguous: Some(centres.ambiguous),
-            ..parts
+            ambiguous: Some(ambiguous),
+            ..SurfaceAndInside::with_inside(surface?, centres)
         });
     }
     mesh.require_closed(FLOOD_NEEDS_CLOSED)?;
