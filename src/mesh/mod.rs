@@ -23,6 +23,7 @@ pub mod surface_distance;
 pub mod triangle_distance;
 mod up_axis;
 pub mod winding;
+pub mod winding_split;
 pub use gltf_scene::GltfLayout;
 pub use up_axis::UpAxis;
 

@@ -494,12 +494,9 @@ impl RimBound {
             } else if let Some(children) = g.children {
                 stack.extend(children);
             } else {
-                for &[a, b] in &self.segments[g.first..g.last] {
-                    let gap = segment_distance(p, a, b) - reach;
-                    if gap <= 0.0 {
-                        return f64::INFINITY;
-                    }
-                    total += a.distance(b) / gap.powi(power);
+                total += segments_power_sum(&self.segments[g.first..g.last], p, reach, power);
+                if total.is_infinite() {
+                    return total;
                 }
             }
         }
@@ -507,39 +504,67 @@ impl RimBound {
     }
 
     /// The gradient and the second derivatives (Hessian) at `p` (off the rim) of the winding
-    /// number of any surface the segments bound, facing as a triangle (c, a, b) faces along its
-    /// segment a to b: the Biot-Savart integral F(p) of (x - p) x dx / |x - p|^3 over the rim,
-    /// over 4 pi, and its derivative, each segment in closed form. With u = a - p, v = b - p:
-    /// F = (u x v) J, J = (|u| + |v|) / (|u| |v| (|u| |v| + u . v)); the derivative along p_j
-    /// of u x v is e_j x (u - v), and that of J follows from its three factors.
+    /// number of any surface the rim bounds (`boundary_derivatives`).
     pub fn winding_derivatives(&self, p: DVec3) -> (DVec3, DMat3) {
-        let mut field = DVec3::ZERO;
-        let mut derivative = DMat3::ZERO;
-        for &[a, b] in &self.segments {
-            let (u, v) = (a - p, b - p);
-            let (lu, lv) = (u.length(), v.length());
-            let (product, sum) = (lu * lv, lu + lv);
-            let q = product + u.dot(v);
-            if product * q <= 0.0 {
-                continue;
-            }
-            let j = sum / (product * q);
-            let (uu, vu) = (u / lu, v / lv);
-            let weighted = lv * uu + lu * vu;
-            let grad_j = j * (-(uu + vu) / sum + weighted / product + (weighted + u + v) / q);
-            let cross = u.cross(v);
-            field += cross * j;
-            let w = u - v;
-            // Column k: e_k x w times J, plus (u x v) times the k-th partial of J.
-            derivative += DMat3::from_cols(
-                DVec3::X.cross(w) * j + cross * grad_j.x,
-                DVec3::Y.cross(w) * j + cross * grad_j.y,
-                DVec3::Z.cross(w) * j + cross * grad_j.z,
-            );
-        }
-        let four_pi = 4.0 * std::f64::consts::PI;
-        (field / four_pi, derivative * (1.0 / four_pi))
+        boundary_derivatives(&self.segments, p)
     }
+}
+
+/// The sum over `segments` of their length over the power `power` of their least distance from
+/// the ball of radius `reach` around `p`, bounded above; a long segment is charged piece by
+/// piece, each at its own distance; infinite where a segment comes within `reach`.
+pub fn segments_power_sum(segments: &[[DVec3; 2]], p: DVec3, reach: f64, power: i32) -> f64 {
+    fn piece(a: DVec3, b: DVec3, p: DVec3, reach: f64, power: i32) -> f64 {
+        let gap = segment_distance(p, a, b) - reach;
+        if gap <= 0.0 {
+            return f64::INFINITY;
+        }
+        let length = a.distance(b);
+        if length <= gap {
+            return length / gap.powi(power);
+        }
+        let middle = 0.5 * (a + b);
+        piece(a, middle, p, reach, power) + piece(middle, b, p, reach, power)
+    }
+    segments
+        .iter()
+        .map(|&[a, b]| piece(a, b, p, reach, power))
+        .sum()
+}
+
+/// The gradient and the second derivatives (Hessian) at `p` (off the segments) of the winding
+/// number of any surface the directed `segments` bound, facing as a triangle (c, a, b) faces
+/// along its segment a to b: the Biot-Savart integral F(p) of (x - p) x dx / |x - p|^3 over
+/// them, over 4 pi, and its derivative, each segment in closed form. With u = a - p, v = b - p:
+/// F = (u x v) J, J = (|u| + |v|) / (|u| |v| (|u| |v| + u . v)); the derivative along p_j
+/// of u x v is e_j x (u - v), and that of J follows from its three factors.
+pub fn boundary_derivatives(segments: &[[DVec3; 2]], p: DVec3) -> (DVec3, DMat3) {
+    let mut field = DVec3::ZERO;
+    let mut derivative = DMat3::ZERO;
+    for &[a, b] in segments {
+        let (u, v) = (a - p, b - p);
+        let (lu, lv) = (u.length(), v.length());
+        let (product, sum) = (lu * lv, lu + lv);
+        let q = product + u.dot(v);
+        if product * q <= 0.0 {
+            continue;
+        }
+        let j = sum / (product * q);
+        let (uu, vu) = (u / lu, v / lv);
+        let weighted = lv * uu + lu * vu;
+        let grad_j = j * (-(uu + vu) / sum + weighted / product + (weighted + u + v) / q);
+        let cross = u.cross(v);
+        field += cross * j;
+        let w = u - v;
+        // Column k: e_k x w times J, plus (u x v) times the k-th partial of J.
+        derivative += DMat3::from_cols(
+            DVec3::X.cross(w) * j + cross * grad_j.x,
+            DVec3::Y.cross(w) * j + cross * grad_j.y,
+            DVec3::Z.cross(w) * j + cross * grad_j.z,
+        );
+    }
+    let four_pi = 4.0 * std::f64::consts::PI;
+    (field / four_pi, derivative * (1.0 / four_pi))
 }
 
 #[cfg(test)]

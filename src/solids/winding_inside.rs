@@ -24,7 +24,8 @@ use crate::grid::{Channels, Coord, CoordBox, Leaf, SparseGrid, Transform};
 use crate::mesh::Mesh;
 use crate::mesh::boundary_caps::BoundaryCaps;
 use crate::mesh::inside::{ColumnCrossings, Crossing};
-use crate::mesh::winding::{RimBound, WindingTree, winding_number_of};
+use crate::mesh::winding::{RimBound, WindingBounds, WindingTree, winding_number_of};
+use crate::mesh::winding_split::{SplitWinding, Splitter};
 use crate::progress::Progress;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -33,10 +34,6 @@ use std::collections::BTreeMap;
 /// Centres whose winding number lies within this of 1/2 are reported ambiguous: the input
 /// leaves them undecided (the sheet a hole's rim spans, where two overlapping parts meet).
 pub const AMBIGUOUS: f64 = 0.001;
-
-/// The longest edge, in voxels, of the triangles the caps' tree is built over: fans cut this
-/// small keep its clusters tight, so that a centre's query sums few triangles exactly.
-const CAP_EDGE: f64 = 4.0;
 
 /// The inside of a mesh by its winding number over a box of voxels.
 pub struct WindingInside {
@@ -71,8 +68,6 @@ enum Block {
 
 /// How far from the region's centres the mesh's own surface is asked about: `settle_by_model`
 /// asks about balls of radius at most 4 sqrt(3) (half an 8^3 block's diagonal) around them.
-/// The caps are asked about within `TOP_BLOCK` sqrt(3) of the region: every ball `Caps::range`
-/// asks about lies in the circumsphere of a block that meets the region.
 const SURFACE_REACH: f64 = 8.0;
 
 /// Blocks decided by threshold 1 are not listed: the default far from any cap.
@@ -127,51 +122,32 @@ pub fn winding_inside(
         .collect();
     // Each cap triangle is (centroid, rim vertex, rim vertex).
     let rim = RimBound::new(corners.iter().map(|&[_, a, b]| [a, b]).collect());
-    // Boxes of the region grown by `reach`: what may be asked about near it.
-    let near_region = |reach: f64| {
-        let lo = DVec3::from_array(region.min.map(|v| v as f64)) - reach;
-        let hi = DVec3::from_array(region.max.map(|v| v as f64)) + reach;
-        move |t: &[DVec3; 3]| {
-            let (a, b) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
-            a.cmple(hi).all() && b.cmpge(lo).all()
-        }
-    };
-    let ((tree, fans), surface) = rayon::join(
-        || {
-            rayon::join(
-                || {
-                    let near = near_region(TOP_BLOCK as f64 * 3f64.sqrt());
-                    WindingTree::of_triangles(
-                        corners
-                            .iter()
-                            .filter(|t| near(t))
-                            .flat_map(|&t| refined(t, CAP_EDGE))
-                            .collect(),
-                    )
-                },
-                || WindingTree::of_triangles(corners.clone()),
-            )
-        },
+    let (fans, surface) = rayon::join(
+        || WindingTree::of_triangles(corners.clone()),
         || {
             // Only where caps exist is the mesh's own surface asked about, and only near the
             // region (a part of the grid, as a brick is, needs the triangles near it alone).
             let near_caps = if caps.is_empty() {
                 Vec::new()
             } else {
-                let near = near_region(SURFACE_REACH);
+                let lo = DVec3::from_array(region.min.map(|v| v as f64)) - SURFACE_REACH;
+                let hi = DVec3::from_array(region.max.map(|v| v as f64)) + SURFACE_REACH;
                 mesh.triangles()
                     .map(|(_, t)| t.map(|v| index[v as usize]))
-                    .filter(|t| near(t))
+                    .filter(|t| {
+                        let (a, b) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+                        a.cmple(hi).all() && b.cmpge(lo).all()
+                    })
                     .collect()
             };
             WindingTree::of_triangles(near_caps)
         },
     );
     let caps_winding = Caps {
-        tree: &tree,
         fans: &fans,
         triangles: &corners,
         rim: &rim,
+        splitter: Splitter::new(&corners, &rim),
         orientation,
     };
     let (columns, special) = rayon::join(
@@ -246,34 +222,16 @@ pub fn winds_reversed(points: &[DVec3], triangles: &[[u32; 3]]) -> bool {
     volume < 0.0
 }
 
-/// `t` cut into n^2 triangles of edges at most `longest` (the same surface, facing the same way).
-fn refined(t: [DVec3; 3], longest: f64) -> Vec<[DVec3; 3]> {
-    let [c, a, b] = t;
-    let edge = (a - c).length().max((b - c).length()).max((b - a).length());
-    let n = (edge / longest).ceil().max(1.0) as usize;
-    let at =
-        |i: usize, j: usize| c + (a - c) * (i as f64 / n as f64) + (b - c) * (j as f64 / n as f64);
-    let mut out = Vec::with_capacity(n * n);
-    for i in 0..n {
-        for j in 0..n - i {
-            out.push([at(i, j), at(i + 1, j), at(i, j + 1)]);
-            if i + j + 1 < n {
-                out.push([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
-            }
-        }
-    }
-    out
-}
-
 /// The caps' winding number, as the blocks are classified by it.
 struct Caps<'a> {
-    /// The caps cut small (`CAP_EDGE`): their clusters tell where the caps pass.
-    tree: &'a WindingTree,
-    /// The caps as they close the mesh, clustered: their winding number with its error.
+    /// The caps as they close the mesh, clustered: where they pass, and their winding number
+    /// with its error.
     fans: &'a WindingTree,
     /// The same, for the exact sum where the error cannot tell.
     triangles: &'a [[DVec3; 3]],
     rim: &'a RimBound,
+    /// The same, split around each block whose centres are resolved one by one.
+    splitter: Splitter<'a>,
     orientation: i32,
 }
 
@@ -282,19 +240,24 @@ impl Caps<'_> {
     /// `centre`: its value there, its error, and the most the rim lets it change in the ball;
     /// none where a cap comes within the ball (the number jumps across a cap).
     fn range(&self, centre: DVec3, reach: f64) -> Option<(f64, f64)> {
-        if self.tree.comes_within(centre, reach) {
+        if self.fans.comes_within(centre, reach) {
             return None;
         }
         let b = self.fans.bounds(centre);
         let spread = b.spread + reach * self.rim.gradient(centre, reach);
-        if !spread.is_finite() {
-            return None;
-        }
-        let (x, y) = (
-            (b.value - spread) * self.orientation as f64,
-            (b.value + spread) * self.orientation as f64,
-        );
-        Some((x.min(y), x.max(y)))
+        spread.is_finite().then(|| {
+            self.oriented(WindingBounds {
+                value: b.value,
+                spread,
+            })
+        })
+    }
+
+    /// The range of `b` as the orientation reads it: [low, high].
+    fn oriented(&self, b: WindingBounds) -> (f64, f64) {
+        let o = self.orientation as f64;
+        let (x, y) = (b.low() * o, b.high() * o);
+        (x.min(y), x.max(y))
     }
 }
 
@@ -399,6 +362,11 @@ fn stretches(crossings: &[Crossing], orientation: i32) -> Vec<(i64, i64, i32)> {
 /// centres to pay for itself.
 const MODEL_SIZE: i64 = 4;
 
+/// How far beyond an 8^3 block's ball the caps are summed exactly when its centres are
+/// resolved (voxels): those farther are modelled, within an error that falls with the fourth
+/// power of this.
+const FAR_GAP: f64 = 32.0;
+
 /// A model's middle centre this close to a cap is not used (voxels).
 const ON_CAP: f64 = 1e-9;
 
@@ -469,7 +437,14 @@ impl Context<'_> {
                     }
                 }
                 Block::Near { low, high } => {
-                    self.resolve(origin, 8, Some((low, high)), k, &mut decided);
+                    if self.settle_by_range(origin, 8, (low, high), k, &mut decided) {
+                        let split = self.caps.splitter.around(
+                            DVec3::from_array(origin.map(|v| v as f64)) + 3.5,
+                            3.5 * 3f64.sqrt(),
+                            FAR_GAP,
+                        );
+                        self.resolve(&split, origin, 8, k, &mut decided);
+                    }
                 }
             }
             masks[slot(bz)] = decided.inside;
@@ -493,36 +468,32 @@ impl Context<'_> {
     }
 
     /// Decides the centres of the cube at `origin` of edge `size` inside an 8^3 block
-    /// (integer windings `k`, by leaf offset): those the caps' range `known` decides from their
-    /// integer winding alone, those the second-order model around the cube's middle decides
-    /// (cubes of `MODEL_SIZE` and more; on smaller ones the caps' range over the cube instead),
-    /// the rest by the cube's eighths, down to single centres.
+    /// (integer windings `k`, by leaf offset), with the caps' number split around the block:
+    /// those the second-order model around the cube's middle decides (cubes of `MODEL_SIZE`
+    /// and more), those the caps' range over the cube decides from their integer winding alone
+    /// (smaller cubes), the rest by the cube's eighths, down to single centres.
     fn resolve(
         &self,
+        split: &SplitWinding,
         origin: Coord,
         size: i64,
-        known: Option<(f64, f64)>,
         k: &[i32; 512],
         decided: &mut Decided,
     ) {
-        let pending = match known {
-            Some(range) => self.settle_by_range(origin, size, range, k, decided),
-            None => cube_centres(origin, size)
-                .map(crate::grid::leaf_offset)
-                .any(|n| k[n] != OUTSIDE_REGION && !decided.is_settled(n)),
-        };
+        let pending = cube_centres(origin, size)
+            .map(crate::grid::leaf_offset)
+            .any(|n| k[n] != OUTSIDE_REGION && !decided.is_settled(n));
         if !pending {
             return;
         }
-        if size >= MODEL_SIZE && self.settle_by_model(origin, size, k, decided) {
+        if size >= MODEL_SIZE && self.settle_by_model(split, origin, size, k, decided) {
             return;
         }
-        // Below the models' size, the caps' range alone (cheaper).
-        if size > 1 && size < MODEL_SIZE && known.is_none() {
+        if size > 1 && size < MODEL_SIZE {
             let half = (size - 1) as f64 / 2.0;
             let centre = DVec3::from_array(origin.map(|v| v as f64)) + half;
-            if let Some(range) = self.caps.range(centre, half * 3f64.sqrt())
-                && !self.settle_by_range(origin, size, range, k, decided)
+            if let Some(b) = split.range(centre, half * 3f64.sqrt())
+                && !self.settle_by_range(origin, size, self.caps.oriented(b), k, decided)
             {
                 return;
             }
@@ -531,15 +502,14 @@ impl Context<'_> {
             let h = size / 2;
             for corner in 0..8 {
                 let child = [0, 1, 2].map(|a| origin[a] + if corner >> a & 1 == 1 { h } else { 0 });
-                self.resolve(child, h, None, k, decided);
+                self.resolve(split, child, h, k, decided);
             }
             return;
         }
         let n = crate::grid::leaf_offset(origin);
-        if k[n] != OUTSIDE_REGION && !decided.is_settled(n) {
-            let (inside, near) = self.evaluate(k[n], DVec3::from_array(origin.map(|v| v as f64)));
-            decided.settle(n, inside, near);
-        }
+        let p = DVec3::from_array(origin.map(|v| v as f64));
+        let (inside, near) = self.evaluate(split, k[n], p);
+        decided.settle(n, inside, near);
     }
 
     /// Settles the centres of the cube at `origin` of edge `size` whose integer winding `k`
@@ -579,6 +549,7 @@ impl Context<'_> {
     /// every centre is settled.
     fn settle_by_model(
         &self,
+        split: &SplitWinding,
         origin: Coord,
         size: i64,
         k: &[i32; 512],
@@ -591,34 +562,30 @@ impl Context<'_> {
         }
         let q = DVec3::from_array(middle.map(|v| v as f64));
         let reach = (size / 2) as f64 * 3f64.sqrt();
-        let caps_smooth = !self.caps.tree.comes_within(q, reach);
+        let caps_smooth = !split.comes_within(q, reach);
         // On a cap the integer winding's tie rule and the caps' number need not agree.
-        let winding_smooth = !caps_smooth
-            && !self.surface.comes_within(q, reach)
-            && !self.caps.tree.comes_within(q, ON_CAP);
+        let winding_smooth =
+            !caps_smooth && !self.surface.comes_within(q, reach) && !split.comes_within(q, ON_CAP);
         if !caps_smooth && !winding_smooth {
             return false;
         }
-        let third = self.caps.rim.third_derivative(q, reach) / 6.0;
-        if !third.is_finite() {
+        let Some(model) = split.model(q, reach) else {
             return false;
-        }
+        };
         let o = self.caps.orientation as f64;
-        let bounds = self.caps.fans.bounds(q);
-        let (gradient, hessian) = self.caps.rim.winding_derivatives(q);
-        let half_hessian = hessian * 0.5;
+        let most_error = model.most_error(reach);
         let mut all = true;
         for c in cube_centres(origin, size) {
             let n = crate::grid::leaf_offset(c);
             if k[n] == OUTSIDE_REGION || decided.is_settled(n) {
                 continue;
             }
-            let d = DVec3::from_array(c.map(|v| v as f64)) - q;
-            let caps = bounds.value + gradient.dot(d) + d.dot(half_hessian * d);
+            let p = DVec3::from_array(c.map(|v| v as f64));
             let integer = if caps_smooth { k[n] } else { kq };
-            let from_half = integer as f64 - o * caps - 0.5;
-            let error = bounds.spread + third * d.length_squared() * d.length();
-            if from_half.abs() > error + AMBIGUOUS {
+            let from_half = integer as f64 - o * model.value_at(p) - 0.5;
+            if from_half.abs() > most_error + AMBIGUOUS
+                || from_half.abs() > model.error_at(p) + AMBIGUOUS
+            {
                 decided.settle(n, from_half > 0.0, false);
             } else {
                 all = false;
@@ -630,10 +597,10 @@ impl Context<'_> {
     /// Whether the centre `p` of integer winding `k` is inside, and whether its winding number
     /// lies within `AMBIGUOUS` of 1/2: by the caps' tree, or where its bound cannot tell, by
     /// the exact sum.
-    fn evaluate(&self, k: i32, p: DVec3) -> (bool, bool) {
+    fn evaluate(&self, split: &SplitWinding, k: i32, p: DVec3) -> (bool, bool) {
         let o = self.caps.orientation as f64;
         let from_half = |caps: f64| k as f64 - o * caps - 0.5;
-        let bounds = self.caps.fans.bounds(p);
+        let bounds = split.bounds(p);
         let (d, spread) = (from_half(bounds.value), bounds.spread);
         let d = if d.abs() <= spread || (d.abs() - AMBIGUOUS).abs() <= spread {
             from_half(winding_number_of(self.caps.triangles, p))
@@ -644,12 +611,16 @@ impl Context<'_> {
     }
 }
 
-/// The centres of the cube at `origin` of edge `size`.
+/// The centres of the cube at `origin` of edge `size` (a power of two).
 fn cube_centres(origin: Coord, size: i64) -> impl Iterator<Item = Coord> {
-    (0..size).flat_map(move |x| {
-        (0..size).flat_map(move |y| {
-            (0..size).map(move |z| [origin[0] + x, origin[1] + y, origin[2] + z])
-        })
+    let shift = size.trailing_zeros();
+    let mask = size - 1;
+    (0..size * size * size).map(move |i| {
+        [
+            origin[0] + (i >> (2 * shift)),
+            origin[1] + ((i >> shift) & mask),
+            origin[2] + (i & mask),
+        ]
     })
 }
 
