@@ -66,9 +66,8 @@ enum Block {
     Near { low: f64, high: f64 },
 }
 
-/// How far from the region's centres the mesh's own surface is asked about: `settle_by_model`
-/// asks about balls of radius at most 4 sqrt(3) (half an 8^3 block's diagonal) around them.
-const SURFACE_REACH: f64 = 8.0;
+/// The largest ball `settle_by_model` asks about: half an 8^3 block's diagonal.
+const MODEL_REACH: f64 = 4.0 * 1.7320508075688772;
 
 /// Blocks decided by threshold 1 are not listed: the default far from any cap.
 const DEFAULT_THRESHOLD: i32 = 1;
@@ -122,27 +121,7 @@ pub fn winding_inside(
         .collect();
     // Each cap triangle is (centroid, rim vertex, rim vertex).
     let rim = RimBound::new(corners.iter().map(|&[_, a, b]| [a, b]).collect());
-    let (fans, surface) = rayon::join(
-        || WindingTree::of_triangles(corners.clone()),
-        || {
-            // Only where caps exist is the mesh's own surface asked about, and only near the
-            // region (a part of the grid, as a brick is, needs the triangles near it alone).
-            let near_caps = if caps.is_empty() {
-                Vec::new()
-            } else {
-                let lo = DVec3::from_array(region.min.map(|v| v as f64)) - SURFACE_REACH;
-                let hi = DVec3::from_array(region.max.map(|v| v as f64)) + SURFACE_REACH;
-                mesh.triangles()
-                    .map(|(_, t)| t.map(|v| index[v as usize]))
-                    .filter(|t| {
-                        let (a, b) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
-                        a.cmple(hi).all() && b.cmpge(lo).all()
-                    })
-                    .collect()
-            };
-            WindingTree::of_triangles(near_caps)
-        },
-    );
+    let fans = WindingTree::of_triangles(corners.clone());
     let caps_winding = Caps {
         fans: &fans,
         triangles: &corners,
@@ -150,13 +129,16 @@ pub fn winding_inside(
         splitter: Splitter::new(&corners, &rim),
         orientation,
     };
-    let (columns, special) = rayon::join(
+    let (columns, (special, surface)) = rayon::join(
         || ColumnCrossings::of_triangles(&points, &triangles, &transform, region),
         || {
             if caps.is_empty() {
-                BTreeMap::new()
+                (BTreeMap::new(), WindingTree::of_triangles(Vec::new()))
             } else {
-                classify_blocks(&caps_winding, region)
+                rayon::join(
+                    || classify_blocks(&caps_winding, region),
+                    || surface_near_caps(mesh, &index, &fans, region),
+                )
             }
         },
     );
@@ -194,6 +176,34 @@ pub fn winding_inside(
     }
     inside.ambiguous = SparseGrid::from_distinct_leaves(transform, Channels::NONE, ambiguous);
     Ok(inside)
+}
+
+/// The mesh's own triangles (`index`: its points in index space) that `settle_by_model` may
+/// ask about: it asks whether the mesh comes within a ball of radius at most `MODEL_REACH`
+/// only where a cap comes within it too, so triangles farther than twice that from every cap
+/// (or beyond that of the region) are never found there.
+fn surface_near_caps(
+    mesh: &Mesh,
+    index: &[DVec3],
+    caps: &WindingTree,
+    region: CoordBox,
+) -> WindingTree {
+    let lo = DVec3::from_array(region.min.map(|v| v as f64)) - MODEL_REACH;
+    let hi = DVec3::from_array(region.max.map(|v| v as f64)) + MODEL_REACH;
+    let triangles: Vec<[u32; 3]> = mesh.triangles().map(|(_, t)| t).collect();
+    WindingTree::of_triangles(
+        triangles
+            .par_iter()
+            .map(|t| t.map(|v| index[v as usize]))
+            .filter(|t| {
+                let (a, b) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+                let centre = 0.5 * (a + b);
+                a.cmple(hi).all()
+                    && b.cmpge(lo).all()
+                    && caps.comes_within(centre, centre.distance(b) + 2.0 * MODEL_REACH)
+            })
+            .collect(),
+    )
 }
 
 /// The mesh closed by its caps: their points and triangles together.
