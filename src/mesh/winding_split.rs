@@ -46,9 +46,26 @@ pub struct LocalModel {
 
 impl LocalModel {
     /// The model's value at `p`.
+    #[cfg(test)]
     pub fn value_at(&self, p: DVec3) -> f64 {
-        let d = p - self.at;
-        self.value + self.gradient.dot(d) + d.dot(self.half_hessian * d)
+        let (c0, c1, c2) = self.along_z(p.x, p.y);
+        let t = p.z - self.at.z;
+        c0 + t * (c1 + t * c2)
+    }
+
+    /// The model along the line through (x, y) parallel to z, as coefficients (c0, c1, c2):
+    /// its value at z is c0 + c1 t + c2 t^2 with t = z minus the model point's z.
+    pub fn along_z(&self, x: f64, y: f64) -> (f64, f64, f64) {
+        let (dx, dy) = (x - self.at.x, y - self.at.y);
+        let (g, h) = (self.gradient, self.half_hessian);
+        let c0 = self.value
+            + g.x * dx
+            + g.y * dy
+            + h.x_axis.x * dx * dx
+            + h.y_axis.y * dy * dy
+            + (h.y_axis.x + h.x_axis.y) * dx * dy;
+        let c1 = g.z + (h.z_axis.x + h.x_axis.z) * dx + (h.z_axis.y + h.y_axis.z) * dy;
+        (c0, c1, h.z_axis.z)
     }
 
     /// The most the true number may differ from the model at `p`.

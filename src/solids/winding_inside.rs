@@ -585,20 +585,26 @@ impl Context<'_> {
         let o = self.caps.orientation as f64;
         let most_error = model.most_error(reach);
         let mut all = true;
-        for c in cube_centres(origin, size) {
-            let n = crate::grid::leaf_offset(c);
-            if k[n] == OUTSIDE_REGION || decided.is_settled(n) {
-                continue;
-            }
-            let p = DVec3::from_array(c.map(|v| v as f64));
-            let integer = if caps_smooth { k[n] } else { kq };
-            let from_half = integer as f64 - o * model.value_at(p) - 0.5;
-            if from_half.abs() > most_error + AMBIGUOUS
-                || from_half.abs() > model.error_at(p) + AMBIGUOUS
-            {
-                decided.settle(n, from_half > 0.0, false);
-            } else {
-                all = false;
+        for x in origin[0]..origin[0] + size {
+            for y in origin[1]..origin[1] + size {
+                let (c0, c1, c2) = model.along_z(x as f64, y as f64);
+                for z in origin[2]..origin[2] + size {
+                    let n = crate::grid::leaf_offset([x, y, z]);
+                    if k[n] == OUTSIDE_REGION || decided.is_settled(n) {
+                        continue;
+                    }
+                    let t = (z - middle[2]) as f64;
+                    let integer = if caps_smooth { k[n] } else { kq };
+                    let from_half = integer as f64 - o * (c0 + t * (c1 + t * c2)) - 0.5;
+                    let error = || model.error_at(DVec3::new(x as f64, y as f64, z as f64));
+                    if from_half.abs() > most_error + AMBIGUOUS
+                        || from_half.abs() > error() + AMBIGUOUS
+                    {
+                        decided.settle(n, from_half > 0.0, false);
+                    } else {
+                        all = false;
+                    }
+                }
             }
         }
         all
