@@ -372,10 +372,15 @@ fn stretches(crossings: &[Crossing], orientation: i32) -> Vec<(i64, i64, i32)> {
 /// centres to pay for itself.
 const MODEL_SIZE: i64 = 4;
 
-/// How far beyond an 8^3 block's ball the caps are summed exactly when its centres are
+/// How far beyond a stack of blocks' ball the caps are summed exactly when its centres are
 /// resolved (voxels): those farther are modelled, within an error that falls with the fourth
 /// power of this.
 const FAR_GAP: f64 = 32.0;
+
+/// The height along z of the stacks of blocks that share one split of the caps: two blocks
+/// (most blocks resolved one by one lie in pairs along a hole's rim), not more (the far
+/// model's error grows with the cube of its ball's radius).
+const SPLIT_HEIGHT: i64 = 16;
 
 /// A model's middle centre this close to a cap is not used (voxels).
 const ON_CAP: f64 = 1e-9;
@@ -435,6 +440,7 @@ impl Context<'_> {
             }
         }
         let mut ambiguous: Vec<Leaf> = Vec::new();
+        let mut split: Option<(i64, SplitWinding)> = None;
         for (&(bz, block), k) in special.iter().zip(&windings) {
             let origin = [bx, by, bz];
             let mut decided = Decided::default();
@@ -448,12 +454,12 @@ impl Context<'_> {
                 }
                 Block::Near { low, high } => {
                     if self.settle_by_range(origin, 8, (low, high), k, &mut decided) {
-                        let split = self.caps.splitter.around(
-                            DVec3::from_array(origin.map(|v| v as f64)) + 3.5,
-                            3.5 * 3f64.sqrt(),
-                            FAR_GAP,
-                        );
-                        self.resolve(&split, origin, 8, k, &mut decided);
+                        let stack = bz.div_euclid(SPLIT_HEIGHT);
+                        let split = match split.take() {
+                            Some((at, s)) if at == stack => split.insert((at, s)),
+                            _ => split.insert((stack, self.split_around(bx, by, stack))),
+                        };
+                        self.resolve(&split.1, origin, 8, k, &mut decided);
                     }
                 }
             }
@@ -475,6 +481,16 @@ impl Context<'_> {
         }
         out.ambiguous = ambiguous;
         out
+    }
+
+    /// The caps split around the `stack`-th stack of `SPLIT_HEIGHT` centres along z in the
+    /// column of blocks at (bx, by).
+    fn split_around(&self, bx: i64, by: i64, stack: i64) -> SplitWinding {
+        let half = [3.5, 3.5, (SPLIT_HEIGHT - 1) as f64 / 2.0];
+        let middle = DVec3::new(bx as f64, by as f64, (stack * SPLIT_HEIGHT) as f64)
+            + DVec3::from_array(half);
+        let reach = DVec3::from_array(half).length();
+        self.caps.splitter.around(middle, reach, FAR_GAP)
     }
 
     /// Decides the centres of the cube at `origin` of edge `size` inside an 8^3 block
