@@ -14,6 +14,7 @@ use super::vdb_format::{COMPRESS_ACTIVE_MASK, FILE_VERSION, LIBRARY_VERSION, MAG
 use super::vdb_tree_structure::{TreeFormat, tree_memory};
 use crate::error::{Error, Result};
 use crate::grid::{LEAF_VOXELS, Leaf, Transform};
+use crate::progress::StageClock;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -87,43 +88,82 @@ pub(super) fn write_grids(
     clocks: &mut WriteClocks,
 ) -> Result<()> {
     let io_error = |e| Error::io(path, e);
-    let mut file =
+    let mut out =
         std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(file).map_err(io_error)?);
     let header = file_header(grids.len());
     clocks
         .write
-        .time(|| file.write_all(&header))
+        .time(|| out.write_all(&header))
         .map_err(io_error)?;
     let mut pos = header.len() as u64;
-    for g in grids {
-        let encoded = clocks.encode.time(|| encode_grid(path, g, encoding))?;
-        let mut descriptor = Vec::new();
-        push_string(&mut descriptor, &g.name);
-        let mut tree_type = tree_type_of(g.values);
-        if encoding.half && (g.values.value_type() != ValueType::Bool) {
-            tree_type.push_str("_HalfFloat");
-        }
-        push_string(&mut descriptor, &tree_type);
-        push_string(&mut descriptor, ""); // not an instance of another grid
-        let grid_pos = pos + descriptor.len() as u64 + 24;
-        let block_pos = grid_pos + encoded.head.len() as u64;
-        let end_pos = block_pos + encoded.buffers.iter().map(|b| b.len() as u64).sum::<u64>();
-        for p in [grid_pos, block_pos, end_pos] {
-            descriptor.extend_from_slice(&(p as i64).to_le_bytes());
-        }
-        clocks
-            .write
-            .time(|| {
-                [&descriptor, &encoded.head]
+    // Each grid is written on its own thread while the next one is encoded; the write clock
+    // counts only the time spent waiting for a write to finish.
+    std::thread::scope(|scope| {
+        let mut writing = None;
+        let mut idle = Some(out);
+        let finish = |handle: std::thread::ScopedJoinHandle<'_, (Output, std::io::Result<()>)>,
+                      write: &mut StageClock| {
+            let (out, done) = write
+                .time(|| handle.join())
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            done.map(|()| out).map_err(io_error)
+        };
+        for (n, g) in grids.iter().enumerate() {
+            let encoded = clocks.encode.time(|| encode_grid(path, g, encoding))?;
+            let mut descriptor = Vec::new();
+            push_string(&mut descriptor, &g.name);
+            let mut tree_type = tree_type_of(g.values);
+            if encoding.half && (g.values.value_type() != ValueType::Bool) {
+                tree_type.push_str("_HalfFloat");
+            }
+            push_string(&mut descriptor, &tree_type);
+            push_string(&mut descriptor, ""); // not an instance of another grid
+            let grid_pos = pos + descriptor.len() as u64 + 24;
+            let block_pos = grid_pos + encoded.head.len() as u64;
+            let end_pos = block_pos + encoded.buffers.iter().map(|b| b.len() as u64).sum::<u64>();
+            for p in [grid_pos, block_pos, end_pos] {
+                descriptor.extend_from_slice(&(p as i64).to_le_bytes());
+            }
+            // A large grid followed by others starts reaching the disk while they are
+            // encoded, so that the final sync has less left to wait for.
+            let sync_early = n + 1 < grids.len() && end_pos - pos >= EARLY_SYNC_BYTES;
+            pos = end_pos;
+            let mut out = match writing.take() {
+                Some(handle) => finish(handle, &mut clocks.write)?,
+                None => idle
+                    .take()
+                    .expect("the file is either idle or being written"),
+            };
+            writing = Some(scope.spawn(move || {
+                let done = [&descriptor, &encoded.head]
                     .into_iter()
                     .chain(&encoded.buffers)
-                    .try_for_each(|bytes| file.write_all(bytes))
-            })
-            .map_err(io_error)?;
-        pos = end_pos;
-    }
-    clocks.write.time(|| file.flush()).map_err(io_error)
+                    .try_for_each(|bytes| out.write_all(bytes))
+                    .and_then(|()| {
+                        if sync_early {
+                            out.flush()?;
+                            out.get_ref().sync_data()?;
+                        }
+                        Ok(())
+                    });
+                (out, done)
+            }));
+        }
+        let mut out = match writing.take() {
+            Some(handle) => finish(handle, &mut clocks.write)?,
+            None => idle
+                .take()
+                .expect("the file is either idle or being written"),
+        };
+        clocks.write.time(|| out.flush()).map_err(io_error)
+    })
 }
+
+/// The buffered file a `.vdb` is written through.
+type Output = std::io::BufWriter<std::fs::File>;
+
+/// The size from which a grid that other grids follow is synced as soon as it is written.
+const EARLY_SYNC_BYTES: u64 = 16 << 20;
 
 /// The magic number, versions, a flag for grid offsets, a UUID, no file metadata, the grid
 /// count.
