@@ -35,9 +35,9 @@ pub struct SplitWinding {
 /// triangle passes (or continued smoothly across them): the value, gradient and half Hessian
 /// there, and the remainder's bound.
 pub struct LocalModel {
-    pub value: f64,
-    pub gradient: DVec3,
-    pub half_hessian: DMat3,
+    value: f64,
+    gradient: DVec3,
+    half_hessian: DMat3,
     near_third: f64,
     far_third: f64,
     at: DVec3,

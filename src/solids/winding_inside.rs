@@ -10,12 +10,14 @@
 //! centres are decided together from a proven range of c over each (`WindingTree::bounds`,
 //! Barill et al.'s hierarchy with its error bounded): where no integer lies within `AMBIGUOUS`
 //! of c + 1/2 over a block, one integer threshold decides all its centres from the crossings
-//! alone. Blocks a cap's w = 1/2 sheet passes through are split into cubes: where the mesh does
-//! not pass through a cube, w is smooth there, and where no cap does, c is; a second-order
-//! Taylor model around the cube's middle (gradient and Hessian exact from the rim, the
-//! remainder bounded by the rim's third derivatives) then settles every centre it leaves clear
-//! of 1/2. The rest, mostly beside a hole's rim, are evaluated centre by centre, where a bound
-//! too loose to decide falls back to the exact sum over the caps. A closed,
+//! alone. Blocks a cap's w = 1/2 sheet passes through are resolved with the caps split around
+//! them (`mesh::winding_split`: the caps near the block summed exactly, the far ones by a
+//! second-order model with a proven error), into cubes: where the mesh does not pass through a
+//! cube, w is smooth there, and where no cap does, c is; a second-order Taylor model around the
+//! cube's middle (gradient and Hessian exact from the boundaries, the remainder bounded by
+//! their third derivatives) then settles every centre it leaves clear of 1/2. The rest, mostly
+//! beside a hole's rim, are evaluated centre by centre, where a bound too loose to decide falls
+//! back to the exact sum over the caps. A closed,
 //! consistently oriented mesh has no caps: every block's threshold is 1 and the answer is ray
 //! crossings alone, as fast as parity and equal to it wherever the mesh does not overlap itself.
 
