@@ -91,16 +91,10 @@ pub(super) fn write_grids(
     let mut out =
         std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(file).map_err(io_error)?);
     let header = file_header(grids.len());
-    clocks
-        .write
-        .time(|| out.write_all(&header))
-        .map_err(io_error)?;
     let mut pos = header.len() as u64;
-    // Each grid is written on its own thread while the next one is encoded; the write clock
-    // counts only the time spent waiting for a write to finish.
+    // Each grid is written on its own thread while the next one is encoded (the header while
+    // the first is); the write clock counts only the time spent waiting for a write to finish.
     std::thread::scope(|scope| {
-        let mut writing = None;
-        let mut idle = Some(out);
         let finish = |handle: std::thread::ScopedJoinHandle<'_, (Output, std::io::Result<()>)>,
                       write: &mut StageClock| {
             let (out, done) = write
@@ -108,6 +102,10 @@ pub(super) fn write_grids(
                 .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
             done.map(|()| out).map_err(io_error)
         };
+        let mut writing = scope.spawn(move || {
+            let done = out.write_all(&header);
+            (out, done)
+        });
         for (n, g) in grids.iter().enumerate() {
             let encoded = clocks.encode.time(|| encode_grid(path, g, encoding))?;
             let mut descriptor = Vec::new();
@@ -128,13 +126,8 @@ pub(super) fn write_grids(
             // encoded, so that the final sync has less left to wait for.
             let sync_early = n + 1 < grids.len() && end_pos - pos >= EARLY_SYNC_BYTES;
             pos = end_pos;
-            let mut out = match writing.take() {
-                Some(handle) => finish(handle, &mut clocks.write)?,
-                None => idle
-                    .take()
-                    .expect("the file is either idle or being written"),
-            };
-            writing = Some(scope.spawn(move || {
+            let mut out = finish(writing, &mut clocks.write)?;
+            writing = scope.spawn(move || {
                 let done = [&descriptor, &encoded.head]
                     .into_iter()
                     .chain(&encoded.buffers)
@@ -147,14 +140,9 @@ pub(super) fn write_grids(
                         Ok(())
                     });
                 (out, done)
-            }));
+            });
         }
-        let mut out = match writing.take() {
-            Some(handle) => finish(handle, &mut clocks.write)?,
-            None => idle
-                .take()
-                .expect("the file is either idle or being written"),
-        };
+        let mut out = finish(writing, &mut clocks.write)?;
         clocks.write.time(|| out.flush()).map_err(io_error)
     })
 }

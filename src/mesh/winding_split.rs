@@ -100,6 +100,11 @@ impl<'a> Splitter<'a> {
         }
     }
 
+    /// The exact sum over every triangle at `p`.
+    pub fn winding_number(&self, p: DVec3) -> f64 {
+        winding_number_of(self.triangles, p)
+    }
+
     /// The split for queries within `reach` of `middle`: the triangles within `reach + gap`
     /// of it are near.
     pub fn around(&self, middle: DVec3, reach: f64, gap: f64) -> SplitWinding {
@@ -122,8 +127,7 @@ impl<'a> Splitter<'a> {
         far_boundary.extend(interface.iter().map(|&[a, b]| [b, a]));
         let mut near_boundary: Vec<[DVec3; 2]> = near.iter().map(|&[_, a, b]| [a, b]).collect();
         near_boundary.extend(interface);
-        let far_value =
-            winding_number_of(self.triangles, middle) - winding_number_of(&near, middle);
+        let far_value = self.winding_number(middle) - winding_number_of(&near, middle);
         let (rim_gradient, rim_hessian) = self.rim.winding_derivatives(middle);
         let (near_gradient, near_hessian) = boundary_derivatives(&near_boundary, middle);
         let far_third = third_coefficient(&far_boundary, middle, reach);

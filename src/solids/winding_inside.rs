@@ -26,7 +26,7 @@ use crate::grid::{Channels, Coord, CoordBox, Leaf, SparseGrid, Transform};
 use crate::mesh::Mesh;
 use crate::mesh::boundary_caps::BoundaryCaps;
 use crate::mesh::inside::{ColumnCrossings, Crossing};
-use crate::mesh::winding::{RimBound, WindingBounds, WindingTree, winding_number_of};
+use crate::mesh::winding::{RimBound, WindingBounds, WindingTree};
 use crate::mesh::winding_split::{SplitWinding, Splitter};
 use crate::progress::Progress;
 use glam::DVec3;
@@ -126,7 +126,6 @@ pub fn winding_inside(
     let fans = WindingTree::of_triangles(corners.clone());
     let caps_winding = Caps {
         fans: &fans,
-        triangles: &corners,
         rim: &rim,
         splitter: Splitter::new(&corners, &rim),
         orientation,
@@ -139,7 +138,10 @@ pub fn winding_inside(
             } else {
                 rayon::join(
                     || classify_blocks(&caps_winding, region),
-                    || surface_near_caps(mesh, &index, &fans, region),
+                    || {
+                        let mesh_part = &triangles[..triangles.len() - caps.triangles.len()];
+                        surface_near_caps(mesh_part, &index, &fans, region)
+                    },
                 )
             }
         },
@@ -180,19 +182,18 @@ pub fn winding_inside(
     Ok(inside)
 }
 
-/// The mesh's own triangles (`index`: its points in index space) that `settle_by_model` may
-/// ask about: it asks whether the mesh comes within a ball of radius at most `MODEL_REACH`
-/// only where a cap comes within it too, so triangles farther than twice that from every cap
-/// (or beyond that of the region) are never found there.
+/// The mesh's own `triangles` (over `index`, its points in index space) that
+/// `settle_by_model` may ask about: it asks whether the mesh comes within a ball of radius at
+/// most `MODEL_REACH` only where a cap comes within it too, so triangles farther than twice
+/// that from every cap (or beyond that of the region) are never found there.
 fn surface_near_caps(
-    mesh: &Mesh,
+    triangles: &[[u32; 3]],
     index: &[DVec3],
     caps: &WindingTree,
     region: CoordBox,
 ) -> WindingTree {
     let lo = DVec3::from_array(region.min.map(|v| v as f64)) - MODEL_REACH;
     let hi = DVec3::from_array(region.max.map(|v| v as f64)) + MODEL_REACH;
-    let triangles: Vec<[u32; 3]> = mesh.triangles().map(|(_, t)| t).collect();
     WindingTree::of_triangles(
         triangles
             .par_iter()
@@ -239,10 +240,9 @@ struct Caps<'a> {
     /// The caps as they close the mesh, clustered: where they pass, and their winding number
     /// with its error.
     fans: &'a WindingTree,
-    /// The same, for the exact sum where the error cannot tell.
-    triangles: &'a [[DVec3; 3]],
     rim: &'a RimBound,
-    /// The same, split around each block whose centres are resolved one by one.
+    /// The same, split around each block whose centres are resolved one by one, and summed
+    /// exactly where no bound can tell.
     splitter: Splitter<'a>,
     orientation: i32,
 }
@@ -319,11 +319,17 @@ fn classify(
         found.push((origin, Block::Near { low, high }));
         return;
     }
-    let h = size / 2;
-    for corner in 0..8 {
-        let child = [0, 1, 2].map(|a| origin[a] + if corner >> a & 1 == 1 { h } else { 0 });
-        classify(caps, region, child, h, found);
+    for child in eighths(origin, size) {
+        classify(caps, region, child, size / 2, found);
     }
+}
+
+/// The origins of the eight cubes of half the edge that make the cube at `origin` of edge
+/// `size`.
+fn eighths(origin: Coord, size: i64) -> impl Iterator<Item = Coord> {
+    let h = size / 2;
+    (0..8)
+        .map(move |corner| [0, 1, 2].map(|a| origin[a] + if corner >> a & 1 == 1 { h } else { 0 }))
 }
 
 /// Calls `f` with the origin of every 8^3 block of the block at `origin` of edge `size`.
@@ -527,10 +533,8 @@ impl Context<'_> {
             }
         }
         if size > 1 {
-            let h = size / 2;
-            for corner in 0..8 {
-                let child = [0, 1, 2].map(|a| origin[a] + if corner >> a & 1 == 1 { h } else { 0 });
-                self.resolve(split, child, h, k, decided);
+            for child in eighths(origin, size) {
+                self.resolve(split, child, size / 2, k, decided);
             }
             return;
         }
@@ -637,7 +641,7 @@ impl Context<'_> {
         let bounds = split.bounds(p);
         let (d, spread) = (from_half(bounds.value), bounds.spread);
         let d = if d.abs() <= spread || (d.abs() - AMBIGUOUS).abs() <= spread {
-            from_half(winding_number_of(self.caps.triangles, p))
+            from_half(self.caps.splitter.winding_number(p))
         } else {
             d
         };
