@@ -4,6 +4,8 @@ pub mod binvox;
 #[cfg(feature = "vdb")]
 pub mod brick_set;
 #[cfg(feature = "vdb")]
+mod direct_file;
+#[cfg(feature = "vdb")]
 pub mod grid_export;
 #[cfg(feature = "vdb")]
 mod grid_out;

@@ -1,12 +1,14 @@
 //! Writes `.vdb` files directly from sparse grids, in the layout OpenVDB 10 reads (file
 //! format 224): leaves and tiles are encoded in parallel, each root child's topology and each
-//! batch of leaf buffers on its own thread, then written in order. Building OpenVDB's own tree
-//! first and letting it write serially took longer than voxelizing.
+//! batch of leaf buffers on its own thread, and a writer thread writes each piece as soon as
+//! those before it are written (`direct_file`: large files around the page cache). Building
+//! OpenVDB's own tree first and letting it write serially took longer than voxelizing.
 //!
 //! A grid is laid out as OpenVDB lays out its standard 5-4-3 tree: the root's children (4096^3
 //! blocks) in coordinate order, each with its 128^3 children and 128^3 tiles, those with
 //! their leaves and 8^3 tiles; then every leaf's buffer in the same order.
 
+use super::direct_file::DirectFile;
 use super::grid_out::{Entry, GridOut, GridValues, Key, ValueType, tree_entries};
 use super::vdb::WriteClocks;
 use super::vdb_chunks::{compression_name, push_chunk};
@@ -14,10 +16,8 @@ use super::vdb_format::{COMPRESS_ACTIVE_MASK, FILE_VERSION, LIBRARY_VERSION, MAG
 use super::vdb_tree_structure::{TreeFormat, tree_memory};
 use crate::error::{Error, Result};
 use crate::grid::{LEAF_VOXELS, Leaf, Transform};
-use crate::progress::StageClock;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -88,67 +88,131 @@ pub(super) fn write_grids(
     clocks: &mut WriteClocks,
 ) -> Result<()> {
     let io_error = |e| Error::io(path, e);
-    let mut out =
-        std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(file).map_err(io_error)?);
-    let header = file_header(grids.len());
-    let mut pos = header.len() as u64;
-    // Each grid is written on its own thread while the next one is encoded (the header while
-    // the first is); the write clock counts only the time spent waiting for a write to finish.
-    std::thread::scope(|scope| {
-        let finish = |handle: std::thread::ScopedJoinHandle<'_, (Output, std::io::Result<()>)>,
-                      write: &mut StageClock| {
-            let (out, done) = write
-                .time(|| handle.join())
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-            done.map(|()| out).map_err(io_error)
+    let out = DirectFile::create(file).map_err(io_error)?;
+    // Every piece goes to a writer thread as soon as it is encoded, numbered in file order;
+    // a grid's end is known only once its last buffer is, so it is patched in afterwards.
+    // The write clock counts only the time spent waiting for the writer at the end.
+    let (send, pieces) = std::sync::mpsc::channel();
+    let (out, done, patches) = std::thread::scope(|scope| {
+        let writer = scope.spawn(move || write_in_order(out, pieces));
+        let mut file_out = Pieces {
+            send,
+            next: 0,
+            pos: 0,
         };
-        let mut writing = scope.spawn(move || {
-            let done = out.write_all(&header);
-            (out, done)
-        });
-        for (n, g) in grids.iter().enumerate() {
-            let encoded = clocks.encode.time(|| encode_grid(path, g, encoding))?;
+        file_out.push(file_header(grids.len()));
+        let mut patches = Vec::new();
+        let encoded = grids.iter().enumerate().try_for_each(|(n, g)| {
+            let head = clocks.encode.time(|| grid_head(path, g, encoding))?;
             let mut descriptor = Vec::new();
             push_string(&mut descriptor, &g.name);
             let mut tree_type = tree_type_of(g.values);
-            if encoding.half && (g.values.value_type() != ValueType::Bool) {
+            if head.half {
                 tree_type.push_str("_HalfFloat");
             }
             push_string(&mut descriptor, &tree_type);
             push_string(&mut descriptor, ""); // not an instance of another grid
-            let grid_pos = pos + descriptor.len() as u64 + 24;
-            let block_pos = grid_pos + encoded.head.len() as u64;
-            let end_pos = block_pos + encoded.buffers.iter().map(|b| b.len() as u64).sum::<u64>();
-            for p in [grid_pos, block_pos, end_pos] {
+            let grid_pos = file_out.pos + descriptor.len() as u64 + 24;
+            let block_pos = grid_pos + head.head.len() as u64;
+            for p in [grid_pos, block_pos, 0] {
                 descriptor.extend_from_slice(&(p as i64).to_le_bytes());
             }
+            file_out.push(descriptor);
+            file_out.push(head.head);
+            let first = file_out.next;
+            file_out.next += head.leaves.len().div_ceil(BATCH);
+            let send = &file_out.send;
+            let size = clocks.encode.time(|| {
+                stream_leaf_buffers(&head.leaves, g.values, head.compression, head.half, |k, b| {
+                    send.send((first + k, Piece::Bytes(b))).is_ok()
+                })
+            });
+            file_out.pos += size;
+            patches.push((grid_pos - 8, file_out.pos));
             // A large grid followed by others starts reaching the disk while they are
             // encoded, so that the final sync has less left to wait for.
-            let sync_early = n + 1 < grids.len() && end_pos - pos >= EARLY_SYNC_BYTES;
-            pos = end_pos;
-            let mut out = finish(writing, &mut clocks.write)?;
-            writing = scope.spawn(move || {
-                let done = [&descriptor, &encoded.head]
-                    .into_iter()
-                    .chain(&encoded.buffers)
-                    .try_for_each(|bytes| out.write_all(bytes))
-                    .and_then(|()| {
-                        if sync_early {
-                            out.flush()?;
-                            out.get_ref().sync_data()?;
-                        }
-                        Ok(())
-                    });
-                (out, done)
-            });
-        }
-        let mut out = finish(writing, &mut clocks.write)?;
-        clocks.write.time(|| out.flush()).map_err(io_error)
-    })
+            if n + 1 < grids.len() && file_out.pos - grid_pos >= EARLY_SYNC_BYTES {
+                file_out.sync();
+            }
+            Ok(())
+        });
+        drop(file_out);
+        let (out, written) = clocks
+            .write
+            .time(|| writer.join())
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (out, encoded.and(written.map_err(io_error)), patches)
+    });
+    done?;
+    clocks
+        .write
+        .time(|| {
+            let file = out.finish()?;
+            use std::os::unix::fs::FileExt;
+            patches
+                .iter()
+                .try_for_each(|&(at, end)| file.write_all_at(&(end as i64).to_le_bytes(), at))
+        })
+        .map_err(io_error)
 }
 
-/// The buffered file a `.vdb` is written through.
-type Output = std::io::BufWriter<std::fs::File>;
+/// The numbered pieces of a file on their way to the writer thread, and the file's length
+/// so far.
+struct Pieces {
+    send: std::sync::mpsc::Sender<(usize, Piece)>,
+    next: usize,
+    pos: u64,
+}
+
+impl Pieces {
+    fn push(&mut self, bytes: Vec<u8>) {
+        self.pos += bytes.len() as u64;
+        self.send_next(Piece::Bytes(bytes));
+    }
+
+    fn sync(&mut self) {
+        self.send_next(Piece::Sync);
+    }
+
+    fn send_next(&mut self, piece: Piece) {
+        // A closed channel means the writer stopped at an error, which its join reports.
+        let _ = self.send.send((self.next, piece));
+        self.next += 1;
+    }
+}
+
+/// What the writer thread is handed: bytes to append, or a point at which to sync the file.
+enum Piece {
+    Bytes(Vec<u8>),
+    Sync,
+}
+
+/// Writes the numbered pieces to `out` in their order, whatever order they arrive in;
+/// stops at the first error, closing the channel so that the encoders stop too.
+fn write_in_order(
+    mut out: Output,
+    pieces: std::sync::mpsc::Receiver<(usize, Piece)>,
+) -> (Output, std::io::Result<()>) {
+    let mut waiting = BTreeMap::new();
+    let mut next = 0;
+    for (n, piece) in pieces {
+        waiting.insert(n, piece);
+        while let Some(piece) = waiting.remove(&next) {
+            next += 1;
+            let done = match piece {
+                Piece::Bytes(bytes) => out.write_all(&bytes),
+                Piece::Sync => out.sync_data(),
+            };
+            if let Err(e) = done {
+                return (out, Err(e));
+            }
+        }
+    }
+    (out, Ok(()))
+}
+
+/// The file a `.vdb` is written through.
+type Output = DirectFile;
 
 /// The size from which a grid that other grids follow is synced as soon as it is written.
 const EARLY_SYNC_BYTES: u64 = 16 << 20;
@@ -200,15 +264,16 @@ fn push_string(out: &mut Vec<u8>, s: &str) {
     out.extend_from_slice(s.as_bytes());
 }
 
-/// A grid's bytes: `head` from its compression flags through its topology, then its leaf
-/// buffers in batches.
-struct EncodedGrid {
+/// A grid's head, from its compression flags through its topology, and its leaves in the
+/// order their buffers follow it.
+struct GridHead<'g> {
     head: Vec<u8>,
-    buffers: Vec<Vec<u8>>,
+    leaves: Vec<&'g Leaf>,
+    compression: u32,
+    half: bool,
 }
 
-fn encode_grid(path: &Path, g: &GridOut, encoding: Encoding) -> Result<EncodedGrid> {
-    let grid = g.grid;
+fn grid_head<'g>(path: &Path, g: &GridOut<'g>, encoding: Encoding) -> Result<GridHead<'g>> {
     let entries = tree_entries(path, g)?;
     let half = encoding.half && (g.values.value_type() != ValueType::Bool);
     let compression = encoding.compression | COMPRESS_ACTIVE_MASK;
@@ -219,35 +284,13 @@ fn encode_grid(path: &Path, g: &GridOut, encoding: Encoding) -> Result<EncodedGr
         .map(|child| root_child_topology(child, g.values, compression, half))
         .collect();
     let leaves: Vec<&Leaf> = encoded.iter().flat_map(|e| e.1.iter().copied()).collect();
-    let constant_chunks: Vec<OnceLock<Vec<u8>>> =
-        (0..=LEAF_VOXELS).map(|_| OnceLock::new()).collect();
-    let buffers: Vec<Vec<u8>> = leaves
-        .par_chunks(BATCH)
-        .map(|batch| {
-            let mut out = Vec::with_capacity(batch.len() * 200);
-            let mut scratch = Vec::new();
-            for leaf in batch {
-                leaf_buffer(
-                    &mut out,
-                    &mut scratch,
-                    leaf,
-                    g.values,
-                    &constant_chunks,
-                    compression,
-                    half,
-                );
-            }
-            out
-        })
-        .collect();
-
     let mut head = Vec::new();
     head.extend_from_slice(&compression.to_le_bytes());
     let internal = encoded
         .iter()
         .fold([0u64; 2], |a, e| [a[0] + e.2[0], a[1] + e.2[1]]);
     push_metadata(&mut head, g, encoding, internal, leaves.len() as u64);
-    push_transform(&mut head, grid.transform);
+    push_transform(&mut head, g.grid.transform);
     head.extend_from_slice(&1u32.to_le_bytes()); // one buffer per leaf
     match g.values {
         GridValues::Bool => head.push(0),
@@ -259,7 +302,55 @@ fn encode_grid(path: &Path, g: &GridOut, encoding: Encoding) -> Result<EncodedGr
     for (bytes, _, _) in &encoded {
         head.extend_from_slice(bytes);
     }
-    Ok(EncodedGrid { head, buffers })
+    Ok(GridHead {
+        head,
+        leaves,
+        compression,
+        half,
+    })
+}
+
+/// Encodes the buffers of `leaves` in batches of `BATCH` on all threads, taken in order so
+/// that the first are ready first, handing each to `deliver` with its number; stops early
+/// when `deliver` refuses one. Their total size.
+fn stream_leaf_buffers(
+    leaves: &[&Leaf],
+    values: GridValues,
+    compression: u32,
+    half: bool,
+    deliver: impl Fn(usize, Vec<u8>) -> bool + Sync,
+) -> u64 {
+    use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering::Relaxed};
+    let constant_chunks: Vec<OnceLock<Vec<u8>>> =
+        (0..=LEAF_VOXELS).map(|_| OnceLock::new()).collect();
+    let batches: Vec<&[&Leaf]> = leaves.chunks(BATCH).collect();
+    let (next, size, refused) = (AtomicUsize::new(0), AtomicU64::new(0), AtomicBool::new(false));
+    // Each task takes the next batch, whichever task it is: rayon would otherwise give
+    // each thread a contiguous half, and the writer would wait for the second half's start.
+    (0..batches.len()).into_par_iter().for_each(|_| {
+        let k = next.fetch_add(1, Relaxed);
+        if refused.load(Relaxed) {
+            return;
+        }
+        let mut out = Vec::with_capacity(batches[k].len() * 200);
+        let mut scratch = Vec::new();
+        for leaf in batches[k] {
+            leaf_buffer(
+                &mut out,
+                &mut scratch,
+                leaf,
+                values,
+                &constant_chunks,
+                compression,
+                half,
+            );
+        }
+        size.fetch_add(out.len() as u64, Relaxed);
+        if !deliver(k, out) {
+            refused.store(true, Relaxed);
+        }
+    });
+    size.into_inner()
 }
 
 /// One root child (a 4096^3 node): its origin, then its node topology; its leaves in order,

@@ -1,0 +1,176 @@
+//! Large outputs written around the page cache. Every file voxelkit writes is synced before
+//! it is renamed into place (`atomic`), so its bytes must reach the disk before the run ends
+//! anyway; copying them into the page cache first costs more CPU than compressing them (each
+//! megabyte of fresh page cache is about 2 ms on a virtual machine whose host reclaims free
+//! memory) and adds the file's size to the memory the run touches. Whole aligned blocks go
+//! to the disk directly (`O_DIRECT`) from one reused buffer; a small file, the last partial
+//! block and later patches go through the page cache as usual, and so does everything where
+//! the file system refuses direct I/O (tmpfs, some network file systems).
+
+use std::fs::File;
+use std::io;
+use std::os::unix::fs::FileExt;
+use std::os::unix::io::AsRawFd;
+use std::path::Path;
+
+/// Bytes per direct write: large enough that the device's latency is small beside the
+/// transfer, small enough to stay in the cache while it is filled.
+const BLOCK: usize = 4 << 20;
+
+/// The alignment direct I/O asks of buffers, lengths and offsets: a page, which every
+/// device's logical block size divides.
+const ALIGN: usize = 4096;
+
+/// A new file written front to back in blocks.
+pub(super) struct DirectFile {
+    file: File,
+    /// `BLOCK + ALIGN` bytes, of which the aligned `BLOCK` from `start` are the block.
+    buffer: Vec<u8>,
+    start: usize,
+    /// Bytes of the block filled.
+    filled: usize,
+    /// Bytes already handed to the file.
+    written: u64,
+    /// Whether whole blocks still go around the page cache (until the file system refuses).
+    direct: bool,
+}
+
+impl DirectFile {
+    pub(super) fn create(path: &Path) -> io::Result<Self> {
+        let file = File::create(path)?;
+        let buffer = vec![0u8; BLOCK + ALIGN];
+        let start = buffer.as_ptr().align_offset(ALIGN);
+        Ok(DirectFile {
+            file,
+            buffer,
+            start,
+            filled: 0,
+            written: 0,
+            direct: true,
+        })
+    }
+
+    pub(super) fn write_all(&mut self, mut bytes: &[u8]) -> io::Result<()> {
+        while !bytes.is_empty() {
+            let n = (BLOCK - self.filled).min(bytes.len());
+            let at = self.start + self.filled;
+            self.buffer[at..at + n].copy_from_slice(&bytes[..n]);
+            self.filled += n;
+            bytes = &bytes[n..];
+            if self.filled == BLOCK {
+                self.write_block()?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Makes the bytes written so far durable where they went through the page cache (direct
+    /// blocks are on the device already; the partial block is not written yet).
+    pub(super) fn sync_data(&mut self) -> io::Result<()> {
+        if self.direct {
+            return Ok(());
+        }
+        self.file.sync_data()
+    }
+
+    /// Writes the partial block and hands back the file, its direct I/O turned off so that
+    /// small writes (patches) may follow anywhere.
+    pub(super) fn finish(self) -> io::Result<File> {
+        if self.direct {
+            set_direct(&self.file, false)?;
+        }
+        let block = &self.buffer[self.start..self.start + self.filled];
+        self.file.write_all_at(block, self.written)?;
+        Ok(self.file)
+    }
+
+    /// Writes the full block at its (aligned) place: directly while the file system allows,
+    /// else through the page cache.
+    fn write_block(&mut self) -> io::Result<()> {
+        let block = &self.buffer[self.start..self.start + BLOCK];
+        if self.direct && self.written == 0 && set_direct(&self.file, true).is_err() {
+            self.direct = false;
+        }
+        if self.direct {
+            match self.file.write_all_at(block, self.written) {
+                Err(e) if e.raw_os_error() == Some(libc::EINVAL) => {
+                    // Accepted at open, refused on write: the rest goes through the cache.
+                    self.direct = false;
+                    set_direct(&self.file, false)?;
+                    self.file.write_all_at(block, self.written)?;
+                }
+                done => done?,
+            }
+        } else {
+            self.file.write_all_at(block, self.written)?;
+        }
+        self.written += BLOCK as u64;
+        self.filled = 0;
+        Ok(())
+    }
+}
+
+/// Turns direct I/O on or off for `file`.
+fn set_direct(file: &File, on: bool) -> io::Result<()> {
+    let fd = file.as_raw_fd();
+    // SAFETY: fcntl on a descriptor this file owns; F_GETFL and F_SETFL take no pointers.
+    let flags = unsafe { libc::fcntl(fd, libc::F_GETFL) };
+    if flags < 0 {
+        return Err(io::Error::last_os_error());
+    }
+    let flags = if on {
+        flags | libc::O_DIRECT
+    } else {
+        flags & !libc::O_DIRECT
+    };
+    // SAFETY: as above.
+    if unsafe { libc::fcntl(fd, libc::F_SETFL, flags) } < 0 {
+        return Err(io::Error::last_os_error());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Files of every size around the block and alignment boundaries, written in uneven
+    /// pieces, read back byte for byte: in the temporary folder (direct where its file
+    /// system allows) and in memory (tmpfs, where it may not).
+    #[test]
+    fn what_is_written_reads_back() {
+        let folders = [std::env::temp_dir(), "/dev/shm".into()];
+        for folder in folders.iter().filter(|f| f.is_dir()) {
+            written_files_read_back(folder);
+        }
+    }
+
+    fn written_files_read_back(folder: &Path) {
+        let dir = folder.join(format!("voxelkit-direct-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut random = crate::random::SplitMix64(3);
+        for size in [0, 1, ALIGN - 1, BLOCK - 1, BLOCK, BLOCK + 1, 2 * BLOCK + 12345] {
+            let bytes: Vec<u8> = (0..size).map(|_| random.next_u64() as u8).collect();
+            let path = dir.join(format!("{size}.bin"));
+            let mut out = DirectFile::create(&path).unwrap();
+            let mut rest = &bytes[..];
+            while !rest.is_empty() {
+                let n = (random.next_u64() as usize % 300_000 + 1).min(rest.len());
+                out.write_all(&rest[..n]).unwrap();
+                rest = &rest[n..];
+            }
+            out.sync_data().unwrap();
+            let file = out.finish().unwrap();
+            if size > 8 {
+                file.write_all_at(b"patched!", 1).unwrap();
+            }
+            drop(file);
+            let mut expected = bytes.clone();
+            if size > 8 {
+                expected[1..9].copy_from_slice(b"patched!");
+            }
+            assert!(std::fs::read(&path).unwrap() == expected, "size {size}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
