@@ -655,7 +655,9 @@ pub(super) fn face_body<const C: usize>(
     let inv_nw = 1.0 / n[w];
     // Clip each row to the columns whose slab segment can reach inside every edge plane: the
     // best k of the slab turns each plane test into a linear bound on iv, `at(iu) + slope iv
-    // >= 0` with `at(iu) = at0 + at1 iu`, set up once per triangle.
+    // >= 0` with `at(iu) = at0 + at1 iu`, set up once per triangle. The worst k of the slab
+    // (`at0` less `across`) bounds the columns whose whole segment lies inside every plane,
+    // with room for rounding: those need no cut.
     let bounds = sides.map(|(m, p)| {
         let slope = m[v] - m[w] * n[v] / n[w];
         let at1 = m[u] - m[w] * n[u] / n[w];
@@ -664,12 +666,13 @@ pub(super) fn face_body<const C: usize>(
             + m[w] * (n[u] * a[u] + n[v] * a[v]) / n[w]
             + m[w].abs() * half
             + ROW_SLACK;
-        (slope, at0, at1)
+        let across = 2.0 * (m[w].abs() * half + ROW_SLACK);
+        (slope, at0, at1, across)
     });
-    for iu in clipped(int_range(lo[u], hi[u]), clip, u) {
+    let row = |iu: i64, inner: bool| {
         let (mut v_lo, mut v_hi) = (lo[v], hi[v]);
-        for &(slope, at0, at1) in &bounds {
-            let at_zero = at0 + at1 * iu as f64;
+        for &(slope, at0, at1, across) in &bounds {
+            let at_zero = at0 + at1 * iu as f64 - if inner { across } else { 0.0 };
             if slope > 0.0 {
                 v_lo = v_lo.max(-at_zero / slope);
             } else if slope < 0.0 {
@@ -678,10 +681,23 @@ pub(super) fn face_body<const C: usize>(
                 v_hi = f64::NEG_INFINITY;
             }
         }
+        // Checked before converting: a near-zero slope puts a bound far beyond i64.
         if v_lo > v_hi {
+            return int_range(0.0, -1.0);
+        }
+        int_range(v_lo, v_hi)
+    };
+    for iu in clipped(int_range(lo[u], hi[u]), clip, u) {
+        let reached = clipped(row(iu, false), clip, v);
+        if reached.is_empty() {
             continue;
         }
-        for iv in clipped(int_range(v_lo, v_hi), clip, v) {
+        let uncut = if column_cut.is_empty() {
+            int_range(0.0, -1.0)
+        } else {
+            row(iu, true)
+        };
+        for iv in reached {
             let s = n[u] * (iu as f64 - a[u]) + n[v] * (iv as f64 - a[v]);
             // d_lo <= s + n_w (k - a_w) < d_hi with n_w > 0, solved for k (the slab's
             // margins dwarf the reciprocal's rounding).
@@ -691,15 +707,41 @@ pub(super) fn face_body<const C: usize>(
             column[u] = iu as f64;
             column[v] = iv as f64;
             let slab = clipped(half_open_range(k0, k1), clip, w);
-            for k in within(slab, column, w, column_cut) {
-                let mut x = column;
-                x[w] = k as f64;
+            if !column_cut.is_empty() {
+                let ks = if uncut.contains(&iv) {
+                    slab
+                } else {
+                    within(slab, column, w, column_cut)
+                };
                 // A cut column is exact to 1e-6 voxels, which moves a plane distance by less
                 // than 1e-12: the distance band needs no test per voxel.
-                if !column_cut.is_empty() || within_edge_planes(&sides, x) {
+                let distance = plane_distance_along(n, a, column, w);
+                sink.add_column(to_coord(column), w, ks, distance, tri.normal);
+                continue;
+            }
+            for k in slab {
+                let mut x = column;
+                x[w] = k as f64;
+                if within_edge_planes(&sides, x) {
                     sink.add(to_coord(x), || n.dot(x - a).abs(), tri.normal);
                 }
             }
+        }
+    }
+}
+
+/// `|n·(x - a)|` at the centres `x` of `column` along `axis` (`x[axis] = k`), the sum taken
+/// in the order `DVec3::dot` takes it, so that each value is the same to the bit; the two
+/// fixed products once per column.
+#[inline]
+fn plane_distance_along(n: DVec3, a: DVec3, column: DVec3, axis: usize) -> impl Fn(i64) -> f64 {
+    let p = n * (column - a);
+    move |k| {
+        let q = n[axis] * (k as f64 - a[axis]);
+        match axis {
+            0 => ((q + p.y) + p.z).abs(),
+            1 => ((p.x + q) + p.z).abs(),
+            _ => ((p.x + p.y) + q).abs(),
         }
     }
 }
