@@ -21,8 +21,8 @@
 use super::Progress;
 use super::brick_bins::voxelize_in_bricks;
 use super::separating_kernel::{
-    Adjacency, HalfSpace, MARGIN, Primitive, PrimitiveClass, Primitives, Triangle, edge_cylinder,
-    face_body, primitives, reach_box, vertex_sphere,
+    Adjacency, HalfSpace, MARGIN, Primitive, PrimitiveClass, Primitives, SECTOR_SLACK, Triangle,
+    edge_cylinder, face_body, primitives, reach_box, sector_directions, vertex_sphere,
 };
 use crate::error::{Error, Result};
 use crate::grid::{Channels, CoordBox, SparseGrid, Transform};
@@ -161,13 +161,6 @@ fn edge_halves(e: &Primitive, adjacency: &Adjacency, triangles: &[Triangle]) -> 
     halves
 }
 
-/// Slack on `sector_box`: it bounds the exact sector, and the half-spaces' margins widen
-/// it by at most 2 MARGIN / SECTOR_ANGLE_SLACK = 0.002 voxels.
-const SECTOR_SLACK: f64 = 0.01;
-/// Angle (radians) by which a boundary ray of the sector may break a half-space and still
-/// bound it: a sector narrower than this keeps both its sides.
-const SECTOR_ANGLE_SLACK: f64 = 1e-6;
-
 /// A box holding every voxel centre that edge `e`'s cylinder of radius `r` marks within
 /// `halves`, planes through the edge (`edge_halves`). Across the edge they cut the disc of
 /// radius `r` to a sector: its box is the box of the apex and of the points of the circle
@@ -181,17 +174,14 @@ fn sector_box(e: &Primitive, halves: &[HalfSpace], r: f64) -> CoordBox {
         let e1 = dn.any_orthonormal_vector();
         [e1, dn.cross(e1)]
     };
-    // In-plane directions: each axis's farthest (both ways), and each plane's two rays.
+    // Each axis's farthest direction across the edge.
     let toward_axes = [DVec3::X, DVec3::Y, DVec3::Z].map(|axis| {
         (across[0] * axis.dot(across[0]) + across[1] * axis.dot(across[1])).normalize_or_zero()
     });
-    let rays = halves.iter().map(|h| dn.cross(h.g).normalize_or_zero());
     let (mut lo, mut hi) = (DVec3::ZERO, DVec3::ZERO);
-    for u in toward_axes.into_iter().chain(rays).flat_map(|u| [u, -u]) {
-        if halves.iter().all(|h| h.g.dot(u) <= SECTOR_ANGLE_SLACK) {
-            lo = lo.min(u * r);
-            hi = hi.max(u * r);
-        }
+    for u in sector_directions(dn, halves, toward_axes) {
+        lo = lo.min(u * r);
+        hi = hi.max(u * r);
     }
     reach_box(e.a.min(e.b) + lo, e.a.max(e.b) + hi, SECTOR_SLACK)
 }

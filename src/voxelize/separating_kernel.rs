@@ -498,6 +498,32 @@ pub(super) fn vertex_sphere<const C: usize>(
     }
 }
 
+/// Angle (radians) by which a boundary ray of a sector may break a half-space and still
+/// bound it: a sector narrower than this keeps both its sides.
+const SECTOR_ANGLE_SLACK: f64 = 1e-6;
+
+/// Slack on bounds taken from `sector_directions`: the half-spaces' margins widen the exact
+/// sector by at most 2 MARGIN / SECTOR_ANGLE_SLACK = 0.002 voxels.
+pub(super) const SECTOR_SLACK: f64 = 0.01;
+
+/// The unit directions across an edge (along the unit vector `dn`) at which a linear function
+/// of the direction can be extreme over the sector that `halves`, planes through the edge,
+/// cut from the disc across it: each of `toward` (directions across the edge, where the
+/// functions are extreme on the whole disc) and each plane's two boundary rays, both ways,
+/// kept where they lie in every half-space.
+pub(super) fn sector_directions<const N: usize>(
+    dn: DVec3,
+    halves: &[HalfSpace],
+    toward: [DVec3; N],
+) -> impl Iterator<Item = DVec3> + '_ {
+    let rays = halves.iter().map(move |h| dn.cross(h.g).normalize_or_zero());
+    toward
+        .into_iter()
+        .chain(rays)
+        .flat_map(|u| [u, -u])
+        .filter(|u| halves.iter().all(|h| h.g.dot(*u) <= SECTOR_ANGLE_SLACK))
+}
+
 /// S_e: voxel centres within `r` of the edge whose projection falls on the edge (and that
 /// `keep` accepts), in `clip`.
 pub(super) fn edge_cylinder<const C: usize>(
@@ -521,6 +547,22 @@ pub(super) fn edge_cylinder<const C: usize>(
     // r sqrt(1 - dn_v^2) / |dn_w| from the axis along u; the caps, discs of radius r across
     // the edge, reach r sqrt(1 - dn_w^2) beyond its ends along w.
     let reach = r * (1.0 - dn[v] * dn[v]).sqrt() / dn[w].abs() + ROW_SLACK;
+    // Planes through the edge (`halves`) cut the disc across it to a sector. A point rho q
+    // off the axis (q across the edge) lies in the plane across axis w through the axis's
+    // point c when moved back along the edge by rho q_w / dn_w, which puts it rho q.f from
+    // c along u, for f = e_u - (dn_u / dn_w) e_w (itself across the edge, |f| r = reach):
+    // so the sector's rows lie within r [min q.f, max q.f] of c, 0 (the axis) included.
+    let (reach_lo, reach_hi) = if halves.is_empty() {
+        (-reach, reach)
+    } else {
+        let mut f = DVec3::ZERO;
+        f[u] = 1.0;
+        f[w] = -dn[u] / dn[w];
+        let (lo, hi) = sector_directions(dn, halves, [f.normalize()])
+            .map(|q| q.dot(f))
+            .fold((0.0f64, 0.0f64), |(lo, hi), l| (lo.min(l), hi.max(l)));
+        (r * lo - SECTOR_SLACK, r * hi + SECTOR_SLACK)
+    };
     let cap = r * (1.0 - dn[w] * dn[w]).max(0.0).sqrt() + ROW_SLACK;
     let tau_margin = MARGIN / len2.sqrt();
     let test = EdgeTest::new(e, r);
@@ -539,7 +581,7 @@ pub(super) fn edge_cylinder<const C: usize>(
         w,
     ) {
         let c = p + d * ((k as f64 - p[w]) / d[w]);
-        for iu in clipped(int_range(c[u] - reach, c[u] + reach), clip, u) {
+        for iu in clipped(int_range(c[u] + reach_lo, c[u] + reach_hi), clip, u) {
             let mut row = DVec3::ZERO;
             row[w] = k as f64;
             row[u] = iu as f64;
