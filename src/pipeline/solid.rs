@@ -336,20 +336,23 @@ pub(super) fn distance_band(
         inside,
         attributes,
     } = asked;
-    let (grid, interior, choice, ambiguous) = if signed {
+    // Unsigned distances have no inside.
+    let (grid, interior, choice, ambiguous, inside_band_voxels) = if signed {
         let choice = choose_inside(inside, mesh, SIGN_NEEDS_CLOSED)?;
         let set = level_set(mesh, t, band, &choice.inside, progress)?;
         let ambiguous = matches!(choice.inside, Inside::Winding(_)).then_some(set.ambiguous);
-        (set.band, Some(set.interior), Some(choice), ambiguous)
-    } else {
+        let inside_band_voxels = set.inside_band_voxels;
         (
-            unsigned_distance(mesh, t, band, progress)?,
-            None,
-            None,
-            None,
+            set.band,
+            Some(set.interior),
+            Some(choice),
+            ambiguous,
+            inside_band_voxels,
         )
+    } else {
+        let grid = unsigned_distance(mesh, t, band, progress)?;
+        (grid, None, None, None, 0)
     };
-    let inside_band_voxels = inside_band_voxels(&grid);
     let background = band * t.voxel_size;
     let method = if signed {
         "exact-signed-distance-band"

@@ -33,6 +33,8 @@ pub struct LevelSet {
     pub interior: SparseGrid,
     /// The centres whose winding number lies near 1/2 (none by parity).
     pub ambiguous: SparseGrid,
+    /// The band's voxels whose centre is inside (its negative values).
+    pub inside_band_voxels: u64,
 }
 
 /// Signed distances (world units, negative inside) on every voxel within `band` voxels of
@@ -73,18 +75,22 @@ pub fn level_set(
     let mut interior = SparseGrid::from_distinct_leaves(transform, Channels::NONE, leaves);
     interior.fill_leaf_blocks(full_free);
     let h = transform.voxel_size as f32;
-    grid.leaves_mut().par_iter_mut().for_each(|leaf| {
-        sign_leaf(leaf, &interior.block_mask(leaf.origin), h);
-    });
+    let inside_band_voxels = grid
+        .leaves_mut()
+        .par_iter_mut()
+        .map(|leaf| sign_leaf(leaf, &interior.block_mask(leaf.origin), h))
+        .sum();
     Ok(LevelSet {
         band: grid,
         interior,
         ambiguous: inside.ambiguous,
+        inside_band_voxels,
     })
 }
 
-/// Negates the distances of `leaf`'s voxels in `inside` and scales all to world units.
-fn sign_leaf(leaf: &mut Leaf, inside: &[u64; 8], h: f32) {
+/// Negates the distances of `leaf`'s voxels in `inside` and scales all to world units; how
+/// many it negated.
+fn sign_leaf(leaf: &mut Leaf, inside: &[u64; 8], h: f32) -> u64 {
     let values = leaf.value.as_mut().expect("distances");
     for n in crate::grid::bits::ones(&leaf.mask) {
         values[n] *= if inside[n / 64] >> (n % 64) & 1 == 1 {
@@ -93,6 +99,9 @@ fn sign_leaf(leaf: &mut Leaf, inside: &[u64; 8], h: f32) {
             h
         };
     }
+    (0..8)
+        .map(|w| (leaf.mask[w] & inside[w]).count_ones() as u64)
+        .sum()
 }
 
 /// The level set of a closed mesh signed by ray parity.
@@ -114,20 +123,22 @@ fn parity_level_set(
             band: grid,
             interior: SparseGrid::new(transform, Channels::NONE),
             ambiguous: SparseGrid::new(transform, Channels::NONE),
+            inside_band_voxels: 0,
         });
     }
     let h = transform.voxel_size as f32;
-    let inside: Vec<Leaf> = grid
+    let (inside, counts): (Vec<Option<Leaf>>, Vec<u64>) = grid
         .leaves_mut()
         .par_iter_mut()
-        .filter_map(|leaf| {
+        .map(|leaf| {
             let mask = inside_mask(&columns, leaf.origin);
-            sign_leaf(leaf, &mask, h);
+            let count = sign_leaf(leaf, &mask, h);
             let mut inside = Leaf::new(leaf.origin, Channels::NONE);
             inside.mask = mask;
-            (!inside.is_empty()).then_some(inside)
+            ((!inside.is_empty()).then_some(inside), count)
         })
-        .collect();
+        .unzip();
+    let inside: Vec<Leaf> = inside.into_iter().flatten().collect();
     let mut interior = SparseGrid::from_distinct_leaves(transform, Channels::NONE, inside);
     // Band leaves stay leaves, even wholly inside: the level set writes its tiles.
     interior.fill_leaf_blocks(inside_blocks(&columns, &grid));
@@ -135,6 +146,7 @@ fn parity_level_set(
         band: grid,
         interior,
         ambiguous: SparseGrid::new(transform, Channels::NONE),
+        inside_band_voxels: counts.iter().sum(),
     })
 }
 
