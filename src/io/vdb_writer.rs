@@ -102,8 +102,13 @@ pub(super) fn write_grids(
         };
         file_out.push(file_header(grids.len()));
         let mut patches = Vec::new();
+        // Each grid's head (its topology: serial in good part) is built while the grid
+        // before it encodes its leaf buffers.
+        let mut following = grids
+            .first()
+            .map(|g| clocks.encode.time(|| grid_head(path, g, encoding)));
         let encoded = grids.iter().enumerate().try_for_each(|(n, g)| {
-            let head = clocks.encode.time(|| grid_head(path, g, encoding))?;
+            let head = following.take().expect("each grid's head is built")?;
             let mut descriptor = Vec::new();
             push_string(&mut descriptor, &g.name);
             let mut tree_type = tree_type_of(g.values);
@@ -122,11 +127,18 @@ pub(super) fn write_grids(
             let first = file_out.next;
             file_out.next += head.leaves.len().div_ceil(BATCH);
             let send = &file_out.send;
-            let size = clocks.encode.time(|| {
-                stream_leaf_buffers(&head.leaves, g.values, head.compression, head.half, |k, b| {
-                    send.send((first + k, Piece::Bytes(b))).is_ok()
-                })
+            let (size, next) = clocks.encode.time(|| {
+                rayon::join(
+                    || {
+                        let leaves = &head.leaves;
+                        stream_leaf_buffers(leaves, g.values, head.compression, head.half, |k, b| {
+                            send.send((first + k, Piece::Bytes(b))).is_ok()
+                        })
+                    },
+                    || grids.get(n + 1).map(|g| grid_head(path, g, encoding)),
+                )
             });
+            following = next;
             file_out.pos += size;
             patches.push((grid_pos - 8, file_out.pos));
             // A large grid followed by others starts reaching the disk while they are
