@@ -4,10 +4,10 @@
 //! every reader of these formats expects. Writes are atomic.
 
 use super::atomic::write_atomic;
+use super::direct_file::DirectFile;
 use crate::contour::TriangleMesh;
 use crate::error::{Error, Result};
 use rayon::prelude::*;
-use std::io::Write;
 use std::path::Path;
 
 /// The mesh formats written.
@@ -58,8 +58,10 @@ pub fn write_mesh(path: &Path, mesh: &TriangleMesh) -> Result<()> {
         MeshFormat::Glb => glb(mesh),
     };
     write_atomic(path, |tmp| {
-        let mut file = std::fs::File::create(tmp).map_err(|e| Error::io(tmp, e))?;
-        file.write_all(&bytes).map_err(|e| Error::io(tmp, e))
+        let io_error = |e| Error::io(tmp, e);
+        let mut file = DirectFile::create(tmp).map_err(io_error)?;
+        file.write_all(&bytes).map_err(io_error)?;
+        file.finish().map(drop).map_err(io_error)
     })
 }
 

@@ -3,7 +3,6 @@ pub mod atomic;
 pub mod binvox;
 #[cfg(feature = "vdb")]
 pub mod brick_set;
-#[cfg(feature = "vdb")]
 mod direct_file;
 #[cfg(feature = "vdb")]
 pub mod grid_export;
