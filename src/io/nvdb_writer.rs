@@ -16,13 +16,13 @@
 //! A grid is built whole in memory (counted by the memory plan first), its nodes filled in
 //! parallel; grids are written one after another and the header last.
 
+use super::direct_file::DirectFile;
 use super::grid_out::{Entry, GridOut, GridValues, Key, ValueType, block_origin, tree_entries};
 use super::vdb::WriteClocks;
 use super::vdb_format::{FOG_VOLUME, LEVEL_SET};
 use crate::error::{Error, Result};
 use crate::grid::{LEAF_VOXELS, Leaf};
 use rayon::prelude::*;
-use std::io::{Seek, SeekFrom, Write};
 use std::path::Path;
 
 /// "NanoVDB0", little-endian.
@@ -636,15 +636,14 @@ pub(super) fn write_nvdb_grids(
     clocks: &mut WriteClocks,
 ) -> Result<()> {
     let io_error = |e| Error::io(path, e);
-    let mut out =
-        std::io::BufWriter::with_capacity(1 << 20, std::fs::File::create(file).map_err(io_error)?);
+    let mut out = DirectFile::create(file).map_err(io_error)?;
     let index_bytes = FILE_HEADER_BYTES
         + grids
             .iter()
             .map(|g| GRID_META_BYTES + g.name.len() + 1)
             .sum::<usize>();
-    out.seek(SeekFrom::Start(index_bytes as u64))
-        .map_err(io_error)?;
+    // Room for the index, written over it once the grids' sizes are known.
+    out.write_all(&vec![0; index_bytes]).map_err(io_error)?;
     let mut index = Vec::with_capacity(index_bytes);
     index.extend_from_slice(&MAGIC.to_le_bytes());
     index.extend_from_slice(&VERSION.to_le_bytes());
@@ -667,9 +666,8 @@ pub(super) fn write_nvdb_grids(
     clocks
         .write
         .time(|| {
-            out.seek(SeekFrom::Start(0))?;
-            out.write_all(&index)?;
-            out.flush()
+            use std::os::unix::fs::FileExt;
+            out.finish()?.write_all_at(&index, 0)
         })
         .map_err(io_error)
 }
