@@ -149,7 +149,15 @@ mod tests {
         let dir = folder.join(format!("voxelkit-direct-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let mut random = crate::random::SplitMix64(3);
-        for size in [0, 1, ALIGN - 1, BLOCK - 1, BLOCK, BLOCK + 1, 2 * BLOCK + 12345] {
+        for size in [
+            0,
+            1,
+            ALIGN - 1,
+            BLOCK - 1,
+            BLOCK,
+            BLOCK + 1,
+            2 * BLOCK + 12345,
+        ] {
             let bytes: Vec<u8> = (0..size).map(|_| random.next_u64() as u8).collect();
             let path = dir.join(format!("{size}.bin"));
             let mut out = DirectFile::create(&path).unwrap();

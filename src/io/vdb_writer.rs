@@ -131,9 +131,13 @@ pub(super) fn write_grids(
                 rayon::join(
                     || {
                         let leaves = &head.leaves;
-                        stream_leaf_buffers(leaves, g.values, head.compression, head.half, |k, b| {
-                            send.send((first + k, Piece::Bytes(b))).is_ok()
-                        })
+                        stream_leaf_buffers(
+                            leaves,
+                            g.values,
+                            head.compression,
+                            head.half,
+                            |k, b| send.send((first + k, Piece::Bytes(b))).is_ok(),
+                        )
                     },
                     || grids.get(n + 1).map(|g| grid_head(path, g, encoding)),
                 )
@@ -336,7 +340,11 @@ fn stream_leaf_buffers(
     let constant_chunks: Vec<OnceLock<Vec<u8>>> =
         (0..=LEAF_VOXELS).map(|_| OnceLock::new()).collect();
     let batches: Vec<&[&Leaf]> = leaves.chunks(BATCH).collect();
-    let (next, size, refused) = (AtomicUsize::new(0), AtomicU64::new(0), AtomicBool::new(false));
+    let (next, size, refused) = (
+        AtomicUsize::new(0),
+        AtomicU64::new(0),
+        AtomicBool::new(false),
+    );
     // Each task takes the next batch, whichever task it is: rayon would otherwise give
     // each thread a contiguous half, and the writer would wait for the second half's start.
     (0..batches.len()).into_par_iter().for_each(|_| {

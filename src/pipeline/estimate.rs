@@ -90,12 +90,14 @@ fn area_in_voxels(mesh: &Mesh, t: &Transform) -> f64 {
 
 /// Mesh surfaces and solids, calibrated on the whole process (bunny-closed, igea, armadillo,
 /// skull and horse at 1024, estimate/peak 0.94-1.10): a separating or projective surface
-/// crosses a leaf per 44 voxels^2 of area and costs 470 bytes per leaf at the peak (the leaf
-/// and its encoded buffers; the file is written straight from the grid), 8.3 KB more with
-/// normals or colours (the channel and its encoded values); each triangle about 330 bytes
-/// (reading the file, the voxelizer's tables and bins).
+/// crosses a leaf per 44 voxels^2 of area and costs 430 bytes per leaf at the peak (the leaf
+/// and the encoded buffers on their way to the file, which is written straight from the grid),
+/// 8.3 KB more with normals or colours (the channel and its encoded values); each triangle
+/// about 330 bytes (reading the file, the voxelizer's tables and bins). The leaf's cost was
+/// refitted when the writer began streaming its buffers (estimate/peak 0.96-1.11 on those
+/// five, 0.98-1.25 on fandisk, scorpion, rocker-arm and spot).
 const MESH_AREA_PER_LEAF: f64 = 44.0;
-const MESH_LEAF_BYTES: f64 = 470.0;
+const MESH_LEAF_BYTES: f64 = 430.0;
 const MESH_VECTOR_LEAF_BYTES: f64 = 8300.0;
 const TRIANGLE_BYTES: f64 = 330.0;
 
@@ -354,11 +356,14 @@ fn tessellation_bytes(control: &ControlMesh, t: &Transform) -> f64 {
 }
 
 /// A distance band's leaf with its values and encoded buffers: 2.4 KB; a level set's also
-/// holds its interior's leaf and the fog volume's buffers, 3 KB. Each triangle 150 bytes
+/// holds its interior's leaf and the fog volume's buffers, 2.6 KB. Each triangle 150 bytes
 /// (its corners, the bins). Fitted on bunny-closed (`--sdf`) and igea (`--udf`) at 1024; the
-/// unsigned leaf refitted by `voxelkit-bench calibrate` on the five meshes (factor 1.15).
+/// unsigned leaf refitted by `voxelkit-bench calibrate` on the five meshes (factor 1.15), the
+/// signed one when the writer began streaming its buffers (factor 0.87; estimate/peak
+/// 0.92-1.01 on bunny-closed, igea, horse, armadillo and skull, 0.99-1.23 on fandisk,
+/// scorpion, rocker-arm and spot).
 const UNSIGNED_BAND_LEAF_BYTES: f64 = 2400.0;
-const SIGNED_BAND_LEAF_BYTES: f64 = 3000.0;
+const SIGNED_BAND_LEAF_BYTES: f64 = 2600.0;
 const BAND_TRIANGLE_BYTES: f64 = 150.0;
 
 /// `check`: the surface and its word-wise span floods, about 2.2 dense volumes over the box

@@ -516,7 +516,9 @@ pub(super) fn sector_directions<const N: usize>(
     halves: &[HalfSpace],
     toward: [DVec3; N],
 ) -> impl Iterator<Item = DVec3> + '_ {
-    let rays = halves.iter().map(move |h| dn.cross(h.g).normalize_or_zero());
+    let rays = halves
+        .iter()
+        .map(move |h| dn.cross(h.g).normalize_or_zero());
     toward
         .into_iter()
         .chain(rays)
