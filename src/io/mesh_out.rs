@@ -51,18 +51,39 @@ pub fn write_mesh(path: &Path, mesh: &TriangleMesh) -> Result<()> {
             mesh.triangles.len()
         )));
     }
-    let bytes = match format {
-        MeshFormat::Obj => obj(mesh),
-        MeshFormat::Ply => ply(mesh),
-        MeshFormat::Stl => stl(mesh),
-        MeshFormat::Glb => glb(mesh),
-    };
     write_atomic(path, |tmp| {
         let io_error = |e| Error::io(tmp, e);
         let mut file = DirectFile::create(tmp).map_err(io_error)?;
-        file.write_all(&bytes).map_err(io_error)?;
+        let mut put = |bytes: &[u8]| file.write_all(bytes);
+        match format {
+            MeshFormat::Obj => put(&obj(mesh)),
+            MeshFormat::Ply => ply(mesh, &mut put),
+            MeshFormat::Stl => stl(mesh, &mut put),
+            MeshFormat::Glb => put(&glb(mesh)),
+        }
+        .map_err(io_error)?;
         file.finish().map(drop).map_err(io_error)
     })
+}
+
+/// Rows per piece of a binary file handed to the file: the large binary formats are written
+/// piece by piece from one reused buffer rather than built whole in fresh memory first.
+const ROWS_PER_PIECE: usize = 1 << 16;
+
+/// Hands `put` the bytes `row` appends for each of `rows`, a piece of `ROWS_PER_PIECE` rows
+/// at a time.
+fn put_rows<T>(
+    rows: &[T],
+    put: &mut dyn FnMut(&[u8]) -> std::io::Result<()>,
+    row: impl Fn(&mut Vec<u8>, &T),
+) -> std::io::Result<()> {
+    let mut piece = Vec::new();
+    for chunk in rows.chunks(ROWS_PER_PIECE) {
+        piece.clear();
+        chunk.iter().for_each(|r| row(&mut piece, r));
+        put(&piece)?;
+    }
+    Ok(())
 }
 
 fn point(mesh: &TriangleMesh, i: u32) -> [f32; 3] {
@@ -103,7 +124,10 @@ fn obj(mesh: &TriangleMesh) -> Vec<u8> {
     out
 }
 
-fn ply(mesh: &TriangleMesh) -> Vec<u8> {
+fn ply(
+    mesh: &TriangleMesh,
+    put: &mut dyn FnMut(&[u8]) -> std::io::Result<()>,
+) -> std::io::Result<()> {
     let header = format!(
         "ply\nformat binary_little_endian 1.0\ncomment written by voxelkit {}\nelement vertex {}\n\
          property float x\nproperty float y\nproperty float z\nelement face {}\n\
@@ -112,34 +136,33 @@ fn ply(mesh: &TriangleMesh) -> Vec<u8> {
         mesh.positions.len(),
         mesh.triangles.len()
     );
-    let mut out =
-        Vec::with_capacity(header.len() + 12 * mesh.positions.len() + 13 * mesh.triangles.len());
-    out.extend_from_slice(header.as_bytes());
-    for p in &mesh.positions {
+    put(header.as_bytes())?;
+    put_rows(&mesh.positions, put, |out, p| {
         for v in p.as_vec3().to_array() {
             out.extend_from_slice(&v.to_le_bytes());
         }
-    }
-    for t in &mesh.triangles {
+    })?;
+    put_rows(&mesh.triangles, put, |out, t| {
         out.push(3);
         for v in t {
             out.extend_from_slice(&(*v as i32).to_le_bytes());
         }
-    }
-    out
+    })
 }
 
-fn stl(mesh: &TriangleMesh) -> Vec<u8> {
-    let mut out = Vec::with_capacity(84 + 50 * mesh.triangles.len());
+fn stl(
+    mesh: &TriangleMesh,
+    put: &mut dyn FnMut(&[u8]) -> std::io::Result<()>,
+) -> std::io::Result<()> {
     let mut header = format!(
         "binary STL written by voxelkit {}",
         env!("CARGO_PKG_VERSION")
     )
     .into_bytes();
     header.resize(80, b' ');
-    out.extend_from_slice(&header);
-    out.extend_from_slice(&(mesh.triangles.len() as u32).to_le_bytes());
-    for t in &mesh.triangles {
+    header.extend_from_slice(&(mesh.triangles.len() as u32).to_le_bytes());
+    put(&header)?;
+    put_rows(&mesh.triangles, put, |out, t| {
         let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
         let normal = (b - a)
             .cross(c - a)
@@ -151,8 +174,7 @@ fn stl(mesh: &TriangleMesh) -> Vec<u8> {
             out.extend(point(mesh, i).iter().flat_map(|v| v.to_le_bytes()));
         }
         out.extend_from_slice(&0u16.to_le_bytes());
-    }
-    out
+    })
 }
 
 /// One buffer (positions, then indices), two accessors, one mesh, one node.
