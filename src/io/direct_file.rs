@@ -1,8 +1,8 @@
 //! Large outputs written around the page cache. Every file voxelkit writes is synced before
 //! it is renamed into place (`atomic`), so its bytes must reach the disk before the run ends
-//! anyway; copying them into the page cache first costs more CPU than compressing them (each
-//! megabyte of fresh page cache is about 2 ms on a virtual machine whose host reclaims free
-//! memory) and adds the file's size to the memory the run touches. Whole aligned blocks go
+//! anyway; copying them into the page cache first cost more CPU than compressing them on the
+//! virtual machine measured (about 2 ms per megabyte of fresh page cache) and adds the file's
+//! size to the memory the run touches. Whole aligned blocks go
 //! to the disk directly (`O_DIRECT`) from one reused buffer; a small file, the last partial
 //! block and later patches go through the page cache as usual, and so does everything where
 //! the file system refuses direct I/O (tmpfs, some network file systems).

@@ -463,11 +463,11 @@ impl Context<'_> {
                 Block::Near { low, high } => {
                     if self.settle_by_range(origin, 8, (low, high), k, &mut decided) {
                         let stack = bz.div_euclid(SPLIT_HEIGHT);
-                        let split = match split.take() {
-                            Some((at, s)) if at == stack => split.insert((at, s)),
-                            _ => split.insert((stack, self.split_around(bx, by, stack))),
-                        };
-                        self.resolve(&split.1, origin, 8, k, &mut decided);
+                        if split.as_ref().map(|s| s.0) != Some(stack) {
+                            split = Some((stack, self.split_around(bx, by, stack)));
+                        }
+                        let (_, around) = split.as_ref().expect("made for this stack");
+                        self.resolve(around, origin, 8, k, &mut decided);
                     }
                 }
             }

@@ -75,24 +75,6 @@ impl<const CLASSES: usize> BrickSink<'_, CLASSES> {
         }
     }
 
-    /// `add` for the voxels `first` with coordinate `axis` set to each of `ks` (all inside
-    /// the brick), `distance(k)` voxels from the primitive.
-    #[inline]
-    pub fn add_column(
-        &mut self,
-        first: Coord,
-        axis: usize,
-        ks: std::ops::RangeInclusive<i64>,
-        distance: impl Fn(i64) -> f64,
-        normal: DVec3,
-    ) {
-        let mut c = first;
-        for k in ks {
-            c[axis] = k;
-            self.add(c, || distance(k), normal);
-        }
-    }
-
     /// Whether the brick keeps only voxel bits: then `add_z_run` may mark them.
     pub fn bits_only(&self) -> bool {
         self.bits.distance.is_none() && self.bits.normal.is_none()

@@ -760,7 +760,11 @@ pub(super) fn face_body<const C: usize>(
                 // A cut column is exact to 1e-6 voxels, which moves a plane distance by less
                 // than 1e-12: the distance band needs no test per voxel.
                 let distance = plane_distance_along(n, a, column, w);
-                sink.add_column(to_coord(column), w, ks, distance, tri.normal);
+                let mut c = to_coord(column);
+                for k in ks {
+                    c[w] = k;
+                    sink.add(c, || distance(k), tri.normal);
+                }
                 continue;
             }
             for k in slab {
