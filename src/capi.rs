@@ -19,7 +19,7 @@ use crate::ops::csg::BooleanOp;
 use crate::pipeline::request::{
     CombineRequest, Directions, FillKind, FloodKind, ImplicitRequest, LimitsRequest, LinesRequest,
     MeasureRequest, MeshRequest, Placement, Request, Schema, SolidRequest, SubdivRequest,
-    SurfaceKind, WriteRequest,
+    SurfaceKind, ToMeshRequest, WriteRequest,
 };
 use crate::pipeline::to_mesh::check_mesh_output;
 use crate::pipeline::{Details, GridSource, Job, MeasureSource, MeshSource, Outcome, Task};
@@ -1228,7 +1228,9 @@ pub extern "C" fn vk_grid_to_mesh(grid: *const VkGrid, out: *mut *mut VkMesh) ->
     guard(|| {
         non_null_out(out)?;
         let g = borrow(grid, Kind::Grid)?;
-        let surface = g.outcome.surface_mesh()?;
+        let surface = g
+            .outcome
+            .surface_mesh(ToMeshRequest::default().adaptivity)?;
         let polygons: Vec<Vec<u32>> = surface.triangles.iter().map(|t| t.to_vec()).collect();
         let mut mesh = Mesh::from_polygons("vk_grid_to_mesh", surface.positions, &polygons);
         mesh.numbered_from_zero = true;
@@ -1241,7 +1243,9 @@ pub extern "C" fn vk_grid_write_mesh(grid: *const VkGrid, path: *const c_char) -
     guard(|| {
         let path = PathBuf::from(c_str(path, "path")?);
         check_mesh_output(&path, &[])?;
-        Ok(borrow(grid, Kind::Grid)?.outcome.save_mesh(&path)?)
+        Ok(borrow(grid, Kind::Grid)?
+            .outcome
+            .save_mesh(&path, ToMeshRequest::default().adaptivity)?)
     })
 }
 

@@ -10,7 +10,7 @@ mod common;
 use cli_support::{text, voxelkit};
 use glam::DVec3;
 use rustc_hash::FxHashMap;
-use voxelkit::contour::{Meaning, ScalarField, contour};
+use voxelkit::contour::{Meaning, ScalarField, TriangleMesh, contour, simplify};
 use voxelkit::grid::{Channels, Leaf, SparseGrid, Transform, leaf_offset, leaf_origin};
 use voxelkit::mesh::Mesh;
 use voxelkit::mesh::generate::icosphere;
@@ -404,6 +404,183 @@ fn shared_level_sets_give_closed_accurate_meshes() {
             );
         }
     }
+}
+
+fn corners_of(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[DVec3; 3]> {
+    triangles
+        .iter()
+        .map(|t| t.map(|i| positions[i as usize]))
+        .collect()
+}
+
+/// The two-sided distance, in voxels, between two meshes, over each one's probe points.
+fn mesh_distance(a: &TriangleMesh, b: &TriangleMesh, voxel: f64) -> (f64, f64) {
+    let tree_a = WindingTree::of_triangles(corners_of(&a.positions, &a.triangles));
+    let tree_b = WindingTree::of_triangles(corners_of(&b.positions, &b.triangles));
+    (
+        farthest(&probe_points(&a.positions, &a.triangles), &tree_b) / voxel,
+        farthest(&probe_points(&b.positions, &b.triangles), &tree_a) / voxel,
+    )
+}
+
+/// Checks a mesh merged from `full` at `adaptivity`: closed, manifold, free of flat triangles
+/// and self-intersections, outward, and within `adaptivity` of `full` both ways.
+fn assert_merged_within(
+    what: &str,
+    merged: &TriangleMesh,
+    full: &TriangleMesh,
+    adaptivity: f64,
+    voxel: f64,
+) {
+    let (positions, triangles) = (&merged.positions, &merged.triangles);
+    assert_closed_manifold(what, positions, triangles, 1e-9 * voxel * voxel);
+    assert_no_self_intersections(what, positions, triangles, voxel);
+    assert!(signed_volume(positions, triangles) > 0.0, "{what}: inward");
+    let (to_full, from_full) = mesh_distance(merged, full, voxel);
+    eprintln!(
+        "{what}: {} -> {} triangles, distance {to_full:.3} / {from_full:.3} voxels",
+        full.triangles.len(),
+        triangles.len()
+    );
+    assert!(
+        to_full <= adaptivity && from_full <= adaptivity,
+        "{what}: {to_full} / {from_full} voxels from the full mesh"
+    );
+}
+
+/// The triangles of `mesh` that face along an axis.
+fn on_faces(mesh: &TriangleMesh) -> usize {
+    corners_of(&mesh.positions, &mesh.triangles)
+        .iter()
+        .filter(|c| {
+            let n = (c[1] - c[0]).cross(c[2] - c[0]).normalize();
+            n.abs().max_element() > 0.99999
+        })
+        .count()
+}
+
+/// Merging flat regions: a box's faces fall to a few triangles, a sphere keeps its shape;
+/// every mesh stays closed, manifold, outward and free of self-intersections, and lies within
+/// the adaptivity of the mesh it was merged from, both ways.
+#[test]
+fn adaptivity_merges_flat_regions_within_its_bound() {
+    let centre = DVec3::splat(19.6);
+    let box_distance = |c: [i64; 3]| {
+        let q = (DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) - centre).abs()
+            - DVec3::new(12.2, 9.7, 7.4);
+        (q.max(DVec3::ZERO).length() + q.max_element().min(0.0)) as f32
+    };
+    let sphere = |c: [i64; 3]| {
+        ((DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) - centre).length() - 15.3) as f32
+    };
+    for (name, grid) in [
+        ("box", level_set(40, box_distance)),
+        ("sphere", level_set(40, sphere)),
+    ] {
+        let voxel = grid.transform.voxel_size;
+        let full = contour(&ScalarField::level_set(grid, 0.0).unwrap(), None).unwrap();
+        let full_volume = signed_volume(&full.positions, &full.triangles);
+        for adaptivity in [0.1, 0.25, 0.5] {
+            let mut merged = full.clone();
+            let done = simplify(&mut merged, adaptivity, voxel);
+            let what = format!("{name} at adaptivity {adaptivity}");
+            assert_eq!(done.triangles_before, full.triangles.len());
+            assert_merged_within(&what, &merged, &full, adaptivity, voxel);
+            let volume = signed_volume(&merged.positions, &merged.triangles);
+            assert!(
+                (volume / full_volume - 1.0).abs() < 0.01,
+                "{what}: volume {volume} against {full_volume}"
+            );
+            // The box's faces: a flat region merges into about as few triangles as its border
+            // allows (its edges, rounded by the values, are not flat).
+            if name == "box" {
+                let (before, after) = (on_faces(&full), on_faces(&merged));
+                assert!(
+                    after * 4 < before,
+                    "{what}: {after} of {before} triangles on the faces left"
+                );
+            }
+        }
+    }
+}
+
+/// `--adaptivity` on the shared closed meshes' level sets at 128: fewer triangles, still
+/// closed, manifold, outward and free of self-intersections, within the adaptivity of the
+/// full mesh both ways; a negative adaptivity is refused.
+#[test]
+fn to_mesh_adaptivity_on_the_shared_meshes() {
+    let Some(data) = common::data_dir() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let adaptivity = 0.25;
+    for name in common::CLOSED_MESHES {
+        let input = data.join("meshes").join(format!("{name}.obj"));
+        let p = |n: &str| {
+            dir.path()
+                .join(format!("{name}{n}"))
+                .to_str()
+                .unwrap()
+                .to_string()
+        };
+        let o = voxelkit(&[
+            "mesh",
+            input.to_str().unwrap(),
+            "--sdf",
+            "-r",
+            "128",
+            "-o",
+            &p(".vdb"),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        let o = voxelkit(&["to-mesh", &p(".vdb"), "-o", &p("-full.ply")]);
+        assert!(o.status.success(), "{}", text(&o));
+        let o = voxelkit(&[
+            "to-mesh",
+            &p(".vdb"),
+            "-o",
+            &p("-merged.ply"),
+            "--adaptivity",
+            &adaptivity.to_string(),
+            "--json",
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let load = |n: &str| {
+            let m = Mesh::load(std::path::Path::new(&p(n))).unwrap();
+            TriangleMesh {
+                triangles: triangles_of(&m),
+                positions: m.positions,
+            }
+        };
+        let (full, merged) = (load("-full.ply"), load("-merged.ply"));
+        assert_eq!(report["triangles"], merged.triangles.len() as u64);
+        assert_eq!(
+            report["triangles_before_merging"],
+            full.triangles.len() as u64
+        );
+        let voxel = Mesh::load(&input).unwrap().bbox().extent().max_element() / 128.0;
+        let what = format!("{name} at 128, adaptivity {adaptivity}");
+        assert_merged_within(&what, &merged, &full, adaptivity, voxel);
+        assert!(
+            merged.triangles.len() * 3 < full.triangles.len() * 2,
+            "{what}: little merged"
+        );
+    }
+    let o = voxelkit(&[
+        "to-mesh",
+        dir.path().join("fandisk.vdb").to_str().unwrap(),
+        "-o",
+        dir.path().join("x.ply").to_str().unwrap(),
+        "--adaptivity=-1",
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o).contains("adaptivity must be 0 or a positive number of voxels, not -1"),
+        "{}",
+        text(&o)
+    );
+    assert!(!dir.path().join("x.ply").exists());
 }
 
 /// Every format reads back as the same mesh; a fog volume and a voxel set give meshes too;

@@ -294,3 +294,22 @@ def test_to_mesh_gives_a_closed_mesh_trimesh_takes(trimesh, tmp_path):
     back = trimesh.load(tmp_path / "torus.ply", process=False)
     assert len(back.faces) == len(triangles)
     assert np.allclose(back.vertices, vertices, atol=1e-6)
+
+
+def test_to_mesh_adaptivity_merges_flat_regions(trimesh, tmp_path):
+    """adaptivity (voxels) leaves fewer triangles, still watertight and of the same volume;
+    write() of a mesh takes it too and refuses a file's grid options."""
+    box = trimesh.creation.box(extents=(1.0, 0.8, 0.6))
+    grid = voxelkit.mesh(box, sdf=True, resolution=64)
+    full = trimesh.Trimesh(*grid.to_mesh(), process=False)
+    merged = trimesh.Trimesh(*grid.to_mesh(adaptivity=0.5), process=False)
+    assert merged.is_watertight and merged.is_winding_consistent
+    assert len(merged.faces) * 3 < len(full.faces)
+    assert abs(merged.volume / full.volume - 1) < 0.002
+    grid.write(tmp_path / "box.ply", adaptivity=0.5)
+    back = trimesh.load(tmp_path / "box.ply", process=False)
+    assert len(back.faces) == len(merged.faces)
+    with pytest.raises(ValueError, match="adaptivity must be 0 or a positive number"):
+        grid.to_mesh(adaptivity=-1)
+    with pytest.raises(ValueError, match="a result's mesh takes adaptivity"):
+        grid.write(tmp_path / "iso.ply", iso=0.1)

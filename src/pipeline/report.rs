@@ -11,12 +11,33 @@ pub struct MeshWritten {
     pub file: String,
     pub vertices: u64,
     pub triangles: u64,
+    /// With adaptivity: the triangles before flat regions were merged, and the bound (voxels).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub triangles_before_merging: Option<u64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adaptivity: Option<f64>,
     /// Remeshing: the largest distance from the mesh to its source and from the source to
     /// it (world units).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub distance_to_source: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub source_to_mesh: Option<f64>,
+}
+
+impl MeshWritten {
+    /// The file and its counts, and what merging flat regions left of the triangles.
+    pub fn describe(&self) -> String {
+        let merged = match (self.triangles_before_merging, self.adaptivity) {
+            (Some(before), Some(a)) => {
+                format!("; {before} before flat regions were merged within {a} voxels")
+            }
+            _ => String::new(),
+        };
+        format!(
+            "{} ({} vertices, {} triangles, closed and manifold{merged})",
+            self.file, self.vertices, self.triangles
+        )
+    }
 }
 
 /// The report of one job. Every number is a number; `seconds` is the whole run.
@@ -489,10 +510,7 @@ impl Report {
             text.push_str(&format!("\npreview: {p}"));
         }
         if let Some(m) = &self.mesh {
-            text.push_str(&format!(
-                "\nmesh: {} ({} vertices, {} triangles, closed and manifold)",
-                m.file, m.vertices, m.triangles
-            ));
+            text.push_str(&format!("\nmesh: {}", m.describe()));
             if let (Some(to), Some(from)) = (m.distance_to_source, m.source_to_mesh) {
                 text.push_str(&format!(
                     "\n  two-sided distance to the input: mesh to input {to:.6} ({:.3} voxels), \

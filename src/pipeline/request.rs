@@ -562,6 +562,10 @@ request! {
         /// The value the surface passes through (none: 0 for a level set, 0.5 for a fog
         /// volume; a voxel set takes none).
         iso: Option<f64> = None,
+        /// Merge the triangles of flat regions, moving the surface by at most about this many
+        /// voxels: every vertex stays within half of it of the plane of each triangle it
+        /// replaces (0: every cell keeps its vertex).
+        adaptivity: f64 = 0.0,
     }
 }
 

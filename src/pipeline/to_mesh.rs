@@ -4,7 +4,7 @@
 use super::Outcome;
 use super::request::ToMeshRequest;
 use super::{Limits, MeshWritten, on_threads};
-use crate::contour::{ExactSurface, Meaning, ScalarField, TriangleMesh, contour};
+use crate::contour::{ExactSurface, Meaning, ScalarField, TriangleMesh, contour, simplify};
 use crate::error::{Error, Result};
 use crate::io::atomic::check_output;
 use crate::io::mesh_out::{MeshFormat, write_mesh};
@@ -36,11 +36,8 @@ pub struct MeshReport {
 impl MeshReport {
     pub fn summary(&self) -> String {
         format!(
-            "{}: {} vertices, {} triangles (closed, manifold) from the {} of {} at iso {}\n\
-             {:.2} s, peak {:.0} MiB: {}",
-            self.mesh.file,
-            self.mesh.vertices,
-            self.mesh.triangles,
+            "{} from the {} of {} at iso {}\n{:.2} s, peak {:.0} MiB: {}",
+            self.mesh.describe(),
             self.meaning,
             self.input.display(),
             self.iso,
@@ -64,12 +61,14 @@ pub fn vdb_to_mesh(
     limits: &Limits,
 ) -> Result<MeshReport> {
     MeshFormat::of(output)?;
+    check_adaptivity(request.adaptivity)?;
     check_output(output, &[input])?;
     let start = std::time::Instant::now();
     on_threads(limits.threads, || {
         let mut read = StageClock::new("read");
         let field = read.time(|| read_vdb_field(input, request.grid.as_deref(), request.iso))?;
-        let (_, mesh, mut stages) = contour_to_file(&field, None, output, input)?;
+        let (_, mesh, mut stages) =
+            contour_to_file(&field, None, request.adaptivity, output, input)?;
         stages.insert(0, read.stage());
         Ok(MeshReport {
             input: input.to_path_buf(),
@@ -85,6 +84,17 @@ pub fn vdb_to_mesh(
             peak_mib: crate::system::peak_memory_mib(),
         })
     })
+}
+
+/// Refuses an adaptivity that is not a finite number of voxels, 0 or more.
+pub fn check_adaptivity(adaptivity: f64) -> Result<()> {
+    if adaptivity.is_finite() && adaptivity >= 0.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidArgument(format!(
+            "adaptivity must be 0 or a positive number of voxels, not {adaptivity}"
+        )))
+    }
 }
 
 /// Checks before a job runs that its mesh can be written to `output`.
@@ -116,43 +126,55 @@ impl Outcome {
 
     /// The surface of the result as a closed, manifold triangle mesh (empty when the
     /// result is).
-    pub fn surface_mesh(&self) -> Result<TriangleMesh> {
+    pub fn surface_mesh(&self, adaptivity: f64) -> Result<TriangleMesh> {
+        check_adaptivity(adaptivity)?;
         let field = self.field()?;
-        on_threads(self.threads, || contour(&field, self.exact.as_deref()))
+        on_threads(self.threads, || {
+            let mut mesh = contour(&field, self.exact.as_deref())?;
+            simplify(&mut mesh, adaptivity, field.grid.transform.voxel_size);
+            Ok(mesh)
+        })
     }
 
-    /// Writes the surface of the result to `output` (.obj, .ply, .stl or .glb), noted in the
-    /// report.
-    pub fn write_mesh(&mut self, output: &Path) -> Result<()> {
-        self.write_mesh_of(output, None)
+    /// Writes the surface of the result to `output` (.obj, .ply, .stl or .glb), flat regions
+    /// merged within `adaptivity` voxels, noted in the report.
+    pub fn write_mesh(&mut self, output: &Path, adaptivity: f64) -> Result<()> {
+        self.write_mesh_of(output, adaptivity, None)
     }
 
     /// Writes the surface as `write_mesh` does, and measures how far it lies from `source`,
     /// the mesh the result was made of: a mesh remade closed and manifold.
-    pub fn write_remesh(&mut self, output: &Path, source: &Mesh) -> Result<()> {
-        self.write_mesh_of(output, Some(source))
+    pub fn write_remesh(&mut self, output: &Path, adaptivity: f64, source: &Mesh) -> Result<()> {
+        self.write_mesh_of(output, adaptivity, Some(source))
     }
 
     /// Writes the surface of the result to `output` as `write_mesh` does, without noting it
     /// in the report (the result is only borrowed, as the C interface holds it).
-    pub fn save_mesh(&self, output: &Path) -> Result<()> {
-        self.contour_and_write(output).map(|_| ())
+    pub fn save_mesh(&self, output: &Path, adaptivity: f64) -> Result<()> {
+        self.contour_and_write(output, adaptivity).map(|_| ())
     }
 
     /// The surface contoured (placed by the exact source where there is one) and written.
     fn contour_and_write(
         &self,
         output: &Path,
+        adaptivity: f64,
     ) -> Result<(TriangleMesh, MeshWritten, Vec<StageTime>)> {
+        check_adaptivity(adaptivity)?;
         let field = self.field()?;
         let input = PathBuf::from(&self.report.input);
         on_threads(self.threads, || {
-            contour_to_file(&field, self.exact.as_deref(), output, &input)
+            contour_to_file(&field, self.exact.as_deref(), adaptivity, output, &input)
         })
     }
 
-    fn write_mesh_of(&mut self, output: &Path, source: Option<&Mesh>) -> Result<()> {
-        let (mesh, mut written, mut stages) = self.contour_and_write(output)?;
+    fn write_mesh_of(
+        &mut self,
+        output: &Path,
+        adaptivity: f64,
+        source: Option<&Mesh>,
+    ) -> Result<()> {
+        let (mesh, mut written, mut stages) = self.contour_and_write(output, adaptivity)?;
         if let Some(source) = source {
             let mut measure = StageClock::new("distance to input");
             let distance = measure.time(|| {
@@ -180,16 +202,18 @@ impl Outcome {
     }
 }
 
-/// Contours `field` (placed by `exact` where it knows the source) and writes the mesh to
-/// `output`; refuses a field without a surface, naming `source`.
+/// Contours `field` (placed by `exact` where it knows the source), merges flat regions within
+/// `adaptivity` voxels and writes the mesh to `output`; refuses a field without a surface,
+/// naming `source`.
 fn contour_to_file(
     field: &ScalarField,
     exact: Option<&dyn ExactSurface>,
+    adaptivity: f64,
     output: &Path,
     source: &Path,
 ) -> Result<(TriangleMesh, MeshWritten, Vec<StageTime>)> {
     let mut contouring = StageClock::new("contour");
-    let mesh = contouring.time(|| contour(field, exact))?;
+    let mut mesh = contouring.time(|| contour(field, exact))?;
     if mesh.triangles.is_empty() {
         return Err(Error::InvalidArgument(format!(
             "{}: the grid has no surface at iso {} (its values never cross it)",
@@ -197,13 +221,25 @@ fn contour_to_file(
             field.iso
         )));
     }
+    let mut stages = vec![contouring.stage()];
+    let mut merged = None;
+    if adaptivity > 0.0 {
+        let mut merging = StageClock::new("merge flat regions");
+        let simplified =
+            merging.time(|| simplify(&mut mesh, adaptivity, field.grid.transform.voxel_size));
+        merged = Some(simplified.triangles_before as u64);
+        stages.push(merging.stage());
+    }
     let mut writing = StageClock::new("write mesh");
     writing.time(|| write_mesh(output, &mesh))?;
     let written = MeshWritten {
         file: output.display().to_string(),
         vertices: mesh.positions.len() as u64,
         triangles: mesh.triangles.len() as u64,
+        triangles_before_merging: merged,
+        adaptivity: merged.map(|_| adaptivity),
         ..MeshWritten::default()
     };
-    Ok((mesh, written, vec![contouring.stage(), writing.stage()]))
+    stages.push(writing.stage());
+    Ok((mesh, written, stages))
 }

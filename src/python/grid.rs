@@ -11,7 +11,7 @@ use crate::io::mesh_out::MeshFormat;
 use crate::mesh::UpAxis;
 use crate::mesh::attributes::{AttributeGrid, AttributeKind};
 use crate::pipeline::Outcome;
-use crate::pipeline::request::WriteRequest;
+use crate::pipeline::request::{ToMeshRequest, WriteRequest};
 use crate::pipeline::to_mesh::check_mesh_output;
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArrayLike2};
@@ -388,7 +388,7 @@ impl Grid {
     /// names: `density`, `voxels`, `normal`, `Cd`, `shell`, ...), `.nvdb` (the same grids
     /// for NanoVDB), `.binvox` or `.vox`; or its surface as a mesh (`to_mesh`'s): `.obj`,
     /// `.ply`, `.stl` or `.glb`; atomically, never over an input of the job. The keywords are `OPTIONS["write"]`'s:
-    /// `grids`, `compression` (blosc, zip or none) and `half`.
+    /// `grids`, `compression` (blosc, zip or none) and `half`; for a mesh, `adaptivity`.
     #[pyo3(signature = (path, **options))]
     fn write(
         &mut self,
@@ -396,31 +396,46 @@ impl Grid {
         path: PathBuf,
         options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<()> {
-        let options = Keywords::<WriteRequest>::new(options)?.request.options();
         let inputs: Vec<&std::path::Path> = self.inputs.iter().map(PathBuf::as_path).collect();
         let outcome = &mut self.outcome;
-        py.detach(|| {
-            if MeshFormat::of(&path).is_ok() {
-                check_mesh_output(&path, &inputs)?;
-                return outcome.write_mesh(&path);
+        if MeshFormat::of(&path).is_ok() {
+            let request = Keywords::<ToMeshRequest>::new(options)?.request;
+            if request.grid.is_some() || request.iso.is_some() {
+                return Err(PyValueError::new_err(
+                    "grid and iso choose a .vdb file's grid: a result's mesh takes adaptivity",
+                ));
             }
-            outcome.write(&path, &inputs, &options)
-        })
-        .map_err(to_py_err)
+            return py
+                .detach(|| {
+                    check_mesh_output(&path, &inputs)?;
+                    outcome.write_mesh(&path, request.adaptivity)
+                })
+                .map_err(to_py_err);
+        }
+        let options = Keywords::<WriteRequest>::new(options)?.request.options();
+        py.detach(|| outcome.write(&path, &inputs, &options))
+            .map_err(to_py_err)
     }
 
     /// The surface as a closed, manifold triangle mesh, counter-clockwise seen from outside:
     /// `(vertices, triangles)`, an (n, 3) float64 array of world positions and an (m, 3)
     /// int64 array of vertex rows. A level set's zero set (sdf), a formula's F < 0 within its
     /// bounds, a solid's or a voxel surface's boundary, half way between its voxels and empty
-    /// ones.
+    /// ones. `adaptivity` (voxels, `OPTIONS["to_mesh"]`'s) merges flat regions, moving the surface
+    /// by at most about that much: every vertex stays within half of it of the plane of each
+    /// triangle it replaces.
     #[allow(clippy::type_complexity)]
+    #[pyo3(signature = (adaptivity = None))]
     fn to_mesh<'py>(
         &self,
         py: Python<'py>,
+        adaptivity: Option<f64>,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>)> {
         let outcome = &self.outcome;
-        let mesh = py.detach(|| outcome.surface_mesh()).map_err(to_py_err)?;
+        let adaptivity = adaptivity.unwrap_or(ToMeshRequest::default().adaptivity);
+        let mesh = py
+            .detach(|| outcome.surface_mesh(adaptivity))
+            .map_err(to_py_err)?;
         let vertices: Vec<f64> = mesh.positions.iter().flat_map(|p| p.to_array()).collect();
         let triangles: Vec<i64> = mesh
             .triangles

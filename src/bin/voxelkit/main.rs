@@ -14,7 +14,9 @@ mod to_mesh;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use voxelkit::pipeline::request::{LimitsRequest, MeshRequest, SurfaceKind, WriteRequest};
+use voxelkit::pipeline::request::{
+    LimitsRequest, MeshRequest, SurfaceKind, ToMeshRequest, WriteRequest,
+};
 use voxelkit::voxelize::Separability;
 use voxelkit::voxelize::separating::Criterion;
 
@@ -82,6 +84,9 @@ pub struct WriteArgs {
     /// solid's or a voxel surface's boundary (sharp where the source is known exactly).
     #[arg(long, value_name = "MESH")]
     pub mesh_out: Option<PathBuf>,
+    /// With --mesh-out: how far merging its flat regions may move it.
+    #[command(flatten)]
+    pub adaptivity: to_mesh::AdaptivityArgs,
 }
 
 /// The up axis of input mesh files: an option of the commands that read meshes.
@@ -305,6 +310,9 @@ fn main() -> ExitCode {
         json: cli.json,
         preview: write.is_some_and(|w| w.preview),
         mesh_out: write.and_then(|w| w.mesh_out.clone()),
+        mesh_adaptivity: write.map_or(ToMeshRequest::default().adaptivity, |w| {
+            w.adaptivity.adaptivity
+        }),
         write: write.map_or_else(Default::default, |w| voxelkit::io::vdb::WriteOptions {
             grids: w.grids.clone(),
             compression: w.compression,

@@ -10,7 +10,7 @@ use std::time::Instant;
 use voxelkit::Result;
 use voxelkit::io::vdb::{WriteOptions, check_voxel_size};
 use voxelkit::pipeline::request::LimitsRequest;
-use voxelkit::pipeline::to_mesh::check_mesh_output;
+use voxelkit::pipeline::to_mesh::{check_adaptivity, check_mesh_output};
 use voxelkit::pipeline::{Job, Limits, Outcome, PlannedJob, check_output_path};
 use voxelkit::progress::Observer;
 
@@ -25,6 +25,8 @@ pub struct Global {
     pub preview: bool,
     /// Also write the result's surface as a mesh (`--mesh-out`).
     pub mesh_out: Option<std::path::PathBuf>,
+    /// How far merging the mesh's flat regions may move it, in voxels (`--adaptivity`).
+    pub mesh_adaptivity: f64,
 }
 
 impl Global {
@@ -100,6 +102,7 @@ pub fn plan_job(
         if let Some(mesh) = &global.mesh_out {
             inputs.push(out);
             check_mesh_output(mesh, &inputs)?;
+            check_adaptivity(global.mesh_adaptivity)?;
         }
     }
     Ok(planned)
@@ -125,7 +128,7 @@ pub fn finish_job(
             outcome.report.preview = Some(png.display().to_string());
         }
         if let Some(mesh) = &global.mesh_out {
-            outcome.write_mesh(mesh)?;
+            outcome.write_mesh(mesh, global.mesh_adaptivity)?;
         }
     }
     outcome.report.finish(start);

@@ -6,7 +6,7 @@ use clap::Args;
 use std::path::PathBuf;
 use voxelkit::Result;
 use voxelkit::pipeline::request::{MeshRequest, Request, ToMeshRequest};
-use voxelkit::pipeline::to_mesh::{check_mesh_output, vdb_to_mesh};
+use voxelkit::pipeline::to_mesh::{check_adaptivity, check_mesh_output, vdb_to_mesh};
 use voxelkit::pipeline::{Job, MeshSource};
 
 #[derive(Args)]
@@ -24,12 +24,26 @@ pub struct ToMeshArgs {
     /// volume; a voxel set's surface lies half way between its voxels and empty ones].
     #[arg(long, allow_hyphen_values = true, value_name = "V")]
     pub iso: Option<f64>,
+    #[command(flatten)]
+    pub adaptivity: AdaptivityArgs,
+}
+
+/// How far merging flat regions may move a mesh written: an option of every command that
+/// writes one.
+#[derive(Args, Clone, Copy)]
+pub struct AdaptivityArgs {
+    /// Merge the triangles of flat regions, moving the surface by at most about this many
+    /// voxels: every vertex stays within half of it of the plane of each triangle it replaces
+    /// (0: every cell keeps its vertex; 0.25 leaves about a third of a smooth mesh's triangles).
+    #[arg(long, default_value_t = ToMeshRequest::default().adaptivity, value_name = "VOXELS")]
+    pub adaptivity: f64,
 }
 
 pub fn run(args: &ToMeshArgs, global: &Global) -> Result<()> {
     let request = ToMeshRequest {
         grid: args.grid.clone(),
         iso: args.iso,
+        adaptivity: args.adaptivity.adaptivity,
     };
     let report = vdb_to_mesh(&args.input, &args.output, &request, &global.limits())?;
     if global.json {
@@ -54,6 +68,8 @@ pub struct RemeshArgs {
     pub inside: crate::solids::InsideArgs,
     #[command(flatten)]
     pub up: crate::UpAxisArgs,
+    #[command(flatten)]
+    pub adaptivity: AdaptivityArgs,
 }
 
 /// The mesh's level set on the grid, signed by the inside rule, drawn as a mesh, and its
@@ -66,10 +82,11 @@ pub fn remesh(args: &RemeshArgs, global: &Global) -> Result<()> {
         ..MeshRequest::default()
     };
     check_mesh_output(&args.output, &[&args.input])?;
+    check_adaptivity(args.adaptivity.adaptivity)?;
     let mesh = source.load(false, global.up_axis)?;
     let job = Job::new(request.task(source)?, args.fit.grid_fit()?);
     let mut outcome = run_job(job, None, global)?;
-    outcome.write_remesh(&args.output, &mesh)?;
+    outcome.write_remesh(&args.output, args.adaptivity.adaptivity, &mesh)?;
     println!(
         "{}",
         if global.json {
