@@ -506,7 +506,7 @@ fn adaptivity_merges_flat_regions_within_its_bound() {
 
 /// `--adaptivity` on the shared closed meshes' level sets at 128: fewer triangles, still
 /// closed, manifold, outward and free of self-intersections, within the adaptivity of the
-/// full mesh both ways; a negative adaptivity is refused.
+/// full mesh both ways, the same at any number of threads; a negative adaptivity is refused.
 #[test]
 fn to_mesh_adaptivity_on_the_shared_meshes() {
     let Some(data) = common::data_dir() else {
@@ -554,6 +554,24 @@ fn to_mesh_adaptivity_on_the_shared_meshes() {
             }
         };
         let (full, merged) = (load("-full.ply"), load("-merged.ply"));
+        // The cubes of space the threads share out decide, not the threads: one thread
+        // writes the same bytes.
+        let o = voxelkit(&[
+            "to-mesh",
+            &p(".vdb"),
+            "-o",
+            &p("-one-thread.ply"),
+            "--adaptivity",
+            &adaptivity.to_string(),
+            "--threads",
+            "1",
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        assert_eq!(
+            std::fs::read(p("-merged.ply")).unwrap(),
+            std::fs::read(p("-one-thread.ply")).unwrap(),
+            "{name}: one thread merged otherwise"
+        );
         assert_eq!(report["triangles"], merged.triangles.len() as u64);
         assert_eq!(
             report["triangles_before_merging"],

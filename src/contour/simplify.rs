@@ -9,11 +9,18 @@
 //!
 //! The mesh is held as half-edges: half-edge `3t + i` runs from corner `i` of triangle `t` to
 //! corner `i + 1`, and `twin` names the half-edge running the other way.
+//!
+//! Each sweep hands every vertex to the cube of space (`CELL` voxels) it started in, and the
+//! cubes run on all threads at once: a collapse is made only where every vertex around both
+//! ends belongs to the cube making it, so no two threads ever touch one triangle or vertex.
+//! Alternate sweeps shift the cubes by half, so that the edges along one sweep's cube faces
+//! lie inside the next sweep's cubes. The result does not depend on the number of threads.
 
 use super::extract::TriangleMesh;
 use crate::mesh::triangle_distance::triangle_distance_squared;
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
+use std::cell::UnsafeCell;
 
 /// The cosine of the largest turn a collapse may give a triangle's normal (about 37 degrees).
 const MAX_TURN: f64 = 0.8;
@@ -27,6 +34,8 @@ const FAN_SIDE: f64 = 0.2;
 const MAX_VALENCE: usize = 16;
 /// Sweeps over the mesh at most: each takes about a third of what is left where all is flat.
 const MAX_SWEEPS: u32 = 40;
+/// The edge of the cubes of space that sweeps hand out to threads, in voxels.
+const CELL: f64 = 32.0;
 /// A triangle removed by a collapse.
 const GONE: u32 = u32::MAX;
 
@@ -53,14 +62,37 @@ pub fn simplify(mesh: &mut TriangleMesh, adaptivity: f64, voxel_size: f64) -> Si
             collapses: 0,
         };
     }
-    let mut state = Collapser::new(std::mem::take(mesh), tolerance);
+    let cubes = [0.0, 0.5].map(|shift| Cubes::of(&mesh.positions, CELL * voxel_size, shift));
+    let state = Collapser::new(std::mem::take(mesh), tolerance);
     let mut collapses = 0;
-    // Each sweep collapses edges whose neighbourhoods do not overlap, so the mesh coarsens
-    // evenly instead of around whichever vertex the scan meets first.
+    // The vertices whose surroundings changed since they last found no edge to collapse.
+    let mut pending: Vec<u32> = (0..state.leaving.0.len() as u32).collect();
+    let mut idle = 0;
     for sweep in 1..=MAX_SWEEPS {
-        let made = state.sweep(sweep);
+        if pending.is_empty() {
+            break;
+        }
+        let cubes = &cubes[sweep as usize % 2];
+        // Each vertex once, keyed by its cube in the high half, grouped by cube.
+        let mut keyed: Vec<u64> = pending
+            .par_iter()
+            .map(|&v| (cubes.owner[v as usize] as u64) << 32 | v as u64)
+            .collect();
+        keyed.par_sort_unstable();
+        keyed.dedup();
+        let runs: Vec<&[u64]> = keyed.chunk_by(|a, b| a >> 32 == b >> 32).collect();
+        let swept: Vec<(usize, Vec<u32>)> = runs
+            .into_par_iter()
+            .map_init(Rings::default, |rings, run| {
+                state.sweep_cube(run, cubes, sweep, rings)
+            })
+            .collect();
+        let made: usize = swept.iter().map(|s| s.0).sum();
         collapses += made;
-        if made == 0 {
+        pending = swept.into_iter().flat_map(|s| s.1).collect();
+        // Both placements of the cubes found nothing more.
+        idle = if made == 0 { idle + 1 } else { 0 };
+        if idle == 2 {
             break;
         }
     }
@@ -68,6 +100,28 @@ pub fn simplify(mesh: &mut TriangleMesh, adaptivity: f64, voxel_size: f64) -> Si
     Simplified {
         triangles_before: before,
         collapses,
+    }
+}
+
+/// The cube of space each vertex lies in.
+struct Cubes {
+    owner: Vec<u32>,
+}
+
+impl Cubes {
+    /// Cubes of `edge` world units, their corners shifted by `shift` of an edge.
+    fn of(positions: &[DVec3], edge: f64, shift: f64) -> Cubes {
+        let lo = positions.iter().fold(DVec3::INFINITY, |a, p| a.min(*p)) - shift * edge;
+        let hi = positions.iter().fold(DVec3::NEG_INFINITY, |a, p| a.max(*p));
+        let dims = ((hi - lo) / edge).floor().as_uvec3() + 1;
+        let owner = positions
+            .par_iter()
+            .map(|p| {
+                let c = ((*p - lo) / edge).floor().as_uvec3().min(dims - 1);
+                (c.x * dims.y + c.y) * dims.z + c.z
+            })
+            .collect();
+        Cubes { owner }
     }
 }
 
@@ -135,19 +189,66 @@ impl Quadric {
     }
 }
 
+/// Values that several threads read and write at once, each only the elements it owns.
+///
+/// Safety: during a sweep, the thread sweeping cube `k` reads and writes the vertices `k`
+/// owns and the triangles (corners, twins) around them; it writes a triangle only when all its
+/// corners are `k`'s, and reads a vertex's values only once it has seen that `k` owns it. A
+/// triangle around a vertex of `k` has a corner of `k`, so no other thread writes it; no two
+/// threads ever touch one element but to read it.
+struct Shared<T>(Vec<UnsafeCell<T>>);
+
+unsafe impl<T: Send> Sync for Shared<T> {}
+
+impl<T: Copy> Shared<T> {
+    fn new(values: Vec<T>) -> Shared<T> {
+        Shared(values.into_iter().map(UnsafeCell::new).collect())
+    }
+
+    fn get(&self, i: usize) -> T {
+        // SAFETY: see the type's note: no other thread writes element `i` meanwhile.
+        unsafe { *self.0[i].get() }
+    }
+
+    fn set(&self, i: usize, value: T) {
+        // SAFETY: see the type's note: this thread alone touches element `i` meanwhile.
+        unsafe { *self.0[i].get() = value }
+    }
+
+    fn into_inner(self) -> Vec<T> {
+        self.0.into_iter().map(UnsafeCell::into_inner).collect()
+    }
+}
+
 struct Collapser {
-    positions: Vec<DVec3>,
-    corners: Vec<[u32; 3]>,
-    twin: Vec<u32>,
-    /// A half-edge leaving each vertex.
-    leaving: Vec<u32>,
-    quadrics: Vec<Quadric>,
+    positions: Shared<DVec3>,
+    corners: Shared<[u32; 3]>,
+    twin: Shared<u32>,
+    /// A half-edge leaving each vertex (`GONE` once the vertex is merged away).
+    leaving: Shared<u32>,
+    quadrics: Shared<Quadric>,
     /// The last sweep whose collapse moved a vertex or one of its neighbours.
-    touched: Vec<u32>,
+    touched: Shared<u32>,
     /// How far the collapses that made each vertex moved the surface around it, summed.
-    moved: Vec<f64>,
+    moved: Shared<f64>,
     /// The most a vertex may move, by its planes and by its collapses.
     tolerance: f64,
+}
+
+/// What came of trying an edge.
+enum Collapse {
+    Made,
+    /// It would break a bound or the mesh.
+    Refused,
+    /// Vertices around it belong to another cube this sweep.
+    Untried,
+}
+
+/// The half-edges leaving the two ends of an edge, reused from vertex to vertex.
+#[derive(Default)]
+struct Rings {
+    u: Vec<u32>,
+    v: Vec<u32>,
 }
 
 fn next(h: u32) -> u32 {
@@ -199,58 +300,68 @@ impl Collapser {
                 fill[v as usize] += 1;
             }
         }
+        drop(fill);
         let head = |h: u32| corners[h as usize / 3][(h as usize % 3 + 1) % 3];
         let tail = |h: u32| corners[h as usize / 3][h as usize % 3];
+        let around =
+            |v: u32| &leaving_all[start[v as usize] as usize..start[v as usize + 1] as usize];
         let twin: Vec<u32> = (0..corners.len() as u32 * 3)
             .into_par_iter()
             .map(|h| {
                 let (from, to) = (tail(h), head(h));
-                let around =
-                    &leaving_all[start[to as usize] as usize..start[to as usize + 1] as usize];
-                *around
+                *around(to)
                     .iter()
                     .find(|&&o| head(o) == from)
                     .expect("a closed mesh: every edge has its reverse")
             })
             .collect();
-        let leaving: Vec<u32> = (0..n).map(|v| leaving_all[start[v] as usize]).collect();
+        let plane = |t: u32| {
+            let p = corners[t as usize].map(|v| positions[v as usize]);
+            Quadric::plane(normal(p).normalize_or_zero(), p[0])
+        };
+        let (leaving, quadrics): (Vec<u32>, Vec<Quadric>) = (0..n as u32)
+            .into_par_iter()
+            .map(|v| {
+                let mut q = Quadric::default();
+                for &h in around(v) {
+                    q.add(&plane(h / 3));
+                }
+                (around(v)[0], q)
+            })
+            .unzip();
         drop(leaving_all);
-        let mut quadrics = vec![Quadric::default(); n];
-        for c in &corners {
-            let p = c.map(|v| positions[v as usize]);
-            let q = Quadric::plane(normal(p).normalize_or_zero(), p[0]);
-            for &v in c {
-                quadrics[v as usize].add(&q);
-            }
-        }
         Collapser {
-            positions,
-            corners,
-            twin,
-            leaving,
-            quadrics,
-            touched: vec![0; n],
-            moved: vec![0.0; n],
+            positions: Shared::new(positions),
+            corners: Shared::new(corners),
+            twin: Shared::new(twin),
+            leaving: Shared::new(leaving),
+            quadrics: Shared::new(quadrics),
+            touched: Shared::new(vec![0; n]),
+            moved: Shared::new(vec![0.0; n]),
             tolerance,
         }
     }
 
     fn tail(&self, h: u32) -> u32 {
-        self.corners[h as usize / 3][h as usize % 3]
+        self.corners.get(h as usize / 3)[h as usize % 3]
     }
 
     fn head(&self, h: u32) -> u32 {
         self.tail(next(h))
     }
 
+    fn position(&self, v: u32) -> DVec3 {
+        self.positions.get(v as usize)
+    }
+
     /// The half-edges leaving `v`, in turn around it.
     fn ring(&self, v: u32, out: &mut Vec<u32>) {
         out.clear();
-        let first = self.leaving[v as usize];
+        let first = self.leaving.get(v as usize);
         let mut h = first;
         loop {
             out.push(h);
-            h = self.twin[prev(h) as usize];
+            h = self.twin.get(prev(h) as usize);
             // A ring this long can merge with no other: it need not be walked further.
             if h == first || out.len() > MAX_VALENCE + 1 {
                 break;
@@ -258,42 +369,75 @@ impl Collapser {
         }
     }
 
-    /// One sweep over every edge, collapsing those within the tolerance whose ends no other
-    /// collapse of this sweep has touched; returns how many.
-    fn sweep(&mut self, sweep: u32) -> usize {
-        let (mut ring_u, mut ring_v) = (Vec::new(), Vec::new());
+    /// Sweeps `vertices` (keyed by their cube, all one): collapses into each the first edge around it that
+    /// stays within the tolerance, where no other collapse of this sweep has touched either
+    /// end. Returns how many it made, and the vertices to sweep again: those around each
+    /// collapse and those with an edge this sweep could not try.
+    fn sweep_cube(
+        &self,
+        vertices: &[u64],
+        cubes: &Cubes,
+        sweep: u32,
+        rings: &mut Rings,
+    ) -> (usize, Vec<u32>) {
+        let k = (vertices[0] >> 32) as u32;
         let mut made = 0;
-        for h in 0..self.corners.len() as u32 * 3 {
-            if self.corners[h as usize / 3][0] == GONE || self.twin[h as usize] < h {
+        let mut again = Vec::new();
+        for u in vertices.iter().map(|&key| key as u32) {
+            if self.leaving.get(u as usize) == GONE {
                 continue;
             }
-            let (u, v) = (self.tail(h), self.head(h));
-            if self.touched[u as usize] == sweep || self.touched[v as usize] == sweep {
+            if self.touched.get(u as usize) == sweep {
+                again.push(u);
                 continue;
             }
-            if self.try_collapse(h, &mut ring_u, &mut ring_v) {
-                for &o in ring_u.iter().chain(&ring_v) {
-                    if self.corners[o as usize / 3][0] != GONE {
-                        let w = self.head(o);
-                        self.touched[w as usize] = sweep;
-                    }
+            self.ring(u, &mut rings.u);
+            let mut untried = false;
+            for i in 0..rings.u.len() {
+                let h = rings.u[i];
+                let v = self.head(h);
+                if cubes.owner[v as usize] != k || self.touched.get(v as usize) == sweep {
+                    untried = true;
+                    continue;
                 }
-                self.touched[u as usize] = sweep;
-                made += 1;
+                match self.try_collapse(h, cubes, k, rings) {
+                    Collapse::Made => {
+                        for &o in rings.u.iter().chain(&rings.v) {
+                            if self.corners.get(o as usize / 3)[0] != GONE {
+                                again.push(self.head(o));
+                            }
+                        }
+                        self.touched.set(u as usize, sweep);
+                        again.push(u);
+                        made += 1;
+                        untried = false;
+                        break;
+                    }
+                    Collapse::Untried => untried = true,
+                    Collapse::Refused => {}
+                }
+            }
+            if untried {
+                again.push(u);
             }
         }
-        made
+        (made, again)
     }
 
-    /// Collapses half-edge `h`'s head into its tail if the merged vertex can stand somewhere
-    /// within the tolerance of its planes and of the surface it replaces that keeps the mesh
-    /// sound.
-    fn try_collapse(&mut self, h: u32, ring_u: &mut Vec<u32>, ring_v: &mut Vec<u32>) -> bool {
+    /// Collapses half-edge `h`'s head into its tail (both of cube `k`; `rings.u` the tail's
+    /// ring) if the merged vertex
+    /// can stand somewhere within the tolerance of its planes and of the surface it replaces
+    /// that keeps the mesh sound; leaves it untried unless every vertex around both ends is
+    /// `k`'s.
+    fn try_collapse(&self, h: u32, cubes: &Cubes, k: u32, rings: &mut Rings) -> Collapse {
         let tolerance = self.tolerance;
         let bound = tolerance * tolerance;
         let (u, v) = (self.tail(h), self.head(h));
-        let q = self.quadrics[u as usize].sum(&self.quadrics[v as usize]);
-        let (pu, pv) = (self.positions[u as usize], self.positions[v as usize]);
+        let q = self
+            .quadrics
+            .get(u as usize)
+            .sum(&self.quadrics.get(v as usize));
+        let (pu, pv) = (self.position(u), self.position(v));
         let mut candidates: Vec<(f64, DVec3)> =
             [Some(pu), Some(pv), Some(0.5 * (pu + pv)), q.minimum()]
                 .into_iter()
@@ -302,31 +446,41 @@ impl Collapser {
                 .filter(|(cost, _)| *cost <= bound)
                 .collect();
         if candidates.is_empty() {
-            return false;
+            return Collapse::Refused;
         }
-        self.ring(u, ring_u);
-        self.ring(v, ring_v);
-        if ring_u.len() + ring_v.len() - 4 > MAX_VALENCE || !self.link_holds(h, ring_u, ring_v) {
-            return false;
+        self.ring(v, &mut rings.v);
+        let (ring_u, ring_v) = (&rings.u, &rings.v);
+        if ring_u.len() + ring_v.len() - 4 > MAX_VALENCE {
+            return Collapse::Refused;
+        }
+        if ring_u
+            .iter()
+            .chain(ring_v)
+            .any(|&o| cubes.owner[self.head(o) as usize] != k)
+        {
+            return Collapse::Untried;
+        }
+        if !self.link_holds(h, ring_u, ring_v) {
+            return Collapse::Refused;
         }
         candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let moved = self.moved[u as usize].max(self.moved[v as usize]);
+        let moved = self.moved.get(u as usize).max(self.moved.get(v as usize));
         let Some((p, moved)) = candidates.iter().find_map(|&(_, p)| {
             let moved = moved + self.movement(h, p, ring_u, ring_v)?;
             (moved <= tolerance).then_some((p, moved))
         }) else {
-            return false;
+            return Collapse::Refused;
         };
         self.collapse(h, p, ring_v);
-        self.quadrics[u as usize] = q;
-        self.moved[u as usize] = moved;
-        true
+        self.quadrics.set(u as usize, q);
+        self.moved.set(u as usize, moved);
+        Collapse::Made
     }
 
     /// The link condition: the ends of `h` share only the two corners opposite it.
     fn link_holds(&self, h: u32, ring_u: &[u32], ring_v: &[u32]) -> bool {
         let a = self.head(next(h));
-        let b = self.head(next(self.twin[h as usize]));
+        let b = self.head(next(self.twin.get(h as usize)));
         if a == b {
             return false;
         }
@@ -343,24 +497,23 @@ impl Collapser {
     /// stay turned by at most `MAX_TURN`, no thinner than `MIN_QUALITY` (or than before) and
     /// form a fan that a plane sees from one side (so that no two of them overlap).
     fn movement(&self, h: u32, p: DVec3, ring_u: &[u32], ring_v: &[u32]) -> Option<f64> {
-        let (t1, t2) = (h / 3, self.twin[h as usize] / 3);
+        let (t1, t2) = (h / 3, self.twin.get(h as usize) / 3);
         let (u, v) = (self.tail(h), self.head(h));
         let mut normals = [DVec3::ZERO; 2 * MAX_VALENCE];
         let mut new_fan = [[DVec3::ZERO; 3]; 2 * MAX_VALENCE];
-        let (mut count, mut to_old) = (0, f64::INFINITY);
+        let mut count = 0;
         for &o in ring_u.iter().chain(ring_v) {
             let t = o / 3;
-            let c = self.corners[t as usize];
-            let old = c.map(|w| self.positions[w as usize]);
-            to_old = to_old.min(triangle_distance_squared(p, old));
             if t == t1 || t == t2 {
                 continue;
             }
+            let c = self.corners.get(t as usize);
+            let old = c.map(|w| self.position(w));
             let new = c.map(|w| {
                 if w == u || w == v {
                     p
                 } else {
-                    self.positions[w as usize]
+                    self.position(w)
                 }
             });
             let n_new = normal(new).normalize_or_zero();
@@ -377,62 +530,83 @@ impl Collapser {
         if normals[..count].iter().any(|n| n.dot(axis) < FAN_SIDE) {
             return None;
         }
+        // An end left where it was is a corner of both fans: it moves nothing.
+        let (pu, pv) = (self.position(u), self.position(v));
+        let to_old = if p == pu || p == pv {
+            0.0
+        } else {
+            ring_u
+                .iter()
+                .chain(ring_v)
+                .map(|&o| {
+                    let c = self.corners.get(o as usize / 3);
+                    triangle_distance_squared(p, c.map(|w| self.position(w)))
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
         let from_new = |q: DVec3| {
             new_fan[..count]
                 .iter()
                 .map(|t| triangle_distance_squared(q, *t))
                 .fold(f64::INFINITY, f64::min)
         };
-        let farthest = to_old
-            .max(from_new(self.positions[u as usize]))
-            .max(from_new(self.positions[v as usize]));
+        let from_u = if p == pu { 0.0 } else { from_new(pu) };
+        let from_v = if p == pv { 0.0 } else { from_new(pv) };
+        let farthest = to_old.max(from_u).max(from_v);
         Some(farthest.sqrt())
     }
 
     /// Removes `h`'s two triangles and its head `v`, whose half-edges (`ring_v`) now leave its
     /// tail `u`, moved to `p`.
-    fn collapse(&mut self, h: u32, p: DVec3, ring_v: &[u32]) {
-        let g = self.twin[h as usize];
+    fn collapse(&self, h: u32, p: DVec3, ring_v: &[u32]) {
+        let g = self.twin.get(h as usize);
         let (u, v) = (self.tail(h), self.head(h));
         let (a, b) = (self.head(next(h)), self.head(next(g)));
         // The outer edges of each removed triangle become twins of each other.
-        let join = |s: &mut Collapser, x: u32, y: u32| {
-            let (tx, ty) = (s.twin[x as usize], s.twin[y as usize]);
-            s.twin[tx as usize] = ty;
-            s.twin[ty as usize] = tx;
+        let join = |x: u32, y: u32| {
+            let (tx, ty) = (self.twin.get(x as usize), self.twin.get(y as usize));
+            self.twin.set(tx as usize, ty);
+            self.twin.set(ty as usize, tx);
         };
-        let (u_to_a, a_to_v) = (self.twin[prev(h) as usize], self.twin[next(h) as usize]);
-        let b_to_u = self.twin[next(g) as usize];
-        join(self, next(h), prev(h));
-        join(self, next(g), prev(g));
+        let (u_to_a, a_to_v) = (
+            self.twin.get(prev(h) as usize),
+            self.twin.get(next(h) as usize),
+        );
+        let b_to_u = self.twin.get(next(g) as usize);
+        join(next(h), prev(h));
+        join(next(g), prev(g));
         for &o in ring_v {
             let t = o as usize / 3;
             if t as u32 != h / 3 && t as u32 != g / 3 {
-                self.corners[t][o as usize % 3] = u;
+                let mut c = self.corners.get(t);
+                c[o as usize % 3] = u;
+                self.corners.set(t, c);
             }
         }
-        self.corners[h as usize / 3] = [GONE; 3];
-        self.corners[g as usize / 3] = [GONE; 3];
-        self.positions[u as usize] = p;
-        self.leaving[u as usize] = u_to_a;
-        self.leaving[a as usize] = a_to_v;
-        self.leaving[b as usize] = b_to_u;
-        self.leaving[v as usize] = GONE;
+        self.corners.set(h as usize / 3, [GONE; 3]);
+        self.corners.set(g as usize / 3, [GONE; 3]);
+        self.positions.set(u as usize, p);
+        self.leaving.set(u as usize, u_to_a);
+        self.leaving.set(a as usize, a_to_v);
+        self.leaving.set(b as usize, b_to_u);
+        self.leaving.set(v as usize, GONE);
     }
 
     /// The remaining vertices and triangles, in their first order.
     fn into_mesh(self) -> TriangleMesh {
-        let mut number = vec![GONE; self.positions.len()];
+        let leaving = self.leaving.into_inner();
+        let mut number = vec![GONE; leaving.len()];
         let mut positions = Vec::new();
-        for (v, p) in self.positions.iter().enumerate() {
-            if self.leaving[v] != GONE {
+        for (v, p) in self.positions.into_inner().into_iter().enumerate() {
+            if leaving[v] != GONE {
                 number[v] = positions.len() as u32;
-                positions.push(*p);
+                positions.push(p);
             }
         }
         let triangles = self
             .corners
-            .iter()
+            .into_inner()
+            .into_iter()
             .filter(|c| c[0] != GONE)
             .map(|c| c.map(|v| number[v as usize]))
             .collect();
