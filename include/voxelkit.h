@@ -212,8 +212,8 @@ vk_status vk_options_set_udf(vk_options *options, double band);
 vk_status vk_options_set_compression(vk_options *options, vk_compression compression);
 vk_status vk_options_set_half(vk_options *options, int half);
 /*
- * Any option by name: field `field` of request `request` (mesh, solid, subdiv, lines, limits
- * or write: the tables of Python's voxelkit.OPTIONS) set to `value`, a JSON text such as
+ * Any option by name: field `field` of request `request` (mesh, solid, subdiv, lines, limits,
+ * write, or to_mesh's adaptivity: the tables of Python's voxelkit.OPTIONS) set to `value`, a JSON text such as
  * "2.5", "\"projective\"", "true", "null" or "[\"shell\"]". Checked and refused with the same
  * message as Python's keyword. The placement of mesh, solid, subdiv and lines (`resolution`,
  * `voxel_size`, `origin`, `bounds`) sets the grid every call shares: `resolution` as
@@ -302,6 +302,12 @@ vk_status vk_grid_write_vdb_with(const vk_grid *grid, const char *path,
 vk_status vk_grid_to_mesh(const vk_grid *grid, vk_mesh **out);
 /* The same mesh written to `path`: .obj, .ply, .stl or .glb by the extension (atomically). */
 vk_status vk_grid_write_mesh(const vk_grid *grid, const char *path);
+/* vk_grid_to_mesh and vk_grid_write_mesh with the flat regions merged as `options` say
+ * (vk_options_set(options, "to_mesh", "adaptivity", "0.25"): every vertex within half that
+ * many voxels of the plane of each triangle it replaces; options NULL: none merged). */
+vk_status vk_grid_to_mesh_with(const vk_grid *grid, const vk_options *options, vk_mesh **out);
+vk_status vk_grid_write_mesh_with(const vk_grid *grid, const char *path,
+                                  const vk_options *options);
 
 /*
  * The grids vk_grid_write_vdb_with(grid, path, options) writes (options NULL: those

@@ -21,7 +21,7 @@ use crate::pipeline::request::{
     MeasureRequest, MeshRequest, Placement, Request, Schema, SolidRequest, SubdivRequest,
     SurfaceKind, ToMeshRequest, WriteRequest,
 };
-use crate::pipeline::to_mesh::check_mesh_output;
+use crate::pipeline::to_mesh::{check_adaptivity, check_mesh_output};
 use crate::pipeline::{Details, GridSource, Job, MeasureSource, MeshSource, Outcome, Task};
 use crate::progress::Observer;
 use crate::solids::depth_layers::Layers;
@@ -118,6 +118,7 @@ struct Options {
     lines: LinesRequest,
     limits: LimitsRequest,
     write: WriteRequest,
+    to_mesh: ToMeshRequest,
     progress: Option<(VkProgressFn, *mut c_void)>,
     cancel: *const AtomicI32,
 }
@@ -133,6 +134,7 @@ impl Default for Options {
             lines: LinesRequest::default(),
             limits: LimitsRequest::default(),
             write: WriteRequest::default(),
+            to_mesh: ToMeshRequest::default(),
             progress: None,
             cancel: std::ptr::null(),
         }
@@ -785,10 +787,20 @@ pub extern "C" fn vk_options_set(
             "lines" => set_field(&mut o.lines, &mut o.placement, &mut o.fit, field, value)?,
             "limits" => o.limits = changed(&o.limits, vec![(field, value)])?,
             "write" => o.write = changed(&o.write, vec![(field, value)])?,
+            "to_mesh" if field == "adaptivity" => {
+                o.to_mesh = changed(&o.to_mesh, vec![(field, value)])?;
+                check_adaptivity(o.to_mesh.adaptivity)?;
+            }
+            "to_mesh" => {
+                return Err(invalid(format!(
+                    "to_mesh.{field} chooses a .vdb file's grid: a result's mesh takes \
+                     adaptivity"
+                )));
+            }
             other => {
                 return Err(invalid(format!(
-                    "no request {other:?} in the C options: mesh, solid, subdiv, lines, limits \
-                     or write"
+                    "no request {other:?} in the C options: mesh, solid, subdiv, lines, limits, \
+                     write or to_mesh"
                 )));
             }
         }
@@ -1223,14 +1235,29 @@ pub extern "C" fn vk_grid_write_vdb_with(
     })
 }
 
+/// The adaptivity of `options` (NULL: the default).
+fn adaptivity_of(options: *const VkOptions) -> std::result::Result<f64, Failure> {
+    if options.is_null() {
+        return Ok(ToMeshRequest::default().adaptivity);
+    }
+    Ok(options_of(options)?.to_mesh.adaptivity)
+}
+
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_grid_to_mesh(grid: *const VkGrid, out: *mut *mut VkMesh) -> VkStatus {
+    vk_grid_to_mesh_with(grid, std::ptr::null(), out)
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_to_mesh_with(
+    grid: *const VkGrid,
+    options: *const VkOptions,
+    out: *mut *mut VkMesh,
+) -> VkStatus {
     guard(|| {
         non_null_out(out)?;
         let g = borrow(grid, Kind::Grid)?;
-        let surface = g
-            .outcome
-            .surface_mesh(ToMeshRequest::default().adaptivity)?;
+        let surface = g.outcome.surface_mesh(adaptivity_of(options)?)?;
         let polygons: Vec<Vec<u32>> = surface.triangles.iter().map(|t| t.to_vec()).collect();
         let mut mesh = Mesh::from_polygons("vk_grid_to_mesh", surface.positions, &polygons);
         mesh.numbered_from_zero = true;
@@ -1240,12 +1267,22 @@ pub extern "C" fn vk_grid_to_mesh(grid: *const VkGrid, out: *mut *mut VkMesh) ->
 
 #[unsafe(no_mangle)]
 pub extern "C" fn vk_grid_write_mesh(grid: *const VkGrid, path: *const c_char) -> VkStatus {
+    vk_grid_write_mesh_with(grid, path, std::ptr::null())
+}
+
+#[unsafe(no_mangle)]
+pub extern "C" fn vk_grid_write_mesh_with(
+    grid: *const VkGrid,
+    path: *const c_char,
+    options: *const VkOptions,
+) -> VkStatus {
     guard(|| {
         let path = PathBuf::from(c_str(path, "path")?);
         check_mesh_output(&path, &[])?;
+        let adaptivity = adaptivity_of(options)?;
         Ok(borrow(grid, Kind::Grid)?
             .outcome
-            .save_mesh(&path, ToMeshRequest::default().adaptivity)?)
+            .save_mesh(&path, adaptivity)?)
     })
 }
 

@@ -175,6 +175,20 @@ static void check_mesh(const vk_grid *sdf, const char *vdb_path) {
     OK(vk_grid_write_mesh(sdf, path));
     snprintf(path, sizeof path, "%s.txt", vdb_path);
     CHECK(vk_grid_write_mesh(sdf, path) == VK_ERROR_INVALID_ARGUMENT);
+    /* Merging the box's flat faces leaves far fewer triangles. */
+    vk_options *merge = NULL;
+    OK(vk_options_new(&merge));
+    CHECK(vk_options_set(merge, "to_mesh", "adaptivity", "-1") == VK_ERROR_INVALID_ARGUMENT);
+    CHECK(vk_options_set(merge, "to_mesh", "iso", "0.5") == VK_ERROR_INVALID_ARGUMENT);
+    OK(vk_options_set(merge, "to_mesh", "adaptivity", "0.5"));
+    OK(vk_grid_to_mesh_with(sdf, merge, &mesh));
+    size_t merged_vertices = 0, merged_triangles = 0;
+    OK(vk_mesh_counts(mesh, &merged_vertices, &merged_triangles));
+    CHECK(merged_triangles > 0 && 3 * merged_triangles < triangles);
+    OK(vk_mesh_free(mesh));
+    snprintf(path, sizeof path, "%s.merged.ply", vdb_path);
+    OK(vk_grid_write_mesh_with(sdf, path, merge));
+    OK(vk_options_free(merge));
 }
 
 int main(int argc, char **argv) {
