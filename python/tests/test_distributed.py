@@ -263,3 +263,49 @@ def test_two_runs_to_one_output_are_refused_while_the_first_runs(data, dask, tmp
     _, err = first.communicate(timeout=600)
     assert first.returncode == 0, err
     assert voxel_set(voxelkit.read_vdb(out).ijk) == voxel_set(voxelkit.mesh(path, resolution=1024).ijk)
+
+
+def _cube_frames(folder, count):
+    """An animation: a box that moves and grows, one OBJ per frame (f_0001.obj, ...)."""
+    corners = [(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)]
+    faces = [(1, 3, 4, 2), (5, 6, 8, 7), (1, 2, 6, 5), (3, 7, 8, 4), (1, 5, 7, 3), (2, 4, 8, 6)]
+    for f in range(1, count + 1):
+        scale, shift = 1.0 + 0.2 * f, 0.7 * f
+        lines = [f"v {shift + scale * x} {0.5 * shift + 0.8 * scale * y} {0.6 * scale * z}"
+                 for x, y, z in corners]
+        lines += ["f " + " ".join(map(str, q)) for q in faces]
+        (folder / f"f_{f:04d}.obj").write_text("\n".join(lines) + "\n")
+
+
+@pytest.mark.parametrize("solid", [False, True], ids=["surface", "solid"])
+def test_frames_on_the_cluster_equal_the_command_lines_frames(client, cli, tmp_path, solid):
+    """A frame farm: each frame whole on a worker, all on the grid the command line's --frames
+    fits to the union of their boxes: the same voxels, frame by frame."""
+    _cube_frames(tmp_path, 4)
+    command = "solid" if solid else "mesh"
+    result = vd.frames(tmp_path / "f_####.obj", tmp_path / "farm" / "v_####.vdb", "1-4", solid=solid,
+                       resolution=48, client=client)
+    cli(command, tmp_path / "f_####.obj", "--frames", "1-4", "-r", "48", "-o", tmp_path / "cli" / "v_####.vdb")
+    assert result["frames"] == 4 and len(result["outputs"]) == 4
+    for f in range(1, 5):
+        farm = voxelkit.read_vdb(tmp_path / "farm" / f"v_{f:04d}.vdb")
+        single = voxelkit.read_vdb(tmp_path / "cli" / f"v_{f:04d}.vdb")
+        assert farm.same_voxels(single), f
+        assert len(farm) == result["voxels"][f - 1] > 0
+    assert result["voxels"][3] > result["voxels"][0], "the box grows"
+    with pytest.raises(ValueError, match="needs `#` for the frame number"):
+        vd.frames(tmp_path / "f_0001.obj", tmp_path / "x_####.vdb", "1-2", client=client)
+    with pytest.raises(ValueError, match="the last frame must not come before the first"):
+        vd.frames(tmp_path / "f_####.obj", tmp_path / "x_####.vdb", "4-1", client=client)
+
+
+def test_the_command_line_farms_frames(dask, tmp_path):
+    _cube_frames(tmp_path, 3)
+    done = subprocess.run(
+        [sys.executable, "-m", "voxelkit.distributed", "mesh", str(tmp_path / "f_####.obj"), "--frames", "1-3:2",
+         "-r", "32", "--workers", "2", "-o", str(tmp_path / "out" / "f_####.vdb")],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "2 frames" in done.stdout and "worker peak memory" in done.stdout
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["f_0001.vdb", "f_0003.vdb"]

@@ -2,6 +2,7 @@
 
     python -m voxelkit.distributed mesh IN -r 16384 --brick 1024 --workers 4 -o OUT.vdb
     python -m voxelkit.distributed solid IN -r 4096 --brick 512 --scheduler tcp://host:8786 -o OUT.vdb
+    python -m voxelkit.distributed mesh 'f_####.obj' --frames 1-240 -r 512 -o 'out/f_####.vdb'
 
 The grid is placed as a single run would place it and cut into cubic bricks of ``--brick``
 voxels. The client reads the mesh once and bins its faces: each brick receives only the
@@ -23,6 +24,9 @@ brick reports the bytes its leaves and tiles take; a solid's inside is mostly ti
 with ``--keep-bricks``) kept as ``OUT.bricks/`` with an index ``OUT.bricks/index.json`` that
 ``voxelkit info`` and ``voxelkit.read_vdb`` read as one grid. Workers write brick files into
 that folder, so with ``--scheduler`` it must be on a file system every worker sees.
+
+With ``--frames`` the input and output are frame patterns and each frame runs whole on one
+worker, every frame on the grid fitted to the union of their boxes (see ``frames``).
 
 Without ``--scheduler`` a local cluster of ``--workers`` processes is started, each running
 its bricks on (cores / workers) threads; the worker processes are spawned, so a script that
@@ -78,6 +82,17 @@ def _winding_brick(arrays, mesh, origin, voxel_size, brick, size, path, max_memo
         positions, indices, starts, *mesh, origin, voxel_size, brick, size, path,
         max_memory_mib=max_memory_mib,
     )
+
+
+def _frame(input, output, solid, voxel_size, origin, options):
+    """One frame voxelized whole on a worker on the shared grid and written (atomically:
+    a retried frame writes the same file again); returns its voxel count."""
+    from . import mesh as surface, solid as filled
+
+    os.makedirs(os.path.dirname(os.path.abspath(output)), exist_ok=True)
+    grid = (filled if solid else surface)(input, voxel_size=voxel_size, origin=origin, **options)
+    grid.write(output)
+    return len(grid)
 
 
 def _peak_rss_mib():
@@ -157,6 +172,24 @@ def _client(scheduler, workers, threads):
         env={"RAYON_NUM_THREADS": str(threads), "DASK_LOGGING__DISTRIBUTED": "critical"},
     )
     return Client(cluster), cluster
+
+
+@contextlib.contextmanager
+def _using(client, scheduler, workers):
+    """`client`, else a client of the scheduler at `scheduler`, else of a local cluster of
+    `workers` processes (each on cores / workers threads) started for the call and closed
+    after it."""
+    if client is not None:
+        yield client
+        return
+    threads = max(1, (os.cpu_count() or 1) // max(1, workers))
+    client, cluster = _client(scheduler, workers, threads)
+    try:
+        yield client
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
 
 
 #: How often a brick whose worker died is run again on another worker.
@@ -266,11 +299,7 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
             start, check):
     separability, max_memory_mib = plan.separability, plan.max_memory_mib
     show = _Progress(progress)
-    threads = max(1, (os.cpu_count() or 1) // max(1, workers))
-    own = client is None
-    if own:
-        client, cluster = _client(scheduler, workers, threads)
-    try:
+    with _using(client, scheduler, workers) as client:
         origin, h, size = plan.origin, plan.voxel_size, plan.size
         bricks = plan.winding_bricks if solid and plan.winding else plan.bricks
         arrays = {b: plan.faces_of(b) for b in bricks}
@@ -308,11 +337,6 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
             }
             counts = _run(client, calls, "surface", show, check)
         peaks = list(client.run(_peak_rss_mib).values())
-    finally:
-        if own:
-            client.close()
-            if cluster is not None:
-                cluster.close()
     # Each brick task gives its voxels and the bytes its leaves and tiles take in the merge.
     voxels = sum(v for v, _ in counts.values()) + len(full_bricks) * size**3
     merged_bytes = sum(b for _, b in counts.values()) + len(full_bricks) * plan.full_brick_bytes
@@ -330,6 +354,32 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
         "full_bricks": len(full_bricks),
         "inside_rule": plan.inside_reason,
         "voxels": voxels,
+        "seconds": time.perf_counter() - start,
+        "worker_peak_mib": peaks,
+    }
+
+
+def frames(inputs, outputs, frames, solid=False, scheduler=None, workers=2, progress=False,
+           client=None, **options):
+    start = time.perf_counter()
+    inputs, outputs = os.fspath(inputs), os.fspath(outputs)
+    plan, voxel_size, origin = vk.frame_plan(inputs, frames, outputs, **options)
+    # Each frame's job takes the options that apply to one frame on the shared grid.
+    defaults = {f["name"]: f["default"] for f in _FIELDS}
+    job = {name: options.get(name, defaults[name]) for name in ("max_memory_mib", "up_axis")}
+    kept = "inside" if solid else "separability"
+    job[kept] = options.get(kept, defaults[kept])
+    show = _Progress(progress)
+    with _stopped_by_signals() as check, _using(client, scheduler, workers) as client:
+        calls = {f: (_frame, (i, o, solid, voxel_size, origin, job)) for f, i, o in plan}
+        voxels = _run(client, calls, "frames", show, check)
+        peaks = list(client.run(_peak_rss_mib).values())
+    return {
+        "outputs": [o for _, _, o in plan],
+        "frames": len(plan),
+        "voxels": [voxels[f] for f, _, _ in plan],
+        "voxel_size": voxel_size,
+        "origin": origin,
         "seconds": time.perf_counter() - start,
         "worker_peak_mib": peaks,
     }
@@ -356,6 +406,22 @@ Returns a dict: the merged ``grid`` (a voxelkit.Grid, or None when the bricks we
 The options, as for every voxelkit function (``voxelkit.OPTIONS["distributed"]``):
 """
 run = _with_table_options(run)
+
+frames.__doc__ = """Voxelizes the frames ``frames`` (``"1-240"``, ``"1-240:2"`` or one frame) of the
+input pattern ``inputs`` (``f_####.obj``: ``#`` for the zero-padded frame number) into the
+output pattern ``outputs``, frame by frame over Dask (``client``, ``scheduler`` or ``workers``
+as for ``run``): the surface, or with ``solid`` the solid. Every frame shares one voxel size
+and origin, fitted to the union of the frames' boxes, as ``voxelkit mesh --frames`` fits them,
+so that the animated volume does not jitter; each frame runs whole on one worker (``brick``
+does not apply) and its file is written atomically, so that a frame whose worker dies is
+written again, whole, elsewhere.
+
+Returns a dict: ``outputs``, ``frames``, ``voxels`` (per frame), ``voxel_size``, ``origin``,
+``seconds`` and ``worker_peak_mib``.
+
+The options (``voxelkit.OPTIONS["distributed"]``):
+"""
+frames = _with_table_options(frames)
 
 
 def mesh(source, output, **options):
@@ -408,8 +474,13 @@ def main(argv=None):
         ("solid", "the solid (surface and inside, by the option inside)"),
     ):
         p = commands.add_parser(name, help=help_text)
-        p.add_argument("input", help="mesh file (.obj, .stl, .ply, .off, .gltf, .glb)")
-        p.add_argument("-o", "--output", required=True, help="output .vdb")
+        p.add_argument("input", help="mesh file (.obj, .stl, .ply, .off, .gltf, .glb); with "
+                       "--frames a pattern with # for the frame number (f_####.obj)")
+        p.add_argument("-o", "--output", required=True,
+                       help="output .vdb; with --frames a pattern (out/f_####.vdb)")
+        p.add_argument("--frames", metavar="RANGE",
+                       help="FIRST-LAST, FIRST-LAST:STEP or FRAME of the input pattern, each "
+                            "frame whole on one worker, all on one shared grid")
         fit = p.add_mutually_exclusive_group()
         for field in _FIELDS:
             if (field["name"], name) in (("separability", "solid"), ("inside", "mesh")):
@@ -420,31 +491,38 @@ def main(argv=None):
         where.add_argument("--workers", type=int, default=2, help="local worker processes (default 2)")
         p.add_argument("--keep-bricks", action="store_true", help="keep the brick set instead of merging")
     args = parser.parse_args(argv)
+    given = vars(args)
+    table = {f["name"]: given[f["name"]] for f in _FIELDS if f["name"] in given}
+    if args.frames is not None and args.keep_bricks:
+        print("error: --keep-bricks applies to a brick run, not to --frames", file=sys.stderr)
+        return 1
+    common = dict(solid=args.command == "solid", scheduler=args.scheduler, workers=args.workers,
+                  progress=True, **table)
     try:
-        given = vars(args)
-        result = run(
-            args.input,
-            args.output,
-            solid=args.command == "solid",
-            scheduler=args.scheduler,
-            workers=args.workers,
-            keep_bricks=args.keep_bricks,
-            progress=True,
-            **{f["name"]: given[f["name"]] for f in _FIELDS if f["name"] in given},
-        )
+        if args.frames is None:
+            result = run(args.input, args.output, keep_bricks=args.keep_bricks, **common)
+        else:
+            result = frames(args.input, args.output, args.frames, **common)
     except (ValueError, MemoryError, OSError, RuntimeError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
     except KeyboardInterrupt as e:
-        print(f"error: {e or 'interrupted'}; the partial bricks were removed", file=sys.stderr)
+        removed = "" if args.frames else "; the partial bricks were removed"
+        print(f"error: {e or 'interrupted'}{removed}", file=sys.stderr)
         return 130
     peaks = ", ".join(f"{p:.0f}" for p in result["worker_peak_mib"])
-    print(
-        f"{result['output']}: {result['voxels']} voxels from {result['bricks']} bricks "
-        f"(+{result['full_bricks']} whole) in {result['seconds']:.2f} s; "
-        f"worker peak memory {peaks} MiB"
-        + (f"; inside: {result['inside_rule']}" if result["inside_rule"] else "")
-    )
+    if args.frames is None:
+        done = (
+            f"{result['output']}: {result['voxels']} voxels from {result['bricks']} bricks "
+            f"(+{result['full_bricks']} whole)"
+        )
+    else:
+        done = (
+            f"{args.output}: {result['frames']} frames, {sum(result['voxels'])} voxels, voxel size "
+            f"{result['voxel_size']:.6g},"
+        )
+    inside = f"; inside: {result['inside_rule']}" if result.get("inside_rule") else ""
+    print(f"{done} in {result['seconds']:.2f} s; worker peak memory {peaks} MiB{inside}")
     return 0
 
 

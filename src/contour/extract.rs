@@ -92,18 +92,25 @@ pub fn contour(field: &ScalarField, exact: Option<&dyn ExactSurface>) -> Result<
         shares.push((mine, my_triangles));
     }
     let transform = field.grid.transform;
-    let resolve = |piece: &BlockPiece, base: u32, v: u32| -> u32 {
+    // The pieces of a block and of its neighbours up each axis, by a crossing's code (`None`
+    // where no piece is: no crossing names it).
+    let owners = |piece: &BlockPiece| -> [Option<usize>; 8] {
+        std::array::from_fn(|code| {
+            let owner = [
+                piece.origin[0] + 8 * (code & 1) as i64,
+                piece.origin[1] + 8 * (code >> 1 & 1) as i64,
+                piece.origin[2] + 8 * (code >> 2 & 1) as i64,
+            ];
+            index.get(&owner).map(|&i| i as usize)
+        })
+    };
+    let resolve = |owners: &[Option<usize>; 8], base: u32, v: u32| -> u32 {
         if v & CROSSING_REF == 0 {
             return base + v;
         }
-        let code = (v >> 12) & 7;
+        let code = ((v >> 12) & 7) as usize;
         let bit = (v & 0xfff) as usize;
-        let owner = [
-            piece.origin[0] + 8 * (code & 1) as i64,
-            piece.origin[1] + 8 * (code >> 1 & 1) as i64,
-            piece.origin[2] + 8 * (code >> 2 & 1) as i64,
-        ];
-        let i = index[&owner] as usize;
+        let i = owners[code].expect("a crossing names a block with a piece");
         let other = &pieces[i];
         let below = other.crossings[bit / 64] & ((1u64 << (bit % 64)) - 1);
         bases[i] + other.ranks[bit / 64] + below.count_ones()
@@ -115,8 +122,9 @@ pub fn contour(field: &ScalarField, exact: Option<&dyn ExactSurface>) -> Result<
             for (out, q) in positions.iter_mut().zip(&piece.positions) {
                 *out = transform.origin + transform.voxel_size * *q;
             }
+            let owners = owners(piece);
             for (out, t) in triangles.iter_mut().zip(&piece.triangles) {
-                *out = t.map(|v| resolve(piece, base, v));
+                *out = t.map(|v| resolve(&owners, base, v));
             }
         });
     Ok(mesh)

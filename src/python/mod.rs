@@ -3,6 +3,7 @@
 
 mod arrays;
 mod bricks;
+mod frames;
 mod grid;
 mod jobs;
 mod keywords;
@@ -44,6 +45,7 @@ fn _voxelkit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(queries::contains, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::read_vdb, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::placement, m)?)?;
+    m.add_function(wrap_pyfunction!(frames::frame_plan, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::options, m)?)?;
     bricks::register(m)?;
     Ok(())
