@@ -506,7 +506,8 @@ fn adaptivity_merges_flat_regions_within_its_bound() {
 
 /// `--adaptivity` on the shared closed meshes' level sets at 128: fewer triangles, still
 /// closed, manifold, outward and free of self-intersections, within the adaptivity of the
-/// full mesh both ways, the same at any number of threads; a negative adaptivity is refused.
+/// full mesh both ways, the same at any number of threads; a negative adaptivity is refused;
+/// `--mesh-out` takes it, and a voxelizing command refuses it without one.
 #[test]
 fn to_mesh_adaptivity_on_the_shared_meshes() {
     let Some(data) = common::data_dir() else {
@@ -599,6 +600,39 @@ fn to_mesh_adaptivity_on_the_shared_meshes() {
         text(&o)
     );
     assert!(!dir.path().join("x.ply").exists());
+    // With --mesh-out on a voxelizing command, and refused without one.
+    let fandisk = data.join("meshes/fandisk.obj");
+    let (vdb, ply) = (dir.path().join("f.vdb"), dir.path().join("f.ply"));
+    let mut args = vec![
+        "mesh",
+        fandisk.to_str().unwrap(),
+        "--sdf",
+        "-r",
+        "64",
+        "-o",
+        vdb.to_str().unwrap(),
+        "--adaptivity",
+        "0.25",
+    ];
+    let o = voxelkit(&args);
+    assert!(!o.status.success());
+    assert!(
+        text(&o).contains("--adaptivity shapes the mesh of --mesh-out"),
+        "{}",
+        text(&o)
+    );
+    assert!(!vdb.exists());
+    args.extend(["--mesh-out", ply.to_str().unwrap(), "--json"]);
+    let o = voxelkit(&args);
+    assert!(o.status.success(), "{}", text(&o));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let mesh = &report["mesh"];
+    assert!(mesh["triangles_before_merging"].as_u64() > mesh["triangles"].as_u64());
+    assert_eq!(mesh["adaptivity"], 0.25);
+    assert_eq!(
+        Mesh::load(&ply).unwrap().face_count() as u64,
+        mesh["triangles"].as_u64().unwrap()
+    );
 }
 
 /// Every format reads back as the same mesh; a fog volume and a voxel set give meshes too;

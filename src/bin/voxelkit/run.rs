@@ -7,12 +7,12 @@ use std::ops::ControlFlow;
 use std::path::Path;
 use std::sync::Mutex;
 use std::time::Instant;
-use voxelkit::Result;
 use voxelkit::io::vdb::{WriteOptions, check_voxel_size};
-use voxelkit::pipeline::request::LimitsRequest;
+use voxelkit::pipeline::request::{LimitsRequest, ToMeshRequest};
 use voxelkit::pipeline::to_mesh::{check_adaptivity, check_mesh_output};
 use voxelkit::pipeline::{Job, Limits, Outcome, PlannedJob, check_output_path};
 use voxelkit::progress::Observer;
+use voxelkit::{Error, Result};
 
 /// What every command shares: threads, memory limit, output style.
 #[derive(Clone)]
@@ -99,10 +99,18 @@ pub fn plan_job(
         inputs.extend_from_slice(also_read);
         check_output_path(out, &inputs)?;
         check_voxel_size(out, planned.plan().transform.voxel_size)?;
-        if let Some(mesh) = &global.mesh_out {
-            inputs.push(out);
-            check_mesh_output(mesh, &inputs)?;
-            check_adaptivity(global.mesh_adaptivity)?;
+        match &global.mesh_out {
+            Some(mesh) => {
+                inputs.push(out);
+                check_mesh_output(mesh, &inputs)?;
+                check_adaptivity(global.mesh_adaptivity)?;
+            }
+            None if global.mesh_adaptivity != ToMeshRequest::default().adaptivity => {
+                return Err(Error::InvalidArgument(
+                    "--adaptivity shapes the mesh of --mesh-out: give --mesh-out too".into(),
+                ));
+            }
+            None => {}
         }
     }
     Ok(planned)
