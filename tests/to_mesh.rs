@@ -10,10 +10,11 @@ mod common;
 use cli_support::{text, voxelkit};
 use glam::DVec3;
 use rustc_hash::FxHashMap;
-use voxelkit::contour::{Meaning, ScalarField, TriangleMesh, contour, simplify};
+use voxelkit::contour::{Meaning, ScalarField, TriangleMesh, contour};
 use voxelkit::grid::{Channels, Leaf, SparseGrid, Transform, leaf_offset, leaf_origin};
 use voxelkit::mesh::Mesh;
 use voxelkit::mesh::generate::icosphere;
+use voxelkit::mesh::simplify::simplify;
 use voxelkit::mesh::winding::WindingTree;
 use voxelkit::random::SplitMix64;
 

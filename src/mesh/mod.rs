@@ -1,6 +1,6 @@
 //! Polygon meshes: loading (OBJ with n-gons kept, binary and ASCII STL, PLY, OFF, glTF),
-//! validation,
-//! measurement, fitting to a grid, and the project's own generated fixtures.
+//! validation, measurement, fitting to a grid, merging a contoured mesh's flat regions
+//! (`simplify`), and the project's own generated fixtures.
 
 pub mod attributes;
 pub mod boundary_caps;
@@ -18,6 +18,7 @@ mod off;
 mod ply;
 pub mod segment_hits;
 pub mod shells;
+pub mod simplify;
 mod stl;
 pub mod surface_distance;
 pub mod triangle_distance;

@@ -4,12 +4,13 @@
 use super::Outcome;
 use super::request::ToMeshRequest;
 use super::{Limits, MeshWritten, on_threads};
-use crate::contour::{ExactSurface, Meaning, ScalarField, TriangleMesh, contour, simplify};
+use crate::contour::{ExactSurface, Meaning, ScalarField, TriangleMesh, contour};
 use crate::error::{Error, Result};
 use crate::io::atomic::check_output;
 use crate::io::mesh_out::{MeshFormat, write_mesh};
 use crate::io::vdb::read_vdb_field;
 use crate::mesh::Mesh;
+use crate::mesh::simplify::simplify;
 use crate::mesh::surface_distance::two_sided_distance;
 use crate::progress::{StageClock, StageTime};
 use glam::DVec3;

@@ -1,4 +1,4 @@
-//! Adaptive simplification of a closed, 2-manifold mesh: edges collapsed where the surface is
+//! Adaptive simplification of a closed, 2-manifold triangle mesh (a contoured surface's): edges collapsed where the surface is
 //! flat, within a stated bound. Every vertex carries the quadric of the planes of the original
 //! triangles it stands for (Garland and Heckbert): its value at a point is the sum of the
 //! squared distances to those planes, so a collapse whose vertex costs at most `tolerance`
@@ -16,8 +16,8 @@
 //! Alternate sweeps shift the cubes by half, so that the edges along one sweep's cube faces
 //! lie inside the next sweep's cubes. The result does not depend on the number of threads.
 
-use super::extract::TriangleMesh;
-use crate::mesh::triangle_distance::triangle_distance_squared;
+use super::triangle_distance::triangle_distance_squared;
+use crate::contour::TriangleMesh;
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 use std::cell::UnsafeCell;
