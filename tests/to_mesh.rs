@@ -483,7 +483,7 @@ fn adaptivity_merges_flat_regions_within_its_bound() {
         let full_volume = signed_volume(&full.positions, &full.triangles);
         for adaptivity in [0.1, 0.25, 0.5] {
             let mut merged = full.clone();
-            let done = simplify(&mut merged, adaptivity, voxel);
+            let done = simplify(&mut merged, adaptivity, voxel).unwrap();
             let what = format!("{name} at adaptivity {adaptivity}");
             assert_eq!(done.triangles_before, full.triangles.len());
             assert_merged_within(&what, &merged, &full, adaptivity, voxel);

@@ -132,7 +132,7 @@ impl Outcome {
         let field = self.field()?;
         on_threads(self.threads, || {
             let mut mesh = contour(&field, self.exact.as_deref())?;
-            simplify(&mut mesh, adaptivity, field.grid.transform.voxel_size);
+            simplify(&mut mesh, adaptivity, field.grid.transform.voxel_size)?;
             Ok(mesh)
         })
     }
@@ -227,7 +227,7 @@ fn contour_to_file(
     if adaptivity > 0.0 {
         let mut merging = StageClock::new("merge flat regions");
         let simplified =
-            merging.time(|| simplify(&mut mesh, adaptivity, field.grid.transform.voxel_size));
+            merging.time(|| simplify(&mut mesh, adaptivity, field.grid.transform.voxel_size))?;
         merged = Some(simplified.triangles_before as u64);
         stages.push(merging.stage());
     }
