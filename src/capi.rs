@@ -21,7 +21,7 @@ use crate::pipeline::request::{
     MeasureRequest, MeshRequest, Placement, Request, Schema, SolidRequest, SubdivRequest,
     SurfaceKind, ToMeshRequest, WriteRequest,
 };
-use crate::pipeline::to_mesh::{check_adaptivity, check_mesh_output};
+use crate::pipeline::to_mesh::check_mesh_output;
 use crate::pipeline::{Details, GridSource, Job, MeasureSource, MeshSource, Outcome, Task};
 use crate::progress::Observer;
 use crate::solids::depth_layers::Layers;
@@ -787,15 +787,10 @@ pub extern "C" fn vk_options_set(
             "lines" => set_field(&mut o.lines, &mut o.placement, &mut o.fit, field, value)?,
             "limits" => o.limits = changed(&o.limits, vec![(field, value)])?,
             "write" => o.write = changed(&o.write, vec![(field, value)])?,
-            "to_mesh" if field == "adaptivity" => {
-                o.to_mesh = changed(&o.to_mesh, vec![(field, value)])?;
-                check_adaptivity(o.to_mesh.adaptivity)?;
-            }
             "to_mesh" => {
-                return Err(invalid(format!(
-                    "to_mesh.{field} chooses a .vdb file's grid: a result's mesh takes \
-                     adaptivity"
-                )));
+                let request = changed(&o.to_mesh, vec![(field, value)])?;
+                request.result_adaptivity()?;
+                o.to_mesh = request;
             }
             other => {
                 return Err(invalid(format!(

@@ -364,11 +364,10 @@ def frames(inputs, outputs, frames, solid=False, scheduler=None, workers=2, prog
     start = time.perf_counter()
     inputs, outputs = os.fspath(inputs), os.fspath(outputs)
     plan, voxel_size, origin = vk.frame_plan(inputs, frames, outputs, **options)
-    # Each frame's job takes the options that apply to one frame on the shared grid.
-    defaults = {f["name"]: f["default"] for f in _FIELDS}
-    job = {name: options.get(name, defaults[name]) for name in ("max_memory_mib", "up_axis")}
-    kept = "inside" if solid else "separability"
-    job[kept] = options.get(kept, defaults[kept])
+    # Each frame's job takes the options given that apply to one frame on the shared grid; the
+    # library's defaults stand for the rest.
+    applies = ("max_memory_mib", "up_axis", "inside" if solid else "separability")
+    job = {name: options[name] for name in applies if name in options}
     show = _Progress(progress)
     with _stopped_by_signals() as check, _using(client, scheduler, workers) as client:
         calls = {f: (_frame, (i, o, solid, voxel_size, origin, job)) for f, i, o in plan}

@@ -49,7 +49,6 @@ const GONE: u32 = u32::MAX;
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Simplified {
     pub triangles_before: usize,
-    pub collapses: usize,
 }
 
 /// Merges the flat regions of `mesh` (closed and 2-manifold) within `adaptivity` voxels of
@@ -65,7 +64,6 @@ pub fn simplify(mesh: &mut TriangleMesh, adaptivity: f64, voxel_size: f64) -> Re
     if tolerance <= 0.0 || before == 0 {
         return Ok(Simplified {
             triangles_before: before,
-            collapses: 0,
         });
     }
     crate::system::check_fits(
@@ -75,7 +73,6 @@ pub fn simplify(mesh: &mut TriangleMesh, adaptivity: f64, voxel_size: f64) -> Re
     )?;
     let cubes = [0.0, 0.5].map(|shift| Cubes::of(&mesh.positions, CELL * voxel_size, shift));
     let state = Collapser::new(std::mem::take(mesh), tolerance);
-    let mut collapses = 0;
     // The vertices whose surroundings changed since they last found no edge to collapse.
     let mut pending: Vec<u32> = (0..state.leaving.0.len() as u32).collect();
     let mut idle = 0;
@@ -99,7 +96,6 @@ pub fn simplify(mesh: &mut TriangleMesh, adaptivity: f64, voxel_size: f64) -> Re
             })
             .collect();
         let made: usize = swept.iter().map(|s| s.0).sum();
-        collapses += made;
         pending = swept.into_iter().flat_map(|s| s.1).collect();
         // Both placements of the cubes found nothing more.
         idle = if made == 0 { idle + 1 } else { 0 };
@@ -110,7 +106,6 @@ pub fn simplify(mesh: &mut TriangleMesh, adaptivity: f64, voxel_size: f64) -> Re
     *mesh = state.into_mesh();
     Ok(Simplified {
         triangles_before: before,
-        collapses,
     })
 }
 
@@ -449,13 +444,20 @@ impl Collapser {
             .get(u as usize)
             .sum(&self.quadrics.get(v as usize));
         let (pu, pv) = (self.position(u), self.position(v));
-        let mut candidates: Vec<(f64, DVec3)> =
-            [Some(pu), Some(pv), Some(0.5 * (pu + pv)), q.minimum()]
-                .into_iter()
-                .flatten()
-                .map(|p| (q.at(p), p))
-                .filter(|(cost, _)| *cost <= bound)
-                .collect();
+        // The places within the bound, on the stack: this runs for every edge tried.
+        let mut within = [(0.0, DVec3::ZERO); 4];
+        let mut count = 0;
+        for p in [Some(pu), Some(pv), Some(0.5 * (pu + pv)), q.minimum()]
+            .into_iter()
+            .flatten()
+        {
+            let cost = q.at(p);
+            if cost <= bound {
+                within[count] = (cost, p);
+                count += 1;
+            }
+        }
+        let candidates = &mut within[..count];
         if candidates.is_empty() {
             return Collapse::Refused;
         }

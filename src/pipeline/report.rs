@@ -11,11 +11,9 @@ pub struct MeshWritten {
     pub file: String,
     pub vertices: u64,
     pub triangles: u64,
-    /// With adaptivity: the triangles before flat regions were merged, and the bound (voxels).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub triangles_before_merging: Option<u64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub adaptivity: Option<f64>,
+    /// With adaptivity: what merging flat regions started from.
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub merged: Option<Merged>,
     /// Remeshing: the largest distance from the mesh to its source and from the source to
     /// it (world units).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -24,15 +22,22 @@ pub struct MeshWritten {
     pub source_to_mesh: Option<f64>,
 }
 
+/// A mesh's flat regions merged: the triangles before, and the bound (voxels).
+#[derive(Serialize, Debug, Clone, Copy)]
+pub struct Merged {
+    pub triangles_before_merging: u64,
+    pub adaptivity: f64,
+}
+
 impl MeshWritten {
     /// The file and its counts, and what merging flat regions left of the triangles.
     pub fn describe(&self) -> String {
-        let merged = match (self.triangles_before_merging, self.adaptivity) {
-            (Some(before), Some(a)) => {
-                format!("; {before} before flat regions were merged within {a} voxels")
-            }
-            _ => String::new(),
-        };
+        let merged = self.merged.map_or(String::new(), |m| {
+            format!(
+                "; {} before flat regions were merged within {} voxels",
+                m.triangles_before_merging, m.adaptivity
+            )
+        });
         format!(
             "{} ({} vertices, {} triangles, closed and manifold{merged})",
             self.file, self.vertices, self.triangles

@@ -3,7 +3,7 @@
 
 use super::Outcome;
 use super::request::ToMeshRequest;
-use super::{Limits, MeshWritten, on_threads};
+use super::{Limits, Merged, MeshWritten, on_threads};
 use crate::contour::{ExactSurface, Meaning, ScalarField, TriangleMesh, contour};
 use crate::error::{Error, Result};
 use crate::io::atomic::check_output;
@@ -95,6 +95,20 @@ pub fn check_adaptivity(adaptivity: f64) -> Result<()> {
         Err(Error::InvalidArgument(format!(
             "adaptivity must be 0 or a positive number of voxels, not {adaptivity}"
         )))
+    }
+}
+
+impl ToMeshRequest {
+    /// The adaptivity of a mesh drawn from a result in memory, checked: `grid` and `iso`
+    /// choose a `.vdb` file's grid and are refused.
+    pub fn result_adaptivity(&self) -> Result<f64> {
+        if self.grid.is_some() || self.iso.is_some() {
+            return Err(Error::InvalidArgument(
+                "grid and iso choose a .vdb file's grid: a result's mesh takes adaptivity".into(),
+            ));
+        }
+        check_adaptivity(self.adaptivity)?;
+        Ok(self.adaptivity)
     }
 }
 
@@ -228,7 +242,10 @@ fn contour_to_file(
         let mut merging = StageClock::new("merge flat regions");
         let simplified =
             merging.time(|| simplify(&mut mesh, adaptivity, field.grid.transform.voxel_size))?;
-        merged = Some(simplified.triangles_before as u64);
+        merged = Some(Merged {
+            triangles_before_merging: simplified.triangles_before as u64,
+            adaptivity,
+        });
         stages.push(merging.stage());
     }
     let mut writing = StageClock::new("write mesh");
@@ -237,8 +254,7 @@ fn contour_to_file(
         file: output.display().to_string(),
         vertices: mesh.positions.len() as u64,
         triangles: mesh.triangles.len() as u64,
-        triangles_before_merging: merged,
-        adaptivity: merged.map(|_| adaptivity),
+        merged,
         ..MeshWritten::default()
     };
     stages.push(writing.stage());

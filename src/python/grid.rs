@@ -400,15 +400,11 @@ impl Grid {
         let outcome = &mut self.outcome;
         if MeshFormat::of(&path).is_ok() {
             let request = Keywords::<ToMeshRequest>::new(options)?.request;
-            if request.grid.is_some() || request.iso.is_some() {
-                return Err(PyValueError::new_err(
-                    "grid and iso choose a .vdb file's grid: a result's mesh takes adaptivity",
-                ));
-            }
+            let adaptivity = request.result_adaptivity().map_err(to_py_err)?;
             return py
                 .detach(|| {
                     check_mesh_output(&path, &inputs)?;
-                    outcome.write_mesh(&path, request.adaptivity)
+                    outcome.write_mesh(&path, adaptivity)
                 })
                 .map_err(to_py_err);
         }
