@@ -4,6 +4,7 @@ the memory limit; kept brick sets read back as one grid."""
 
 import os
 import signal
+import struct
 import subprocess
 import sys
 import time
@@ -41,15 +42,39 @@ def meshes(data):
     return found
 
 
+def tree_bytes(path):
+    """A .vdb's first grid from its tree on (topology and leaf buffers), without its metadata."""
+    b = path.read_bytes()
+
+    def string(p):
+        n = struct.unpack_from("<I", b, p)[0]
+        return p + 4 + n
+
+    p = 8 + 4 + 8 + 1 + 36 + 4 + 4  # magic, versions, offsets flag, UUID, no metadata, count
+    for _ in range(3):  # grid name, tree type, instance parent
+        p = string(p)
+    grid, _, end = struct.unpack_from("<qqq", b, p)
+    (entries,) = struct.unpack_from("<I", b, grid + 4)
+    p = grid + 8
+    for _ in range(3 * entries):  # name, type, value
+        p = string(p)
+    return b[string(p) + 6 * 24:end]  # after the transform's map name and its six vectors
+
+
 @pytest.mark.parametrize("solid", [False, True], ids=["surface", "solid"])
-def test_bricks_equal_the_single_run(meshes, client, tmp_path, solid):
+def test_bricks_equal_the_single_run(meshes, client, tmp_path, pyopenvdb, solid):
     for path in meshes:
         out = tmp_path / f"{path.stem}-{solid}.vdb"
         result = vd.run(path, out, solid=solid, resolution=512, brick=128, client=client)
         single = voxelkit.solid(path, resolution=512) if solid else voxelkit.mesh(path, resolution=512)
-        assert result["grid"].same_voxels(single), path.name
         assert result["voxels"] == len(single) and result["bricks"] > 8
-        assert result["output"] == str(out) and voxelkit.read_vdb(out).same_voxels(single)
+        assert result["output"] == str(out) and voxelkit.read_vdb(out).same_voxels(single), path.name
+        # Spliced from the bricks' nodes, the tree is the single run's byte for byte.
+        assert result["merged_by"] == "splicing"
+        single.write(tmp_path / "single.vdb")
+        assert tree_bytes(out) == tree_bytes(tmp_path / "single.vdb"), path.name
+        assert pyopenvdb.read(str(out), "density").activeVoxelCount() == len(single)
+    assert not list(tmp_path.glob("*.bricks")), "the bricks of a merged run go"
 
 
 def test_bricks_fit_where_the_single_run_does_not(data, client, tmp_path):
@@ -64,7 +89,7 @@ def test_bricks_fit_where_the_single_run_does_not(data, client, tmp_path):
     # The exterior flood across bricks (the winding number's bricks are all tasks).
     result = vd.solid(path, tmp_path / "b.vdb", resolution=768, brick=128, max_memory_mib=limit, client=client,
                       inside="parity")
-    assert result["grid"].same_voxels(single)
+    assert voxelkit.read_vdb(tmp_path / "b.vdb").same_voxels(single)
     assert result["full_bricks"] > 0, "bricks wholly inside are written as tiles"
     # A brick that cannot fit is refused with the reason.
     with pytest.raises(MemoryError, match="brick"):
@@ -79,7 +104,9 @@ def test_bricks_of_open_meshes_give_the_single_runs_winding_solid(data, client, 
     single = voxelkit.solid(path, resolution=160)
     assert result["inside_rule"].startswith("winding") and "open" in result["inside_rule"]
     assert result["bricks"] > 8
-    assert result["grid"].same_voxels(single), name
+    # Bricks of 32 voxels share OpenVDB's 128^3 nodes: merged through one grid.
+    assert result["merged_by"] == "reading"
+    assert voxelkit.read_vdb(tmp_path / f"{name}.vdb").same_voxels(single), name
 
 
 def test_kept_bricks_read_as_one_grid(data, client, cli, tmp_path):
@@ -88,12 +115,49 @@ def test_kept_bricks_read_as_one_grid(data, client, cli, tmp_path):
     result = vd.mesh(path, tmp_path / "t.vdb", resolution=300, brick=64, keep_bricks=True, client=client,
                      max_memory_mib=0)
     index = tmp_path / "t.bricks" / "index.json"
-    assert result["output"] == str(index) and result["grid"] is None
+    assert result["output"] == str(index) and result["merged_by"] is None
     assert not (tmp_path / "t.vdb").exists()
     merged = voxelkit.read_vdb(index)
     assert voxel_set(merged.ijk) == voxel_set(voxelkit.mesh(path, resolution=300).ijk)
     info = cli("info", index).stdout
     assert "bricks" in info and str(result["voxels"]) in info
+
+
+def test_a_kept_brick_set_merges_later_and_refuses_foreign_bricks(data, client, tmp_path):
+    path = data / "meshes" / "torus.obj"
+    vd.mesh(path, tmp_path / "t.vdb", resolution=400, brick=128, keep_bricks=True, client=client)
+    index = tmp_path / "t.bricks" / "index.json"
+    single = voxelkit.mesh(path, resolution=400)
+    single.write(tmp_path / "single.vdb")
+    out = tmp_path / "merged.vdb"
+    done = subprocess.run(
+        [sys.executable, "-m", "voxelkit.distributed", "merge", str(index), "-o", str(out)],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    assert f"{len(single)} voxels merged by splicing" in done.stdout
+    assert tree_bytes(out) == tree_bytes(tmp_path / "single.vdb")
+    out.unlink()
+    bricks = sorted((tmp_path / "t.bricks").glob("brick_*.vdb"))
+    # Every refusal names the file and leaves no output behind.
+    with pytest.raises(OSError, match="brick_"):
+        vd.merge(index, bricks[0])
+    victim = bricks[len(bricks) // 2]
+    whole = victim.read_bytes()
+    victim.write_bytes(whole[: len(whole) // 2])
+    with pytest.raises(OSError, match=victim.name):
+        vd.merge(index, out)
+    # A voxel set on another grid.
+    voxelkit.mesh(path, resolution=40).write(victim)
+    with pytest.raises(ValueError, match=victim.name):
+        vd.merge(index, out)
+    # The same voxels written with half-precision values: not the layout the merge copies.
+    victim.write_bytes(whole)
+    voxelkit.read_vdb(victim).write(tmp_path / "half.vdb", half=True)
+    os.replace(tmp_path / "half.vdb", victim)
+    with pytest.raises(OSError, match=victim.name):
+        vd.merge(index, out)
+    assert not out.exists() and not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
 
 
 def test_the_command_line_starts_its_own_cluster(data, dask, tmp_path):

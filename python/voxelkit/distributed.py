@@ -3,6 +3,7 @@
     python -m voxelkit.distributed mesh IN -r 16384 --brick 1024 --workers 4 -o OUT.vdb
     python -m voxelkit.distributed solid IN -r 4096 --brick 512 --scheduler tcp://host:8786 -o OUT.vdb
     python -m voxelkit.distributed mesh 'f_####.obj' --frames 1-240 -r 512 -o 'out/f_####.vdb'
+    python -m voxelkit.distributed merge OUT.bricks/index.json -o OUT.vdb
 
 The grid is placed as a single run would place it and cut into cubic bricks of ``--brick``
 voxels. The client reads the mesh once and bins its faces: each brick receives only the
@@ -19,10 +20,14 @@ client joins them across bricks and finds the exterior (what reaches the grid's 
 brick then writes its surface and the components that are not exterior, and bricks without
 faces are wholly outside or wholly inside (written as tiles, no task).
 
-The bricks are merged into ``OUT.vdb`` when the result fits in the client's memory (each
-brick reports the bytes its leaves and tiles take; a solid's inside is mostly tiles), else (or
-with ``--keep-bricks``) kept as ``OUT.bricks/`` with an index ``OUT.bricks/index.json`` that
-``voxelkit info`` and ``voxelkit.read_vdb`` read as one grid. Workers write brick files into
+The bricks are merged into ``OUT.vdb``. Bricks of a multiple of 128 voxels (the default 1024)
+lie on OpenVDB's 128^3 nodes and each brick file holds its nodes as the merged file does, so the
+client copies them into place in OpenVDB's order without reading a voxel, building only the
+4096^3 nodes' masks: its memory does not grow with the voxels. Bricks of other sizes are read
+into one grid, and merged only when it fits in the client's memory (each brick reports the
+bytes its leaves and tiles take). With ``--keep-bricks`` (or when that does not fit) the bricks
+stay as ``OUT.bricks/`` with an index ``OUT.bricks/index.json`` that ``voxelkit info`` and
+``voxelkit.read_vdb`` read as one grid. Workers write brick files into
 that folder, so with ``--scheduler`` it must be on a file system every worker sees.
 
 With ``--frames`` the input and output are frame patterns and each frame runs whole on one
@@ -337,24 +342,28 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
             }
             counts = _run(client, calls, "surface", show, check)
         peaks = list(client.run(_peak_rss_mib).values())
-    # Each brick task gives its voxels and the bytes its leaves and tiles take in the merge.
+    bricks_done = time.perf_counter()
+    # Each brick task gives its voxels and the bytes its leaves and tiles take in a merge that
+    # reads them; bricks on OpenVDB's 128^3 nodes are spliced without reading a voxel.
     voxels = sum(v for v, _ in counts.values()) + len(full_bricks) * size**3
     merged_bytes = sum(b for _, b in counts.values()) + len(full_bricks) * plan.full_brick_bytes
     available = _available_bytes()
-    merge = not keep_bricks and (available is None or merged_bytes < available)
+    merge = not keep_bricks and (plan.splices or available is None or merged_bytes < available)
     check()
     index = os.path.join(folder, "index.json")
-    grid = vk.brick_finish(plan, files, full_bricks, index, merged=output if merge else None)
+    merged_by = vk.brick_finish(plan, files, full_bricks, index, merged=output if merge else None)
     if merge:
         shutil.rmtree(folder)
     return {
-        "grid": grid,
         "output": output if merge else index,
+        "merged_by": merged_by,
         "bricks": len(bricks),
         "full_bricks": len(full_bricks),
         "inside_rule": plan.inside_reason,
         "voxels": voxels,
         "seconds": time.perf_counter() - start,
+        "brick_seconds": bricks_done - start,
+        "merge_seconds": time.perf_counter() - bricks_done,
         "worker_peak_mib": peaks,
     }
 
@@ -384,6 +393,23 @@ def frames(inputs, outputs, frames, solid=False, scheduler=None, workers=2, prog
     }
 
 
+def merge(index, output):
+    """Merges a kept brick set (its ``index.json``) into the one .vdb ``output``, atomically, as
+    a run merges it: by splicing bricks of a multiple of 128 voxels (memory that does not grow
+    with the voxels), else by reading them into one grid. The brick set stays.
+
+    Returns a dict: ``output``, ``merged_by`` (``"splicing"`` or ``"reading"``), ``voxels`` and
+    ``seconds``."""
+    start = time.perf_counter()
+    merged_by, voxels = vk.brick_merge(os.fspath(index), os.fspath(output))
+    return {
+        "output": os.fspath(output),
+        "merged_by": merged_by,
+        "voxels": voxels,
+        "seconds": time.perf_counter() - start,
+    }
+
+
 def _with_table_options(fn):
     """``fn`` with the table's options in its signature and docs, after its own."""
     own = [p for p in inspect.signature(fn).parameters.values() if p.kind != p.VAR_KEYWORD]
@@ -397,10 +423,13 @@ run.__doc__ = """Voxelizes ``source`` (a path or a (vertices, faces) pair) in br
 ``client`` (a dask.distributed.Client) when given, else on the scheduler at ``scheduler``,
 else on a local cluster of ``workers`` processes started for the call.
 
-Returns a dict: the merged ``grid`` (a voxelkit.Grid, or None when the bricks were kept),
-``output`` (the .vdb, or the brick set's index), ``bricks`` (the bricks run), ``full_bricks``
-(wholly inside without a task), ``voxels``, ``inside_rule`` (a solid's rule and why),
-``seconds``, and ``worker_peak_mib`` (each worker process's peak memory).
+Returns a dict: ``output`` (the .vdb, or the brick set's index when the bricks were kept;
+``voxelkit.read_vdb`` reads either), ``merged_by`` (``"splicing"``: bricks of a multiple of 128
+voxels, their nodes copied without reading a voxel; ``"reading"``: other sizes, through one
+grid in memory; None when kept), ``bricks`` (the bricks run), ``full_bricks`` (wholly inside
+without a task), ``voxels``, ``inside_rule`` (a solid's rule and why), ``seconds`` (of which
+``brick_seconds`` up to the last brick and ``merge_seconds`` after), and ``worker_peak_mib``
+(each worker process's peak memory).
 
 The options, as for every voxelkit function (``voxelkit.OPTIONS["distributed"]``):
 """
@@ -489,7 +518,19 @@ def main(argv=None):
         where.add_argument("--scheduler", help="address of a running Dask scheduler")
         where.add_argument("--workers", type=int, default=2, help="local worker processes (default 2)")
         p.add_argument("--keep-bricks", action="store_true", help="keep the brick set instead of merging")
+    p = commands.add_parser("merge", help="merge a kept brick set into one .vdb")
+    p.add_argument("index", help="the brick set's index (OUT.bricks/index.json)")
+    p.add_argument("-o", "--output", required=True, help="output .vdb")
     args = parser.parse_args(argv)
+    if args.command == "merge":
+        try:
+            result = merge(args.index, args.output)
+        except (ValueError, MemoryError, OSError, RuntimeError) as e:
+            print(f"error: {e}", file=sys.stderr)
+            return 1
+        print(f"{result['output']}: {result['voxels']} voxels merged by {result['merged_by']} "
+              f"in {result['seconds']:.2f} s")
+        return 0
     given = vars(args)
     table = {f["name"]: given[f["name"]] for f in _FIELDS if f["name"] in given}
     if args.frames is not None and args.keep_bricks:
@@ -521,7 +562,11 @@ def main(argv=None):
             f"{result['voxel_size']:.6g},"
         )
     inside = f"; inside: {result['inside_rule']}" if result.get("inside_rule") else ""
-    print(f"{done} in {result['seconds']:.2f} s; worker peak memory {peaks} MiB{inside}")
+    took = f"in {result['seconds']:.2f} s"
+    if result.get("merged_by"):
+        took += (f" (bricks {result['brick_seconds']:.2f} s, merge by {result['merged_by']} "
+                 f"{result['merge_seconds']:.2f} s)")
+    print(f"{done} {took}; worker peak memory {peaks} MiB{inside}")
     return 0
 
 

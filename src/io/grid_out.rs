@@ -197,7 +197,8 @@ pub(super) enum Entry<'g> {
 /// order.
 pub(super) type Key = ([i32; 3], u16, u16);
 
-fn key(path: &Path, origin: [i64; 3]) -> Result<Key> {
+/// The key of the block at `origin`; errors name `path`.
+pub(super) fn key(path: &Path, origin: [i64; 3]) -> Result<Key> {
     let mut c = [0i32; 3];
     for (o, &v) in c.iter_mut().zip(&origin) {
         *o = i32::try_from(v)

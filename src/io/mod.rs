@@ -3,6 +3,8 @@ pub mod atomic;
 pub mod binvox;
 #[cfg(feature = "vdb")]
 pub mod brick_set;
+#[cfg(feature = "vdb")]
+pub mod brick_splice;
 mod direct_file;
 #[cfg(feature = "vdb")]
 pub mod grid_export;

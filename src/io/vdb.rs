@@ -213,7 +213,7 @@ pub fn content_grid_count(
 
 /// Every grid `contents` can write, before `options` choose among them: its own, then its
 /// attributes' (scalars as FloatGrids, texture coordinates and normals as Vec3SGrids).
-fn candidates<'g>(
+pub(super) fn candidates<'g>(
     path: &Path,
     contents: &Contents<'g>,
     meta: &'g [(String, MetaValue)],

@@ -17,6 +17,18 @@ pub(super) struct Reader {
 }
 
 impl Reader {
+    /// The file at `path`, read through a large buffer: most skips (compressed chunks of a
+    /// few hundred bytes) stay inside it.
+    pub(super) fn open(path: &Path) -> Result<Reader> {
+        let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+        let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
+        Ok(Reader {
+            input: BufReader::with_capacity(1 << 20, file),
+            pos: 0,
+            len,
+        })
+    }
+
     pub(super) fn bytes<const N: usize>(
         &mut self,
         what: &str,
@@ -91,14 +103,7 @@ impl Reader {
 /// Checks the structure of the `.vdb` at `path`; the error says where it breaks. Returns the
 /// bytes OpenVDB allocates to read its trees.
 pub fn check_structure(path: &Path) -> Result<u64> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
-    let mut r = Reader {
-        // A large buffer: most skips (compressed chunks of a few hundred bytes) stay inside it.
-        input: BufReader::with_capacity(1 << 20, file),
-        pos: 0,
-        len,
-    };
+    let mut r = Reader::open(path)?;
     walk(&mut r).map_err(|message| Error::Vdb {
         path: path.to_path_buf(),
         message: format!(
@@ -109,7 +114,11 @@ pub fn check_structure(path: &Path) -> Result<u64> {
 
 /// A metadata map: a count, then name, type and value of each entry. OpenVDB's per-leaf
 /// delayed-load table sizes itself by a count of its own: it must fit `max_entries`.
-fn metadata(r: &mut Reader, what: &str, max_entries: u64) -> std::result::Result<(), String> {
+pub(super) fn metadata(
+    r: &mut Reader,
+    what: &str,
+    max_entries: u64,
+) -> std::result::Result<(), String> {
     let entries = r.u32(what)?;
     for _ in 0..entries {
         r.string(what)?;

@@ -246,7 +246,7 @@ fn ones(mask: &[u8]) -> u64 {
 /// One leaf's buffer record, laid out by the tree's leaf kind. A value leaf repeats its voxel
 /// mask, which must agree with its topology: OpenVDB counts the stored values by one or the
 /// other.
-fn leaf_buffer(
+pub(super) fn leaf_buffer(
     r: &mut Reader,
     format: TreeFormat,
     compression: u32,
@@ -272,7 +272,7 @@ fn leaf_buffer(
 
 /// OpenVDB's node values: a flag saying what follows (up to two inactive values and a
 /// selection mask), then every value, or with mask compression only the active ones.
-fn compressed_values(
+pub(super) fn compressed_values(
     r: &mut Reader,
     format: TreeFormat,
     compression: u32,

@@ -12,10 +12,12 @@ use super::direct_file::DirectFile;
 use super::grid_out::{Entry, GridOut, GridValues, Key, ValueType, tree_entries};
 use super::vdb::WriteClocks;
 use super::vdb_chunks::{compression_name, push_chunk};
-use super::vdb_format::{COMPRESS_ACTIVE_MASK, FILE_VERSION, LIBRARY_VERSION, MAGIC, tree_type};
+use super::vdb_format::{
+    COMPRESS_ACTIVE_MASK, FILE_VERSION, HALF_SUFFIX, LIBRARY_VERSION, MAGIC, tree_type,
+};
 use super::vdb_tree_structure::{TreeFormat, tree_memory};
 use crate::error::{Error, Result};
-use crate::grid::{LEAF_VOXELS, Leaf, Transform};
+use crate::grid::{CoordBox, LEAF_VOXELS, Leaf, Transform};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -25,7 +27,7 @@ use std::sync::OnceLock;
 const BATCH: usize = 2048;
 
 /// The standard tree's type name of a grid.
-fn tree_type_of(values: GridValues) -> String {
+pub(super) fn tree_type_of(values: GridValues) -> String {
     tree_type(match values.value_type() {
         ValueType::Bool => "bool",
         ValueType::Vec3 => "vec3s",
@@ -109,14 +111,7 @@ pub(super) fn write_grids(
             .map(|g| clocks.encode.time(|| grid_head(path, g, encoding)));
         let encoded = grids.iter().enumerate().try_for_each(|(n, g)| {
             let head = following.take().expect("each grid's head is built")?;
-            let mut descriptor = Vec::new();
-            push_string(&mut descriptor, &g.name);
-            let mut tree_type = tree_type_of(g.values);
-            if head.half {
-                tree_type.push_str("_HalfFloat");
-            }
-            push_string(&mut descriptor, &tree_type);
-            push_string(&mut descriptor, ""); // not an instance of another grid
+            let mut descriptor = descriptor_names(g, head.half);
             let grid_pos = file_out.pos + descriptor.len() as u64 + 24;
             let block_pos = grid_pos + head.head.len() as u64;
             for p in [grid_pos, block_pos, 0] {
@@ -235,7 +230,7 @@ const EARLY_SYNC_BYTES: u64 = 16 << 20;
 
 /// The magic number, versions, a flag for grid offsets, a UUID, no file metadata, the grid
 /// count.
-fn file_header(grids: usize) -> Vec<u8> {
+pub(super) fn file_header(grids: usize) -> Vec<u8> {
     let mut out = Vec::new();
     out.extend_from_slice(&MAGIC.to_le_bytes());
     out.extend_from_slice(&FILE_VERSION.to_le_bytes());
@@ -275,9 +270,23 @@ fn uuid() -> String {
     )
 }
 
-fn push_string(out: &mut Vec<u8>, s: &str) {
+pub(super) fn push_string(out: &mut Vec<u8>, s: &str) {
     out.extend_from_slice(&(s.len() as u32).to_le_bytes());
     out.extend_from_slice(s.as_bytes());
+}
+
+/// A grid descriptor's names: the grid's, its tree type's and the empty name of the grid it
+/// would be an instance of; its three offsets follow.
+pub(super) fn descriptor_names(g: &GridOut, half: bool) -> Vec<u8> {
+    let mut out = Vec::new();
+    push_string(&mut out, &g.name);
+    let mut tree_type = tree_type_of(g.values);
+    if half {
+        tree_type.push_str(HALF_SUFFIX);
+    }
+    push_string(&mut out, &tree_type);
+    push_string(&mut out, "");
+    out
 }
 
 /// A grid's head, from its compression flags through its topology, and its leaves in the
@@ -305,7 +314,13 @@ fn grid_head<'g>(path: &Path, g: &GridOut<'g>, encoding: Encoding) -> Result<Gri
     let internal = encoded
         .iter()
         .fold([0u64; 2], |a, e| [a[0] + e.2[0], a[1] + e.2[1]]);
-    push_metadata(&mut head, g, encoding, internal, leaves.len() as u64);
+    let stats = TreeStats {
+        bbox: g.grid.bbox(),
+        voxels: g.grid.voxel_count(),
+        internal,
+        leaves: leaves.len() as u64,
+    };
+    push_metadata(&mut head, g, encoding, &stats);
     push_transform(&mut head, g.grid.transform);
     head.extend_from_slice(&1u32.to_le_bytes()); // one buffer per leaf
     match g.values {
@@ -431,7 +446,7 @@ fn root_child_topology<'g>(
 
 /// An internal node's child and value masks, then its tile values: every non-child slot
 /// holds the background except the active tiles, so only those are stored.
-fn push_internal_values(
+pub(super) fn push_internal_values(
     out: &mut Vec<u8>,
     children: &[u64],
     tiles: &[u64],
@@ -531,15 +546,18 @@ fn push_values(out: &mut Vec<u8>, data: &[u8], values: GridValues, compression: 
     push_chunk(out, data, component, compression);
 }
 
+/// What a tree holds, as its metadata states it: its active voxels' box and count, its
+/// internal nodes by depth and its leaves.
+pub(super) struct TreeStats {
+    pub bbox: Option<CoordBox>,
+    pub voxels: u64,
+    pub internal: [u64; 2],
+    pub leaves: u64,
+}
+
 /// The grid's metadata map, sorted by name as OpenVDB keeps it: the caller's entries, then
 /// the grid's name, class and vector type, and the statistics OpenVDB adds when it writes.
-fn push_metadata(
-    out: &mut Vec<u8>,
-    g: &GridOut,
-    encoding: Encoding,
-    internal: [u64; 2],
-    leaves: u64,
-) {
+pub(super) fn push_metadata(out: &mut Vec<u8>, g: &GridOut, encoding: Encoding, stats: &TreeStats) {
     use super::vdb_format::MetaValue;
     enum Meta {
         Str(String),
@@ -567,7 +585,7 @@ fn push_metadata(
     if let Some(kind) = g.vector_type {
         map.insert("vector_type", Meta::Str(kind.to_string()));
     }
-    if let Some(b) = g.grid.bbox() {
+    if let Some(b) = stats.bbox {
         map.insert("file_bbox_min", Meta::Vec3i(b.min.map(|v| v as i32)));
         map.insert("file_bbox_max", Meta::Vec3i(b.max.map(|v| v as i32)));
     }
@@ -578,9 +596,9 @@ fn push_metadata(
     let format = TreeFormat::of(&tree_type_of(g.values)).expect("a standard tree");
     map.insert(
         "file_mem_bytes",
-        Meta::Int64(tree_memory(format, internal, leaves) as i64),
+        Meta::Int64(tree_memory(format, stats.internal, stats.leaves) as i64),
     );
-    map.insert("file_voxel_count", Meta::Int64(g.grid.voxel_count() as i64));
+    map.insert("file_voxel_count", Meta::Int64(stats.voxels as i64));
     map.insert(
         "is_saved_as_half_float",
         Meta::Bool(encoding.half && (g.values.value_type() != ValueType::Bool)),
@@ -604,7 +622,7 @@ fn push_metadata(
 /// A uniform scale and translation, as OpenVDB's `UniformScaleTranslateMap` stores it: the
 /// translation, the scale, the voxel size and the scale's inverse, inverse square and
 /// inverse double.
-fn push_transform(out: &mut Vec<u8>, t: Transform) {
+pub(super) fn push_transform(out: &mut Vec<u8>, t: Transform) {
     push_string(out, "UniformScaleTranslateMap");
     let s = t.voxel_size;
     let vectors = [

@@ -7,6 +7,7 @@
 mod attribute_grids;
 pub mod batch;
 pub mod brick_exterior;
+pub mod brick_merge;
 pub mod bricks;
 mod estimate;
 mod load;

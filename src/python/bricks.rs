@@ -4,7 +4,6 @@
 //! back, and where each face starts (m + 1 entries).
 
 use super::arrays::mesh_source;
-use super::grid::Grid;
 use super::keywords::Keywords;
 use super::to_py_err;
 use crate::choice::Choice;
@@ -15,6 +14,7 @@ use crate::io::vdb::WriteOptions;
 use crate::mesh::GridFit;
 use crate::mesh::Mesh;
 use crate::pipeline::brick_exterior::exterior_labels;
+use crate::pipeline::brick_merge::merge_brick_set;
 use crate::pipeline::bricks::{BrickIndex, BrickRun, sub_mesh};
 use crate::pipeline::request::{BricksRequest, mib_limit};
 use crate::pipeline::{BrickStage, BrickTask, Details, Job, Limits, Outcome, Task, merged_bytes};
@@ -124,6 +124,13 @@ impl BrickPlan {
         let mut full = crate::grid::SparseGrid::new(layout.transform, Default::default());
         crate::io::brick_set::fill_box(&mut full, layout.voxels(layout.min));
         merged_bytes(&full)
+    }
+
+    /// Whether the bricks lie on OpenVDB's 128^3 nodes, so that their merge copies each
+    /// brick's nodes without reading a voxel, in memory that does not grow with them.
+    #[getter]
+    fn splices(&self) -> bool {
+        self.0.layout.size % crate::grid::NODE_DIM == 0
     }
 
     /// The bricks a winding solid runs (with faces, or within the mesh's box).
@@ -401,7 +408,8 @@ pub fn brick_exterior(
 }
 
 /// Writes the brick-set index `index` (brick files named relative to it); with `merged`, also
-/// merges the bricks into that one `.vdb` and returns it as a Grid.
+/// merges the bricks into that one `.vdb` (see `pipeline::brick_merge`) and returns how
+/// (`"splicing"` or `"reading"`).
 #[pyfunction]
 #[pyo3(signature = (plan, files, full_bricks, index, merged = None))]
 pub fn brick_finish(
@@ -411,7 +419,7 @@ pub fn brick_finish(
     full_bricks: Vec<PyBrick>,
     index: PathBuf,
     merged: Option<PathBuf>,
-) -> PyResult<Option<Grid>> {
+) -> PyResult<Option<&'static str>> {
     let set = BrickSet {
         format: crate::io::brick_set::BRICK_SET_FORMAT.into(),
         voxel_size: plan.0.layout.transform.voxel_size,
@@ -426,16 +434,30 @@ pub fn brick_finish(
             .collect(),
         full_bricks: full_bricks.into_iter().map(from_py).collect(),
     };
-    py.detach(|| -> Result<Option<Grid>> {
+    let source = plan.0.mesh.source.display().to_string();
+    py.detach(|| -> Result<Option<&'static str>> {
         set.write(&index)?;
         let Some(out) = merged else {
             return Ok(None);
         };
-        let mut outcome = Outcome::read_vdb(&index, None)?;
-        outcome.write(&out, &[index.as_path()], &WriteOptions::default())?;
-        Ok(Some(Grid::new(outcome, vec![index.clone()])))
+        let (by, _) = merge_brick_set(&index, &out, &source)?;
+        Ok(Some(by.name()))
     })
     .map_err(to_py_err)
+}
+
+/// Merges the brick set of the index at `index` into the one `.vdb` `output` (see
+/// `pipeline::brick_merge`); returns how (`"splicing"` or `"reading"`) and its voxels.
+#[pyfunction]
+pub fn brick_merge(
+    py: Python<'_>,
+    index: PathBuf,
+    output: PathBuf,
+) -> PyResult<(&'static str, u64)> {
+    let source = index.display().to_string();
+    py.detach(|| merge_brick_set(&index, &output, &source))
+        .map(|(by, voxels)| (by.name(), voxels))
+        .map_err(to_py_err)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -447,5 +469,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(brick_winding_file, m)?)?;
     m.add_function(wrap_pyfunction!(brick_exterior, m)?)?;
     m.add_function(wrap_pyfunction!(brick_finish, m)?)?;
+    m.add_function(wrap_pyfunction!(brick_merge, m)?)?;
     Ok(())
 }

@@ -1,0 +1,608 @@
+//! A brick set merged into one `.vdb` without decoding a voxel. A brick whose edge is a
+//! multiple of 128 voxels holds whole 128^3 nodes of OpenVDB's tree, and its file holds each
+//! of them as the merged file does: the node's topology (masks, tile values, its leaves'
+//! masks) and its leaves' compressed buffers, byte for byte. The merge walks each brick file's
+//! structure (masks and chunk sizes, never a value), sorts the nodes of all bricks into
+//! OpenVDB's order and copies their bytes into place, building only the root's children
+//! (4096^3 nodes: which of their slots hold a node or a tile) itself. It holds a few dozen
+//! bytes per 128^3 node and no voxel, so its memory does not grow with the voxels merged.
+
+use super::atomic::{check_output, write_atomic};
+use super::brick_set::{BrickSet, brick_voxels};
+use super::direct_file::DirectFile;
+use super::grid_out::{GridOut, block_origin, key};
+use super::vdb::{Contents, MetaValue, WriteOptions, candidates, meta_entries};
+use super::vdb_format::{
+    COMPRESS_ACTIVE_MASK, LEAF_MASK_BYTES, MAGIC, NODE_LOG2, NODE_MASK_VERSION, ROOT_TILE,
+};
+use super::vdb_structure::{Reader, metadata};
+use super::vdb_tree_structure::{TreeFormat, compressed_values, leaf_buffer};
+use super::vdb_writer::{
+    Encoding, TreeStats, descriptor_names, file_header, push_internal_values, push_metadata,
+    push_string, push_transform, tree_type_of,
+};
+use crate::error::{Error, Result};
+use crate::grid::{Channels, CoordBox, NODE_DIM, SparseGrid, Transform};
+use glam::DVec3;
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::fs::File;
+use std::ops::Range;
+use std::os::unix::fs::FileExt;
+use std::path::{Path, PathBuf};
+
+/// Where a 128^3 slot lies: its root child's origin and its slot there. Sorting by key gives
+/// OpenVDB's order.
+type NodeKey = ([i32; 3], u16);
+
+/// A 128^3 node in one brick file: the bytes of its topology and of its leaves' buffers.
+struct NodeBytes {
+    brick: usize,
+    topology: Range<u64>,
+    buffers: Range<u64>,
+    leaves: u64,
+}
+
+/// A 128^3 slot of the merged tree: a node copied from a brick file, or an active tile.
+type Slot = (NodeKey, Option<NodeBytes>);
+
+/// What a merge wrote.
+#[derive(Clone, Copy, Debug)]
+pub struct Spliced {
+    pub voxels: u64,
+    /// 128^3 nodes copied from brick files, and 128^3 tiles.
+    pub nodes: u64,
+    pub tiles: u64,
+    pub bytes: u64,
+}
+
+/// Whether the bricks of `set` lie on OpenVDB's 128^3 nodes, as `splice_brick_set` needs.
+pub fn splices(set: &BrickSet) -> bool {
+    set.brick_size % NODE_DIM == 0
+}
+
+/// Merges the brick set of the index at `index` into the `.vdb` `output` (atomically), as
+/// the voxel set voxelkit writes (`density`) with `metadata`, copying each brick's nodes
+/// without decoding them. Refuses bricks that do not lie on 128^3 nodes (`splices`) and a
+/// brick file not laid out as voxelkit writes a voxel set, naming it.
+pub fn splice_brick_set(
+    set: &BrickSet,
+    index: &Path,
+    output: &Path,
+    metadata: &[(&str, MetaValue)],
+) -> Result<Spliced> {
+    if !splices(set) {
+        return Err(Error::InvalidArgument(format!(
+            "{}: bricks of {} voxels do not lie on OpenVDB's {NODE_DIM}-voxel nodes; only \
+             bricks of a multiple of {NODE_DIM} merge without reading their voxels",
+            index.display(),
+            set.brick_size
+        )));
+    }
+    let files = set.files(index)?;
+    let inputs: Vec<&Path> = std::iter::once(index)
+        .chain(files.iter().map(PathBuf::as_path))
+        .collect();
+    check_output(output, &inputs)?;
+    let meta = meta_entries(metadata);
+    let empty = SparseGrid::new(set.transform(), Channels::NONE);
+    let contents = Contents::Voxels {
+        grid: &empty,
+        masks: Vec::new(),
+        attributes: &[],
+    };
+    let options = WriteOptions::default();
+    let grid = candidates(output, &contents, &meta, &options)?
+        .into_iter()
+        .next()
+        .expect("a voxel set writes its fog volume");
+    let encoding = Encoding {
+        compression: options.compression.flags(),
+        half: false,
+    };
+    let layout = Layout::of(&grid, encoding);
+    let bricks: Vec<BrickNodes> = set
+        .bricks
+        .par_iter()
+        .zip(&files)
+        .enumerate()
+        .map(|(n, (brick, file))| {
+            let nodes = brick_nodes(file, n, &layout)?;
+            set.check_part(brick, file, nodes.bbox, &nodes.transform)?;
+            Ok(nodes)
+        })
+        .collect::<Result<_>>()?;
+    // Every brick's transform is close to the set's (`check_part`); the merged file takes the
+    // first brick's, and the others must be equal to it.
+    let transform = bricks.first().map_or(set.transform(), |b| b.transform);
+    if let Some((_, file)) = bricks
+        .iter()
+        .zip(&files)
+        .find(|(b, _)| b.transform != transform)
+    {
+        return Err(Error::Vdb {
+            path: file.clone(),
+            message: "its transform is not the first brick's".into(),
+        });
+    }
+    let mut merged = Merged::default();
+    for b in bricks {
+        merged.add(b.slots, b.bbox, b.voxels);
+    }
+    for &b in &set.full_bricks {
+        merged.add_full(brick_voxels(b, set.brick_size), output)?;
+    }
+    merged.slots.par_sort_unstable_by_key(|s| s.0);
+    if let Some(w) = merged.slots.windows(2).find(|w| w[0].0 == w[1].0) {
+        return Err(Error::Parse {
+            path: index.to_path_buf(),
+            line: 0,
+            message: format!(
+                "two bricks hold the node at {:?}",
+                block_origin(&(w[0].0.0, w[0].0.1, 0), false)
+            ),
+        });
+    }
+    let spliced = Spliced {
+        voxels: merged.voxels,
+        nodes: merged.slots.iter().filter(|s| s.1.is_some()).count() as u64,
+        tiles: merged.slots.iter().filter(|s| s.1.is_none()).count() as u64,
+        bytes: 0,
+    };
+    let mut bytes = 0;
+    write_atomic(output, |tmp| {
+        bytes = write_spliced(tmp, output, &grid, encoding, transform, &merged, &files)?;
+        Ok(())
+    })?;
+    Ok(Spliced { bytes, ..spliced })
+}
+
+/// What every brick file must hold to be copied into the merged file: the grid's name, tree
+/// type, compression and background as the merge writes them.
+struct Layout {
+    name: String,
+    tree_type: String,
+    compression: u32,
+    background: Vec<u8>,
+    format: TreeFormat,
+}
+
+impl Layout {
+    fn of(grid: &GridOut, encoding: Encoding) -> Layout {
+        let tree_type = tree_type_of(grid.values);
+        Layout {
+            name: grid.name.to_string(),
+            format: TreeFormat::of(&tree_type).expect("a standard tree"),
+            tree_type,
+            compression: encoding.compression | COMPRESS_ACTIVE_MASK,
+            background: grid.values.background().to_le_bytes().to_vec(),
+        }
+    }
+}
+
+/// One brick file's 128^3 slots, the box and count of its active voxels, and its transform.
+struct BrickNodes {
+    slots: Vec<Slot>,
+    bbox: Option<CoordBox>,
+    voxels: u64,
+    transform: Transform,
+}
+
+/// Walks the brick file `file` (number `brick` of the set) against `layout`.
+fn brick_nodes(file: &Path, brick: usize, layout: &Layout) -> Result<BrickNodes> {
+    let mut r = Reader::open(file)?;
+    walk_brick(&mut r, brick, layout).map_err(|message| Error::Vdb {
+        path: file.to_path_buf(),
+        message: format!(
+            "cannot merge it: not a brick as voxelkit writes one, or a damaged or truncated one \
+             ({message})"
+        ),
+    })
+}
+
+fn walk_brick(
+    r: &mut Reader,
+    brick: usize,
+    layout: &Layout,
+) -> std::result::Result<BrickNodes, String> {
+    if r.i64("the header")? != MAGIC {
+        return Err("it does not start with OpenVDB's magic number".into());
+    }
+    if r.u32("the header")? < NODE_MASK_VERSION {
+        return Err("an older file format than voxelkit writes".into());
+    }
+    r.skip(8, "the library version")?;
+    if r.bytes::<1>("the header")?[0] == 0 {
+        return Err("it has no grid offsets (an OpenVDB stream, not a file)".into());
+    }
+    r.skip(36, "the file's UUID")?;
+    metadata(r, "the file's metadata", 0)?;
+    if r.u32("the grid count")? == 0 {
+        return Err("it holds no grid".into());
+    }
+    let what = "the first grid's descriptor";
+    let name = r.short_string(what)?;
+    let tree_type = r.short_string(what)?;
+    let instance = r.short_string(what)?;
+    if name != layout.name || tree_type != layout.tree_type || !instance.is_empty() {
+        return Err(format!(
+            "its first grid is `{name}` of type {tree_type}, not the voxel set `{}` of type {} \
+             that bricks hold",
+            layout.name, layout.tree_type
+        ));
+    }
+    let (grid, block, end) = (r.i64(what)?, r.i64(what)?, r.i64(what)?);
+    let inside = |p: i64| p >= 0 && (p as u64) <= r.len;
+    if !(inside(grid) && inside(block) && inside(end) && grid <= block && block <= end) {
+        return Err(format!(
+            "the grid claims bytes {grid}..{end}, outside the file"
+        ));
+    }
+    r.seek(grid as u64)?;
+    let compression = r.u32("the grid's compression")?;
+    if compression != layout.compression {
+        return Err(format!(
+            "compression flags {compression}, where the merge writes {}",
+            layout.compression
+        ));
+    }
+    let file_len = std::mem::replace(&mut r.len, block as u64);
+    metadata(r, "the grid's metadata", (end - grid) as u64 / 64 + 1)?;
+    let transform = brick_transform(r)?;
+    let what = "the tree";
+    if r.u32(what)? != 1 {
+        return Err("a tree of more than one buffer".into());
+    }
+    if r.vec(layout.background.len() as u64, what)? != layout.background {
+        return Err("a background other than the voxel set's".into());
+    }
+    if r.u32(what)? != 0 {
+        return Err("tiles at the root".into());
+    }
+    let children = r.u32(what)?;
+    let mut walk = Walk::default();
+    let mut previous = None;
+    for _ in 0..children {
+        let mut origin = [0i32; 3];
+        for v in &mut origin {
+            *v = i32::from_le_bytes(r.bytes::<4>(what)?);
+        }
+        if origin.iter().any(|v| v.rem_euclid(ROOT_TILE) != 0) || previous >= Some(origin) {
+            return Err(format!(
+                "a root child at {origin:?}, off the lattice or out of order"
+            ));
+        }
+        previous = Some(origin);
+        walk.root_child(r, origin, brick, layout)?;
+    }
+    r.len = end as u64;
+    r.seek(block as u64)?;
+    let mut leaves = walk.leaves.iter();
+    for (_, node) in &mut walk.slots {
+        let Some(node) = node else { continue };
+        let start = r.pos;
+        for &active in leaves.by_ref().take(node.leaves as usize) {
+            leaf_buffer(r, layout.format, compression, active, "a leaf buffer")?;
+        }
+        node.buffers = start..r.pos;
+    }
+    r.len = file_len;
+    Ok(BrickNodes {
+        slots: walk.slots,
+        bbox: walk.bbox,
+        voxels: walk.voxels,
+        transform,
+    })
+}
+
+/// The grid's transform, which must be laid out as voxelkit writes it (a uniform scale and
+/// translation with its derived values).
+fn brick_transform(r: &mut Reader) -> std::result::Result<Transform, String> {
+    let what = "the transform";
+    let name = r.short_string(what)?;
+    let mut stored = Vec::new();
+    push_string(&mut stored, &name);
+    stored.extend_from_slice(&r.vec(6 * 24, what)?);
+    let real = |at: usize| f64::from_le_bytes(stored[at..at + 8].try_into().expect("8 bytes"));
+    let at = 4 + name.len();
+    let transform = Transform::new(
+        DVec3::new(real(at), real(at + 8), real(at + 16)),
+        real(at + 24),
+    );
+    let mut expected = Vec::new();
+    push_transform(&mut expected, transform);
+    if stored != expected {
+        return Err(format!(
+            "a transform ({name}) not laid out as voxelkit writes one"
+        ));
+    }
+    Ok(transform)
+}
+
+/// A brick file's slots as its tree is walked, its leaves' voxel counts in buffer order, and
+/// the box and count of its voxels.
+#[derive(Default)]
+struct Walk {
+    slots: Vec<Slot>,
+    leaves: Vec<u16>,
+    bbox: Option<CoordBox>,
+    voxels: u64,
+}
+
+impl Walk {
+    fn grow(&mut self, min: [i64; 3], max: [i64; 3], voxels: u64) {
+        self.voxels += voxels;
+        self.bbox = Some(match self.bbox {
+            None => CoordBox { min, max },
+            Some(b) => CoordBox {
+                min: [0, 1, 2].map(|a| b.min[a].min(min[a])),
+                max: [0, 1, 2].map(|a| b.max[a].max(max[a])),
+            },
+        });
+    }
+
+    /// A root child (4096^3): its masks and tile values, then each 128^3 child's topology.
+    fn root_child(
+        &mut self,
+        r: &mut Reader,
+        origin: [i32; 3],
+        brick: usize,
+        layout: &Layout,
+    ) -> std::result::Result<(), String> {
+        let what = "a root child";
+        let bytes = (1u64 << (3 * NODE_LOG2[0])) / 8;
+        let children = r.vec(bytes, what)?;
+        let values = r.vec(bytes, what)?;
+        compressed_values(r, layout.format, layout.compression, &values, what)?;
+        for slot in set_bits(&values).filter(|&s| !bit(&children, s)) {
+            let key = (origin, slot as u16);
+            let min = block_origin(&(origin, slot as u16, 0), false).map(i64::from);
+            let edge = i64::from(NODE_DIM as i32);
+            self.grow(min, min.map(|v| v + edge - 1), (edge as u64).pow(3));
+            self.slots.push((key, None));
+        }
+        for slot in set_bits(&children) {
+            let start = r.pos;
+            let leaves = self.lower_node(r, (origin, slot as u16), layout)?;
+            self.slots.push((
+                (origin, slot as u16),
+                Some(NodeBytes {
+                    brick,
+                    topology: start..r.pos,
+                    buffers: 0..0,
+                    leaves,
+                }),
+            ));
+        }
+        Ok(())
+    }
+
+    /// A 128^3 node's masks, tile values and leaf masks; its leaf count.
+    fn lower_node(
+        &mut self,
+        r: &mut Reader,
+        key: NodeKey,
+        layout: &Layout,
+    ) -> std::result::Result<u64, String> {
+        let what = "a 128^3 node";
+        let bytes = (1u64 << (3 * NODE_LOG2[1])) / 8;
+        let children = r.vec(bytes, what)?;
+        let values = r.vec(bytes, what)?;
+        compressed_values(r, layout.format, layout.compression, &values, what)?;
+        let block = |slot: usize| block_origin(&(key.0, key.1, slot as u16), true).map(i64::from);
+        for slot in set_bits(&values).filter(|&s| !bit(&children, s)) {
+            let min = block(slot);
+            self.grow(min, min.map(|v| v + 7), 512);
+        }
+        let mut leaves = 0;
+        for slot in set_bits(&children) {
+            let mask = r.vec(LEAF_MASK_BYTES, "a leaf's mask")?;
+            let active = mask.iter().map(|b| b.count_ones()).sum::<u32>();
+            self.leaves.push(active as u16);
+            leaves += 1;
+            if let Some((lo, hi)) = mask_box(&mask) {
+                let o = block(slot);
+                let at = |c: [i64; 3]| [0, 1, 2].map(|a| o[a] + c[a]);
+                self.grow(at(lo), at(hi), u64::from(active));
+            }
+        }
+        Ok(leaves)
+    }
+}
+
+fn bit(mask: &[u8], n: usize) -> bool {
+    mask[n / 8] >> (n % 8) & 1 == 1
+}
+
+fn set_bits(mask: &[u8]) -> impl Iterator<Item = usize> + '_ {
+    (0..mask.len() * 8).filter(|&n| bit(mask, n))
+}
+
+/// The box of a leaf's active voxels within it (offset `x * 64 + y * 8 + z`), if any.
+fn mask_box(mask: &[u8]) -> Option<([i64; 3], [i64; 3])> {
+    let words: Vec<u64> = mask
+        .chunks_exact(8)
+        .map(|w| u64::from_le_bytes(w.try_into().expect("8 bytes")))
+        .collect();
+    let xs: Vec<i64> = (0..8).filter(|&x| words[x as usize] != 0).collect();
+    let (&x0, &x1) = (xs.first()?, xs.last()?);
+    let rows = words.iter().fold(0u64, |a, w| a | w); // bit y * 8 + z
+    let ys: Vec<i64> = (0..8).filter(|&y| (rows >> (8 * y)) & 0xff != 0).collect();
+    let zs = (0..8).fold(0u64, |a, y| a | (rows >> (8 * y)) & 0xff);
+    let z0 = zs.trailing_zeros() as i64;
+    let z1 = 63 - zs.leading_zeros() as i64;
+    Some(([x0, ys[0], z0], [x1, ys[ys.len() - 1], z1]))
+}
+
+/// The slots of all bricks and full bricks, and the box and count of their voxels.
+#[derive(Default)]
+struct Merged {
+    slots: Vec<Slot>,
+    bbox: Option<CoordBox>,
+    voxels: u64,
+    leaves: u64,
+}
+
+impl Merged {
+    fn add(&mut self, slots: Vec<Slot>, bbox: Option<CoordBox>, voxels: u64) {
+        self.leaves += slots
+            .iter()
+            .filter_map(|s| s.1.as_ref())
+            .map(|n| n.leaves)
+            .sum::<u64>();
+        self.slots.extend(slots);
+        self.voxels += voxels;
+        if let Some(b) = bbox {
+            self.bbox = Some(match self.bbox {
+                None => b,
+                Some(a) => CoordBox {
+                    min: [0, 1, 2].map(|i| a.min[i].min(b.min[i])),
+                    max: [0, 1, 2].map(|i| a.max[i].max(b.max[i])),
+                },
+            });
+        }
+    }
+
+    /// A brick wholly inside: a tile on each of its 128^3 slots.
+    fn add_full(&mut self, b: CoordBox, output: &Path) -> Result<()> {
+        let mut slots = Vec::new();
+        let step = NODE_DIM as usize;
+        for x in (b.min[0]..=b.max[0]).step_by(step) {
+            for y in (b.min[1]..=b.max[1]).step_by(step) {
+                for z in (b.min[2]..=b.max[2]).step_by(step) {
+                    let k = key(output, [x, y, z])?;
+                    slots.push(((k.0, k.1), None));
+                }
+            }
+        }
+        let voxels = (0..3).map(|a| (b.max[a] - b.min[a] + 1) as u64).product();
+        self.add(slots, Some(b), voxels);
+        Ok(())
+    }
+}
+
+/// Writes the merged file to `file` (errors name `output`); its length.
+fn write_spliced(
+    file: &Path,
+    output: &Path,
+    grid: &GridOut,
+    encoding: Encoding,
+    transform: Transform,
+    merged: &Merged,
+    bricks: &[PathBuf],
+) -> Result<u64> {
+    let roots: Vec<&[Slot]> = merged.slots.chunk_by(|a, b| a.0.0 == b.0.0).collect();
+    let values = grid.values;
+    let compression = encoding.compression | COMPRESS_ACTIVE_MASK;
+    // Each root child's own bytes: its origin, masks and tile values.
+    let uppers: Vec<Vec<u8>> = roots
+        .iter()
+        .map(|slots| {
+            let mut out = Vec::new();
+            slots[0]
+                .0
+                .0
+                .iter()
+                .for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
+            let words = (1usize << (3 * NODE_LOG2[0])) / 64;
+            let (mut children, mut tiles) = (vec![0u64; words], vec![0u64; words]);
+            for (key, node) in slots.iter() {
+                let mask = if node.is_some() {
+                    &mut children
+                } else {
+                    &mut tiles
+                };
+                mask[key.1 as usize / 64] |= 1 << (key.1 % 64);
+            }
+            push_internal_values(&mut out, &children, &tiles, values, compression, false);
+            out
+        })
+        .collect();
+    let nodes = || merged.slots.iter().filter_map(|s| s.1.as_ref());
+    let stats = TreeStats {
+        bbox: merged.bbox,
+        voxels: merged.voxels,
+        internal: [roots.len() as u64, nodes().count() as u64],
+        leaves: merged.leaves,
+    };
+    let mut head = compression.to_le_bytes().to_vec();
+    push_metadata(&mut head, grid, encoding, &stats);
+    push_transform(&mut head, transform);
+    head.extend_from_slice(&1u32.to_le_bytes()); // one buffer per leaf
+    head.extend_from_slice(&values.background().to_le_bytes());
+    head.extend_from_slice(&0u32.to_le_bytes()); // no root tiles
+    head.extend_from_slice(&(roots.len() as u32).to_le_bytes());
+    let length = |r: &Range<u64>| r.end - r.start;
+    let topology: u64 = uppers.iter().map(|u| u.len() as u64).sum::<u64>()
+        + nodes().map(|n| length(&n.topology)).sum::<u64>();
+    let buffers: u64 = nodes().map(|n| length(&n.buffers)).sum();
+    let mut out = file_header(1);
+    out.extend_from_slice(&descriptor_names(grid, false));
+    let grid_pos = out.len() as u64 + 24;
+    let block_pos = grid_pos + head.len() as u64 + topology;
+    let end = block_pos + buffers;
+    for p in [grid_pos, block_pos, end] {
+        out.extend_from_slice(&(p as i64).to_le_bytes());
+    }
+    out.extend_from_slice(&head);
+    let io_error = |e| Error::io(output, e);
+    let mut copy = Copier::new(DirectFile::create(file).map_err(io_error)?, bricks);
+    copy.out.write_all(&out).map_err(io_error)?;
+    for (slots, upper) in roots.iter().zip(&uppers) {
+        copy.out.write_all(upper).map_err(io_error)?;
+        for node in slots.iter().filter_map(|s| s.1.as_ref()) {
+            copy.range(node.brick, &node.topology)?;
+        }
+    }
+    for node in nodes() {
+        copy.range(node.brick, &node.buffers)?;
+    }
+    copy.out.finish().map_err(io_error)?;
+    Ok(end)
+}
+
+/// Copies byte ranges of brick files to the output, through one buffer, keeping a bounded
+/// number of brick files open.
+struct Copier<'a> {
+    out: DirectFile,
+    bricks: &'a [PathBuf],
+    open: HashMap<usize, File>,
+    buffer: Vec<u8>,
+}
+
+/// Brick files held open at once; more are closed and opened again as needed.
+const OPEN_FILES: usize = 64;
+
+impl<'a> Copier<'a> {
+    fn new(out: DirectFile, bricks: &'a [PathBuf]) -> Copier<'a> {
+        Copier {
+            out,
+            bricks,
+            open: HashMap::new(),
+            buffer: vec![0; 1 << 20],
+        }
+    }
+
+    fn range(&mut self, brick: usize, range: &Range<u64>) -> Result<()> {
+        let path = &self.bricks[brick];
+        if !self.open.contains_key(&brick) {
+            if self.open.len() == OPEN_FILES {
+                self.open.clear();
+            }
+            let f = File::open(path).map_err(|e| Error::io(path, e))?;
+            self.open.insert(brick, f);
+        }
+        let f = &self.open[&brick];
+        let mut at = range.start;
+        while at < range.end {
+            let n = (range.end - at).min(self.buffer.len() as u64) as usize;
+            f.read_exact_at(&mut self.buffer[..n], at)
+                .map_err(|e| Error::io(path, e))?;
+            self.out
+                .write_all(&self.buffer[..n])
+                .map_err(|e| Error::io(path, e))?;
+            at += n as u64;
+        }
+        Ok(())
+    }
+}
