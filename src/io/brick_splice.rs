@@ -396,7 +396,7 @@ impl Walk {
         }
         let mut leaves = 0;
         for slot in set_bits(&children) {
-            let mask = r.vec(LEAF_MASK_BYTES, "a leaf's mask")?;
+            let mask = r.bytes::<{ LEAF_MASK_BYTES as usize }>("a leaf's mask")?;
             let active = mask.iter().map(|b| b.count_ones()).sum::<u32>();
             self.leaves.push(active as u16);
             leaves += 1;
@@ -414,24 +414,44 @@ fn bit(mask: &[u8], n: usize) -> bool {
     mask[n / 8] >> (n % 8) & 1 == 1
 }
 
+/// The set bits of a mask, in order.
 fn set_bits(mask: &[u8]) -> impl Iterator<Item = usize> + '_ {
-    (0..mask.len() * 8).filter(|&n| bit(mask, n))
+    mask.chunks_exact(8).enumerate().flat_map(|(w, bytes)| {
+        let mut word = u64::from_le_bytes(bytes.try_into().expect("8 bytes"));
+        std::iter::from_fn(move || {
+            (word != 0).then(|| {
+                let b = word.trailing_zeros() as usize;
+                word &= word - 1;
+                64 * w + b
+            })
+        })
+    })
 }
 
 /// The box of a leaf's active voxels within it (offset `x * 64 + y * 8 + z`), if any.
-fn mask_box(mask: &[u8]) -> Option<([i64; 3], [i64; 3])> {
-    let words: Vec<u64> = mask
-        .chunks_exact(8)
-        .map(|w| u64::from_le_bytes(w.try_into().expect("8 bytes")))
-        .collect();
-    let xs: Vec<i64> = (0..8).filter(|&x| words[x as usize] != 0).collect();
-    let (&x0, &x1) = (xs.first()?, xs.last()?);
+fn mask_box(mask: &[u8; 64]) -> Option<([i64; 3], [i64; 3])> {
+    let words: [u64; 8] =
+        std::array::from_fn(|x| u64::from_le_bytes(mask[8 * x..8 * x + 8].try_into().expect("8")));
+    let xs = words
+        .iter()
+        .enumerate()
+        .fold(0u8, |a, (x, &w)| a | (u8::from(w != 0) << x));
+    if xs == 0 {
+        return None;
+    }
     let rows = words.iter().fold(0u64, |a, w| a | w); // bit y * 8 + z
-    let ys: Vec<i64> = (0..8).filter(|&y| (rows >> (8 * y)) & 0xff != 0).collect();
-    let zs = (0..8).fold(0u64, |a, y| a | (rows >> (8 * y)) & 0xff);
-    let z0 = zs.trailing_zeros() as i64;
-    let z1 = 63 - zs.leading_zeros() as i64;
-    Some(([x0, ys[0], z0], [x1, ys[ys.len() - 1], z1]))
+    let ys = (0..8).fold(0u8, |a, y| {
+        a | (u8::from((rows >> (8 * y)) & 0xff != 0) << y)
+    });
+    let zs = (0..8).fold(0u8, |a, y| a | (rows >> (8 * y)) as u8);
+    let span = |bits: u8| {
+        (
+            bits.trailing_zeros() as i64,
+            7 - bits.leading_zeros() as i64,
+        )
+    };
+    let ((x0, x1), (y0, y1), (z0, z1)) = (span(xs), span(ys), span(zs));
+    Some(([x0, y0, z0], [x1, y1, z1]))
 }
 
 /// The slots of all bricks and full bricks, and the box and count of their voxels.
@@ -546,41 +566,90 @@ fn write_spliced(
     }
     out.extend_from_slice(&head);
     let io_error = |e| Error::io(output, e);
-    let mut copy = Copier::new(DirectFile::create(file).map_err(io_error)?, bricks);
-    copy.out.write_all(&out).map_err(io_error)?;
-    for (slots, upper) in roots.iter().zip(&uppers) {
-        copy.out.write_all(upper).map_err(io_error)?;
-        for node in slots.iter().filter_map(|s| s.1.as_ref()) {
-            copy.range(node.brick, &node.topology)?;
-        }
-    }
-    for node in nodes() {
-        copy.range(node.brick, &node.buffers)?;
-    }
-    copy.out.finish().map_err(io_error)?;
+    let out_file = DirectFile::create(file).map_err(io_error)?;
+    // One thread gathers the bytes in order into chunks, another writes them: the disk works
+    // while the next chunk is read.
+    let (send, chunks) = std::sync::mpsc::sync_channel::<Vec<u8>>(2);
+    let (give_back, returned) = std::sync::mpsc::channel::<Vec<u8>>();
+    let (copied, written) = std::thread::scope(|scope| {
+        let writer = scope.spawn(move || {
+            let mut out_file = out_file;
+            for chunk in chunks {
+                out_file.write_all(&chunk)?;
+                let _ = give_back.send(chunk);
+            }
+            Ok::<_, std::io::Error>(out_file)
+        });
+        let mut copy = Copier {
+            send,
+            returned,
+            chunk: Vec::with_capacity(CHUNK),
+            bricks,
+            open: HashMap::new(),
+        };
+        let copied = (|| {
+            copy.bytes(&out);
+            for (slots, upper) in roots.iter().zip(&uppers) {
+                copy.bytes(upper);
+                for node in slots.iter().filter_map(|s| s.1.as_ref()) {
+                    copy.range(node.brick, &node.topology)?;
+                }
+            }
+            for node in nodes() {
+                copy.range(node.brick, &node.buffers)?;
+            }
+            copy.flush();
+            Ok(())
+        })();
+        drop(copy);
+        let written = writer
+            .join()
+            .unwrap_or_else(|p| std::panic::resume_unwind(p));
+        (copied, written)
+    });
+    copied?;
+    written.map_err(io_error)?.finish().map_err(io_error)?;
     Ok(end)
 }
 
-/// Copies byte ranges of brick files to the output, through one buffer, keeping a bounded
-/// number of brick files open.
+/// Bytes gathered before a chunk goes to the writer thread.
+const CHUNK: usize = 4 << 20;
+
+/// Gathers the merged file's bytes (its own and byte ranges of brick files) in order into
+/// chunks for the writer thread, reusing the chunks it hands back; keeps a bounded number
+/// of brick files open.
 struct Copier<'a> {
-    out: DirectFile,
+    send: std::sync::mpsc::SyncSender<Vec<u8>>,
+    returned: std::sync::mpsc::Receiver<Vec<u8>>,
+    chunk: Vec<u8>,
     bricks: &'a [PathBuf],
     open: HashMap<usize, File>,
-    buffer: Vec<u8>,
 }
 
 /// Brick files held open at once; more are closed and opened again as needed.
 const OPEN_FILES: usize = 64;
 
-impl<'a> Copier<'a> {
-    fn new(out: DirectFile, bricks: &'a [PathBuf]) -> Copier<'a> {
-        Copier {
-            out,
-            bricks,
-            open: HashMap::new(),
-            buffer: vec![0; 1 << 20],
+impl Copier<'_> {
+    fn bytes(&mut self, bytes: &[u8]) {
+        self.chunk.extend_from_slice(bytes);
+        if self.chunk.len() >= CHUNK {
+            self.flush();
         }
+    }
+
+    /// Hands the chunk to the writer (a writer that stopped at an error reports it when
+    /// joined) and takes a fresh one.
+    fn flush(&mut self) {
+        let next = self
+            .returned
+            .try_recv()
+            .map(|mut c| {
+                c.clear();
+                c
+            })
+            .unwrap_or_else(|_| Vec::with_capacity(CHUNK));
+        let full = std::mem::replace(&mut self.chunk, next);
+        let _ = self.send.send(full);
     }
 
     fn range(&mut self, brick: usize, range: &Range<u64>) -> Result<()> {
@@ -592,16 +661,19 @@ impl<'a> Copier<'a> {
             let f = File::open(path).map_err(|e| Error::io(path, e))?;
             self.open.insert(brick, f);
         }
-        let f = &self.open[&brick];
         let mut at = range.start;
         while at < range.end {
-            let n = (range.end - at).min(self.buffer.len() as u64) as usize;
-            f.read_exact_at(&mut self.buffer[..n], at)
-                .map_err(|e| Error::io(path, e))?;
-            self.out
-                .write_all(&self.buffer[..n])
+            let room = CHUNK.max(self.chunk.len() + 1) - self.chunk.len();
+            let n = (range.end - at).min(room as u64) as usize;
+            let start = self.chunk.len();
+            self.chunk.resize(start + n, 0);
+            self.open[&brick]
+                .read_exact_at(&mut self.chunk[start..], at)
                 .map_err(|e| Error::io(path, e))?;
             at += n as u64;
+            if self.chunk.len() >= CHUNK {
+                self.flush();
+            }
         }
         Ok(())
     }

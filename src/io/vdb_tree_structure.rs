@@ -231,7 +231,7 @@ fn internal_node(
         if depth + 1 == NODE_LOG2.len() {
             nodes
                 .leaves
-                .push(ones(&r.vec(LEAF_MASK_BYTES, what)?) as u16);
+                .push(ones(&r.bytes::<{ LEAF_MASK_BYTES as usize }>(what)?) as u16);
         } else {
             internal_node(r, format, compression, depth + 1, nodes, what)?;
         }
@@ -258,7 +258,7 @@ pub(super) fn leaf_buffer(
         LeafKind::Mask => r.skip(LEAF_MASK_BYTES + 12, what),
         LeafKind::Values => {
             let at = r.pos;
-            let mask = r.vec(LEAF_MASK_BYTES, what)?;
+            let mask = r.bytes::<{ LEAF_MASK_BYTES as usize }>(what)?;
             if ones(&mask) != active as u64 {
                 return Err(format!(
                     "{what}: the leaf at byte {at} has {} active voxels, its topology {active}",
