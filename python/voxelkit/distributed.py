@@ -247,11 +247,24 @@ def _stopped_by_signals():
             signal.signal(s, handler)
 
 
-def _run(client, calls, stage, progress, check):
-    """Submits `calls` ({brick: (function, args)}) and gathers {brick: result}. A brick's
-    arguments travel with its task (not scattered to one worker), so that a brick whose
-    worker dies runs again elsewhere; a brick that still fails ends the run with an error
-    that names it."""
+def _prefetch(path):
+    """Asks the kernel to read a finished brick file ahead, while other bricks run, so that
+    the merge finds it in memory."""
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return  # the merge reports a missing brick, naming it
+    try:
+        os.posix_fadvise(fd, 0, 0, os.POSIX_FADV_WILLNEED)
+    finally:
+        os.close(fd)
+
+
+def _run(client, calls, stage, progress, check, done=lambda b: None):
+    """Submits `calls` ({brick: (function, args)}) and gathers {brick: result}, calling
+    `done(brick)` as each finishes. A brick's arguments travel with its task (not scattered to
+    one worker), so that a brick whose worker dies runs again elsewhere; a brick that still
+    fails ends the run with an error that names it."""
     from dask.distributed import as_completed
 
     futures = {
@@ -271,6 +284,7 @@ def _run(client, calls, stage, progress, check):
                 f"brick {b} ({stage}) failed on its worker after {_RETRIES} retries: "
                 f"{type(e).__name__}: {e}"
             ) from None
+        done(b)
         progress.show(stage, len(results), len(futures))
     check()
     return results
@@ -311,6 +325,7 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
         files = {b: _brick_file(b) for b in bricks}
         path = {b: os.path.abspath(os.path.join(folder, files[b])) for b in bricks}
         full_bricks = []
+        prefetch = (lambda b: _prefetch(path[b])) if not keep_bricks and plan.splices else (lambda b: None)
         if solid and plan.winding:
             # Every worker holds the mesh once; a worker lost takes no brick's only copy.
             mesh = client.scatter(plan.mesh_arrays(), broadcast=True)
@@ -318,7 +333,7 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
                 b: (_winding_brick, (arrays[b], mesh, origin, h, b, size, path[b], max_memory_mib))
                 for b in bricks
             }
-            counts = _run(client, calls, "solid", show, check)
+            counts = _run(client, calls, "solid", show, check, prefetch)
         elif solid:
             faces = _run(
                 client,
@@ -334,13 +349,13 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
                 b: (_solid_brick, (arrays[b], origin, h, b, size, exterior[b], path[b], max_memory_mib))
                 for b in plan.bricks
             }
-            counts = _run(client, calls, "solid", show, check)
+            counts = _run(client, calls, "solid", show, check, prefetch)
         else:
             calls = {
                 b: (_surface_brick, (arrays[b], origin, h, b, size, path[b], separability, max_memory_mib))
                 for b in plan.bricks
             }
-            counts = _run(client, calls, "surface", show, check)
+            counts = _run(client, calls, "surface", show, check, prefetch)
         peaks = list(client.run(_peak_rss_mib).values())
     bricks_done = time.perf_counter()
     # Each brick task gives its voxels and the bytes its leaves and tiles take in a merge that
