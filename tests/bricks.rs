@@ -4,6 +4,8 @@
 //! shells, at brick sizes that cut them anywhere.
 #![cfg(feature = "fixtures")]
 
+mod common;
+
 use glam::DVec3;
 use std::collections::BTreeMap;
 use voxelkit::grid::SparseGrid;
@@ -160,4 +162,86 @@ fn a_brick_job_is_planned_and_refused_as_a_job() {
         unplaced.is_some_and(|e| e.to_string().contains("GridFit::Placed")),
         "a brick without its run's placement must be refused"
     );
+}
+
+/// The bytes of a `.vdb`'s first grid from its tree on (topology and leaf buffers), past its
+/// metadata and transform: what two writes of one grid share whatever their metadata.
+fn tree_bytes(path: &std::path::Path) -> Vec<u8> {
+    let b = std::fs::read(path).unwrap();
+    let u32_at = |p: usize| u32::from_le_bytes(b[p..p + 4].try_into().unwrap()) as usize;
+    let string = |p: usize| p + 4 + u32_at(p);
+    // Magic, versions, offsets flag, UUID, no file metadata, the grid count.
+    let mut p = 8 + 4 + 8 + 1 + 36 + 4 + 4;
+    (0..3).for_each(|_| p = string(p)); // grid name, tree type, instance parent
+    let offset = |p: usize| i64::from_le_bytes(b[p..p + 8].try_into().unwrap()) as usize;
+    let (grid, end) = (offset(p), offset(p + 16));
+    let entries = u32_at(grid + 4);
+    let mut p = grid + 8;
+    (0..3 * entries).for_each(|_| p = string(p)); // name, type, value
+    b[string(p) + 6 * 24..end].to_vec() // the map's name, then its six vectors
+}
+
+/// Bricks on OpenVDB's 128^3 nodes merge by splicing into the tree a single write makes, byte
+/// for byte: leaves, 8^3 and 128^3 tiles, and the bricks wholly inside (no file) as tiles;
+/// OpenVDB reads the result as voxelkit does.
+#[test]
+fn node_bricks_splice_into_the_single_writes_tree() {
+    use voxelkit::io::brick_set::{BRICK_SET_FORMAT, BrickFile, BrickSet, brick_voxels};
+    use voxelkit::io::brick_splice::splice_brick_set;
+    use voxelkit::io::vdb::write_vdb;
+    let mesh = generate::cuboid(DVec3::new(-1.0, -0.7, -0.4), DVec3::new(1.0, 0.8, 0.45));
+    let t = voxelkit::mesh::fit_transform(&mesh.bbox(), GridFit::Resolution(1100)).unwrap();
+    let sep = Separability::TwentySix;
+    let (shell, _) = voxelize_mesh(&mesh, t, &options(sep), &Progress::none()).unwrap();
+    let mut whole = solid_from_surface(&shell, FloodMethod::Spans, &Progress::none())
+        .unwrap()
+        .inside;
+    whole.union(&shell);
+    whole.compact();
+    let dir = tempfile::tempdir().unwrap();
+    let size = 256;
+    let b = whole.bbox().unwrap();
+    let mut set = BrickSet {
+        format: BRICK_SET_FORMAT.into(),
+        voxel_size: t.voxel_size,
+        origin: t.origin.to_array(),
+        brick_size: size,
+        bricks: Vec::new(),
+        full_bricks: Vec::new(),
+    };
+    let range = |a: usize| b.min[a].div_euclid(size)..=b.max[a].div_euclid(size);
+    for x in range(0) {
+        for y in range(1) {
+            for z in range(2) {
+                let voxels = brick_voxels([x, y, z], size);
+                let mut part = whole.clone();
+                part.clip(voxels);
+                if part.voxel_count() == (size as u64).pow(3) {
+                    set.full_bricks.push([x, y, z]);
+                } else if !part.is_empty() {
+                    let file = format!("brick_{x}_{y}_{z}.vdb");
+                    write_vdb(&dir.path().join(&file), &part, &[]).unwrap();
+                    set.bricks.push(BrickFile {
+                        brick: [x, y, z],
+                        file,
+                    });
+                }
+            }
+        }
+    }
+    assert!(!set.full_bricks.is_empty(), "a brick wholly inside");
+    let index = dir.path().join("index.json");
+    set.write(&index).unwrap();
+    let merged = dir.path().join("merged.vdb");
+    let spliced = splice_brick_set(&set, &index, &merged, &[]).unwrap();
+    let single = dir.path().join("single.vdb");
+    write_vdb(&single, &whole, &[]).unwrap();
+    assert_eq!(spliced.voxels, whole.voxel_count());
+    // 128^3 tiles inside brick files too, besides the eight of each brick wholly inside.
+    assert!(whole.tiles().node_tiles().count() > 8 * set.full_bricks.len());
+    assert!(
+        tree_bytes(&merged) == tree_bytes(&single),
+        "the single write's tree"
+    );
+    common::assert_read_as_openvdb_reads(&merged, "density");
 }
