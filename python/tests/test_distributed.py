@@ -160,6 +160,15 @@ def test_a_kept_brick_set_merges_later_and_refuses_foreign_bricks(data, client, 
     assert not out.exists() and not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
 
 
+def test_a_failing_brick_in_a_shared_task_is_named():
+    def fails():
+        return 1 / 0
+
+    with pytest.raises(RuntimeError, match=r"brick \(1, 2, 3\): ZeroDivisionError"):
+        vd._in_turn([((0, 0, 0), int, ()), ((1, 2, 3), fails, ())])
+    assert vd._in_turn([((0, 0, 0), int, ("7",))]) == [((0, 0, 0), 7)]
+
+
 def test_the_command_line_starts_its_own_cluster(data, dask, tmp_path):
     path = data / "meshes" / "cow.obj"
     out = tmp_path / "cow.vdb"

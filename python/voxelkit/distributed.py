@@ -260,32 +260,59 @@ def _prefetch(path):
         os.close(fd)
 
 
-def _run(client, calls, stage, progress, check, done=lambda b: None):
-    """Submits `calls` ({brick: (function, args)}) and gathers {brick: result}, calling
-    `done(brick)` as each finishes. A brick's arguments travel with its task (not scattered to
-    one worker), so that a brick whose worker dies runs again elsewhere; a brick that still
-    fails ends the run with an error that names it."""
-    from dask.distributed import as_completed
+#: Tasks per worker thread when bricks are grouped: enough to balance uneven bricks, few
+#: enough that a task's fixed cost (its trips through the scheduler) is not paid per brick.
+_TASKS_PER_THREAD = 16
 
-    futures = {
-        client.submit(f, *args, pure=False, retries=_RETRIES): b for b, (f, args) in calls.items()
-    }
-    results = {}
-    progress.show(stage, 0, len(futures))
-    for future in as_completed(futures):
-        check()
-        b = futures[future]
+
+def _in_turn(calls):
+    """A task's bricks run one after another on its worker: [(brick, result)]. An error that
+    does not name its brick is raised again naming it."""
+    results = []
+    for b, f, args in calls:
         try:
-            results[b] = future.result()
+            results.append((b, f(*args)))
         except (ValueError, MemoryError, OSError):
             raise
         except Exception as e:
+            raise RuntimeError(f"brick {b}: {type(e).__name__}: {e}") from None
+    return results
+
+
+def _run(client, calls, stage, progress, check, done=lambda b: None, grouped=True):
+    """Submits `calls` ({brick: (function, args)}) and gathers {brick: result}, calling
+    `done(brick)` as each finishes. Consecutive bricks share a task (`grouped`; frames do
+    not). A task's arguments travel with it (not scattered to one worker), so that a task
+    whose worker dies runs again elsewhere; a brick that still fails ends the run with an
+    error that names it."""
+    from dask.distributed import as_completed
+
+    keys = list(calls)
+    threads = sum(client.nthreads().values()) if grouped else 0
+    size = max(1, -(-len(keys) // (_TASKS_PER_THREAD * threads))) if threads else 1
+    futures = {}
+    for i in range(0, len(keys), size):
+        group = keys[i:i + size]
+        work = [(b, *calls[b]) for b in group]
+        futures[client.submit(_in_turn, work, pure=False, retries=_RETRIES)] = group
+    results = {}
+    progress.show(stage, 0, len(keys))
+    for future in as_completed(futures):
+        check()
+        group = futures[future]
+        try:
+            results.update(future.result())
+        except (ValueError, MemoryError, OSError):
+            raise
+        except Exception as e:
+            named = f"brick {group[0]}" if len(group) == 1 else f"bricks {group[0]} to {group[-1]}"
             raise RuntimeError(
-                f"brick {b} ({stage}) failed on its worker after {_RETRIES} retries: "
+                f"{named} ({stage}) failed on its worker after {_RETRIES} retries: "
                 f"{type(e).__name__}: {e}"
             ) from None
-        done(b)
-        progress.show(stage, len(results), len(futures))
+        for b in group:
+            done(b)
+        progress.show(stage, len(results), len(keys))
     check()
     return results
 
@@ -395,7 +422,7 @@ def frames(inputs, outputs, frames, solid=False, scheduler=None, workers=2, prog
     show = _Progress(progress)
     with _stopped_by_signals() as check, _using(client, scheduler, workers) as client:
         calls = {f: (_frame, (i, o, solid, voxel_size, origin, job)) for f, i, o in plan}
-        voxels = _run(client, calls, "frames", show, check)
+        voxels = _run(client, calls, "frames", show, check, grouped=False)
         peaks = list(client.run(_peak_rss_mib).values())
     return {
         "outputs": [o for _, _, o in plan],
