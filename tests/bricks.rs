@@ -233,10 +233,10 @@ fn node_bricks_splice_into_the_single_writes_tree() {
     let index = dir.path().join("index.json");
     set.write(&index).unwrap();
     let merged = dir.path().join("merged.vdb");
-    let spliced = splice_brick_set(&set, &index, &merged, &[]).unwrap();
+    let voxels = splice_brick_set(&set, &index, &merged, &[]).unwrap();
     let single = dir.path().join("single.vdb");
     write_vdb(&single, &whole, &[]).unwrap();
-    assert_eq!(spliced.voxels, whole.voxel_count());
+    assert_eq!(voxels, whole.voxel_count());
     // 128^3 tiles inside brick files too, besides the eight of each brick wholly inside.
     assert!(whole.tiles().node_tiles().count() > 8 * set.full_bricks.len());
     assert!(

@@ -18,7 +18,7 @@ use super::vdb_format::{
 use super::vdb_structure::{Reader, metadata};
 use super::vdb_tree_structure::{TreeFormat, compressed_values, leaf_buffer};
 use super::vdb_writer::{
-    Encoding, TreeStats, descriptor_names, file_header, push_internal_values, push_metadata,
+    Encoding, TreeStats, descriptor_names, file_header, push_grid_head, push_root_child,
     push_string, push_transform, tree_type_of,
 };
 use crate::error::{Error, Result};
@@ -46,16 +46,6 @@ struct NodeBytes {
 /// A 128^3 slot of the merged tree: a node copied from a brick file, or an active tile.
 type Slot = (NodeKey, Option<NodeBytes>);
 
-/// What a merge wrote.
-#[derive(Clone, Copy, Debug)]
-pub struct Spliced {
-    pub voxels: u64,
-    /// 128^3 nodes copied from brick files, and 128^3 tiles.
-    pub nodes: u64,
-    pub tiles: u64,
-    pub bytes: u64,
-}
-
 /// Whether the bricks of `set` lie on OpenVDB's 128^3 nodes, as `splice_brick_set` needs.
 pub fn splices(set: &BrickSet) -> bool {
     set.brick_size % NODE_DIM == 0
@@ -64,13 +54,13 @@ pub fn splices(set: &BrickSet) -> bool {
 /// Merges the brick set of the index at `index` into the `.vdb` `output` (atomically), as
 /// the voxel set voxelkit writes (`density`) with `metadata`, copying each brick's nodes
 /// without decoding them. Refuses bricks that do not lie on 128^3 nodes (`splices`) and a
-/// brick file not laid out as voxelkit writes a voxel set, naming it.
+/// brick file not laid out as voxelkit writes a voxel set, naming it. Returns the voxels.
 pub fn splice_brick_set(
     set: &BrickSet,
     index: &Path,
     output: &Path,
     metadata: &[(&str, MetaValue)],
-) -> Result<Spliced> {
+) -> Result<u64> {
     if !splices(set) {
         return Err(Error::InvalidArgument(format!(
             "{}: bricks of {} voxels do not lie on OpenVDB's {NODE_DIM}-voxel nodes; only \
@@ -143,18 +133,10 @@ pub fn splice_brick_set(
             ),
         });
     }
-    let spliced = Spliced {
-        voxels: merged.voxels,
-        nodes: merged.slots.iter().filter(|s| s.1.is_some()).count() as u64,
-        tiles: merged.slots.iter().filter(|s| s.1.is_none()).count() as u64,
-        bytes: 0,
-    };
-    let mut bytes = 0;
     write_atomic(output, |tmp| {
-        bytes = write_spliced(tmp, output, &grid, encoding, transform, &merged, &files)?;
-        Ok(())
+        write_spliced(tmp, output, &grid, encoding, transform, &merged, &files)
     })?;
-    Ok(Spliced { bytes, ..spliced })
+    Ok(merged.voxels)
 }
 
 /// What every brick file must hold to be copied into the merged file: the grid's name, tree
@@ -501,7 +483,7 @@ impl Merged {
     }
 }
 
-/// Writes the merged file to `file` (errors name `output`); its length.
+/// Writes the merged file to `file` (errors name `output`).
 fn write_spliced(
     file: &Path,
     output: &Path,
@@ -510,31 +492,22 @@ fn write_spliced(
     transform: Transform,
     merged: &Merged,
     bricks: &[PathBuf],
-) -> Result<u64> {
+) -> Result<()> {
     let roots: Vec<&[Slot]> = merged.slots.chunk_by(|a, b| a.0.0 == b.0.0).collect();
-    let values = grid.values;
     let compression = encoding.compression | COMPRESS_ACTIVE_MASK;
-    // Each root child's own bytes: its origin, masks and tile values.
     let uppers: Vec<Vec<u8>> = roots
         .iter()
         .map(|slots| {
             let mut out = Vec::new();
-            slots[0]
-                .0
-                .0
-                .iter()
-                .for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
-            let words = (1usize << (3 * NODE_LOG2[0])) / 64;
-            let (mut children, mut tiles) = (vec![0u64; words], vec![0u64; words]);
-            for (key, node) in slots.iter() {
-                let mask = if node.is_some() {
-                    &mut children
-                } else {
-                    &mut tiles
-                };
-                mask[key.1 as usize / 64] |= 1 << (key.1 % 64);
-            }
-            push_internal_values(&mut out, &children, &tiles, values, compression, false);
+            let kinds = slots.iter().map(|(key, node)| (key.1, node.is_none()));
+            push_root_child(
+                &mut out,
+                slots[0].0.0,
+                kinds,
+                grid.values,
+                compression,
+                false,
+            );
             out
         })
         .collect();
@@ -545,13 +518,8 @@ fn write_spliced(
         internal: [roots.len() as u64, nodes().count() as u64],
         leaves: merged.leaves,
     };
-    let mut head = compression.to_le_bytes().to_vec();
-    push_metadata(&mut head, grid, encoding, &stats);
-    push_transform(&mut head, transform);
-    head.extend_from_slice(&1u32.to_le_bytes()); // one buffer per leaf
-    head.extend_from_slice(&values.background().to_le_bytes());
-    head.extend_from_slice(&0u32.to_le_bytes()); // no root tiles
-    head.extend_from_slice(&(roots.len() as u32).to_le_bytes());
+    let mut head = Vec::new();
+    push_grid_head(&mut head, grid, encoding, &stats, transform, roots.len());
     let length = |r: &Range<u64>| r.end - r.start;
     let topology: u64 = uppers.iter().map(|u| u.len() as u64).sum::<u64>()
         + nodes().map(|n| length(&n.topology)).sum::<u64>();
@@ -609,7 +577,7 @@ fn write_spliced(
     });
     copied?;
     written.map_err(io_error)?.finish().map_err(io_error)?;
-    Ok(end)
+    Ok(())
 }
 
 /// Bytes gathered before a chunk goes to the writer thread.

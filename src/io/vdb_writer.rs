@@ -13,7 +13,7 @@ use super::grid_out::{Entry, GridOut, GridValues, Key, ValueType, tree_entries};
 use super::vdb::WriteClocks;
 use super::vdb_chunks::{compression_name, push_chunk};
 use super::vdb_format::{
-    COMPRESS_ACTIVE_MASK, FILE_VERSION, HALF_SUFFIX, LIBRARY_VERSION, MAGIC, tree_type,
+    COMPRESS_ACTIVE_MASK, FILE_VERSION, HALF_SUFFIX, LIBRARY_VERSION, MAGIC, NODE_LOG2, tree_type,
 };
 use super::vdb_tree_structure::{TreeFormat, tree_memory};
 use crate::error::{Error, Result};
@@ -309,8 +309,6 @@ fn grid_head<'g>(path: &Path, g: &GridOut<'g>, encoding: Encoding) -> Result<Gri
         .map(|child| root_child_topology(child, g.values, compression, half))
         .collect();
     let leaves: Vec<&Leaf> = encoded.iter().flat_map(|e| e.1.iter().copied()).collect();
-    let mut head = Vec::new();
-    head.extend_from_slice(&compression.to_le_bytes());
     let internal = encoded
         .iter()
         .fold([0u64; 2], |a, e| [a[0] + e.2[0], a[1] + e.2[1]]);
@@ -320,16 +318,15 @@ fn grid_head<'g>(path: &Path, g: &GridOut<'g>, encoding: Encoding) -> Result<Gri
         internal,
         leaves: leaves.len() as u64,
     };
-    push_metadata(&mut head, g, encoding, &stats);
-    push_transform(&mut head, g.grid.transform);
-    head.extend_from_slice(&1u32.to_le_bytes()); // one buffer per leaf
-    match g.values {
-        GridValues::Bool => head.push(0),
-        GridValues::Normals | GridValues::Colors => head.extend_from_slice(&[0; 12]),
-        values => head.extend_from_slice(&values.background().to_le_bytes()),
-    }
-    head.extend_from_slice(&0u32.to_le_bytes()); // no root tiles
-    head.extend_from_slice(&(roots.len() as u32).to_le_bytes());
+    let mut head = Vec::new();
+    push_grid_head(
+        &mut head,
+        g,
+        encoding,
+        &stats,
+        g.grid.transform,
+        roots.len(),
+    );
     for (bytes, _, _) in &encoded {
         head.extend_from_slice(bytes);
     }
@@ -339,6 +336,52 @@ fn grid_head<'g>(path: &Path, g: &GridOut<'g>, encoding: Encoding) -> Result<Gri
         compression,
         half,
     })
+}
+
+/// A grid's head up to its root children: its compression flags, metadata (with `stats`),
+/// transform, buffer count and background, no root tiles, then the count of root children
+/// that follow.
+pub(super) fn push_grid_head(
+    out: &mut Vec<u8>,
+    g: &GridOut,
+    encoding: Encoding,
+    stats: &TreeStats,
+    transform: Transform,
+    root_children: usize,
+) {
+    out.extend_from_slice(&(encoding.compression | COMPRESS_ACTIVE_MASK).to_le_bytes());
+    push_metadata(out, g, encoding, stats);
+    push_transform(out, transform);
+    out.extend_from_slice(&1u32.to_le_bytes()); // one buffer per leaf
+    match g.values {
+        GridValues::Bool => out.push(0),
+        GridValues::Normals | GridValues::Colors => out.extend_from_slice(&[0; 12]),
+        values => out.extend_from_slice(&values.background().to_le_bytes()),
+    }
+    out.extend_from_slice(&0u32.to_le_bytes()); // no root tiles
+    out.extend_from_slice(&(root_children as u32).to_le_bytes());
+}
+
+/// A root child's own bytes: its origin, then its masks and tile values from its 128^3 slots
+/// in order (each a slot number and whether it holds a tile rather than a node).
+pub(super) fn push_root_child(
+    out: &mut Vec<u8>,
+    origin: [i32; 3],
+    slots: impl Iterator<Item = (u16, bool)>,
+    values: GridValues,
+    compression: u32,
+    half: bool,
+) {
+    origin
+        .iter()
+        .for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
+    let words = (1usize << (3 * NODE_LOG2[0])) / 64;
+    let (mut children, mut tiles) = (vec![0u64; words], vec![0u64; words]);
+    for (slot, tile) in slots {
+        let mask = if tile { &mut tiles } else { &mut children };
+        mask[slot as usize / 64] |= 1 << (slot % 64);
+    }
+    push_internal_values(out, &children, &tiles, values, compression, half);
 }
 
 /// Encodes the buffers of `leaves` in batches of `BATCH` on all threads, taken in order so
@@ -397,25 +440,12 @@ fn root_child_topology<'g>(
     half: bool,
 ) -> (Vec<u8>, Vec<&'g Leaf>, [u64; 2]) {
     let mut out = Vec::new();
-    entries[0]
-        .0
-        .0
-        .iter()
-        .for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
     let mut leaves = Vec::new();
     let nodes: Vec<&[(Key, Entry)]> = entries.chunk_by(|a, b| a.0.1 == b.0.1).collect();
-    let mut children = vec![0u64; 32 * 32 * 32 / 64];
-    let mut tiles = vec![0u64; 32 * 32 * 32 / 64];
-    for node in &nodes {
-        let slot = node[0].0.1 as usize;
-        let mask = if matches!(node[0].1, Entry::NodeTile) {
-            &mut tiles
-        } else {
-            &mut children
-        };
-        mask[slot / 64] |= 1 << (slot % 64);
-    }
-    push_internal_values(&mut out, &children, &tiles, values, compression, half);
+    let slots = nodes
+        .iter()
+        .map(|node| (node[0].0.1, matches!(node[0].1, Entry::NodeTile)));
+    push_root_child(&mut out, entries[0].0.0, slots, values, compression, half);
     let mut lower = 0;
     for node in nodes {
         if matches!(node[0].1, Entry::NodeTile) {
@@ -446,7 +476,7 @@ fn root_child_topology<'g>(
 
 /// An internal node's child and value masks, then its tile values: every non-child slot
 /// holds the background except the active tiles, so only those are stored.
-pub(super) fn push_internal_values(
+fn push_internal_values(
     out: &mut Vec<u8>,
     children: &[u64],
     tiles: &[u64],
@@ -557,7 +587,7 @@ pub(super) struct TreeStats {
 
 /// The grid's metadata map, sorted by name as OpenVDB keeps it: the caller's entries, then
 /// the grid's name, class and vector type, and the statistics OpenVDB adds when it writes.
-pub(super) fn push_metadata(out: &mut Vec<u8>, g: &GridOut, encoding: Encoding, stats: &TreeStats) {
+fn push_metadata(out: &mut Vec<u8>, g: &GridOut, encoding: Encoding, stats: &TreeStats) {
     use super::vdb_format::MetaValue;
     enum Meta {
         Str(String),

@@ -36,8 +36,8 @@ pub fn merge_brick_set(index: &Path, output: &Path, source: &str) -> Result<(Mer
     ];
     let set = BrickSet::read(index)?;
     if splices(&set) {
-        let spliced = splice_brick_set(&set, index, output, &metadata)?;
-        return Ok((MergedBy::Splicing, spliced.voxels));
+        let voxels = splice_brick_set(&set, index, output, &metadata)?;
+        return Ok((MergedBy::Splicing, voxels));
     }
     let mut outcome = Outcome::read_vdb(index, None)?;
     outcome.metadata = metadata
