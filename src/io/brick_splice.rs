@@ -46,9 +46,10 @@ struct NodeBytes {
 /// A 128^3 slot of the merged tree: a node copied from a brick file, or an active tile.
 type Slot = (NodeKey, Option<NodeBytes>);
 
-/// Whether the bricks of `set` lie on OpenVDB's 128^3 nodes, as `splice_brick_set` needs.
-pub fn splices(set: &BrickSet) -> bool {
-    set.brick_size % NODE_DIM == 0
+/// Whether bricks of `brick_size` voxels lie on OpenVDB's 128^3 nodes, as
+/// `splice_brick_set` needs.
+pub fn splices(brick_size: i64) -> bool {
+    brick_size % NODE_DIM == 0
 }
 
 /// Merges the brick set of the index at `index` into the `.vdb` `output` (atomically), as
@@ -61,7 +62,7 @@ pub fn splice_brick_set(
     output: &Path,
     metadata: &[(&str, MetaValue)],
 ) -> Result<u64> {
-    if !splices(set) {
+    if !splices(set.brick_size) {
         return Err(Error::InvalidArgument(format!(
             "{}: bricks of {} voxels do not lie on OpenVDB's {NODE_DIM}-voxel nodes; only \
              bricks of a multiple of {NODE_DIM} merge without reading their voxels",

@@ -35,7 +35,7 @@ pub fn merge_brick_set(index: &Path, output: &Path, source: &str) -> Result<(Mer
         ("source_file", source.into()),
     ];
     let set = BrickSet::read(index)?;
-    if splices(&set) {
+    if splices(set.brick_size) {
         let voxels = splice_brick_set(&set, index, output, &metadata)?;
         return Ok((MergedBy::Splicing, voxels));
     }

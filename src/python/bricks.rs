@@ -130,7 +130,7 @@ impl BrickPlan {
     /// brick's nodes without reading a voxel, in memory that does not grow with them.
     #[getter]
     fn splices(&self) -> bool {
-        self.0.layout.size % crate::grid::NODE_DIM == 0
+        crate::io::brick_splice::splices(self.0.layout.size)
     }
 
     /// The bricks a winding solid runs (with faces, or within the mesh's box).
