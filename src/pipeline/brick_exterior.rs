@@ -39,16 +39,34 @@ impl Joins {
     }
 }
 
-/// `faces`: for each brick holding surface, the labels on its six faces (`BrickOutside::face`).
-/// Bricks without an entry hold no surface: one component, label 1, fills them.
+/// A face's labels as runs in cell order: (label, cells in a row). A face that the surface
+/// crosses holds a few runs a row, so a brick's faces travel to the client and wait there in
+/// kilobytes, not in a label per cell.
+pub type FaceRuns = Vec<(u32, u32)>;
+
+/// The runs of a face's labels.
+pub fn face_runs(labels: &[u32]) -> FaceRuns {
+    let mut runs: FaceRuns = Vec::new();
+    for &l in labels {
+        match runs.last_mut() {
+            Some((label, n)) if *label == l => *n += 1,
+            _ => runs.push((l, 1)),
+        }
+    }
+    runs
+}
+
+/// `faces`: for each brick holding surface, the labels on its six faces (`BrickOutside::face`)
+/// as runs. Bricks without an entry hold no surface: one component, label 1, fills them.
 /// Returns, for every brick of the layout, its exterior labels in ascending order.
 pub fn exterior_labels(
     layout: &BrickLayout,
-    faces: &BTreeMap<BrickIndex, Vec<Vec<u32>>>,
+    faces: &BTreeMap<BrickIndex, Vec<FaceRuns>>,
 ) -> Result<BTreeMap<BrickIndex, Vec<u32>>> {
-    let cells = (layout.size * layout.size) as usize;
+    let cells = (layout.size * layout.size) as u64;
     for (b, f) in faces {
-        if f.len() != FACES || f.iter().any(|face| face.len() != cells) {
+        let covers = |face: &FaceRuns| face.iter().map(|r| u64::from(r.1)).sum::<u64>() == cells;
+        if f.len() != FACES || !f.iter().all(covers) {
             return Err(Error::InvalidArgument(format!(
                 "brick {b:?}: expected {FACES} faces of {cells} labels"
             )));
@@ -58,20 +76,24 @@ pub fn exterior_labels(
         ids: HashMap::new(),
         parent: vec![0],
     };
-    let label = |b: BrickIndex, face: usize, i: usize| faces.get(&b).map_or(1, |f| f[face][i]);
+    let whole: FaceRuns = vec![(1, cells as u32)];
+    let runs = |b: BrickIndex, face: usize| faces.get(&b).map_or(&whole, |f| &f[face]);
+    let exterior: FaceRuns = vec![(u32::MAX, cells as u32)];
     for b in layout.all() {
         for axis in 0..3 {
             if b[axis] == layout.min[axis] || b[axis] == layout.max[axis] {
                 let face = 2 * axis + usize::from(b[axis] == layout.max[axis]);
-                join_face(&mut joins, b, face, cells, &label, None);
+                join_face(&mut joins, (b, runs(b, face)), None, &exterior);
                 if layout.min[axis] == layout.max[axis] {
-                    join_face(&mut joins, b, 2 * axis, cells, &label, None);
+                    join_face(&mut joins, (b, runs(b, 2 * axis)), None, &exterior);
                 }
             }
             let mut n = b;
             n[axis] += 1;
             if n[axis] <= layout.max[axis] {
-                join_face(&mut joins, b, 2 * axis + 1, cells, &label, Some(n));
+                let face = 2 * axis + 1;
+                let facing = (n, runs(n, face ^ 1));
+                join_face(&mut joins, (b, runs(b, face)), Some(facing), &exterior);
             }
         }
     }
@@ -89,32 +111,43 @@ pub fn exterior_labels(
     Ok(exterior)
 }
 
-/// Joins the labels on face `face` of `b` to the facing labels of `neighbour`, or to the
-/// exterior when there is no neighbour (the layout's border).
+/// Joins the labels on a face of brick `b` (its runs) to the facing labels of the neighbour
+/// brick, or to the exterior (whose runs are `exterior`) where there is none: the layout's
+/// border. The two faces' runs are walked together, one overlap at a time.
 fn join_face(
     joins: &mut Joins,
-    b: BrickIndex,
-    face: usize,
-    cells: usize,
-    label: &impl Fn(BrickIndex, usize, usize) -> u32,
-    neighbour: Option<BrickIndex>,
+    (b, runs): (BrickIndex, &FaceRuns),
+    neighbour: Option<(BrickIndex, &FaceRuns)>,
+    exterior: &FaceRuns,
 ) {
+    let facing = neighbour.map_or(exterior, |n| n.1);
+    let (mut i, mut j) = (0, 0);
+    let (mut left_a, mut left_b) = (0, 0);
     let mut last = (0, 0);
-    for i in 0..cells {
-        let la = label(b, face, i);
-        let lb = match neighbour {
-            Some(n) => label(n, face ^ 1, i),
-            None => u32::MAX,
-        };
-        if la == 0 || lb == 0 || (la, lb) == last {
-            continue;
+    loop {
+        while left_a == 0 && i < runs.len() {
+            left_a = runs[i].1;
+            i += 1;
         }
-        last = (la, lb);
-        let a = joins.id((b, la));
-        let other = match neighbour {
-            Some(n) => joins.id((n, lb)),
-            None => 0,
-        };
-        joins.join(a, other);
+        while left_b == 0 && j < facing.len() {
+            left_b = facing[j].1;
+            j += 1;
+        }
+        if left_a == 0 || left_b == 0 {
+            return;
+        }
+        let (la, lb) = (runs[i - 1].0, facing[j - 1].0);
+        if la != 0 && lb != 0 && (la, lb) != last {
+            last = (la, lb);
+            let a = joins.id((b, la));
+            let other = match neighbour {
+                Some((n, _)) => joins.id((n, lb)),
+                None => 0,
+            };
+            joins.join(a, other);
+        }
+        let step = left_a.min(left_b);
+        left_a -= step;
+        left_b -= step;
     }
 }

@@ -17,6 +17,7 @@
 //! connected to the layout's border, which lies at least one voxel beyond the surface; each
 //! brick then keeps the rest as inside.
 
+use super::brick_exterior::face_runs;
 use super::request::BricksRequest;
 use super::{BrickFaceDetails, BrickStage, BrickTask, Details, MeshSource, Outcome};
 use crate::error::{Error, Result};
@@ -297,7 +298,7 @@ pub(super) fn run_brick(task: &BrickTask, t: Transform, progress: &Progress) -> 
             let outside = BrickOutside::label(&surface, voxels)?;
             let details = BrickFaceDetails {
                 outside_components: outside.runs.components,
-                labels: (0..FACES).map(|f| outside.face(f)).collect(),
+                labels: (0..FACES).map(|f| face_runs(&outside.face(f))).collect(),
             };
             (surface, Details::BrickFaces(details))
         }

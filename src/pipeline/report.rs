@@ -131,10 +131,10 @@ pub enum Details {
 #[derive(Serialize, Debug, Clone, Default)]
 pub struct BrickFaceDetails {
     pub outside_components: u32,
-    /// The labels on the six faces (see `bricks::FACES`), for the client's join; 0 on the
-    /// surface.
+    /// The labels on the six faces (see `bricks::FACES`) as runs, for the client's join; 0 on
+    /// the surface.
     #[serde(skip)]
-    pub labels: Vec<Vec<u32>>,
+    pub labels: Vec<super::brick_exterior::FaceRuns>,
 }
 
 /// Voxels by the part of Huang et al.'s criterion that first produced them.

@@ -13,7 +13,7 @@ use crate::io::brick_set::BrickSet;
 use crate::io::vdb::WriteOptions;
 use crate::mesh::GridFit;
 use crate::mesh::Mesh;
-use crate::pipeline::brick_exterior::exterior_labels;
+use crate::pipeline::brick_exterior::{FaceRuns, exterior_labels};
 use crate::pipeline::brick_merge::merge_brick_set;
 use crate::pipeline::bricks::{BrickIndex, BrickRun, sub_mesh};
 use crate::pipeline::request::{BricksRequest, mib_limit};
@@ -280,7 +280,8 @@ pub fn brick_surface_file(
 }
 
 /// The labels of a brick's outside components on its six faces (-x, +x, -y, +y, -z, +z),
-/// each a (size * size) uint32 array; 0 marks the surface.
+/// each a uint32 array of runs in cell order (label, count, label, count, ...); 0 marks the
+/// surface.
 #[pyfunction]
 #[pyo3(signature = (positions, indices, starts, origin, voxel_size, brick, size,
     max_memory_mib = None))]
@@ -312,7 +313,10 @@ pub fn brick_faces<'py>(
     Ok(faces
         .labels
         .into_iter()
-        .map(|f| Array1::from_vec(f).into_pyarray(py))
+        .map(|runs| {
+            let flat: Vec<u32> = runs.into_iter().flat_map(|(l, n)| [l, n]).collect();
+            Array1::from_vec(flat).into_pyarray(py)
+        })
         .collect())
 }
 
@@ -391,15 +395,20 @@ pub fn brick_exterior(
     plan: &BrickPlan,
     faces: BTreeMap<PyBrick, Vec<PyReadonlyArray1<u32>>>,
 ) -> PyResult<BTreeMap<PyBrick, Vec<u32>>> {
-    let faces: BTreeMap<BrickIndex, Vec<Vec<u32>>> = faces
-        .into_iter()
-        .map(|(b, f)| {
-            (
-                from_py(b),
-                f.iter().map(|a| a.as_array().to_vec()).collect(),
-            )
-        })
-        .collect();
+    let mut runs: BTreeMap<BrickIndex, Vec<FaceRuns>> = BTreeMap::new();
+    for (b, f) in faces {
+        let face = |a: &PyReadonlyArray1<u32>| -> PyResult<FaceRuns> {
+            let flat: Vec<u32> = a.as_array().iter().copied().collect();
+            if !flat.len().is_multiple_of(2) {
+                return Err(PyValueError::new_err(format!(
+                    "brick {b:?}: a face's runs come in (label, count) pairs"
+                )));
+            }
+            Ok(flat.chunks_exact(2).map(|p| (p[0], p[1])).collect())
+        };
+        runs.insert(from_py(b), f.iter().map(face).collect::<PyResult<_>>()?);
+    }
+    let faces = runs;
     let layout = plan.0.layout;
     let exterior = py
         .detach(|| exterior_labels(&layout, &faces))
