@@ -44,14 +44,25 @@ impl Joins {
 /// kilobytes, not in a label per cell.
 pub type FaceRuns = Vec<(u32, u32)>;
 
-/// The runs of a face's labels.
+/// The runs of a face's labels (a run longer than a `u32` counts split in several).
 pub fn face_runs(labels: &[u32]) -> FaceRuns {
     let mut runs: FaceRuns = Vec::new();
     for &l in labels {
         match runs.last_mut() {
-            Some((label, n)) if *label == l => *n += 1,
+            Some((label, n)) if *label == l && *n < u32::MAX => *n += 1,
             _ => runs.push((l, 1)),
         }
+    }
+    runs
+}
+
+/// A face of `cells` cells, all labelled `label`.
+fn uniform(label: u32, cells: u64) -> FaceRuns {
+    let full = cells / u64::from(u32::MAX);
+    let rest = (cells % u64::from(u32::MAX)) as u32;
+    let mut runs = vec![(label, u32::MAX); full as usize];
+    if rest > 0 {
+        runs.push((label, rest));
     }
     runs
 }
@@ -63,7 +74,7 @@ pub fn exterior_labels(
     layout: &BrickLayout,
     faces: &BTreeMap<BrickIndex, Vec<FaceRuns>>,
 ) -> Result<BTreeMap<BrickIndex, Vec<u32>>> {
-    let cells = (layout.size * layout.size) as u64;
+    let cells = (layout.size as u64).pow(2);
     for (b, f) in faces {
         let covers = |face: &FaceRuns| face.iter().map(|r| u64::from(r.1)).sum::<u64>() == cells;
         if f.len() != FACES || !f.iter().all(covers) {
@@ -76,9 +87,9 @@ pub fn exterior_labels(
         ids: HashMap::new(),
         parent: vec![0],
     };
-    let whole: FaceRuns = vec![(1, cells as u32)];
+    let whole = uniform(1, cells);
     let runs = |b: BrickIndex, face: usize| faces.get(&b).map_or(&whole, |f| &f[face]);
-    let exterior: FaceRuns = vec![(u32::MAX, cells as u32)];
+    let exterior = uniform(u32::MAX, cells);
     for b in layout.all() {
         for axis in 0..3 {
             if b[axis] == layout.min[axis] || b[axis] == layout.max[axis] {
