@@ -393,7 +393,11 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
     merge = not keep_bricks and (plan.splices or available is None or merged_bytes < available)
     check()
     index = os.path.join(folder, "index.json")
+    if merge:
+        show.show("merge", 0, len(files))
     merged_by = vk.brick_finish(plan, files, full_bricks, index, merged=output if merge else None)
+    if merge:
+        show.show("merge", len(files), len(files))
     if merge:
         shutil.rmtree(folder)
     return {
