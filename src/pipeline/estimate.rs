@@ -90,14 +90,16 @@ fn area_in_voxels(mesh: &Mesh, t: &Transform) -> f64 {
 
 /// Mesh surfaces and solids, calibrated on the whole process (bunny-closed, igea, armadillo,
 /// skull and horse at 1024, estimate/peak 0.94-1.10): a separating or projective surface
-/// crosses a leaf per 44 voxels^2 of area and costs 430 bytes per leaf at the peak (the leaf
+/// crosses a leaf per 44 voxels^2 of area and costs 400 bytes per leaf at the peak (the leaf
 /// and the encoded buffers on their way to the file, which is written straight from the grid),
 /// 8.3 KB more with normals or colours (the channel and its encoded values); each triangle
 /// about 330 bytes (reading the file, the voxelizer's tables and bins). The leaf's cost was
-/// refitted when the writer began streaming its buffers (estimate/peak 0.96-1.11 on those
-/// five, 0.98-1.25 on fandisk, scorpion, rocker-arm and spot).
+/// refitted when the writer began streaming its buffers, and again where the buffers in flight
+/// made the same run's peak vary (rocker-arm at 2048: 51-60 MiB over five runs; ogre at 1024:
+/// 62-74): estimate/peak 0.92-0.98 on those five, 0.82-1.24 on fandisk, scorpion, rocker-arm,
+/// spot and ogre.
 const MESH_AREA_PER_LEAF: f64 = 44.0;
-const MESH_LEAF_BYTES: f64 = 430.0;
+const MESH_LEAF_BYTES: f64 = 400.0;
 const MESH_VECTOR_LEAF_BYTES: f64 = 8300.0;
 const TRIANGLE_BYTES: f64 = 330.0;
 
