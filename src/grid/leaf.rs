@@ -3,7 +3,7 @@
 //! leaves cross the bridge as plain arrays.
 
 use super::bits;
-use super::coord::{Coord, LEAF_VOXELS, offset_coord};
+use super::coord::{Coord, CoordBox, LEAF_VOXELS, offset_coord};
 
 /// Which optional per-voxel channels a grid carries.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -91,4 +91,31 @@ impl Leaf {
             d[n] = s[n];
         }
     }
+}
+
+/// The box of the active voxels of a leaf at `origin` with `mask`, if any: x by the non-empty
+/// words, y by the non-empty bytes of their union, z by the union of those bytes.
+pub fn mask_box(origin: Coord, mask: &[u64; 8]) -> Option<CoordBox> {
+    let x0 = mask.iter().position(|&w| w != 0)?;
+    let x1 = mask.iter().rposition(|&w| w != 0)?;
+    let rows = mask.iter().fold(0u64, |a, &w| a | w);
+    let bytes = (0..8).map(|y| rows >> (8 * y) & 0xff);
+    let ys = bytes
+        .clone()
+        .enumerate()
+        .fold(0u64, |a, (y, r)| a | u64::from(r != 0) << y);
+    let zs = bytes.fold(0u64, |a, r| a | r);
+    let o = origin;
+    Some(CoordBox {
+        min: [
+            o[0] + x0 as i64,
+            o[1] + ys.trailing_zeros() as i64,
+            o[2] + zs.trailing_zeros() as i64,
+        ],
+        max: [
+            o[0] + x1 as i64,
+            o[1] + 63 - ys.leading_zeros() as i64,
+            o[2] + 63 - zs.leading_zeros() as i64,
+        ],
+    })
 }

@@ -12,7 +12,7 @@ mod transform;
 mod up_axis;
 
 pub use coord::{Coord, CoordBox, LEAF_VOXELS, leaf_offset, leaf_origin, offset_coord};
-pub use leaf::{Channels, Leaf};
+pub use leaf::{Channels, Leaf, mask_box};
 pub use sparse::{Accessor, Block, SparseGrid};
 pub use tiles::{NODE_DIM, TILE_BYTES, Tiles, node_origin};
 pub use transform::Transform;

@@ -3,7 +3,7 @@
 //! is either a tile or a leaf, never both; tiles carry no channels.
 
 use super::coord::{Coord, CoordBox, leaf_offset, leaf_origin, offset_coord};
-use super::leaf::{Channels, Leaf};
+use super::leaf::{Channels, Leaf, mask_box};
 use super::tiles::{NODE_DIM, NODE_LEAVES, Tiles, node_leaf_origins, node_origin};
 use super::transform::Transform;
 use rayon::prelude::*;
@@ -248,32 +248,10 @@ impl SparseGrid {
     /// Bounding box of the active voxels, `None` for an empty grid.
     pub fn bbox(&self) -> Option<CoordBox> {
         let mut b: Option<CoordBox> = None;
-        let leaf_boxes = self.leaves.iter().filter_map(|leaf| {
-            // A leaf's extent from its mask words: x by the non-empty words, y by the
-            // non-empty bytes of their union, z by the union of those bytes.
-            let x0 = leaf.mask.iter().position(|&w| w != 0)?;
-            let x1 = leaf.mask.iter().rposition(|&w| w != 0)?;
-            let rows = leaf.mask.iter().fold(0u64, |a, &w| a | w);
-            let bytes = (0..8).map(|y| rows >> (8 * y) & 0xff);
-            let ys = bytes
-                .clone()
-                .enumerate()
-                .fold(0u64, |a, (y, r)| a | u64::from(r != 0) << y);
-            let zs = bytes.fold(0u64, |a, r| a | r);
-            let o = leaf.origin;
-            Some(CoordBox {
-                min: [
-                    o[0] + x0 as i64,
-                    o[1] + ys.trailing_zeros() as i64,
-                    o[2] + zs.trailing_zeros() as i64,
-                ],
-                max: [
-                    o[0] + x1 as i64,
-                    o[1] + 63 - ys.leading_zeros() as i64,
-                    o[2] + 63 - zs.leading_zeros() as i64,
-                ],
-            })
-        });
+        let leaf_boxes = self
+            .leaves
+            .iter()
+            .filter_map(|leaf| mask_box(leaf.origin, &leaf.mask));
         for part in leaf_boxes.chain(self.tiles.boxes()) {
             b = Some(b.map_or(part, |b| b.union(&part)));
         }

@@ -12,17 +12,15 @@ use super::brick_set::{BrickSet, brick_voxels};
 use super::direct_file::DirectFile;
 use super::grid_out::{GridOut, block_origin, key};
 use super::vdb::{Contents, MetaValue, WriteOptions, candidates, meta_entries};
-use super::vdb_format::{
-    COMPRESS_ACTIVE_MASK, LEAF_MASK_BYTES, MAGIC, NODE_LOG2, NODE_MASK_VERSION, ROOT_TILE,
-};
-use super::vdb_structure::{Reader, metadata};
+use super::vdb_format::{COMPRESS_ACTIVE_MASK, LEAF_MASK_BYTES, NODE_LOG2, ROOT_TILE};
+use super::vdb_structure::{Reader, grid_offsets, header, metadata};
 use super::vdb_tree_structure::{TreeFormat, compressed_values, leaf_buffer};
 use super::vdb_writer::{
     Encoding, TreeStats, descriptor_names, file_header, push_grid_head, push_root_child,
     push_string, push_transform, tree_type_of,
 };
 use crate::error::{Error, Result};
-use crate::grid::{Channels, CoordBox, NODE_DIM, SparseGrid, Transform};
+use crate::grid::{Channels, CoordBox, NODE_DIM, SparseGrid, Transform, bits, mask_box};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -188,19 +186,7 @@ fn walk_brick(
     brick: usize,
     layout: &Layout,
 ) -> std::result::Result<BrickNodes, String> {
-    if r.i64("the header")? != MAGIC {
-        return Err("it does not start with OpenVDB's magic number".into());
-    }
-    if r.u32("the header")? < NODE_MASK_VERSION {
-        return Err("an older file format than voxelkit writes".into());
-    }
-    r.skip(8, "the library version")?;
-    if r.bytes::<1>("the header")?[0] == 0 {
-        return Err("it has no grid offsets (an OpenVDB stream, not a file)".into());
-    }
-    r.skip(36, "the file's UUID")?;
-    metadata(r, "the file's metadata", 0)?;
-    if r.u32("the grid count")? == 0 {
+    if header(r)? == 0 {
         return Err("it holds no grid".into());
     }
     let what = "the first grid's descriptor";
@@ -214,13 +200,7 @@ fn walk_brick(
             layout.name, layout.tree_type
         ));
     }
-    let (grid, block, end) = (r.i64(what)?, r.i64(what)?, r.i64(what)?);
-    let inside = |p: i64| p >= 0 && (p as u64) <= r.len;
-    if !(inside(grid) && inside(block) && inside(end) && grid <= block && block <= end) {
-        return Err(format!(
-            "the grid claims bytes {grid}..{end}, outside the file"
-        ));
-    }
+    let (grid, block, end) = grid_offsets(r, "the grid", what)?;
     r.seek(grid as u64)?;
     let compression = r.u32("the grid's compression")?;
     if compression != layout.compression {
@@ -313,15 +293,9 @@ struct Walk {
 }
 
 impl Walk {
-    fn grow(&mut self, min: [i64; 3], max: [i64; 3], voxels: u64) {
+    fn grow(&mut self, b: CoordBox, voxels: u64) {
         self.voxels += voxels;
-        self.bbox = Some(match self.bbox {
-            None => CoordBox { min, max },
-            Some(b) => CoordBox {
-                min: [0, 1, 2].map(|a| b.min[a].min(min[a])),
-                max: [0, 1, 2].map(|a| b.max[a].max(max[a])),
-            },
-        });
+        self.bbox = Some(self.bbox.map_or(b, |a| a.union(&b)));
     }
 
     /// A root child (4096^3): its masks and tile values, then each 128^3 child's topology.
@@ -333,18 +307,15 @@ impl Walk {
         layout: &Layout,
     ) -> std::result::Result<(), String> {
         let what = "a root child";
-        let bytes = (1u64 << (3 * NODE_LOG2[0])) / 8;
-        let children = r.vec(bytes, what)?;
-        let values = r.vec(bytes, what)?;
-        compressed_values(r, layout.format, layout.compression, &values, what)?;
-        for slot in set_bits(&values).filter(|&s| !bit(&children, s)) {
-            let key = (origin, slot as u16);
+        let (children, values) = node_masks(r, 0, layout, what)?;
+        let edge = i64::from(NODE_DIM as i32);
+        for slot in bits::ones(&values).filter(|&s| !bits::get(&children, s)) {
             let min = block_origin(&(origin, slot as u16, 0), false).map(i64::from);
-            let edge = i64::from(NODE_DIM as i32);
-            self.grow(min, min.map(|v| v + edge - 1), (edge as u64).pow(3));
-            self.slots.push((key, None));
+            let max = min.map(|v| v + edge - 1);
+            self.grow(CoordBox { min, max }, (edge as u64).pow(3));
+            self.slots.push(((origin, slot as u16), None));
         }
-        for slot in set_bits(&children) {
+        for slot in bits::ones(&children) {
             let start = r.pos;
             let leaves = self.lower_node(r, (origin, slot as u16), layout)?;
             self.slots.push((
@@ -367,74 +338,47 @@ impl Walk {
         key: NodeKey,
         layout: &Layout,
     ) -> std::result::Result<u64, String> {
-        let what = "a 128^3 node";
-        let bytes = (1u64 << (3 * NODE_LOG2[1])) / 8;
-        let children = r.vec(bytes, what)?;
-        let values = r.vec(bytes, what)?;
-        compressed_values(r, layout.format, layout.compression, &values, what)?;
+        let (children, values) = node_masks(r, 1, layout, "a 128^3 node")?;
         let block = |slot: usize| block_origin(&(key.0, key.1, slot as u16), true).map(i64::from);
-        for slot in set_bits(&values).filter(|&s| !bit(&children, s)) {
+        for slot in bits::ones(&values).filter(|&s| !bits::get(&children, s)) {
             let min = block(slot);
-            self.grow(min, min.map(|v| v + 7), 512);
+            let max = min.map(|v| v + 7);
+            self.grow(CoordBox { min, max }, 512);
         }
         let mut leaves = 0;
-        for slot in set_bits(&children) {
-            let mask = r.bytes::<{ LEAF_MASK_BYTES as usize }>("a leaf's mask")?;
-            let active = mask.iter().map(|b| b.count_ones()).sum::<u32>();
+        for slot in bits::ones(&children) {
+            let bytes = r.bytes::<{ LEAF_MASK_BYTES as usize }>("a leaf's mask")?;
+            let mask: [u64; 8] = std::array::from_fn(|w| word(&bytes, w));
+            let active = bits::ones(&mask).count() as u64;
             self.leaves.push(active as u16);
             leaves += 1;
-            if let Some((lo, hi)) = mask_box(&mask) {
-                let o = block(slot);
-                let at = |c: [i64; 3]| [0, 1, 2].map(|a| o[a] + c[a]);
-                self.grow(at(lo), at(hi), u64::from(active));
+            if let Some(b) = mask_box(block(slot), &mask) {
+                self.grow(b, active);
             }
         }
         Ok(leaves)
     }
 }
 
-fn bit(mask: &[u8], n: usize) -> bool {
-    mask[n / 8] >> (n % 8) & 1 == 1
+/// An internal node's child and value masks (at `depth`: 0 for a root child) as words, its
+/// tile values skipped.
+fn node_masks(
+    r: &mut Reader,
+    depth: usize,
+    layout: &Layout,
+    what: &str,
+) -> std::result::Result<(Vec<u64>, Vec<u64>), String> {
+    let bytes = (1u64 << (3 * NODE_LOG2[depth])) / 8;
+    let children = r.vec(bytes, what)?;
+    let values = r.vec(bytes, what)?;
+    compressed_values(r, layout.format, layout.compression, &values, what)?;
+    let words = |m: &[u8]| (0..m.len() / 8).map(|w| word(m, w)).collect();
+    Ok((words(&children), words(&values)))
 }
 
-/// The set bits of a mask, in order.
-fn set_bits(mask: &[u8]) -> impl Iterator<Item = usize> + '_ {
-    mask.chunks_exact(8).enumerate().flat_map(|(w, bytes)| {
-        let mut word = u64::from_le_bytes(bytes.try_into().expect("8 bytes"));
-        std::iter::from_fn(move || {
-            (word != 0).then(|| {
-                let b = word.trailing_zeros() as usize;
-                word &= word - 1;
-                64 * w + b
-            })
-        })
-    })
-}
-
-/// The box of a leaf's active voxels within it (offset `x * 64 + y * 8 + z`), if any.
-fn mask_box(mask: &[u8; 64]) -> Option<([i64; 3], [i64; 3])> {
-    let words: [u64; 8] =
-        std::array::from_fn(|x| u64::from_le_bytes(mask[8 * x..8 * x + 8].try_into().expect("8")));
-    let xs = words
-        .iter()
-        .enumerate()
-        .fold(0u8, |a, (x, &w)| a | (u8::from(w != 0) << x));
-    if xs == 0 {
-        return None;
-    }
-    let rows = words.iter().fold(0u64, |a, w| a | w); // bit y * 8 + z
-    let ys = (0..8).fold(0u8, |a, y| {
-        a | (u8::from((rows >> (8 * y)) & 0xff != 0) << y)
-    });
-    let zs = (0..8).fold(0u8, |a, y| a | (rows >> (8 * y)) as u8);
-    let span = |bits: u8| {
-        (
-            bits.trailing_zeros() as i64,
-            7 - bits.leading_zeros() as i64,
-        )
-    };
-    let ((x0, x1), (y0, y1), (z0, z1)) = (span(xs), span(ys), span(zs));
-    Some(([x0, y0, z0], [x1, y1, z1]))
+/// Word `w` of a mask stored as little-endian bytes.
+fn word(mask: &[u8], w: usize) -> u64 {
+    u64::from_le_bytes(mask[8 * w..8 * w + 8].try_into().expect("8 bytes"))
 }
 
 /// The slots of all bricks and full bricks, and the box and count of their voxels.
@@ -456,13 +400,7 @@ impl Merged {
         self.slots.extend(slots);
         self.voxels += voxels;
         if let Some(b) = bbox {
-            self.bbox = Some(match self.bbox {
-                None => b,
-                Some(a) => CoordBox {
-                    min: [0, 1, 2].map(|i| a.min[i].min(b.min[i])),
-                    max: [0, 1, 2].map(|i| a.max[i].max(b.max[i])),
-                },
-            });
+            self.bbox = Some(self.bbox.map_or(b, |a| a.union(&b)));
         }
     }
 

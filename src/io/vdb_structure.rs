@@ -224,7 +224,10 @@ fn delayed_load_table(
     r.skip(end - r.pos, what)
 }
 
-fn walk(r: &mut Reader) -> std::result::Result<u64, String> {
+/// A file's header through its grid count: OpenVDB's magic number, a format version voxelkit
+/// reads, the library version, grid offsets (a file, not a stream), the UUID and the file's
+/// metadata. Returns the grid count.
+pub(super) fn header(r: &mut Reader) -> std::result::Result<u32, String> {
     if r.i64("the header")? != MAGIC {
         return Err("it does not start with OpenVDB's magic number".into());
     }
@@ -242,7 +245,29 @@ fn walk(r: &mut Reader) -> std::result::Result<u64, String> {
         // Written as a stream: without grid offsets the trees cannot be checked.
         return Err("it has no grid offsets (an OpenVDB stream, not a file)".into());
     }
-    let grids = r.u32("the grid count")?;
+    r.u32("the grid count")
+}
+
+/// A grid descriptor's three offsets (the grid, its block of leaf buffers, its end), each
+/// inside the file and in that order; `grid` names the grid in errors.
+pub(super) fn grid_offsets(
+    r: &mut Reader,
+    grid: &str,
+    what: &str,
+) -> std::result::Result<(i64, i64, i64), String> {
+    let (start, block, end) = (r.i64(what)?, r.i64(what)?, r.i64(what)?);
+    let inside = |p: i64| p >= 0 && (p as u64) <= r.len;
+    if !(inside(start) && inside(block) && inside(end) && start <= block && block <= end) {
+        return Err(format!(
+            "{grid} claims bytes {start}..{end}, outside the file ({} bytes)",
+            r.len
+        ));
+    }
+    Ok((start, block, end))
+}
+
+fn walk(r: &mut Reader) -> std::result::Result<u64, String> {
+    let grids = header(r)?;
     let mut memory = 0u64;
     for g in 0..grids {
         let what = format!("the descriptor of grid {g}");
@@ -250,14 +275,7 @@ fn walk(r: &mut Reader) -> std::result::Result<u64, String> {
         let type_name = r.short_string(&what)?;
         let instance = !r.short_string(&what)?.is_empty();
         let format = TreeFormat::of(&type_name).map_err(|e| format!("grid {g} is {e}"))?;
-        let (grid, block, end) = (r.i64(&what)?, r.i64(&what)?, r.i64(&what)?);
-        let inside = |p: i64| p >= 0 && (p as u64) <= r.len;
-        if !(inside(grid) && inside(block) && inside(end) && grid <= block && block <= end) {
-            return Err(format!(
-                "grid {g} claims bytes {grid}..{end}, outside the file ({} bytes)",
-                r.len
-            ));
-        }
+        let (grid, block, end) = grid_offsets(r, &format!("grid {g}"), &what)?;
         if (end as u64) < r.pos {
             return Err(format!("grid {g} ends before its own descriptor"));
         }

@@ -96,7 +96,7 @@ fn area_in_voxels(mesh: &Mesh, t: &Transform) -> f64 {
 /// about 330 bytes (reading the file, the voxelizer's tables and bins). The leaf's cost was
 /// refitted when the writer began streaming its buffers, and again where the buffers in flight
 /// made the same run's peak vary (rocker-arm at 2048: 51-60 MiB over five runs; ogre at 1024:
-/// 62-74): estimate/peak 0.92-0.98 on those five, 0.82-1.24 on fandisk, scorpion, rocker-arm,
+/// 62-74): estimate/peak 0.92-0.98 on those five, 0.82-1.17 on fandisk, scorpion, rocker-arm,
 /// spot and ogre.
 const MESH_AREA_PER_LEAF: f64 = 44.0;
 const MESH_LEAF_BYTES: f64 = 400.0;
