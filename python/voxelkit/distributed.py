@@ -247,19 +247,6 @@ def _stopped_by_signals():
             signal.signal(s, handler)
 
 
-def _prefetch(path):
-    """Asks the kernel to read a finished brick file ahead, while other bricks run, so that
-    the merge finds it in memory."""
-    try:
-        fd = os.open(path, os.O_RDONLY)
-    except OSError:
-        return  # the merge reports a missing brick, naming it
-    try:
-        os.posix_fadvise(fd, 0, 0, os.POSIX_FADV_WILLNEED)
-    finally:
-        os.close(fd)
-
-
 #: Tasks per worker thread when bricks are grouped: enough to balance uneven bricks, few
 #: enough that a task's fixed cost (its trips through the scheduler) is not paid per brick.
 _TASKS_PER_THREAD = 16
@@ -279,9 +266,8 @@ def _in_turn(calls):
     return results
 
 
-def _run(client, calls, stage, progress, check, done=lambda b: None, grouped=True):
-    """Submits `calls` ({brick: (function, args)}) and gathers {brick: result}, calling
-    `done(brick)` as each finishes. Consecutive bricks share a task (`grouped`; frames do
+def _run(client, calls, stage, progress, check, grouped=True):
+    """Submits `calls` ({brick: (function, args)}) and gathers {brick: result}. Consecutive bricks share a task (`grouped`; frames do
     not). A task's arguments travel with it (not scattered to one worker), so that a task
     whose worker dies runs again elsewhere; a brick that still fails ends the run with an
     error that names it."""
@@ -310,8 +296,6 @@ def _run(client, calls, stage, progress, check, done=lambda b: None, grouped=Tru
                 f"{named} ({stage}) failed on its worker after {_RETRIES} retries: "
                 f"{type(e).__name__}: {e}"
             ) from None
-        for b in group:
-            done(b)
         progress.show(stage, len(results), len(keys))
     check()
     return results
@@ -352,7 +336,6 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
         files = {b: _brick_file(b) for b in bricks}
         path = {b: os.path.abspath(os.path.join(folder, files[b])) for b in bricks}
         full_bricks = []
-        prefetch = (lambda b: _prefetch(path[b])) if not keep_bricks and plan.splices else (lambda b: None)
         if solid and plan.winding:
             # Every worker holds the mesh once; a worker lost takes no brick's only copy.
             mesh = client.scatter(plan.mesh_arrays(), broadcast=True)
@@ -360,7 +343,7 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
                 b: (_winding_brick, (arrays[b], mesh, origin, h, b, size, path[b], max_memory_mib))
                 for b in bricks
             }
-            counts = _run(client, calls, "solid", show, check, prefetch)
+            counts = _run(client, calls, "solid", show, check)
         elif solid:
             faces = _run(
                 client,
@@ -376,13 +359,13 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
                 b: (_solid_brick, (arrays[b], origin, h, b, size, exterior[b], path[b], max_memory_mib))
                 for b in plan.bricks
             }
-            counts = _run(client, calls, "solid", show, check, prefetch)
+            counts = _run(client, calls, "solid", show, check)
         else:
             calls = {
                 b: (_surface_brick, (arrays[b], origin, h, b, size, path[b], separability, max_memory_mib))
                 for b in plan.bricks
             }
-            counts = _run(client, calls, "surface", show, check, prefetch)
+            counts = _run(client, calls, "surface", show, check)
         peaks = list(client.run(_peak_rss_mib).values())
     bricks_done = time.perf_counter()
     # Each brick task gives its voxels and the bytes its leaves and tiles take in a merge that

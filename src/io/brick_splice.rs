@@ -10,11 +10,12 @@
 use super::atomic::{check_output, write_atomic};
 use super::brick_set::{BrickSet, brick_voxels};
 use super::direct_file::DirectFile;
+use super::direct_read::{self, AlignedBlock};
 use super::grid_out::{GridOut, block_origin, key};
 use super::vdb::{Contents, MetaValue, WriteOptions, candidates, meta_entries};
 use super::vdb_format::{COMPRESS_ACTIVE_MASK, LEAF_MASK_BYTES, NODE_LOG2, ROOT_TILE};
 use super::vdb_structure::{Reader, grid_offsets, header, metadata};
-use super::vdb_tree_structure::{TreeFormat, compressed_values, leaf_buffer};
+use super::vdb_tree_structure::{TreeFormat, compressed_values, leaf_buffer, ones};
 use super::vdb_writer::{
     Encoding, TreeStats, descriptor_names, file_header, push_grid_head, push_root_child,
     push_string, push_transform, tree_type_of,
@@ -26,7 +27,6 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::fs::File;
 use std::ops::Range;
-use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
 
 /// Where a 128^3 slot lies: its root child's origin and its slot there. Sorting by key gives
@@ -171,7 +171,7 @@ struct BrickNodes {
 
 /// Walks the brick file `file` (number `brick` of the set) against `layout`.
 fn brick_nodes(file: &Path, brick: usize, layout: &Layout) -> Result<BrickNodes> {
-    let mut r = Reader::open(file)?;
+    let mut r = Reader::open_direct(file)?;
     walk_brick(&mut r, brick, layout).map_err(|message| Error::Vdb {
         path: file.to_path_buf(),
         message: format!(
@@ -349,7 +349,7 @@ impl Walk {
         for slot in bits::ones(&children) {
             let bytes = r.bytes::<{ LEAF_MASK_BYTES as usize }>("a leaf's mask")?;
             let mask: [u64; 8] = std::array::from_fn(|w| word(&bytes, w));
-            let active = bits::ones(&mask).count() as u64;
+            let active = mask.iter().map(|w| u64::from(w.count_ones())).sum();
             self.leaves.push(active as u16);
             leaves += 1;
             if let Some(b) = mask_box(block(slot), &mask) {
@@ -371,7 +371,15 @@ fn node_masks(
     let bytes = (1u64 << (3 * NODE_LOG2[depth])) / 8;
     let children = r.vec(bytes, what)?;
     let values = r.vec(bytes, what)?;
-    compressed_values(r, layout.format, layout.compression, &values, what)?;
+    let slots = 8 * bytes;
+    compressed_values(
+        r,
+        layout.format,
+        layout.compression,
+        slots,
+        ones(&values),
+        what,
+    )?;
     let words = |m: &[u8]| (0..m.len() / 8).map(|w| word(m, w)).collect();
     Ok((words(&children), words(&values)))
 }
@@ -493,17 +501,19 @@ fn write_spliced(
             chunk: Vec::with_capacity(CHUNK),
             bricks,
             open: HashMap::new(),
+            block: AlignedBlock::new(CHUNK),
         };
         let copied = (|| {
             copy.bytes(&out);
             for (slots, upper) in roots.iter().zip(&uppers) {
                 copy.bytes(upper);
-                for node in slots.iter().filter_map(|s| s.1.as_ref()) {
-                    copy.range(node.brick, &node.topology)?;
+                let topology = slots.iter().filter_map(|s| s.1.as_ref());
+                for (brick, range) in runs(topology.map(|n| (n.brick, n.topology.clone()))) {
+                    copy.range(brick, &range)?;
                 }
             }
-            for node in nodes() {
-                copy.range(node.brick, &node.buffers)?;
+            for (brick, range) in runs(nodes().map(|n| (n.brick, n.buffers.clone()))) {
+                copy.range(brick, &range)?;
             }
             copy.flush();
             Ok(())
@@ -519,18 +529,35 @@ fn write_spliced(
     Ok(())
 }
 
+/// Byte ranges of brick files in copy order, each run of ranges that follow one another in
+/// one brick file joined into one: a brick's nodes lie in the merged order as in its file,
+/// a few at a time, and each read around the page cache costs the device's latency.
+fn runs(
+    ranges: impl Iterator<Item = (usize, Range<u64>)>,
+) -> impl Iterator<Item = (usize, Range<u64>)> {
+    let mut ranges = ranges.peekable();
+    std::iter::from_fn(move || {
+        let (brick, mut run) = ranges.next()?;
+        while let Some((_, next)) = ranges.next_if(|(b, r)| *b == brick && r.start == run.end) {
+            run.end = next.end;
+        }
+        Some((brick, run))
+    })
+}
+
 /// Bytes gathered before a chunk goes to the writer thread.
 const CHUNK: usize = 4 << 20;
 
 /// Gathers the merged file's bytes (its own and byte ranges of brick files) in order into
 /// chunks for the writer thread, reusing the chunks it hands back; keeps a bounded number
-/// of brick files open.
+/// of brick files open, and reads them around the page cache through `block`.
 struct Copier<'a> {
     send: std::sync::mpsc::SyncSender<Vec<u8>>,
     returned: std::sync::mpsc::Receiver<Vec<u8>>,
     chunk: Vec<u8>,
     bricks: &'a [PathBuf],
     open: HashMap<usize, File>,
+    block: AlignedBlock,
 }
 
 /// Brick files held open at once; more are closed and opened again as needed.
@@ -565,19 +592,17 @@ impl Copier<'_> {
             if self.open.len() == OPEN_FILES {
                 self.open.clear();
             }
-            let f = File::open(path).map_err(|e| Error::io(path, e))?;
+            let f = direct_read::open(path, true).map_err(|e| Error::io(path, e))?;
             self.open.insert(brick, f);
         }
         let mut at = range.start;
         while at < range.end {
             let room = CHUNK.max(self.chunk.len() + 1) - self.chunk.len();
-            let n = (range.end - at).min(room as u64) as usize;
-            let start = self.chunk.len();
-            self.chunk.resize(start + n, 0);
-            self.open[&brick]
-                .read_exact_at(&mut self.chunk[start..], at)
+            let n = (range.end - at).min(room as u64);
+            self.block
+                .append(&self.open[&brick], &(at..at + n), &mut self.chunk)
                 .map_err(|e| Error::io(path, e))?;
-            at += n as u64;
+            at += n;
             if self.chunk.len() >= CHUNK {
                 self.flush();
             }

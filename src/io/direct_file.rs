@@ -2,10 +2,11 @@
 //! it is renamed into place (`atomic`), so its bytes must reach the disk before the run ends
 //! anyway; copying them into the page cache first cost more CPU than compressing them on the
 //! virtual machine measured (about 2 ms per megabyte of fresh page cache) and adds the file's
-//! size to the memory the run touches. Whole aligned blocks go
-//! to the disk directly (`O_DIRECT`) from one reused buffer; a small file, the last partial
-//! block and later patches go through the page cache as usual, and so does everything where
-//! the file system refuses direct I/O (tmpfs, some network file systems).
+//! size to the memory the run touches. Whole aligned blocks go to the disk directly
+//! (`O_DIRECT`) from one reused buffer, and so do the whole pages of the last partial block
+//! (a file of a few megabytes, a brick's, never fills a block); its last partial page and
+//! later patches go through the page cache as usual, and so does everything where the file
+//! system refuses direct I/O (tmpfs, some network file systems).
 
 use std::fs::File;
 use std::io;
@@ -19,7 +20,7 @@ const BLOCK: usize = 4 << 20;
 
 /// The alignment direct I/O asks of buffers, lengths and offsets: a page, which every
 /// device's logical block size divides.
-const ALIGN: usize = 4096;
+pub(super) const ALIGN: usize = 4096;
 
 /// A new file written front to back in blocks.
 pub(super) struct DirectFile {
@@ -73,21 +74,32 @@ impl DirectFile {
         self.file.sync_data()
     }
 
-    /// Writes the partial block and hands back the file, its direct I/O turned off so that
-    /// small writes (patches) may follow anywhere.
-    pub(super) fn finish(self) -> io::Result<File> {
+    /// Writes the partial block (its whole pages directly, so that a file smaller than a
+    /// block goes around the page cache too) and hands back the file, its direct I/O turned
+    /// off so that small writes (patches) may follow anywhere.
+    pub(super) fn finish(mut self) -> io::Result<File> {
+        let pages = self.filled / ALIGN * ALIGN;
+        if pages > 0 {
+            self.write_direct(pages)?;
+        }
         if self.direct {
             set_direct(&self.file, false)?;
         }
-        let block = &self.buffer[self.start..self.start + self.filled];
-        self.file.write_all_at(block, self.written)?;
+        let rest = &self.buffer[self.start + pages..self.start + self.filled];
+        self.file.write_all_at(rest, self.written)?;
         Ok(self.file)
     }
 
-    /// Writes the full block at its (aligned) place: directly while the file system allows,
-    /// else through the page cache.
     fn write_block(&mut self) -> io::Result<()> {
-        let block = &self.buffer[self.start..self.start + BLOCK];
+        self.write_direct(BLOCK)?;
+        self.filled = 0;
+        Ok(())
+    }
+
+    /// Writes the block's first `len` bytes (whole pages) at their aligned place: directly
+    /// while the file system allows, else through the page cache.
+    fn write_direct(&mut self, len: usize) -> io::Result<()> {
+        let block = &self.buffer[self.start..self.start + len];
         if self.direct && self.written == 0 && set_direct(&self.file, true).is_err() {
             self.direct = false;
         }
@@ -104,14 +116,13 @@ impl DirectFile {
         } else {
             self.file.write_all_at(block, self.written)?;
         }
-        self.written += BLOCK as u64;
-        self.filled = 0;
+        self.written += len as u64;
         Ok(())
     }
 }
 
 /// Turns direct I/O on or off for `file`.
-fn set_direct(file: &File, on: bool) -> io::Result<()> {
+pub(super) fn set_direct(file: &File, on: bool) -> io::Result<()> {
     let fd = file.as_raw_fd();
     // SAFETY: fcntl on a descriptor this file owns; F_GETFL and F_SETFL take no pointers.
     let flags = unsafe { libc::fcntl(fd, libc::F_GETFL) };
@@ -153,6 +164,8 @@ mod tests {
             0,
             1,
             ALIGN - 1,
+            ALIGN,
+            3 * ALIGN + 1,
             BLOCK - 1,
             BLOCK,
             BLOCK + 1,

@@ -6,6 +6,7 @@ pub mod brick_set;
 #[cfg(feature = "vdb")]
 pub mod brick_splice;
 mod direct_file;
+mod direct_read;
 #[cfg(feature = "vdb")]
 pub mod grid_export;
 #[cfg(feature = "vdb")]

@@ -4,14 +4,14 @@
 //! make it allocate gigabytes for one string, a damaged chunk size overruns a node's buffer,
 //! and a header alone reads as a file without grids.
 
+use super::direct_read::BlockReader;
 use super::vdb_format::{DELAYED_LOAD, MAGIC, NODE_MASK_VERSION};
 use super::vdb_tree_structure::{self, TreeFormat};
 use crate::error::{Error, Result};
-use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
 pub(super) struct Reader {
-    input: BufReader<std::fs::File>,
+    input: BlockReader,
     pub(super) pos: u64,
     pub(super) len: u64,
 }
@@ -20,13 +20,27 @@ impl Reader {
     /// The file at `path`, read through a large buffer: most skips (compressed chunks of a
     /// few hundred bytes) stay inside it.
     pub(super) fn open(path: &Path) -> Result<Reader> {
-        let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-        let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
-        Ok(Reader {
-            input: BufReader::with_capacity(1 << 20, file),
-            pos: 0,
-            len,
-        })
+        Reader::open_block_wise(path, false)
+    }
+
+    /// The file at `path`, read around the page cache where the file system allows it: a
+    /// file about to be copied and deleted.
+    pub(super) fn open_direct(path: &Path) -> Result<Reader> {
+        Reader::open_block_wise(path, true)
+    }
+
+    fn open_block_wise(path: &Path, direct: bool) -> Result<Reader> {
+        let input = BlockReader::open(path, 1 << 20, direct).map_err(|e| Error::io(path, e))?;
+        let len = input.len().map_err(|e| Error::io(path, e))?;
+        Ok(Reader { input, pos: 0, len })
+    }
+
+    fn read(&mut self, out: &mut [u8]) -> std::result::Result<(), String> {
+        self.input
+            .read_exact_at(self.pos, out)
+            .map_err(|e| e.to_string())?;
+        self.pos += out.len() as u64;
+        Ok(())
     }
 
     pub(super) fn bytes<const N: usize>(
@@ -37,8 +51,7 @@ impl Reader {
             return Err(format!("it ends inside {what} (byte {})", self.pos));
         }
         let mut b = [0u8; N];
-        self.input.read_exact(&mut b).map_err(|e| e.to_string())?;
-        self.pos += N as u64;
+        self.read(&mut b)?;
         Ok(b)
     }
 
@@ -58,9 +71,6 @@ impl Reader {
                 self.pos, self.len
             ));
         }
-        self.input
-            .seek_relative(n as i64)
-            .map_err(|e| e.to_string())?;
         self.pos += n;
         Ok(())
     }
@@ -71,8 +81,7 @@ impl Reader {
             return Err(format!("it ends inside {what} (byte {})", self.pos));
         }
         let mut v = vec![0u8; n as usize];
-        self.input.read_exact(&mut v).map_err(|e| e.to_string())?;
-        self.pos += n;
+        self.read(&mut v)?;
         Ok(v)
     }
 
@@ -92,9 +101,6 @@ impl Reader {
     }
 
     pub(super) fn seek(&mut self, to: u64) -> std::result::Result<(), String> {
-        self.input
-            .seek(SeekFrom::Start(to))
-            .map_err(|e| e.to_string())?;
         self.pos = to;
         Ok(())
     }

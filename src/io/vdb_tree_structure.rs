@@ -221,7 +221,8 @@ fn internal_node(
     let mask_bytes = (1u64 << (3 * NODE_LOG2[depth])) / 8;
     let child_mask = r.vec(mask_bytes, what)?;
     let value_mask = r.vec(mask_bytes, what)?;
-    compressed_values(r, format, compression, &value_mask, what)?;
+    let slots = 8 * mask_bytes;
+    compressed_values(r, format, compression, slots, ones(&value_mask), what)?;
     nodes.tiles += value_mask
         .iter()
         .zip(&child_mask)
@@ -239,8 +240,12 @@ fn internal_node(
     Ok(())
 }
 
-fn ones(mask: &[u8]) -> u64 {
-    mask.iter().map(|b| b.count_ones() as u64).sum()
+/// The bits set in a mask stored as bytes (whole words, as every node mask is), counted a
+/// word at a time.
+pub(super) fn ones(mask: &[u8]) -> u64 {
+    mask.chunks_exact(8)
+        .map(|w| u64::from_le_bytes(w.try_into().expect("8 bytes")).count_ones() as u64)
+        .sum()
 }
 
 /// One leaf's buffer record, laid out by the tree's leaf kind. A value leaf repeats its voxel
@@ -258,25 +263,26 @@ pub(super) fn leaf_buffer(
         LeafKind::Mask => r.skip(LEAF_MASK_BYTES + 12, what),
         LeafKind::Values => {
             let at = r.pos;
-            let mask = r.bytes::<{ LEAF_MASK_BYTES as usize }>(what)?;
-            if ones(&mask) != active as u64 {
+            let mask = ones(&r.bytes::<{ LEAF_MASK_BYTES as usize }>(what)?);
+            if mask != active as u64 {
                 return Err(format!(
-                    "{what}: the leaf at byte {at} has {} active voxels, its topology {active}",
-                    ones(&mask)
+                    "{what}: the leaf at byte {at} has {mask} active voxels, its topology {active}"
                 ));
             }
-            compressed_values(r, format, compression, &mask, what)
+            compressed_values(r, format, compression, 8 * LEAF_MASK_BYTES, mask, what)
         }
     }
 }
 
-/// OpenVDB's node values: a flag saying what follows (up to two inactive values and a
-/// selection mask), then every value, or with mask compression only the active ones.
+/// OpenVDB's values of a node of `slots` values, `active` of them active: a flag saying
+/// what follows (up to two inactive values and a selection mask), then every value, or with
+/// mask compression only the active ones.
 pub(super) fn compressed_values(
     r: &mut Reader,
     format: TreeFormat,
     compression: u32,
-    mask: &[u8],
+    slots: u64,
+    active: u64,
     what: &str,
 ) -> Check {
     let flag = r.bytes::<1>(what)?[0];
@@ -290,12 +296,12 @@ pub(super) fn compressed_values(
     };
     r.skip(inactive_values * format.value, what)?;
     if selection_mask {
-        r.skip(mask.len() as u64, what)?;
+        r.skip(slots / 8, what)?;
     }
     let count = if compression & COMPRESS_ACTIVE_MASK != 0 && flag != 6 {
-        ones(mask)
+        active
     } else {
-        8 * mask.len() as u64
+        slots
     };
     if format.half && count == 0 {
         return Ok(()); // OpenVDB writes nothing for no values at half precision
