@@ -1,5 +1,6 @@
-//! What the machine offers: available and peak memory (Linux `/proc`), and the check that
-//! refuses work that cannot fit before anything is allocated.
+//! What the machine offers: available and peak memory (Linux `/proc`), the check that
+//! refuses work that cannot fit before anything is allocated, and how a process that runs
+//! many jobs keeps the memory they free.
 
 use crate::error::{Error, Result};
 
@@ -107,4 +108,25 @@ pub fn check_fits(estimated: u64, limit: Option<u64>, detail: &str) -> Result<()
         });
     }
     Ok(())
+}
+
+/// Keeps the memory a job frees inside the process for the next job, in a process that runs
+/// many (a distributed worker's bricks): glibc otherwise hands every block above a few
+/// megabytes back to the kernel, and the next job faults in and zeroes fresh pages again (on
+/// the virtual machine measured, two workers' bricks of igea at 6144 took 2.5 s instead of
+/// 2.9 s). The memory kept is at most a job's own peak, which its estimate counted; blocks
+/// above 32 MiB (glibc's largest threshold) still go back.
+pub fn keep_freed_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        static ONCE: std::sync::Once = std::sync::Once::new();
+        ONCE.call_once(|| {
+            // SAFETY: mallopt changes glibc's thresholds under its own lock; the values are
+            // within the ranges it accepts.
+            unsafe {
+                libc::mallopt(libc::M_MMAP_THRESHOLD, 32 << 20);
+                libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX);
+            }
+        });
+    }
 }

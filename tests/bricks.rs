@@ -187,7 +187,7 @@ fn tree_bytes(path: &std::path::Path) -> Vec<u8> {
 #[test]
 fn node_bricks_splice_into_the_single_writes_tree() {
     use voxelkit::io::brick_set::{BRICK_SET_FORMAT, BrickFile, BrickSet, brick_voxels};
-    use voxelkit::io::brick_splice::splice_brick_set;
+    use voxelkit::io::brick_splice::{BrickWalker, Walked, splice_brick_set};
     use voxelkit::io::vdb::write_vdb;
     let mesh = generate::cuboid(DVec3::new(-1.0, -0.7, -0.4), DVec3::new(1.0, 0.8, 0.45));
     let t = voxelkit::mesh::fit_transform(&mesh.bbox(), GridFit::Resolution(1100)).unwrap();
@@ -233,7 +233,7 @@ fn node_bricks_splice_into_the_single_writes_tree() {
     let index = dir.path().join("index.json");
     set.write(&index).unwrap();
     let merged = dir.path().join("merged.vdb");
-    let voxels = splice_brick_set(&set, &index, &merged, &[]).unwrap();
+    let voxels = splice_brick_set(&set, &index, &merged, &[], Walked::default()).unwrap();
     let single = dir.path().join("single.vdb");
     write_vdb(&single, &whole, &[]).unwrap();
     assert_eq!(voxels, whole.voxel_count());
@@ -244,4 +244,21 @@ fn node_bricks_splice_into_the_single_writes_tree() {
         "the single write's tree"
     );
     common::assert_read_as_openvdb_reads(&merged, "density");
+    // Bricks walked beforehand (every other one, in reverse order, one of them changed after
+    // its walk and so walked again) splice into the same tree.
+    let walker = BrickWalker::new();
+    for brick in set.bricks.iter().rev().step_by(2) {
+        walker.walk(dir.path().join(&brick.file));
+    }
+    let walked = walker.finish();
+    let changed = dir.path().join(&set.bricks.last().unwrap().file);
+    let mut part = voxelkit::io::vdb::read_vdb_grid(&changed, None).unwrap();
+    part.compact();
+    write_vdb(&changed, &part, &[("changed", "after its walk".into())]).unwrap();
+    let again = dir.path().join("again.vdb");
+    splice_brick_set(&set, &index, &again, &[], walked).unwrap();
+    assert!(
+        tree_bytes(&again) == tree_bytes(&single),
+        "the single write's tree from walked bricks"
+    );
 }

@@ -196,11 +196,16 @@ def brick_winding_file(
 def brick_exterior(
     plan: BrickPlan, faces: Dict[Index, Sequence[npt.NDArray[np.uint32]]]
 ) -> Dict[Index, List[int]]: ...
+class BrickWalker:
+    def __init__(self) -> None: ...
+    def walk(self, path: Path) -> None: ...
+
 def brick_finish(
     plan: BrickPlan,
     files: Dict[Index, str],
     full_bricks: Sequence[Index],
     index: Path,
     merged: Optional[Path] = None,
+    walker: Optional[BrickWalker] = None,
 ) -> Optional[str]: ...
 def brick_merge(index: Path, output: Path) -> Tuple[str, int]: ...

@@ -266,8 +266,9 @@ def _in_turn(calls):
     return results
 
 
-def _run(client, calls, stage, progress, check, grouped=True):
-    """Submits `calls` ({brick: (function, args)}) and gathers {brick: result}. Consecutive bricks share a task (`grouped`; frames do
+def _run(client, calls, stage, progress, check, done=lambda b: None, grouped=True):
+    """Submits `calls` ({brick: (function, args)}) and gathers {brick: result}, calling
+    `done(brick)` as each finishes. Consecutive bricks share a task (`grouped`; frames do
     not). A task's arguments travel with it (not scattered to one worker), so that a task
     whose worker dies runs again elsewhere; a brick that still fails ends the run with an
     error that names it."""
@@ -296,6 +297,8 @@ def _run(client, calls, stage, progress, check, grouped=True):
                 f"{named} ({stage}) failed on its worker after {_RETRIES} retries: "
                 f"{type(e).__name__}: {e}"
             ) from None
+        for b in group:
+            done(b)
         progress.show(stage, len(results), len(keys))
     check()
     return results
@@ -336,6 +339,9 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
         files = {b: _brick_file(b) for b in bricks}
         path = {b: os.path.abspath(os.path.join(folder, files[b])) for b in bricks}
         full_bricks = []
+        # Bricks on OpenVDB's nodes are walked as they finish, so that the merge only copies.
+        walker = vk.BrickWalker() if plan.splices and not keep_bricks else None
+        walk = (lambda b: walker.walk(path[b])) if walker else (lambda b: None)
         if solid and plan.winding:
             # Every worker holds the mesh once; a worker lost takes no brick's only copy.
             mesh = client.scatter(plan.mesh_arrays(), broadcast=True)
@@ -343,7 +349,7 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
                 b: (_winding_brick, (arrays[b], mesh, origin, h, b, size, path[b], max_memory_mib))
                 for b in bricks
             }
-            counts = _run(client, calls, "solid", show, check)
+            counts = _run(client, calls, "solid", show, check, walk)
         elif solid:
             faces = _run(
                 client,
@@ -359,13 +365,13 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
                 b: (_solid_brick, (arrays[b], origin, h, b, size, exterior[b], path[b], max_memory_mib))
                 for b in plan.bricks
             }
-            counts = _run(client, calls, "solid", show, check)
+            counts = _run(client, calls, "solid", show, check, walk)
         else:
             calls = {
                 b: (_surface_brick, (arrays[b], origin, h, b, size, path[b], separability, max_memory_mib))
                 for b in plan.bricks
             }
-            counts = _run(client, calls, "surface", show, check)
+            counts = _run(client, calls, "surface", show, check, walk)
         peaks = list(client.run(_peak_rss_mib).values())
     bricks_done = time.perf_counter()
     # Each brick task gives its voxels and the bytes its leaves and tiles take in a merge that
@@ -378,7 +384,9 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
     index = os.path.join(folder, "index.json")
     if merge:
         show.show("merge", 0, len(files))
-    merged_by = vk.brick_finish(plan, files, full_bricks, index, merged=output if merge else None)
+    merged_by = vk.brick_finish(
+        plan, files, full_bricks, index, merged=output if merge else None, walker=walker
+    )
     if merge:
         show.show("merge", len(files), len(files))
     if merge:

@@ -59,6 +59,7 @@ pub fn splice_brick_set(
     index: &Path,
     output: &Path,
     metadata: &[(&str, MetaValue)],
+    mut walked: Walked,
 ) -> Result<u64> {
     if !splices(set.brick_size) {
         return Err(Error::InvalidArgument(format!(
@@ -75,28 +76,20 @@ pub fn splice_brick_set(
     check_output(output, &inputs)?;
     let meta = meta_entries(metadata);
     let empty = SparseGrid::new(set.transform(), Channels::NONE);
-    let contents = Contents::Voxels {
-        grid: &empty,
-        masks: Vec::new(),
-        attributes: &[],
-    };
-    let options = WriteOptions::default();
-    let grid = candidates(output, &contents, &meta, &options)?
-        .into_iter()
-        .next()
-        .expect("a voxel set writes its fog volume");
-    let encoding = Encoding {
-        compression: options.compression.flags(),
-        half: false,
-    };
-    let layout = Layout::of(&grid, encoding);
+    let grid = voxel_set_grid(output, &empty, &meta)?;
+    let layout = Layout::of(&grid, encoding());
+    let walks: Vec<Option<WalkedBrick>> = files.iter().map(|f| walked.0.remove(f)).collect();
     let bricks: Vec<BrickNodes> = set
         .bricks
         .par_iter()
         .zip(&files)
+        .zip(walks)
         .enumerate()
-        .map(|(n, (brick, file))| {
-            let nodes = brick_nodes(file, n, &layout)?;
+        .map(|(n, ((brick, file), walk))| {
+            let nodes = match walk {
+                Some(w) if file_id(file) == Some(w.id) => w.nodes.numbered(n),
+                _ => brick_nodes(file, n, &layout)?,
+            };
             set.check_part(brick, file, nodes.bbox, &nodes.transform)?;
             Ok(nodes)
         })
@@ -133,9 +126,111 @@ pub fn splice_brick_set(
         });
     }
     write_atomic(output, |tmp| {
-        write_spliced(tmp, output, &grid, encoding, transform, &merged, &files)
+        write_spliced(tmp, output, &grid, encoding(), transform, &merged, &files)
     })?;
     Ok(merged.voxels)
+}
+
+/// How the merged file and every brick file encode their values (voxelkit's defaults).
+fn encoding() -> Encoding {
+    Encoding {
+        compression: WriteOptions::default().compression.flags(),
+        half: false,
+    }
+}
+
+/// The voxel set's grid as voxelkit writes it, with `grid`'s transform and `meta`.
+fn voxel_set_grid<'g>(
+    output: &Path,
+    grid: &'g SparseGrid,
+    meta: &'g [(String, MetaValue)],
+) -> Result<GridOut<'g>> {
+    let contents = Contents::Voxels {
+        grid,
+        masks: Vec::new(),
+        attributes: &[],
+    };
+    Ok(
+        candidates(output, &contents, meta, &WriteOptions::default())?
+            .into_iter()
+            .next()
+            .expect("a voxel set writes its fog volume"),
+    )
+}
+
+/// What tells a file from the one walked: its inode (a brick written again is renamed into
+/// place), length and modification time.
+type FileId = (u64, u64, i64, i64);
+
+fn file_id(file: &Path) -> Option<FileId> {
+    use std::os::unix::fs::MetadataExt;
+    let m = std::fs::metadata(file).ok()?;
+    Some((m.ino(), m.len(), m.mtime(), m.mtime_nsec()))
+}
+
+/// Brick files walked while other bricks are still being made, on a thread of their own, so
+/// that the merge after the last brick has little more to do than copy. A brick that fails
+/// its walk is walked again by the merge, which names what is wrong.
+pub struct BrickWalker {
+    send: Option<std::sync::mpsc::Sender<PathBuf>>,
+    thread: Option<std::thread::JoinHandle<Walked>>,
+}
+
+/// The bricks a `BrickWalker` walked, by file; each is taken as walked only while its file
+/// is the one walked (`FileId`).
+#[derive(Default)]
+pub struct Walked(HashMap<PathBuf, WalkedBrick>);
+
+struct WalkedBrick {
+    id: FileId,
+    nodes: BrickNodes,
+}
+
+impl BrickWalker {
+    pub fn new() -> BrickWalker {
+        let (send, paths) = std::sync::mpsc::channel::<PathBuf>();
+        let thread = std::thread::spawn(move || {
+            let mut walked = Walked::default();
+            let empty = SparseGrid::new(Transform::new(DVec3::ZERO, 1.0), Channels::NONE);
+            let Ok(grid) = voxel_set_grid(Path::new("bricks"), &empty, &[]) else {
+                return walked;
+            };
+            let layout = Layout::of(&grid, encoding());
+            for path in paths {
+                let id = file_id(&path);
+                if let (Some(id), Ok(nodes)) = (id, brick_nodes(&path, 0, &layout)) {
+                    walked.0.insert(path, WalkedBrick { id, nodes });
+                }
+            }
+            walked
+        });
+        BrickWalker {
+            send: Some(send),
+            thread: Some(thread),
+        }
+    }
+
+    /// Walks the finished brick file `path` in the background.
+    pub fn walk(&self, path: PathBuf) {
+        if let Some(send) = &self.send {
+            let _ = send.send(path);
+        }
+    }
+
+    /// Waits for the walks asked for and hands them over.
+    pub fn finish(mut self) -> Walked {
+        self.send = None;
+        self.thread
+            .take()
+            .and_then(|t| t.join().ok())
+            .unwrap_or_default()
+    }
+}
+
+impl Default for BrickWalker {
+    fn default() -> Self {
+        BrickWalker::new()
+    }
 }
 
 /// What every brick file must hold to be copied into the merged file: the grid's name, tree
@@ -167,6 +262,16 @@ struct BrickNodes {
     bbox: Option<CoordBox>,
     voxels: u64,
     transform: Transform,
+}
+
+impl BrickNodes {
+    /// The nodes as those of brick `brick` of the set.
+    fn numbered(mut self, brick: usize) -> BrickNodes {
+        for node in self.slots.iter_mut().filter_map(|s| s.1.as_mut()) {
+            node.brick = brick;
+        }
+        self
+    }
 }
 
 /// Walks the brick file `file` (number `brick` of the set) against `layout`.

@@ -214,6 +214,7 @@ fn run_brick(
     stage: BrickStage,
     (origin, voxel_size, brick, size, max_memory_mib): BrickAt,
 ) -> PyResult<Outcome> {
+    crate::system::keep_freed_memory();
     let faces = from_arrays(arrays, "a brick's faces");
     let task = Task::Brick(BrickTask {
         faces,
@@ -416,11 +417,31 @@ pub fn brick_exterior(
     Ok(exterior.into_iter().map(|(b, l)| (to_py(b), l)).collect())
 }
 
+/// Brick files walked (their nodes found) in the background as they are finished, for the
+/// merge that follows (`brick_finish`).
+#[pyclass(module = "voxelkit._voxelkit")]
+pub struct BrickWalker(Option<crate::io::brick_splice::BrickWalker>);
+
+#[pymethods]
+impl BrickWalker {
+    #[new]
+    fn new() -> Self {
+        BrickWalker(Some(Default::default()))
+    }
+
+    /// Walks the finished brick file at `path` on the walker's thread.
+    fn walk(&self, path: PathBuf) {
+        if let Some(w) = &self.0 {
+            w.walk(path);
+        }
+    }
+}
+
 /// Writes the brick-set index `index` (brick files named relative to it); with `merged`, also
-/// merges the bricks into that one `.vdb` (see `pipeline::brick_merge`) and returns how
-/// (`"splicing"` or `"reading"`).
+/// merges the bricks into that one `.vdb` (see `pipeline::brick_merge`), taking the bricks
+/// `walker` walked as they are, and returns how (`"splicing"` or `"reading"`).
 #[pyfunction]
-#[pyo3(signature = (plan, files, full_bricks, index, merged = None))]
+#[pyo3(signature = (plan, files, full_bricks, index, merged = None, walker = None))]
 pub fn brick_finish(
     py: Python<'_>,
     plan: &BrickPlan,
@@ -428,7 +449,9 @@ pub fn brick_finish(
     full_bricks: Vec<PyBrick>,
     index: PathBuf,
     merged: Option<PathBuf>,
+    walker: Option<&mut BrickWalker>,
 ) -> PyResult<Option<&'static str>> {
+    let walker = walker.and_then(|w| w.0.take());
     let set = BrickSet {
         format: crate::io::brick_set::BRICK_SET_FORMAT.into(),
         voxel_size: plan.0.layout.transform.voxel_size,
@@ -446,10 +469,11 @@ pub fn brick_finish(
     let source = plan.0.mesh.source.display().to_string();
     py.detach(|| -> Result<Option<&'static str>> {
         set.write(&index)?;
+        let walked = walker.map(|w| w.finish()).unwrap_or_default();
         let Some(out) = merged else {
             return Ok(None);
         };
-        let (by, _) = merge_brick_set(&index, &out, &source)?;
+        let (by, _) = merge_brick_set(&index, &out, &source, walked)?;
         Ok(Some(by.name()))
     })
     .map_err(to_py_err)
@@ -464,13 +488,14 @@ pub fn brick_merge(
     output: PathBuf,
 ) -> PyResult<(&'static str, u64)> {
     let source = index.display().to_string();
-    py.detach(|| merge_brick_set(&index, &output, &source))
+    py.detach(|| merge_brick_set(&index, &output, &source, Default::default()))
         .map(|(by, voxels)| (by.name(), voxels))
         .map_err(to_py_err)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<BrickPlan>()?;
+    m.add_class::<BrickWalker>()?;
     m.add_function(wrap_pyfunction!(brick_plan, m)?)?;
     m.add_function(wrap_pyfunction!(brick_surface_file, m)?)?;
     m.add_function(wrap_pyfunction!(brick_faces, m)?)?;
