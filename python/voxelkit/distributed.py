@@ -22,8 +22,9 @@ faces are wholly outside or wholly inside (written as tiles, no task).
 
 The bricks are merged into ``OUT.vdb``. Bricks of a multiple of 128 voxels (the default 1024)
 lie on OpenVDB's 128^3 nodes and each brick file holds its nodes as the merged file does, so the
-client copies them into place in OpenVDB's order without reading a voxel, building only the
-4096^3 nodes' masks: its memory does not grow with the voxels. Bricks of other sizes are read
+client walks each brick file's structure as the brick finishes and, after the last, copies the
+nodes into place in OpenVDB's order without reading a voxel, building only the 4096^3 nodes'
+masks: its memory does not grow with the voxels. Bricks of other sizes are read
 into one grid, and merged only when it fits in the client's memory (each brick reports the
 bytes its leaves and tiles take). With ``--keep-bricks`` (or when that does not fit) the bricks
 stay as ``OUT.bricks/`` with an index ``OUT.bricks/index.json`` that ``voxelkit info`` and
