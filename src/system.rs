@@ -114,8 +114,9 @@ pub fn check_fits(estimated: u64, limit: Option<u64>, detail: &str) -> Result<()
 /// many (a distributed worker's bricks): glibc otherwise hands every block above a few
 /// megabytes back to the kernel, and the next job faults in and zeroes fresh pages again (on
 /// the virtual machine measured, two workers' bricks of igea at 6144 took 2.5 s instead of
-/// 2.9 s). The memory kept is at most a job's own peak, which its estimate counted; blocks
-/// above 32 MiB (glibc's largest threshold) still go back.
+/// 2.9 s). A worker's peak then rises a little above one job's, as freed blocks of one size
+/// serve the next job's other sizes only in part (bricks of 1024: 86 -> 100 MiB; of 2048: 128
+/// -> 170-181 MiB); blocks above 32 MiB (glibc's largest threshold) still go back.
 pub fn keep_freed_memory() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     {

@@ -390,7 +390,6 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
     )
     if merge:
         show.show("merge", len(files), len(files))
-    if merge:
         shutil.rmtree(folder)
     return {
         "output": output if merge else index,

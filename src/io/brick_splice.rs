@@ -15,7 +15,7 @@ use super::grid_out::{GridOut, block_origin, key};
 use super::vdb::{Contents, MetaValue, WriteOptions, candidates, meta_entries};
 use super::vdb_format::{COMPRESS_ACTIVE_MASK, LEAF_MASK_BYTES, NODE_LOG2, ROOT_TILE};
 use super::vdb_structure::{Reader, grid_offsets, header, metadata};
-use super::vdb_tree_structure::{TreeFormat, compressed_values, leaf_buffer, ones};
+use super::vdb_tree_structure::{TreeFormat, compressed_values, leaf_buffer, mask_words, ones};
 use super::vdb_writer::{
     Encoding, TreeStats, descriptor_names, file_header, push_grid_head, push_root_child,
     push_string, push_transform, tree_type_of,
@@ -77,7 +77,7 @@ pub fn splice_brick_set(
     let meta = meta_entries(metadata);
     let empty = SparseGrid::new(set.transform(), Channels::NONE);
     let grid = voxel_set_grid(output, &empty, &meta)?;
-    let layout = Layout::of(&grid, encoding());
+    let layout = Layout::voxel_set()?;
     let walks: Vec<Option<WalkedBrick>> = files.iter().map(|f| walked.0.remove(f)).collect();
     let bricks: Vec<BrickNodes> = set
         .bricks
@@ -191,11 +191,9 @@ impl BrickWalker {
         let (send, paths) = std::sync::mpsc::channel::<PathBuf>();
         let thread = std::thread::spawn(move || {
             let mut walked = Walked::default();
-            let empty = SparseGrid::new(Transform::new(DVec3::ZERO, 1.0), Channels::NONE);
-            let Ok(grid) = voxel_set_grid(Path::new("bricks"), &empty, &[]) else {
+            let Ok(layout) = Layout::voxel_set() else {
                 return walked;
             };
-            let layout = Layout::of(&grid, encoding());
             for path in paths {
                 let id = file_id(&path);
                 if let (Some(id), Ok(nodes)) = (id, brick_nodes(&path, 0, &layout)) {
@@ -244,15 +242,18 @@ struct Layout {
 }
 
 impl Layout {
-    fn of(grid: &GridOut, encoding: Encoding) -> Layout {
+    /// What a voxel set's grid holds, whatever its transform and metadata.
+    fn voxel_set() -> Result<Layout> {
+        let empty = SparseGrid::new(Transform::new(DVec3::ZERO, 1.0), Channels::NONE);
+        let grid = voxel_set_grid(Path::new("the bricks"), &empty, &[])?;
         let tree_type = tree_type_of(grid.values);
-        Layout {
+        Ok(Layout {
             name: grid.name.to_string(),
             format: TreeFormat::of(&tree_type).expect("a standard tree"),
             tree_type,
-            compression: encoding.compression | COMPRESS_ACTIVE_MASK,
+            compression: encoding().compression | COMPRESS_ACTIVE_MASK,
             background: grid.values.background().to_le_bytes().to_vec(),
-        }
+        })
     }
 }
 
@@ -306,7 +307,7 @@ fn walk_brick(
         ));
     }
     let (grid, block, end) = grid_offsets(r, "the grid", what)?;
-    r.seek(grid as u64)?;
+    r.seek(grid as u64);
     let compression = r.u32("the grid's compression")?;
     if compression != layout.compression {
         return Err(format!(
@@ -344,7 +345,7 @@ fn walk_brick(
         walk.root_child(r, origin, brick, layout)?;
     }
     r.len = end as u64;
-    r.seek(block as u64)?;
+    r.seek(block as u64);
     let mut leaves = walk.leaves.iter();
     for (_, node) in &mut walk.slots {
         let Some(node) = node else { continue };
@@ -453,7 +454,8 @@ impl Walk {
         let mut leaves = 0;
         for slot in bits::ones(&children) {
             let bytes = r.bytes::<{ LEAF_MASK_BYTES as usize }>("a leaf's mask")?;
-            let mask: [u64; 8] = std::array::from_fn(|w| word(&bytes, w));
+            let mut words = mask_words(&bytes);
+            let mask: [u64; 8] = std::array::from_fn(|_| words.next().expect("a leaf's 8 words"));
             let active = mask.iter().map(|w| u64::from(w.count_ones())).sum();
             self.leaves.push(active as u16);
             leaves += 1;
@@ -485,13 +487,10 @@ fn node_masks(
         ones(&values),
         what,
     )?;
-    let words = |m: &[u8]| (0..m.len() / 8).map(|w| word(m, w)).collect();
-    Ok((words(&children), words(&values)))
-}
-
-/// Word `w` of a mask stored as little-endian bytes.
-fn word(mask: &[u8], w: usize) -> u64 {
-    u64::from_le_bytes(mask[8 * w..8 * w + 8].try_into().expect("8 bytes"))
+    Ok((
+        mask_words(&children).collect(),
+        mask_words(&values).collect(),
+    ))
 }
 
 /// The slots of all bricks and full bricks, and the box and count of their voxels.

@@ -22,12 +22,34 @@ const BLOCK: usize = 4 << 20;
 /// device's logical block size divides.
 pub(super) const ALIGN: usize = 4096;
 
+/// `len` bytes (a multiple of `ALIGN`) at an aligned address, as direct I/O asks.
+pub(super) struct AlignedBuffer {
+    /// `len + ALIGN` bytes, of which the aligned `len` from `start` are the buffer.
+    buffer: Vec<u8>,
+    start: usize,
+    len: usize,
+}
+
+impl AlignedBuffer {
+    pub(super) fn new(len: usize) -> AlignedBuffer {
+        let buffer = vec![0u8; len + ALIGN];
+        let start = buffer.as_ptr().align_offset(ALIGN);
+        AlignedBuffer { buffer, start, len }
+    }
+
+    pub(super) fn bytes(&self) -> &[u8] {
+        &self.buffer[self.start..self.start + self.len]
+    }
+
+    pub(super) fn bytes_mut(&mut self) -> &mut [u8] {
+        &mut self.buffer[self.start..self.start + self.len]
+    }
+}
+
 /// A new file written front to back in blocks.
 pub(super) struct DirectFile {
     file: File,
-    /// `BLOCK + ALIGN` bytes, of which the aligned `BLOCK` from `start` are the block.
-    buffer: Vec<u8>,
-    start: usize,
+    block: AlignedBuffer,
     /// Bytes of the block filled.
     filled: usize,
     /// Bytes already handed to the file.
@@ -38,13 +60,9 @@ pub(super) struct DirectFile {
 
 impl DirectFile {
     pub(super) fn create(path: &Path) -> io::Result<Self> {
-        let file = File::create(path)?;
-        let buffer = vec![0u8; BLOCK + ALIGN];
-        let start = buffer.as_ptr().align_offset(ALIGN);
         Ok(DirectFile {
-            file,
-            buffer,
-            start,
+            file: File::create(path)?,
+            block: AlignedBuffer::new(BLOCK),
             filled: 0,
             written: 0,
             direct: true,
@@ -54,8 +72,7 @@ impl DirectFile {
     pub(super) fn write_all(&mut self, mut bytes: &[u8]) -> io::Result<()> {
         while !bytes.is_empty() {
             let n = (BLOCK - self.filled).min(bytes.len());
-            let at = self.start + self.filled;
-            self.buffer[at..at + n].copy_from_slice(&bytes[..n]);
+            self.block.bytes_mut()[self.filled..self.filled + n].copy_from_slice(&bytes[..n]);
             self.filled += n;
             bytes = &bytes[n..];
             if self.filled == BLOCK {
@@ -85,7 +102,7 @@ impl DirectFile {
         if self.direct {
             set_direct(&self.file, false)?;
         }
-        let rest = &self.buffer[self.start + pages..self.start + self.filled];
+        let rest = &self.block.bytes()[pages..self.filled];
         self.file.write_all_at(rest, self.written)?;
         Ok(self.file)
     }
@@ -99,7 +116,7 @@ impl DirectFile {
     /// Writes the block's first `len` bytes (whole pages) at their aligned place: directly
     /// while the file system allows, else through the page cache.
     fn write_direct(&mut self, len: usize) -> io::Result<()> {
-        let block = &self.buffer[self.start..self.start + len];
+        let block = &self.block.bytes()[..len];
         if self.direct && self.written == 0 && set_direct(&self.file, true).is_err() {
             self.direct = false;
         }
@@ -141,6 +158,14 @@ pub(super) fn set_direct(file: &File, on: bool) -> io::Result<()> {
     Ok(())
 }
 
+/// Where the direct I/O tests write: the temporary folder (direct where its file system
+/// allows) and memory (tmpfs, which refuses it), where they exist.
+#[cfg(test)]
+pub(super) fn test_folders() -> Vec<std::path::PathBuf> {
+    let folders = [std::env::temp_dir(), "/dev/shm".into()];
+    folders.into_iter().filter(|f| f.is_dir()).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -150,9 +175,8 @@ mod tests {
     /// system allows) and in memory (tmpfs, where it may not).
     #[test]
     fn what_is_written_reads_back() {
-        let folders = [std::env::temp_dir(), "/dev/shm".into()];
-        for folder in folders.iter().filter(|f| f.is_dir()) {
-            written_files_read_back(folder);
+        for folder in test_folders() {
+            written_files_read_back(&folder);
         }
     }
 

@@ -1,11 +1,11 @@
 //! Files read in aligned blocks into one reused buffer, around the page cache where asked
 //! (`O_DIRECT`). A brick file is read once or twice by a merge and then deleted: caching it
 //! would only cost fresh page cache (see `direct_file`), and on the virtual machine measured a
-//! file written around the cache read back through it cost about 2 ms of CPU per megabyte,
+//! file written around the cache read back through it cost 1.5-2 ms of CPU per megabyte,
 //! against almost none read directly. Where the file system refuses direct I/O the same
 //! blocks go through the page cache.
 
-use super::direct_file::{ALIGN, set_direct};
+use super::direct_file::{ALIGN, AlignedBuffer, set_direct};
 use std::fs::File;
 use std::io;
 use std::ops::Range;
@@ -25,30 +25,19 @@ pub(super) fn open(path: &Path, direct: bool) -> io::Result<File> {
     }
 }
 
-/// An aligned buffer of `block` bytes that file pages are read into.
-pub(super) struct AlignedBlock {
-    /// `block + ALIGN` bytes, of which the aligned `block` from `start` are the block.
-    buffer: Vec<u8>,
-    start: usize,
-    block: usize,
-}
+/// An aligned block of bytes (a multiple of `ALIGN`) that file pages are read into.
+pub(super) struct AlignedBlock(AlignedBuffer);
 
 impl AlignedBlock {
-    /// A block of `block` bytes, a multiple of `ALIGN`.
     pub(super) fn new(block: usize) -> AlignedBlock {
-        let buffer = vec![0u8; block + ALIGN];
-        let start = buffer.as_ptr().align_offset(ALIGN);
-        AlignedBlock {
-            buffer,
-            start,
-            block,
-        }
+        AlignedBlock(AlignedBuffer::new(block))
     }
 
     /// Reads `file`'s pages from `at` (a page boundary) up to `len` bytes (at most the block)
     /// or the file's end; returns the bytes read.
     fn read(&mut self, file: &File, at: u64, len: usize) -> io::Result<&[u8]> {
-        let block = &mut self.buffer[self.start..self.start + len.min(self.block)];
+        let len = len.min(self.0.bytes().len());
+        let block = &mut self.0.bytes_mut()[..len];
         let mut filled = 0;
         let mut fell_back = false;
         while filled < block.len() {
@@ -141,8 +130,7 @@ impl BlockReader {
             }
             let offset = offset as usize;
             let n = (self.filled - offset).min(out.len());
-            let from = self.block.start + offset;
-            out[..n].copy_from_slice(&self.block.buffer[from..from + n]);
+            out[..n].copy_from_slice(&self.block.0.bytes()[offset..offset + n]);
             pos += n as u64;
             out = &mut out[n..];
         }
@@ -159,8 +147,7 @@ mod tests {
     /// bytes; a read past the end fails.
     #[test]
     fn blocks_read_back_the_file() {
-        let folders = [std::env::temp_dir(), "/dev/shm".into()];
-        for folder in folders.iter().filter(|f| f.is_dir()) {
+        for folder in crate::io::direct_file::test_folders() {
             let path = folder.join(format!("voxelkit-direct-read-{}", std::process::id()));
             let mut random = crate::random::SplitMix64(5);
             let bytes: Vec<u8> = (0..3 * ALIGN * 5 + 77)

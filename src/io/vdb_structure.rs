@@ -100,9 +100,8 @@ impl Reader {
         self.skip(n as u64, what)
     }
 
-    pub(super) fn seek(&mut self, to: u64) -> std::result::Result<(), String> {
+    pub(super) fn seek(&mut self, to: u64) {
         self.pos = to;
-        Ok(())
     }
 }
 
@@ -287,7 +286,7 @@ fn walk(r: &mut Reader) -> std::result::Result<u64, String> {
         }
         // The grid's compression flags, metadata, transform and topology end by its block
         // of leaf buffers.
-        r.seek(grid as u64)?;
+        r.seek(grid as u64);
         let file_len = std::mem::replace(&mut r.len, block as u64);
         let compression = r.u32(&format!("the compression flags of grid {g}"))?;
         // A leaf takes at least its 64-byte mask in the file.
@@ -301,7 +300,7 @@ fn walk(r: &mut Reader) -> std::result::Result<u64, String> {
                 vdb_tree_structure::tree(r, format, compression, block as u64, end as u64, &what)?;
             memory = memory.saturating_add(bytes);
         }
-        r.seek(end as u64)?;
+        r.seek(end as u64);
     }
     Ok(memory)
 }

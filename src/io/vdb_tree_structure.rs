@@ -121,7 +121,7 @@ pub(super) fn tree(
     let nodes = topology(r, format, compression, what);
     r.len = file_len;
     let nodes = nodes?;
-    r.seek(block)?;
+    r.seek(block);
     r.len = end;
     let buffers = nodes
         .leaves
@@ -240,12 +240,15 @@ fn internal_node(
     Ok(())
 }
 
-/// The bits set in a mask stored as bytes (whole words, as every node mask is), counted a
-/// word at a time.
-pub(super) fn ones(mask: &[u8]) -> u64 {
+/// The words of a mask stored as little-endian bytes (whole words, as every node mask is).
+pub(super) fn mask_words(mask: &[u8]) -> impl Iterator<Item = u64> + '_ {
     mask.chunks_exact(8)
-        .map(|w| u64::from_le_bytes(w.try_into().expect("8 bytes")).count_ones() as u64)
-        .sum()
+        .map(|w| u64::from_le_bytes(w.try_into().expect("8 bytes")))
+}
+
+/// The bits set in a mask stored as bytes, counted a word at a time.
+pub(super) fn ones(mask: &[u8]) -> u64 {
+    mask_words(mask).map(|w| u64::from(w.count_ones())).sum()
 }
 
 /// One leaf's buffer record, laid out by the tree's leaf kind. A value leaf repeats its voxel

@@ -282,6 +282,8 @@ impl BrickRun {
 /// A brick's job (see `Task::Brick`): its part of the surface, its outside labels or its
 /// part of the solid.
 pub(super) fn run_brick(task: &BrickTask, t: Transform, progress: &Progress) -> Result<Outcome> {
+    // A process that runs bricks runs many, one after another.
+    crate::system::keep_freed_memory();
     let start = Instant::now();
     let voxels = brick_voxels(task.brick, task.size);
     let surface = |separability| {

@@ -214,7 +214,6 @@ fn run_brick(
     stage: BrickStage,
     (origin, voxel_size, brick, size, max_memory_mib): BrickAt,
 ) -> PyResult<Outcome> {
-    crate::system::keep_freed_memory();
     let faces = from_arrays(arrays, "a brick's faces");
     let task = Task::Brick(BrickTask {
         faces,
@@ -409,10 +408,9 @@ pub fn brick_exterior(
         };
         runs.insert(from_py(b), f.iter().map(face).collect::<PyResult<_>>()?);
     }
-    let faces = runs;
     let layout = plan.0.layout;
     let exterior = py
-        .detach(|| exterior_labels(&layout, &faces))
+        .detach(|| exterior_labels(&layout, &runs))
         .map_err(to_py_err)?;
     Ok(exterior.into_iter().map(|(b, l)| (to_py(b), l)).collect())
 }
