@@ -91,18 +91,19 @@ impl GridValues<'_> {
                     .expect("a distance grid's leaves carry values");
                 leaf.offsets().for_each(|n| put(d[n]));
             }
-            GridValues::Fog { band, background } => {
-                let on_band = band.leaf(leaf.origin);
-                leaf.offsets().for_each(|n| {
-                    put(match on_band {
-                        Some(b) if b.is_on(n) => {
-                            let d = b.value.as_deref().expect("distances")[n];
-                            (-d / background).clamp(0.0, 1.0)
-                        }
-                        _ => 1.0,
-                    })
-                });
-            }
+            GridValues::Fog { band, background } => match band.leaf(leaf.origin) {
+                None => leaf.offsets().for_each(|_| put(1.0)),
+                Some(b) => {
+                    let d = b.value.as_deref().expect("distances");
+                    leaf.offsets().for_each(|n| {
+                        put(if b.is_on(n) {
+                            (-d[n] / background).clamp(0.0, 1.0)
+                        } else {
+                            1.0
+                        })
+                    });
+                }
+            },
             GridValues::Normals | GridValues::Colors => {
                 let vectors = match self {
                     GridValues::Normals => leaf.normal.as_deref(),

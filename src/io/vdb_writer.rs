@@ -39,35 +39,28 @@ pub(super) fn tree_type_of(values: GridValues) -> String {
 fn push_tile_value(out: &mut Vec<u8>, values: GridValues, half: bool) {
     match values.value_type() {
         ValueType::Bool => out.push(1),
-        _ => push_reals(out, &[values.tile_value()], half),
+        _ => push_real(out, values.tile_value(), half),
     }
 }
 
 /// The active values of `leaf`, in offset order, as stored.
 fn push_leaf_values(out: &mut Vec<u8>, leaf: &Leaf, values: GridValues, half: bool) {
-    // Gathered first, then stored in one pass at one precision.
-    let mut reals = [0f32; 3 * LEAF_VOXELS];
-    let mut len = 0;
-    values.for_each_active(leaf, |v| {
-        reals[len] = v;
-        len += 1;
-    });
-    push_reals(out, &reals[..len], half);
+    let components = match values.value_type() {
+        ValueType::Vec3 => 3,
+        _ => 1,
+    };
+    let width = if half { 2 } else { 4 };
+    out.reserve(width * components * leaf.count() as usize);
+    values.for_each_active(leaf, |v| push_real(out, v, half));
 }
 
-/// `values` as stored: little-endian f32, or f16 when `half`.
-fn push_reals(out: &mut Vec<u8>, values: &[f32], half: bool) {
-    let start = out.len();
+/// `v` as stored: little-endian f32, or f16 when `half`.
+#[inline]
+fn push_real(out: &mut Vec<u8>, v: f32, half: bool) {
     if half {
-        out.resize(start + 2 * values.len(), 0);
-        for (bytes, &v) in out[start..].chunks_exact_mut(2).zip(values) {
-            bytes.copy_from_slice(&half::f16::from_f32(v).to_le_bytes());
-        }
+        out.extend_from_slice(&half::f16::from_f32(v).to_le_bytes());
     } else {
-        out.resize(start + 4 * values.len(), 0);
-        for (bytes, v) in out[start..].chunks_exact_mut(4).zip(values) {
-            bytes.copy_from_slice(&v.to_le_bytes());
-        }
+        out.extend_from_slice(&v.to_le_bytes());
     }
 }
 
@@ -95,8 +88,9 @@ pub(super) fn write_grids(
     // a grid's end is known only once its last buffer is, so it is patched in afterwards.
     // The write clock counts only the time spent waiting for the writer at the end.
     let (send, pieces) = std::sync::mpsc::channel();
+    let spent = SpentBuffers::default();
     let (out, done, patches) = std::thread::scope(|scope| {
-        let writer = scope.spawn(move || write_in_order(out, pieces));
+        let writer = scope.spawn(|| write_in_order(out, pieces, &spent));
         let mut file_out = Pieces {
             send,
             next: 0,
@@ -131,6 +125,7 @@ pub(super) fn write_grids(
                             g.values,
                             head.compression,
                             head.half,
+                            &spent,
                             |k, b| send.send((first + k, Piece::Bytes(b))).is_ok(),
                         )
                     },
@@ -198,11 +193,39 @@ enum Piece {
     Sync,
 }
 
+/// Buffers the writer has written, for the encoders to fill again: fresh memory costs more
+/// than encoding into it (the kernel zeroes and maps each page on first touch).
+#[derive(Default)]
+struct SpentBuffers(std::sync::Mutex<Vec<Vec<u8>>>);
+
+impl SpentBuffers {
+    /// The most kept: about as many as the encoders run ahead of the writer.
+    const MOST: usize = 16;
+
+    /// An empty buffer with room for at least `capacity` bytes.
+    fn take(&self, capacity: usize) -> Vec<u8> {
+        let spent = self.0.lock().map(|mut free| free.pop()).ok().flatten();
+        let mut buffer = spent.unwrap_or_default();
+        buffer.clear();
+        buffer.reserve(capacity);
+        buffer
+    }
+
+    fn give_back(&self, buffer: Vec<u8>) {
+        if let Ok(mut free) = self.0.lock()
+            && free.len() < Self::MOST
+        {
+            free.push(buffer);
+        }
+    }
+}
+
 /// Writes the numbered pieces to `out` in their order, whatever order they arrive in;
 /// stops at the first error, closing the channel so that the encoders stop too.
 fn write_in_order(
     mut out: Output,
     pieces: std::sync::mpsc::Receiver<(usize, Piece)>,
+    spent: &SpentBuffers,
 ) -> (Output, std::io::Result<()>) {
     let mut waiting = BTreeMap::new();
     let mut next = 0;
@@ -211,7 +234,11 @@ fn write_in_order(
         while let Some(piece) = waiting.remove(&next) {
             next += 1;
             let done = match piece {
-                Piece::Bytes(bytes) => out.write_all(&bytes),
+                Piece::Bytes(bytes) => {
+                    let written = out.write_all(&bytes);
+                    spent.give_back(bytes);
+                    written
+                }
                 Piece::Sync => out.sync_data(),
             };
             if let Err(e) = done {
@@ -392,6 +419,7 @@ fn stream_leaf_buffers(
     values: GridValues,
     compression: u32,
     half: bool,
+    spent: &SpentBuffers,
     deliver: impl Fn(usize, Vec<u8>) -> bool + Sync,
 ) -> u64 {
     use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering::Relaxed};
@@ -410,7 +438,7 @@ fn stream_leaf_buffers(
         if refused.load(Relaxed) {
             return;
         }
-        let mut out = Vec::with_capacity(batches[k].len() * 200);
+        let mut out = spent.take(batches[k].len() * 200);
         let mut scratch = Vec::new();
         for leaf in batches[k] {
             leaf_buffer(

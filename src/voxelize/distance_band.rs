@@ -21,8 +21,8 @@
 use super::Progress;
 use super::brick_bins::voxelize_in_bricks;
 use super::separating_kernel::{
-    Adjacency, HalfSpace, MARGIN, Primitive, PrimitiveClass, Primitives, SECTOR_SLACK, Triangle,
-    edge_cylinder, face_body, primitives, reach_box, sector_directions, vertex_sphere,
+    Adjacency, HalfSpace, MARGIN, MOST_HALVES, Primitive, PrimitiveClass, Primitives, SECTOR_SLACK,
+    Triangle, edge_cylinder, face_body, primitives, reach_box, sector_directions, vertex_sphere,
 };
 use crate::error::{Error, Result};
 use crate::grid::{Channels, CoordBox, SparseGrid, Transform};
@@ -86,10 +86,6 @@ pub fn distance_band(
     )?;
     Ok(grid)
 }
-
-/// The most half-spaces kept for one feature: more would only narrow its region further,
-/// so leaving them out is safe.
-const MOST_HALVES: usize = 16;
 
 /// Up to `MOST_HALVES` half-spaces.
 struct Halves {

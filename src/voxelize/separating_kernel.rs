@@ -60,39 +60,79 @@ pub(super) struct HalfSpace {
     pub(super) h: f64,
 }
 
-/// `range`, the values of coordinate `axis` with the others as in `x`, narrowed to where
-/// every half-space holds (widened by `ROW_SLACK`: a candidate range).
-#[inline]
-pub(super) fn within(
-    range: std::ops::RangeInclusive<i64>,
-    mut x: DVec3,
+/// The most half-spaces that cut one primitive: more would only narrow its region further,
+/// so a caller leaves the rest out.
+pub(super) const MOST_HALVES: usize = 16;
+
+/// Half-spaces solved once per primitive for coordinate `axis`: along a column (the other
+/// two coordinates fixed) each bounds that coordinate above or below by an affine function
+/// of the column's place, so a column costs a multiply-add per half-space, not a division.
+pub(super) struct AxisCut {
     axis: usize,
-    halves: &[HalfSpace],
-) -> std::ops::RangeInclusive<i64> {
-    let (mut lo, mut hi) = (*range.start(), *range.end());
-    x[axis] = 0.0;
-    for half in halves {
-        // g_axis t <= rhs
-        let rhs = -(half.g.dot(x) + half.h);
-        let ga = half.g[axis];
-        if ga > 0.0 {
-            let bound = rhs / ga + ROW_SLACK;
-            if bound < hi as f64 {
-                hi = floor_int(bound.max(lo as f64 - 1.0));
-            }
-        } else if ga < 0.0 {
-            let bound = rhs / ga - ROW_SLACK;
-            if bound > lo as f64 {
-                lo = ceil_int(bound.min(hi as f64 + 1.0));
-            }
-        } else if rhs < 0.0 {
-            return int_range(0.0, -1.0);
+    /// Per half-space, `bound = base + slope·x` (`slope[axis]` 0) and which side it bounds:
+    /// `Some(true)` above, `Some(false)` below; `None` for a half-space parallel to the axis,
+    /// whose `base + slope·x` must not be negative.
+    bounds: [(f64, DVec3, Option<bool>); MOST_HALVES],
+    len: usize,
+}
+
+impl AxisCut {
+    /// The cut of `halves` (at most `MOST_HALVES`) along `axis`.
+    pub(super) fn new(halves: &[HalfSpace], axis: usize) -> AxisCut {
+        debug_assert!(halves.len() <= MOST_HALVES);
+        let mut bounds = [(0.0, DVec3::ZERO, None); MOST_HALVES];
+        for (bound, half) in bounds.iter_mut().zip(halves) {
+            // g_axis t <= -(g·x + h), with x_axis = 0.
+            let mut g = half.g;
+            let ga = g[axis];
+            g[axis] = 0.0;
+            *bound = if ga == 0.0 {
+                (-half.h, -g, None)
+            } else {
+                (-half.h / ga, -g / ga, Some(ga > 0.0))
+            };
         }
-        if lo > hi {
-            break;
+        AxisCut {
+            axis,
+            bounds,
+            len: halves.len().min(MOST_HALVES),
         }
     }
-    lo..=hi
+
+    /// `range`, the values of coordinate `axis` with the others as in `x`, narrowed to where
+    /// every half-space holds (widened by `ROW_SLACK`: a candidate range).
+    #[inline]
+    pub(super) fn range(
+        &self,
+        range: std::ops::RangeInclusive<i64>,
+        mut x: DVec3,
+    ) -> std::ops::RangeInclusive<i64> {
+        let (mut lo, mut hi) = (*range.start(), *range.end());
+        x[self.axis] = 0.0;
+        for &(base, slope, side) in &self.bounds[..self.len] {
+            let bound = base + slope.dot(x);
+            match side {
+                Some(true) => {
+                    let bound = bound + ROW_SLACK;
+                    if bound < hi as f64 {
+                        hi = floor_int(bound.max(lo as f64 - 1.0));
+                    }
+                }
+                Some(false) => {
+                    let bound = bound - ROW_SLACK;
+                    if bound > lo as f64 {
+                        lo = ceil_int(bound.min(hi as f64 + 1.0));
+                    }
+                }
+                None if bound < 0.0 => return int_range(0.0, -1.0),
+                None => {}
+            }
+            if lo > hi {
+                break;
+            }
+        }
+        lo..=hi
+    }
 }
 
 /// Faces around edges and vertices, and each face's fan triangles.
@@ -469,13 +509,12 @@ pub(super) fn vertex_sphere<const C: usize>(
 ) {
     let p = v.a;
     let r2 = (r + MARGIN) * (r + MARGIN);
+    let cut = AxisCut::new(halves, 2);
     for x in clipped(int_range(p.x - r - MARGIN, p.x + r + MARGIN), clip, 0) {
         for y in clipped(int_range(p.y - r - MARGIN, p.y + r + MARGIN), clip, 1) {
-            let column = within(
+            let column = cut.range(
                 clip.min[2]..=clip.max[2],
                 DVec3::new(x as f64, y as f64, 0.0),
-                2,
-                halves,
             );
             if column.is_empty() {
                 continue;
@@ -577,6 +616,7 @@ pub(super) fn edge_cylinder<const C: usize>(
     let dt = d[v] * inv_len2;
     let inv_dt = 1.0 / dt;
     let columns = clip.min[v]..=clip.max[v];
+    let cut = AxisCut::new(halves, v);
     for k in clipped(
         int_range(p[w].min(e.b[w]) - cap, p[w].max(e.b[w]) + cap),
         clip,
@@ -587,7 +627,7 @@ pub(super) fn edge_cylinder<const C: usize>(
             let mut row = DVec3::ZERO;
             row[w] = k as f64;
             row[u] = iu as f64;
-            let span = within(columns.clone(), row, v, halves);
+            let span = cut.range(columns.clone(), row);
             if span.is_empty() {
                 continue;
             }
@@ -688,11 +728,7 @@ pub(super) fn face_body<const C: usize>(
         g: -m,
         h: m.dot(p) - MARGIN,
     });
-    let column_cut: &[HalfSpace] = if (d_hi - d_lo) / n[w] > 4.0 {
-        &inside_sides
-    } else {
-        &[]
-    };
+    let column_cut = ((d_hi - d_lo) / n[w] > 4.0).then(|| AxisCut::new(&inside_sides, w));
     let lo = a.min(b).min(c) - DVec3::splat(t);
     let hi = a.max(b).max(c) + DVec3::splat(t);
     let half = t / n[w].abs();
@@ -736,10 +772,10 @@ pub(super) fn face_body<const C: usize>(
         if reached.is_empty() {
             continue;
         }
-        let uncut = if column_cut.is_empty() {
-            int_range(0.0, -1.0)
-        } else {
+        let uncut = if column_cut.is_some() {
             row(iu, true)
+        } else {
+            int_range(0.0, -1.0)
         };
         for iv in reached {
             let s = n[u] * (iu as f64 - a[u]) + n[v] * (iv as f64 - a[v]);
@@ -751,11 +787,11 @@ pub(super) fn face_body<const C: usize>(
             column[u] = iu as f64;
             column[v] = iv as f64;
             let slab = clipped(half_open_range(k0, k1), clip, w);
-            if !column_cut.is_empty() {
+            if let Some(cut) = &column_cut {
                 let ks = if uncut.contains(&iv) {
                     slab
                 } else {
-                    within(slab, column, w, column_cut)
+                    cut.range(slab, column)
                 };
                 // A cut column is exact to 1e-6 voxels, which moves a plane distance by less
                 // than 1e-12: the distance band needs no test per voxel.
