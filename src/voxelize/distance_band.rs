@@ -46,8 +46,6 @@ pub fn distance_band(
     let found = primitives(mesh, transform, false)?;
     let Primitives {
         triangles,
-        edges,
-        vertices,
         adjacency,
         ..
     } = &found;
@@ -71,14 +69,16 @@ pub fn distance_band(
         candidates,
         |_, i, clip, sink| match found.numbered(i) {
             (PrimitiveClass::Vertex, v) => {
-                let halves = vertex_halves(&vertices[v], adjacency, triangles);
-                vertex_sphere(&vertices[v], band, &every, halves.as_slice(), clip, sink)
+                let vertex = found.vertex(v);
+                let halves = vertex_halves(&vertex, adjacency, triangles);
+                vertex_sphere(&vertex, band, &every, halves.as_slice(), clip, sink)
             }
             (PrimitiveClass::Edge, e) => {
-                let halves = edge_halves(&edges[e], adjacency, triangles);
-                let sector = sector_box(&edges[e], halves.as_slice(), band + MARGIN);
+                let edge = found.edge(e);
+                let halves = edge_halves(&edge, adjacency, triangles);
+                let sector = sector_box(&edge, halves.as_slice(), band + MARGIN);
                 if let Some(clip) = clip.intersection(&sector) {
-                    edge_cylinder(&edges[e], band, &every, halves.as_slice(), &clip, sink)
+                    edge_cylinder(&edge, band, &every, halves.as_slice(), &clip, sink)
                 }
             }
             (PrimitiveClass::Body, t) => face_body(&triangles[t], slab, clip, sink),

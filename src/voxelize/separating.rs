@@ -120,10 +120,9 @@ pub fn voxelize_mesh(
     let found = primitives(mesh, transform, opts.normals)?;
     let Primitives {
         triangles,
-        edges,
-        vertices,
         adjacency,
         degenerate_faces,
+        ..
     } = &found;
     let keep = |p: &Primitive, x: DVec3| match opts.criterion {
         Criterion::Huang => true,
@@ -149,10 +148,11 @@ pub fn voxelize_mesh(
         progress,
         candidates,
         |class, i, clip, sink| match PrimitiveClass::ALL[class] {
-            PrimitiveClass::Vertex => vertex_sphere(&vertices[i], r, &keep, &[], clip, sink),
+            PrimitiveClass::Vertex => vertex_sphere(&found.vertex(i), r, &keep, &[], clip, sink),
             PrimitiveClass::Edge => {
-                if !(plain && sink.bits_only() && short_edge_cylinder(&edges[i], r, clip, sink)) {
-                    edge_cylinder(&edges[i], r, &keep, &[], clip, sink)
+                let edge = found.edge(i);
+                if !(plain && sink.bits_only() && short_edge_cylinder(&edge, r, clip, sink)) {
+                    edge_cylinder(&edge, r, &keep, &[], clip, sink)
                 }
             }
             PrimitiveClass::Body => {
@@ -168,8 +168,8 @@ pub fn voxelize_mesh(
         vertex_voxels,
         edge_voxels,
         body_voxels,
-        vertices: vertices.len(),
-        edges: edges.len(),
+        vertices: found.counts()[0],
+        edges: found.counts()[1],
         triangles: triangles.len(),
         degenerate_faces: *degenerate_faces,
     };

@@ -42,13 +42,24 @@ pub(super) struct Triangle {
     pub(super) normal: DVec3,
 }
 
-/// A vertex (`a == b`) or an edge, with the faces around it.
+/// A vertex (`a == b`) or an edge, with the faces around it: built from its `Feature` when
+/// it is voxelized.
 pub(super) struct Primitive {
     pub(super) a: DVec3,
     pub(super) b: DVec3,
     normal: DVec3,
     /// Range of `Adjacency::faces` holding the faces around it.
     pub(super) faces: std::ops::Range<usize>,
+}
+
+/// An edge or a vertex (its point as both ends) as the primitives keep it: its ends by
+/// number, its normal at the precision it is written in, and its faces. A third of a
+/// `Primitive`'s size: fresh memory costs about as much as voxelizing the surface of a
+/// mesh of small faces.
+pub(super) struct Feature {
+    ends: [u32; 2],
+    normal: glam::Vec3,
+    faces: std::ops::Range<usize>,
 }
 
 /// A half-space `g·x + h <= 0` that limits a sphere or a cylinder to where its primitive can
@@ -198,12 +209,34 @@ impl Primitives {
         }
     }
 
+    /// Edge `n`.
+    pub(super) fn edge(&self, n: usize) -> Primitive {
+        self.primitive(&self.edges[n])
+    }
+
+    /// Vertex `n`.
+    pub(super) fn vertex(&self, n: usize) -> Primitive {
+        self.primitive(&self.vertices[n])
+    }
+
+    fn primitive(&self, f: &Feature) -> Primitive {
+        Primitive {
+            a: self.points[f.ends[0] as usize],
+            b: self.points[f.ends[1] as usize],
+            normal: f.normal.as_dvec3(),
+            faces: f.faces.clone(),
+        }
+    }
+
     /// The voxels within `reach` of primitive `n` of `class`.
     pub(super) fn reach_box_of(&self, class: PrimitiveClass, n: usize, reach: f64) -> CoordBox {
         match class {
-            PrimitiveClass::Vertex => reach_box(self.vertices[n].a, self.vertices[n].a, reach),
+            PrimitiveClass::Vertex => {
+                let a = self.points[self.vertices[n].ends[0] as usize];
+                reach_box(a, a, reach)
+            }
             PrimitiveClass::Edge => {
-                let e = &self.edges[n];
+                let e = self.edge(n);
                 reach_box(e.a.min(e.b), e.a.max(e.b), reach)
             }
             PrimitiveClass::Body => {
@@ -217,8 +250,10 @@ impl Primitives {
 /// A mesh's primitives in index space: its fan triangles, its edges and its vertices.
 pub(super) struct Primitives {
     pub(super) triangles: Vec<Triangle>,
-    pub(super) edges: Vec<Primitive>,
-    pub(super) vertices: Vec<Primitive>,
+    edges: Vec<Feature>,
+    vertices: Vec<Feature>,
+    /// The mesh's points in index space, which edges and vertices number.
+    points: Vec<DVec3>,
     pub(super) adjacency: Adjacency,
     pub(super) degenerate_faces: usize,
 }
@@ -253,6 +288,7 @@ pub(super) fn primitives(mesh: &Mesh, transform: Transform, normals: bool) -> Re
         triangles,
         edges,
         vertices,
+        points: pos,
         adjacency: Adjacency {
             faces,
             triangle_starts,
@@ -325,7 +361,7 @@ pub(super) fn edges_and_vertices(
     pos: &[DVec3],
     face_normals: &[DVec3],
     normals: bool,
-) -> (Vec<Primitive>, Vec<Primitive>, Vec<u32>) {
+) -> (Vec<Feature>, Vec<Feature>, Vec<u32>) {
     let planar: Vec<bool> = (0..mesh.face_count())
         .map(|f| mesh.face(f).len() == 3 || is_planar(mesh.face(f), pos, face_normals[f]))
         .collect();
@@ -378,7 +414,7 @@ pub(super) fn edges_from_buckets(
     start: &[usize],
     mut buckets: Vec<(u32, u32)>,
     normal_of: &(dyn Fn(&[u32]) -> DVec3 + Sync),
-) -> (Vec<Primitive>, Vec<u32>) {
+) -> (Vec<Feature>, Vec<u32>) {
     let mut faces: Vec<u32> = vec_to_fill(buckets.len());
     let mut edges = vec_to_fill(buckets.len() / 2);
     for lo in 0..pos.len() {
@@ -392,10 +428,9 @@ pub(super) fn edges_from_buckets(
                     faces.push(g.1);
                 }
             }
-            edges.push(Primitive {
-                a: pos[lo],
-                b: pos[group[0].0 as usize],
-                normal: normal_of(&faces[first..]),
+            edges.push(Feature {
+                ends: [lo as u32, group[0].0],
+                normal: normal_of(&faces[first..]).as_vec3(),
                 faces: first..faces.len(),
             });
         }
@@ -408,7 +443,7 @@ pub(super) fn vertices_of(
     mesh: &Mesh,
     pos: &[DVec3],
     normal_of: &(dyn Fn(&[u32]) -> DVec3 + Sync),
-) -> (Vec<Primitive>, Vec<u32>) {
+) -> (Vec<Feature>, Vec<u32>) {
     let mut faces: Vec<u32> = vec_to_fill(mesh.indices.len());
     let (vstart, mut around) = group_by_key(pos.len(), |visit| {
         for f in 0..mesh.face_count() {
@@ -428,10 +463,9 @@ pub(super) fn vertices_of(
                 faces.push(f);
             }
         }
-        vertices.push(Primitive {
-            a: pos[v],
-            b: pos[v],
-            normal: normal_of(&faces[first..]),
+        vertices.push(Feature {
+            ends: [v as u32; 2],
+            normal: normal_of(&faces[first..]).as_vec3(),
             faces: first..faces.len(),
         });
     }
