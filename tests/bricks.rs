@@ -12,8 +12,9 @@ use voxelkit::grid::SparseGrid;
 use voxelkit::io::brick_set::fill_box;
 use voxelkit::mesh::{GridFit, Mesh, generate};
 use voxelkit::pipeline::brick_exterior::exterior_labels;
-use voxelkit::pipeline::bricks::{BrickIndex, BrickLayout, FACES, sub_mesh};
-use voxelkit::pipeline::{BrickStage, BrickTask, Details, Job, Outcome, Task};
+use voxelkit::pipeline::bricks::{BrickIndex, BrickLayout, BrickRun, FACES, sub_mesh};
+use voxelkit::pipeline::request::BricksRequest;
+use voxelkit::pipeline::{BrickStage, BrickTask, Details, Job, MeshSource, Outcome, Task};
 use voxelkit::progress::{Progress, Unobserved};
 use voxelkit::solids::exterior_flood::{FloodMethod, solid_from_surface};
 use voxelkit::voxelize::Separability;
@@ -135,6 +136,43 @@ fn brick_sizes_must_be_multiples_of_eight() {
         let e = BrickLayout::new(&mesh, GridFit::Resolution(64), bad).unwrap_err();
         assert!(e.to_string().contains("multiple of 8"), "{e}");
     }
+}
+
+/// Without a brick size the run takes the largest of 2048, 1024, ..., 128 that gives each
+/// worker thread at least 8 bricks with faces (the smallest where none does); a size given
+/// stays whatever the threads.
+#[test]
+fn a_run_without_a_brick_size_fits_its_bricks_to_the_threads() {
+    let mesh = generate::torus(DVec3::ZERO, 1.0, 0.3, 64, 32);
+    let source = MeshSource::Mesh(mesh.clone());
+    let request = |brick| BricksRequest {
+        resolution: Some(4096),
+        brick,
+        ..Default::default()
+    };
+    let output = std::path::Path::new("torus.vdb");
+    let with_faces = |size: u32| {
+        let layout = BrickLayout::new(&mesh, GridFit::Resolution(4096), size).unwrap();
+        layout.bin_faces(&mesh).len()
+    };
+    for threads in [1, 2, 4, 16, 64, 1000] {
+        let chosen = [2048u32, 1024, 512, 256]
+            .into_iter()
+            .find(|&size| with_faces(size) >= 8 * threads)
+            .unwrap_or(128);
+        let mut run = BrickRun::plan(&source, &request(None), false, output).unwrap();
+        let size = run.fit_to_threads(&request(None), threads).unwrap();
+        assert_eq!(size, i64::from(chosen), "{threads} threads");
+        assert_eq!(run.layout.size, size);
+        assert_eq!(run.bins.len(), with_faces(chosen), "the faces binned anew");
+        let mut given = BrickRun::plan(&source, &request(Some(512)), false, output).unwrap();
+        assert_eq!(
+            given.fit_to_threads(&request(Some(512)), threads).unwrap(),
+            512
+        );
+    }
+    // The thread counts above reach every size but the smallest.
+    assert!(with_faces(2048) >= 8 && with_faces(256) < 8 * 1000);
 }
 
 /// A brick is a pipeline job: its memory plan refuses it with the brick named, and it runs

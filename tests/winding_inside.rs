@@ -382,7 +382,7 @@ fn winding_bricks_give_the_single_runs_solid() {
         for size in [8, 24] {
             let request = BricksRequest {
                 resolution: Some(40),
-                brick: size,
+                brick: Some(size),
                 ..BricksRequest::default()
             };
             let source = MeshSource::Mesh(mesh.clone());

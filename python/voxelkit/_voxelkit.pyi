@@ -130,12 +130,13 @@ class BrickPlan:
     def full_brick_bytes(self) -> int: ...
     @property
     def splices(self) -> bool: ...
+    def fit_to_threads(self, threads: int) -> int: ...
 
 def brick_plan(
     source: MeshSource,
     solid: bool = False,
     output: Optional[Path] = None,
-    brick: int = 1024,
+    brick: Optional[int] = None,
     resolution: Optional[int] = None,
     voxel_size: Optional[float] = None,
     origin: Optional[Sequence[float]] = None,

@@ -1,12 +1,14 @@
 """Scale-out on Dask: one voxelization spread over worker processes or machines in bricks.
 
-    python -m voxelkit.distributed mesh IN -r 16384 --brick 1024 --workers 4 -o OUT.vdb
+    python -m voxelkit.distributed mesh IN -r 16384 --workers 4 -o OUT.vdb
     python -m voxelkit.distributed solid IN -r 4096 --brick 512 --scheduler tcp://host:8786 -o OUT.vdb
     python -m voxelkit.distributed mesh 'f_####.obj' --frames 1-240 -r 512 -o 'out/f_####.vdb'
     python -m voxelkit.distributed merge OUT.bricks/index.json -o OUT.vdb
 
 The grid is placed as a single run would place it and cut into cubic bricks of ``--brick``
-voxels. The client reads the mesh once and bins its faces: each brick receives only the
+voxels; without it, of the largest of 2048, 1024, 512, 256 and 128 that gives every worker
+thread at least 8 bricks with faces (bricks differ in cost: a few each keep every thread busy
+to the end, and larger bricks cost less to merge). The client reads the mesh once and bins its faces: each brick receives only the
 faces whose box, grown by one voxel, reaches it (the separating criterion is local, so this
 halo is all a brick needs), voxelizes them and writes its part as a ``.vdb``.
 
@@ -20,7 +22,7 @@ client joins them across bricks and finds the exterior (what reaches the grid's 
 brick then writes its surface and the components that are not exterior, and bricks without
 faces are wholly outside or wholly inside (written as tiles, no task).
 
-The bricks are merged into ``OUT.vdb``. Bricks of a multiple of 128 voxels (the default 1024)
+The bricks are merged into ``OUT.vdb``. Bricks of a multiple of 128 voxels (every size chosen)
 lie on OpenVDB's 128^3 nodes and each brick file holds its nodes as the merged file does, so the
 client walks each brick file's structure as the brick finishes and, after the last, copies the
 nodes into place in OpenVDB's order without reading a voxel, building only the 4096^3 nodes'
@@ -334,7 +336,8 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
     separability, max_memory_mib = plan.separability, plan.max_memory_mib
     show = _Progress(progress)
     with _using(client, scheduler, workers) as client:
-        origin, h, size = plan.origin, plan.voxel_size, plan.size
+        size = plan.fit_to_threads(sum(client.nthreads().values()))
+        origin, h = plan.origin, plan.voxel_size
         bricks = plan.winding_bricks if solid and plan.winding else plan.bricks
         arrays = {b: plan.faces_of(b) for b in bricks}
         files = {b: _brick_file(b) for b in bricks}
@@ -395,6 +398,7 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
         "output": output if merge else index,
         "merged_by": merged_by,
         "bricks": len(bricks),
+        "brick": size,
         "full_bricks": len(full_bricks),
         "inside_rule": plan.inside_reason,
         "voxels": voxels,
@@ -463,7 +467,8 @@ else on a local cluster of ``workers`` processes started for the call.
 Returns a dict: ``output`` (the .vdb, or the brick set's index when the bricks were kept;
 ``voxelkit.read_vdb`` reads either), ``merged_by`` (``"splicing"``: bricks of a multiple of 128
 voxels, their nodes copied without reading a voxel; ``"reading"``: other sizes, through one
-grid in memory; None when kept), ``bricks`` (the bricks run), ``full_bricks`` (wholly inside
+grid in memory; None when kept), ``bricks`` (the bricks run), ``brick`` (their edge in voxels,
+given or chosen), ``full_bricks`` (wholly inside
 without a task), ``voxels``, ``inside_rule`` (a solid's rule and why), ``seconds`` (of which
 ``brick_seconds`` up to the last brick and ``merge_seconds`` after), and ``worker_peak_mib``
 (each worker process's peak memory).
@@ -503,7 +508,6 @@ def solid(source, output, **options):
 #: field's name (as the voxelkit command names them).
 _SHORT = {"resolution": "-r", "separability": "-s"}
 _LONG = {"max_memory_mib": "--max-memory"}
-#: The types of the table's options that are not given by their default.
 def _xyz(text):
     """Three numbers `x,y,z`."""
     values = [float(v) for v in text.split(",")]
@@ -512,13 +516,14 @@ def _xyz(text):
     return values
 
 
-_TYPES = {"resolution": int, "voxel_size": float, "max_memory_mib": int, "origin": _xyz}
+#: The command-line types of the table's optional options, by their Python type.
+_OPTIONAL_TYPES = {"Optional[int]": int, "Optional[float]": float, "Optional[Sequence[float]]": _xyz}
 
 
 def _add_option(parser, field):
     """The command-line option of a table field: its name, type, default, choices and doc."""
     name, default, choices = field["name"], field["default"], field["choices"]
-    kind = _TYPES.get(name) or type(default)
+    kind = _OPTIONAL_TYPES.get(field["python_type"]) or type(default)
     flags = [_SHORT[name]] if name in _SHORT else []
     flags.append(_LONG.get(name, "--" + name.replace("_", "-")))
     extra = {"metavar": "MIB"} if name == "max_memory_mib" else {}
@@ -590,8 +595,8 @@ def main(argv=None):
     peaks = ", ".join(f"{p:.0f}" for p in result["worker_peak_mib"])
     if args.frames is None:
         done = (
-            f"{result['output']}: {result['voxels']} voxels from {result['bricks']} bricks "
-            f"(+{result['full_bricks']} whole)"
+            f"{result['output']}: {result['voxels']} voxels from {result['bricks']} bricks of "
+            f"{result['brick']} (+{result['full_bricks']} whole)"
         )
     else:
         done = (

@@ -221,6 +221,16 @@ impl BrickOutside {
     }
 }
 
+/// The brick sizes a run chooses from when none is given, largest first: multiples of 128,
+/// so that the merge splices the bricks' nodes (`brick_splice`), and 2048 at most, where a
+/// worker's peak is a few hundred MiB on a dense mesh (igea at 6144: 170-181 MiB).
+const CHOSEN_SIZES: [u32; 5] = [2048, 1024, 512, 256, 128];
+
+/// Bricks with faces each worker thread is given when the size is chosen: bricks differ in
+/// cost, and a few per thread let the ones that finish early take more. igea's surface at
+/// 6144 on two one-thread workers: bricks of 2048 (29 bricks) take 3.3 s, of 1024 (121) 3.5 s.
+const BRICKS_PER_THREAD: usize = 8;
+
 /// A distributed run's plan: the mesh read as the CLI reads it (for a solid, its inside rule
 /// chosen as a single run chooses it), placed on the grid one run would use, its voxel size
 /// one a `.vdb` holds, and cut into bricks with the faces each receives.
@@ -251,7 +261,8 @@ impl BrickRun {
         } else {
             (false, None)
         };
-        let layout = BrickLayout::new(&mesh, request.fit()?, request.brick)?;
+        let size = request.brick.unwrap_or(CHOSEN_SIZES[0]);
+        let layout = BrickLayout::new(&mesh, request.fit()?, size)?;
         check_voxel_size(output, layout.transform.voxel_size)?;
         let bins = layout.bin_faces(&mesh);
         Ok(BrickRun {
@@ -261,6 +272,26 @@ impl BrickRun {
             winding,
             inside_reason,
         })
+    }
+
+    /// For a `request` that gives no brick size, cuts the grid into the largest bricks of
+    /// `CHOSEN_SIZES` that give each of `threads` worker threads at least `BRICKS_PER_THREAD`
+    /// bricks with faces (the smallest where none does); its size.
+    pub fn fit_to_threads(&mut self, request: &BricksRequest, threads: usize) -> Result<i64> {
+        if request.brick.is_some() {
+            return Ok(self.layout.size);
+        }
+        let wanted = threads.max(1) * BRICKS_PER_THREAD;
+        for (n, &size) in CHOSEN_SIZES.iter().enumerate() {
+            if i64::from(size) != self.layout.size {
+                self.layout = BrickLayout::new(&self.mesh, request.fit()?, size)?;
+                self.bins = self.layout.bin_faces(&self.mesh);
+            }
+            if self.bins.len() >= wanted || n + 1 == CHOSEN_SIZES.len() {
+                break;
+            }
+        }
+        Ok(self.layout.size)
     }
 
     /// The bricks a winding solid runs: those with faces and those meeting the mesh's box

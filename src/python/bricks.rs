@@ -138,6 +138,14 @@ impl BrickPlan {
     fn winding_bricks(&self) -> Vec<PyBrick> {
         self.0.winding_bricks().into_iter().map(to_py).collect()
     }
+
+    /// Cuts the grid into bricks sized for `threads` worker threads when the run gave no
+    /// brick size (see `BricksRequest`'s `brick`); the size.
+    fn fit_to_threads(&mut self, py: Python<'_>, threads: usize) -> PyResult<i64> {
+        let BrickPlan(run, request) = self;
+        py.detach(|| run.fit_to_threads(request, threads))
+            .map_err(to_py_err)
+    }
 }
 
 /// A mesh as Python holds it: positions (k, 3), the faces' vertex indices back to back, and
