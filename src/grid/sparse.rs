@@ -115,14 +115,29 @@ impl SparseGrid {
     pub fn fill_leaf_blocks(&mut self, mut origins: Vec<Coord>) {
         origins.par_sort_unstable_by_key(|&o| (node_origin(o), o));
         origins.dedup();
-        for group in origins.chunk_by(|a, b| node_origin(*a) == node_origin(*b)) {
-            let node = node_origin(group[0]);
-            let free =
-                !self.tiles.has_node(node) && group.iter().all(|o| !self.index.contains_key(o));
+        let groups: Vec<&[Coord]> = origins
+            .chunk_by(|a, b| node_origin(*a) == node_origin(*b))
+            .collect();
+        // A group is free where neither a node tile nor a leaf holds any of its blocks.
+        let free: Vec<bool> = groups
+            .iter()
+            .map(|group| {
+                !self.tiles.has_node(node_origin(group[0]))
+                    && (self.index.is_empty() || group.iter().all(|o| !self.index.contains_key(o)))
+            })
+            .collect();
+        let tiles: usize = groups
+            .iter()
+            .zip(&free)
+            .filter(|&(group, &free)| free && group.len() < NODE_LEAVES)
+            .map(|(group, _)| group.len())
+            .sum();
+        self.tiles.reserve_leaves(tiles);
+        for (group, free) in groups.into_iter().zip(free) {
             if free && group.len() == NODE_LEAVES {
-                self.tiles.insert_node(node);
+                self.tiles.insert_node(node_origin(group[0]));
             } else if free {
-                group.iter().for_each(|&o| self.tiles.insert_leaf(o));
+                self.tiles.insert_leaves_off_nodes(group);
             } else {
                 group.iter().for_each(|&o| self.fill_leaf_block(o));
             }

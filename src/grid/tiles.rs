@@ -102,6 +102,21 @@ impl Tiles {
         }
     }
 
+    /// Room for `n` more 8^3 tiles.
+    pub fn reserve_leaves(&mut self, n: usize) {
+        self.leaves.reserve(n);
+    }
+
+    /// Makes the 8^3 blocks at `origins` whole, where no node tile holds any of them.
+    pub fn insert_leaves_off_nodes(&mut self, origins: &[Coord]) {
+        debug_assert!(
+            origins
+                .iter()
+                .all(|&o| !self.nodes.contains(&node_origin(o)))
+        );
+        self.leaves.extend(origins.iter().copied());
+    }
+
     /// Makes the 128^3 block at `origin` whole, absorbing its 8^3 tiles.
     pub fn insert_node(&mut self, origin: Coord) {
         if self.nodes.insert(origin) {

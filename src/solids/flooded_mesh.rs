@@ -47,7 +47,9 @@ impl SurfaceAndInside {
 
     /// The surface and the centres inside it, the surface's voxels not counted twice.
     fn with_inside(surface: SparseGrid, mut inside: SparseGrid) -> SurfaceAndInside {
-        inside.difference(&surface);
+        // (inside less surface) with surface is inside with surface: both are made at once.
+        let mut whole = inside.clone();
+        rayon::join(|| whole.union(&surface), || inside.difference(&surface));
         let measures = SolidMeasures::of(
             inside.voxel_count(),
             surface.voxel_count(),
@@ -58,7 +60,12 @@ impl SurfaceAndInside {
             measures,
             xyz_stats: None,
         };
-        SurfaceAndInside::of(surface, solid)
+        SurfaceAndInside {
+            surface,
+            solid,
+            whole,
+            ambiguous: None,
+        }
     }
 
     /// The closed `surface` and what `flood` cannot reach from outside.
