@@ -223,12 +223,13 @@ impl BrickOutside {
 
 /// The brick sizes a run chooses from when none is given, largest first: multiples of 128,
 /// so that the merge splices the bricks' nodes (`brick_splice`), and 2048 at most, where a
-/// worker's peak is a few hundred MiB on a dense mesh (igea at 6144: 170-181 MiB).
+/// worker's peak is a few hundred MiB on a dense mesh (igea at 6144: 167-182 MiB).
 const CHOSEN_SIZES: [u32; 5] = [2048, 1024, 512, 256, 128];
 
 /// Bricks with faces each worker thread is given when the size is chosen: bricks differ in
 /// cost, and a few per thread let the ones that finish early take more. igea's surface at
-/// 6144 on two one-thread workers: bricks of 2048 (29 bricks) take 3.3 s, of 1024 (121) 3.5 s.
+/// 6144 on two one-thread workers: bricks of 2048 (29 bricks) took 3.29-3.32 s, of 1024 (121)
+/// 3.52-3.55 s.
 const BRICKS_PER_THREAD: usize = 8;
 
 /// A distributed run's plan: the mesh read as the CLI reads it (for a solid, its inside rule
@@ -261,6 +262,7 @@ impl BrickRun {
         } else {
             (false, None)
         };
+        // Without a size, the largest for now: `fit_to_threads` chooses once the cluster is known.
         let size = request.brick.unwrap_or(CHOSEN_SIZES[0]);
         let layout = BrickLayout::new(&mesh, request.fit()?, size)?;
         check_voxel_size(output, layout.transform.voxel_size)?;

@@ -53,9 +53,9 @@ pub(super) struct Primitive {
 }
 
 /// An edge or a vertex (its point as both ends) as the primitives keep it: its ends by
-/// number, its normal at the precision it is written in, and its faces. A third of a
-/// `Primitive`'s size: fresh memory costs about as much as voxelizing the surface of a
-/// mesh of small faces.
+/// number, its normal at the precision it is written in, and its faces: 40 bytes where a
+/// `Primitive` takes 88. On a mesh of small faces fresh memory for them cost about as much
+/// as voxelizing them (igea at 1024: up to a third of the surface's run).
 pub(super) struct Feature {
     ends: [u32; 2],
     normal: glam::Vec3,
