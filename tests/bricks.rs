@@ -138,9 +138,9 @@ fn brick_sizes_must_be_multiples_of_eight() {
     }
 }
 
-/// Without a brick size the run takes the largest of 2048, 1024, ..., 128 that gives each
-/// worker thread at least 8 bricks with faces (the smallest where none does); a size given
-/// stays whatever the threads.
+/// Without a brick size the run takes the largest of 2048 (a solid's 1024), 1024, ..., 128
+/// that gives each worker thread at least 8 bricks with faces (the smallest where none
+/// does); a size given stays whatever the threads.
 #[test]
 fn a_run_without_a_brick_size_fits_its_bricks_to_the_threads() {
     let mesh = generate::torus(DVec3::ZERO, 1.0, 0.3, 64, 32);
@@ -155,21 +155,27 @@ fn a_run_without_a_brick_size_fits_its_bricks_to_the_threads() {
         let layout = BrickLayout::new(&mesh, GridFit::Resolution(4096), size).unwrap();
         layout.bin_faces(&mesh).len()
     };
-    for threads in [1, 2, 4, 16, 64, 1000] {
-        let chosen = [2048u32, 1024, 512, 256]
-            .into_iter()
-            .find(|&size| with_faces(size) >= 8 * threads)
-            .unwrap_or(128);
-        let mut run = BrickRun::plan(&source, &request(None), false, output).unwrap();
-        let size = run.fit_to_threads(&request(None), threads).unwrap();
-        assert_eq!(size, i64::from(chosen), "{threads} threads");
-        assert_eq!(run.layout.size, size);
-        assert_eq!(run.bins.len(), with_faces(chosen), "the faces binned anew");
-        let mut given = BrickRun::plan(&source, &request(Some(512)), false, output).unwrap();
-        assert_eq!(
-            given.fit_to_threads(&request(Some(512)), threads).unwrap(),
-            512
-        );
+    for (solid, sizes) in [
+        (false, &[2048u32, 1024, 512, 256][..]),
+        (true, &[1024, 512, 256]),
+    ] {
+        for threads in [1, 2, 4, 16, 64, 1000] {
+            let chosen = sizes
+                .iter()
+                .copied()
+                .find(|&size| with_faces(size) >= 8 * threads)
+                .unwrap_or(128);
+            let mut run = BrickRun::plan(&source, &request(None), solid, output).unwrap();
+            let size = run.fit_to_threads(&request(None), threads).unwrap();
+            assert_eq!(size, i64::from(chosen), "{threads} threads, solid {solid}");
+            assert_eq!(run.layout.size, size);
+            assert_eq!(run.bins.len(), with_faces(chosen), "the faces binned anew");
+            let mut given = BrickRun::plan(&source, &request(Some(512)), solid, output).unwrap();
+            assert_eq!(
+                given.fit_to_threads(&request(Some(512)), threads).unwrap(),
+                512
+            );
+        }
     }
     // The thread counts above reach every size but the smallest.
     assert!(with_faces(2048) >= 8 && with_faces(256) < 8 * 1000);

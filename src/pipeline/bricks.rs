@@ -223,8 +223,21 @@ impl BrickOutside {
 
 /// The brick sizes a run chooses from when none is given, largest first: multiples of 128,
 /// so that the merge splices the bricks' nodes (`brick_splice`), and 2048 at most, where a
-/// worker's peak is a few hundred MiB on a dense mesh (igea at 6144: 167-182 MiB).
+/// worker's peak is a few hundred MiB on a dense mesh's surface (igea at 6144: 167-182 MiB).
 const CHOSEN_SIZES: [u32; 5] = [2048, 1024, 512, 256, 128];
+
+/// The largest brick a solid run chooses: a solid's brick holds masks and leaves over all its
+/// voxels, eight times as much at 2048 as at 1024 (a surface's grows with its area).
+const LARGEST_SOLID_BRICK: u32 = 1024;
+
+/// The largest size a surface (or a solid, `solid`) run chooses.
+fn largest_chosen(solid: bool) -> u32 {
+    if solid {
+        LARGEST_SOLID_BRICK
+    } else {
+        CHOSEN_SIZES[0]
+    }
+}
 
 /// Bricks with faces each worker thread is given when the size is chosen: bricks differ in
 /// cost, and a few per thread let the ones that finish early take more. igea's surface at
@@ -239,6 +252,8 @@ pub struct BrickRun {
     pub mesh: Mesh,
     pub layout: BrickLayout,
     pub bins: BTreeMap<BrickIndex, Vec<u32>>,
+    /// Whether the run makes a solid (else a surface).
+    pub solid: bool,
     /// A solid's inside rule: winding (true) or the exterior flood, and why.
     pub winding: bool,
     pub inside_reason: Option<String>,
@@ -263,7 +278,7 @@ impl BrickRun {
             (false, None)
         };
         // Without a size, the largest for now: `fit_to_threads` chooses once the cluster is known.
-        let size = request.brick.unwrap_or(CHOSEN_SIZES[0]);
+        let size = request.brick.unwrap_or(largest_chosen(solid));
         let layout = BrickLayout::new(&mesh, request.fit()?, size)?;
         check_voxel_size(output, layout.transform.voxel_size)?;
         let bins = layout.bin_faces(&mesh);
@@ -271,20 +286,26 @@ impl BrickRun {
             mesh,
             layout,
             bins,
+            solid,
             winding,
             inside_reason,
         })
     }
 
     /// For a `request` that gives no brick size, cuts the grid into the largest bricks of
-    /// `CHOSEN_SIZES` that give each of `threads` worker threads at least `BRICKS_PER_THREAD`
-    /// bricks with faces (the smallest where none does); its size.
+    /// `CHOSEN_SIZES` (a solid's at most `LARGEST_SOLID_BRICK`) that give each of `threads`
+    /// worker threads at least `BRICKS_PER_THREAD` bricks with faces (the smallest where none
+    /// does); its size.
     pub fn fit_to_threads(&mut self, request: &BricksRequest, threads: usize) -> Result<i64> {
         if request.brick.is_some() {
             return Ok(self.layout.size);
         }
         let wanted = threads.max(1) * BRICKS_PER_THREAD;
+        let largest = largest_chosen(self.solid);
         for (n, &size) in CHOSEN_SIZES.iter().enumerate() {
+            if size > largest {
+                continue;
+            }
             if i64::from(size) != self.layout.size {
                 self.layout = BrickLayout::new(&self.mesh, request.fit()?, size)?;
                 self.bins = self.layout.bin_faces(&self.mesh);

@@ -574,8 +574,8 @@ request! {
     /// workers, merged into one .vdb.
     BricksRequest as "distributed" placed {
         /// Voxels along a brick's edge, a multiple of 8 (none: chosen for the cluster, the
-        /// largest of 2048, 1024, 512, 256 and 128 that gives every worker thread at least 8
-        /// bricks with faces).
+        /// largest of 2048 (a surface's; a solid's 1024), 1024, 512, 256 and 128 that gives
+        /// every worker thread at least 8 bricks with faces).
         brick: Option<u32> = None,
         /// 6 or 26 (the surface; a solid is always 26).
         separability: Separability = Separability::default(),
