@@ -77,7 +77,7 @@ pub fn splice_brick_set(
     let meta = meta_entries(metadata);
     let empty = SparseGrid::new(set.transform(), Channels::NONE);
     let grid = voxel_set_grid(output, &empty, &meta)?;
-    let layout = Layout::voxel_set()?;
+    let layout = Layout::of(&grid);
     let walks: Vec<Option<WalkedBrick>> = files.iter().map(|f| walked.0.remove(f)).collect();
     let bricks: Vec<BrickNodes> = set
         .bricks
@@ -242,18 +242,27 @@ struct Layout {
 }
 
 impl Layout {
-    /// What a voxel set's grid holds, whatever its transform and metadata.
-    fn voxel_set() -> Result<Layout> {
-        let empty = SparseGrid::new(Transform::new(DVec3::ZERO, 1.0), Channels::NONE);
-        let grid = voxel_set_grid(Path::new("the bricks"), &empty, &[])?;
+    /// What `grid` holds as voxelkit encodes it.
+    fn of(grid: &GridOut) -> Layout {
         let tree_type = tree_type_of(grid.values);
-        Ok(Layout {
+        Layout {
             name: grid.name.to_string(),
             format: TreeFormat::of(&tree_type).expect("a standard tree"),
             tree_type,
             compression: encoding().compression | COMPRESS_ACTIVE_MASK,
             background: grid.values.background().to_le_bytes().to_vec(),
-        })
+        }
+    }
+
+    /// What a voxel set's grid holds, whatever its transform and metadata: for bricks walked
+    /// before the merge knows its grid.
+    fn voxel_set() -> Result<Layout> {
+        let empty = SparseGrid::new(Transform::new(DVec3::ZERO, 1.0), Channels::NONE);
+        Ok(Layout::of(&voxel_set_grid(
+            Path::new("the bricks"),
+            &empty,
+            &[],
+        )?))
     }
 }
 

@@ -226,16 +226,14 @@ impl BrickOutside {
 /// worker's peak is a few hundred MiB on a dense mesh's surface (igea at 6144: 167-182 MiB).
 const CHOSEN_SIZES: [u32; 5] = [2048, 1024, 512, 256, 128];
 
-/// The largest brick a solid run chooses: a solid's brick holds masks and leaves over all its
-/// voxels, eight times as much at 2048 as at 1024 (a surface's grows with its area).
-const LARGEST_SOLID_BRICK: u32 = 1024;
-
-/// The largest size a surface (or a solid, `solid`) run chooses.
-fn largest_chosen(solid: bool) -> u32 {
+/// The sizes a surface run (or a solid run, `solid`) chooses from, largest first: a solid's
+/// brick holds masks and leaves over all its voxels, eight times as much at 2048 as at 1024
+/// (a surface's grows with its area), so a solid's start at 1024.
+fn chosen_sizes(solid: bool) -> &'static [u32] {
     if solid {
-        LARGEST_SOLID_BRICK
+        &CHOSEN_SIZES[1..]
     } else {
-        CHOSEN_SIZES[0]
+        &CHOSEN_SIZES
     }
 }
 
@@ -278,7 +276,7 @@ impl BrickRun {
             (false, None)
         };
         // Without a size, the largest for now: `fit_to_threads` chooses once the cluster is known.
-        let size = request.brick.unwrap_or(largest_chosen(solid));
+        let size = request.brick.unwrap_or(chosen_sizes(solid)[0]);
         let layout = BrickLayout::new(&mesh, request.fit()?, size)?;
         check_voxel_size(output, layout.transform.voxel_size)?;
         let bins = layout.bin_faces(&mesh);
@@ -293,24 +291,19 @@ impl BrickRun {
     }
 
     /// For a `request` that gives no brick size, cuts the grid into the largest bricks of
-    /// `CHOSEN_SIZES` (a solid's at most `LARGEST_SOLID_BRICK`) that give each of `threads`
-    /// worker threads at least `BRICKS_PER_THREAD` bricks with faces (the smallest where none
-    /// does); its size.
+    /// `chosen_sizes` that give each of `threads` worker threads at least `BRICKS_PER_THREAD`
+    /// bricks with faces (the smallest where none does); its size.
     pub fn fit_to_threads(&mut self, request: &BricksRequest, threads: usize) -> Result<i64> {
         if request.brick.is_some() {
             return Ok(self.layout.size);
         }
         let wanted = threads.max(1) * BRICKS_PER_THREAD;
-        let largest = largest_chosen(self.solid);
-        for (n, &size) in CHOSEN_SIZES.iter().enumerate() {
-            if size > largest {
-                continue;
-            }
+        for &size in chosen_sizes(self.solid) {
             if i64::from(size) != self.layout.size {
                 self.layout = BrickLayout::new(&self.mesh, request.fit()?, size)?;
                 self.bins = self.layout.bin_faces(&self.mesh);
             }
-            if self.bins.len() >= wanted || n + 1 == CHOSEN_SIZES.len() {
+            if self.bins.len() >= wanted {
                 break;
             }
         }

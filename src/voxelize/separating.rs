@@ -164,12 +164,13 @@ pub fn voxelize_mesh(
             }
         },
     )?;
+    let [vertices, edges, _] = found.counts();
     let stats = SeparatingStats {
         vertex_voxels,
         edge_voxels,
         body_voxels,
-        vertices: found.counts()[0],
-        edges: found.counts()[1],
+        vertices,
+        edges,
         triangles: triangles.len(),
         degenerate_faces: *degenerate_faces,
     };

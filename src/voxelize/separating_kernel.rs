@@ -80,27 +80,39 @@ pub(super) const MOST_HALVES: usize = 16;
 /// of the column's place, so a column costs a multiply-add per half-space, not a division.
 pub(super) struct AxisCut {
     axis: usize,
-    /// Per half-space, `bound = base + slope·x` (`slope[axis]` 0) and which side it bounds:
-    /// `Some(true)` above, `Some(false)` below; `None` for a half-space parallel to the axis,
-    /// whose `base + slope·x` must not be negative.
-    bounds: [(f64, DVec3, Option<bool>); MOST_HALVES],
+    /// Per half-space, `bound = base + slope·x` (`slope[axis]` 0) and what it bounds.
+    bounds: [(f64, DVec3, Bounds); MOST_HALVES],
     len: usize,
+}
+
+/// What a half-space bounds along a column.
+#[derive(Clone, Copy)]
+enum Bounds {
+    /// The coordinate, from above by `bound`.
+    Above,
+    /// The coordinate, from below by `bound`.
+    Below,
+    /// Nothing along the column (the half-space is parallel to it): the whole column is out
+    /// where `bound` is negative.
+    Column,
 }
 
 impl AxisCut {
     /// The cut of `halves` (at most `MOST_HALVES`) along `axis`.
     pub(super) fn new(halves: &[HalfSpace], axis: usize) -> AxisCut {
         debug_assert!(halves.len() <= MOST_HALVES);
-        let mut bounds = [(0.0, DVec3::ZERO, None); MOST_HALVES];
+        let mut bounds = [(0.0, DVec3::ZERO, Bounds::Column); MOST_HALVES];
         for (bound, half) in bounds.iter_mut().zip(halves) {
             // g_axis t <= -(g·x + h), with x_axis = 0.
             let mut g = half.g;
             let ga = g[axis];
             g[axis] = 0.0;
             *bound = if ga == 0.0 {
-                (-half.h, -g, None)
+                (-half.h, -g, Bounds::Column)
+            } else if ga > 0.0 {
+                (-half.h / ga, -g / ga, Bounds::Above)
             } else {
-                (-half.h / ga, -g / ga, Some(ga > 0.0))
+                (-half.h / ga, -g / ga, Bounds::Below)
             };
         }
         AxisCut {
@@ -120,23 +132,23 @@ impl AxisCut {
     ) -> std::ops::RangeInclusive<i64> {
         let (mut lo, mut hi) = (*range.start(), *range.end());
         x[self.axis] = 0.0;
-        for &(base, slope, side) in &self.bounds[..self.len] {
+        for &(base, slope, bounds) in &self.bounds[..self.len] {
             let bound = base + slope.dot(x);
-            match side {
-                Some(true) => {
+            match bounds {
+                Bounds::Above => {
                     let bound = bound + ROW_SLACK;
                     if bound < hi as f64 {
                         hi = floor_int(bound.max(lo as f64 - 1.0));
                     }
                 }
-                Some(false) => {
+                Bounds::Below => {
                     let bound = bound - ROW_SLACK;
                     if bound > lo as f64 {
                         lo = ceil_int(bound.min(hi as f64 + 1.0));
                     }
                 }
-                None if bound < 0.0 => return int_range(0.0, -1.0),
-                None => {}
+                Bounds::Column if bound < 0.0 => return int_range(0.0, -1.0),
+                Bounds::Column => {}
             }
             if lo > hi {
                 break;
