@@ -14,7 +14,7 @@ mod up_axis;
 pub use coord::{Coord, CoordBox, LEAF_VOXELS, leaf_offset, leaf_origin, offset_coord};
 pub use leaf::{Channels, Leaf, mask_box};
 pub use sparse::{Accessor, Block, SparseGrid};
-pub use tiles::{NODE_DIM, TILE_BYTES, Tiles, node_origin};
+pub use tiles::{NODE_DIM, Tiles, node_origin, tile_bytes};
 pub use transform::Transform;
 pub use up_axis::UpAxis;
 

@@ -4,9 +4,8 @@
 
 use super::coord::{Coord, CoordBox, leaf_offset, leaf_origin, offset_coord};
 use super::leaf::{Channels, Leaf, mask_box};
-use super::tiles::{NODE_DIM, NODE_LEAVES, Tiles, node_leaf_origins, node_origin};
+use super::tiles::{NODE_DIM, Tiles, node_leaf_origins, node_origin};
 use super::transform::Transform;
-use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 #[derive(Clone, Debug, Default)]
@@ -110,38 +109,16 @@ impl SparseGrid {
     }
 
     /// Makes the 8^3 blocks at `origins` whole, as `fill_leaf_block` does one by one, and
-    /// each 128^3 node they fill completely a node tile: in bulk, for the hundreds of
-    /// thousands of blocks of a solid's inside.
-    pub fn fill_leaf_blocks(&mut self, mut origins: Vec<Coord>) {
-        origins.par_sort_unstable_by_key(|&o| (node_origin(o), o));
-        origins.dedup();
-        let groups: Vec<&[Coord]> = origins
-            .chunk_by(|a, b| node_origin(*a) == node_origin(*b))
-            .collect();
-        // A group is free where neither a node tile nor a leaf holds any of its blocks.
-        let free: Vec<bool> = groups
-            .iter()
-            .map(|group| {
-                !self.tiles.has_node(node_origin(group[0]))
-                    && (self.index.is_empty() || group.iter().all(|o| !self.index.contains_key(o)))
-            })
-            .collect();
-        let tiles: usize = groups
-            .iter()
-            .zip(&free)
-            .filter(|&(group, &free)| free && group.len() < NODE_LEAVES)
-            .map(|(group, _)| group.len())
-            .sum();
-        self.tiles.reserve_leaves(tiles);
-        for (group, free) in groups.into_iter().zip(free) {
-            if free && group.len() == NODE_LEAVES {
-                self.tiles.insert_node(node_origin(group[0]));
-            } else if free {
-                self.tiles.insert_leaves_off_nodes(group);
+    /// each 128^3 node whole in 8^3 tiles a node tile.
+    pub fn fill_leaf_blocks(&mut self, origins: Vec<Coord>) {
+        for origin in origins {
+            if self.index.is_empty() || !self.index.contains_key(&origin) {
+                self.tiles.insert_leaf(origin);
             } else {
-                group.iter().for_each(|&o| self.fill_leaf_block(o));
+                self.fill_leaf_block(origin);
             }
         }
+        self.tiles.promote();
     }
 
     /// Makes the 128^3 block at `origin` (a multiple of 128) whole.

@@ -3,8 +3,9 @@
 //! (tiles in a level-2 node). A solid's inside is mostly such blocks, so it costs a few
 //! hash entries instead of hundreds of thousands of leaves.
 
+use super::bits;
 use super::coord::{Coord, CoordBox};
-use rustc_hash::FxHashSet;
+use rustc_hash::{FxHashMap, FxHashSet};
 
 /// Edge of a node tile in voxels (16 leaves of 8).
 pub const NODE_DIM: i64 = 128;
@@ -26,43 +27,128 @@ pub fn node_leaf_origins(origin: Coord) -> impl Iterator<Item = Coord> {
     })
 }
 
+/// The 8^3 blocks of one 128^3 node that are whole: a bit per block, in
+/// `node_leaf_origins` order.
+#[derive(Clone, Debug)]
+struct NodeBlocks {
+    bits: Box<[u64; NODE_LEAVES / 64]>,
+    count: u32,
+}
+
+impl Default for NodeBlocks {
+    fn default() -> Self {
+        NodeBlocks {
+            bits: Box::new([0; NODE_LEAVES / 64]),
+            count: 0,
+        }
+    }
+}
+
+// Counted by branches: the branchless form (`count -= u32::from(was)`) came out of rustc
+// 1.95's release build leaving the count unchanged when inlined into `Tiles::remove_leaf`
+// (the unit test below caught it).
+impl NodeBlocks {
+    /// Sets block `slot`; whether it was not set before.
+    fn insert(&mut self, slot: usize) -> bool {
+        let new = !bits::get(&self.bits[..], slot);
+        if new {
+            bits::set(&mut self.bits[..], slot);
+            self.count += 1;
+        }
+        new
+    }
+
+    /// Clears block `slot`; whether it was set.
+    fn remove(&mut self, slot: usize) -> bool {
+        let was = bits::get(&self.bits[..], slot);
+        if was {
+            bits::clear(&mut self.bits[..], slot);
+            self.count -= 1;
+        }
+        was
+    }
+}
+
+/// The slot of the 8^3 block at `leaf_origin` in its node, in `node_leaf_origins` order.
+#[inline]
+fn block_slot(leaf_origin: Coord) -> usize {
+    let at = leaf_origin.map(|v| ((v & (NODE_DIM - 1)) >> 3) as usize);
+    (at[0] << 8) | (at[1] << 4) | at[2]
+}
+
+/// The origin of block `slot` of the node at `node`.
+fn slot_origin(node: Coord, slot: usize) -> Coord {
+    let at = [slot >> 8, (slot >> 4) & 15, slot & 15];
+    std::array::from_fn(|a| node[a] + 8 * at[a] as i64)
+}
+
+/// Whole 8^3 blocks are kept as a bit per block under their 128^3 node (a solid's inside has
+/// hundreds of thousands of them in a few hundred nodes: setting, testing and copying bits is
+/// what keeps making and combining solids cheap), whole 128^3 blocks by their origin.
 #[derive(Clone, Debug, Default)]
 pub struct Tiles {
-    /// Origins of whole 8^3 blocks, none inside a node tile.
-    leaves: FxHashSet<Coord>,
+    /// Whole 8^3 blocks by the node holding them, none in a node tile; no node without one.
+    leaves: FxHashMap<Coord, NodeBlocks>,
+    /// How many 8^3 blocks `leaves` holds.
+    leaf_count: usize,
     /// Origins of whole 128^3 blocks.
     nodes: FxHashSet<Coord>,
 }
 
-/// Bytes a tile takes in a grid at the peak: its hash-set entry (an origin, its control byte)
-/// at the set's load after growing, and its copy while a grid is read or combined.
-pub const TILE_BYTES: u64 = 64;
+/// Bytes the tiles of a grid take at the peak: a node's 8^3 blocks (their bits and the map's
+/// entry, at the map's load after growing) and a node tile's set entry, each with its copy
+/// while a grid is read or combined.
+pub const NODE_BLOCKS_BYTES: u64 = 1280;
+pub const NODE_TILE_BYTES: u64 = 64;
 
 impl Tiles {
     /// The tiles, 8^3 and 128^3.
     pub fn count(&self) -> u64 {
-        (self.leaves.len() + self.nodes.len()) as u64
+        (self.leaf_count + self.nodes.len()) as u64
     }
 
     pub fn is_empty(&self) -> bool {
-        self.leaves.is_empty() && self.nodes.is_empty()
+        self.leaf_count == 0 && self.nodes.is_empty()
+    }
+
+    /// Bytes the tiles take at the peak (`NODE_BLOCKS_BYTES`).
+    pub fn bytes(&self) -> u64 {
+        tile_bytes(self.leaves.len() as u64, self.nodes.len() as u64)
     }
 
     /// Whether the 8^3 block at `leaf_origin` is whole.
     #[inline]
     pub fn covers(&self, leaf_origin: Coord) -> bool {
-        !self.is_empty()
-            && (self.leaves.contains(&leaf_origin)
-                || self.nodes.contains(&node_origin(leaf_origin)))
+        if self.is_empty() {
+            return false;
+        }
+        let node = node_origin(leaf_origin);
+        self.leaves
+            .get(&node)
+            .is_some_and(|b| bits::get(&b.bits[..], block_slot(leaf_origin)))
+            || self.nodes.contains(&node)
     }
 
     pub fn voxel_count(&self) -> u64 {
-        self.leaves.len() as u64 * 512 + self.nodes.len() as u64 * (NODE_DIM as u64).pow(3)
+        self.leaf_count as u64 * 512 + self.nodes.len() as u64 * (NODE_DIM as u64).pow(3)
     }
 
     /// Origins of the 8^3 tiles.
     pub fn leaf_tiles(&self) -> impl Iterator<Item = Coord> + '_ {
-        self.leaves.iter().copied()
+        self.leaf_tiles_by_node().flat_map(|(_, origins)| origins)
+    }
+
+    /// The nodes holding 8^3 tiles, each with its tiles' origins in `node_leaf_origins`
+    /// order (OpenVDB's order of a 128^3 node's slots).
+    pub fn leaf_tiles_by_node(
+        &self,
+    ) -> impl Iterator<Item = (Coord, impl Iterator<Item = Coord> + '_)> + '_ {
+        self.leaves.iter().map(|(&node, b)| {
+            (
+                node,
+                bits::ones(&b.bits[..]).map(move |s| slot_origin(node, s)),
+            )
+        })
     }
 
     /// Origins of the 128^3 tiles.
@@ -97,51 +183,46 @@ impl Tiles {
 
     /// Makes the 8^3 block at `origin` whole.
     pub fn insert_leaf(&mut self, origin: Coord) {
-        if !self.nodes.contains(&node_origin(origin)) {
-            self.leaves.insert(origin);
+        let node = node_origin(origin);
+        if !self.nodes.contains(&node) {
+            let blocks = self.leaves.entry(node).or_default();
+            self.leaf_count += usize::from(blocks.insert(block_slot(origin)));
         }
-    }
-
-    /// Room for `n` more 8^3 tiles.
-    pub fn reserve_leaves(&mut self, n: usize) {
-        self.leaves.reserve(n);
-    }
-
-    /// Makes the 8^3 blocks at `origins` whole, where no node tile holds any of them.
-    pub fn insert_leaves_off_nodes(&mut self, origins: &[Coord]) {
-        debug_assert!(
-            origins
-                .iter()
-                .all(|&o| !self.nodes.contains(&node_origin(o)))
-        );
-        self.leaves.extend(origins.iter().copied());
     }
 
     /// Makes the 128^3 block at `origin` whole, absorbing its 8^3 tiles.
     pub fn insert_node(&mut self, origin: Coord) {
-        if self.nodes.insert(origin) {
-            if self.leaves.len() < NODE_LEAVES {
-                self.leaves.retain(|&o| node_origin(o) != origin);
-            } else {
-                for o in node_leaf_origins(origin) {
-                    self.leaves.remove(&o);
-                }
-            }
+        if self.nodes.insert(origin)
+            && let Some(blocks) = self.leaves.remove(&origin)
+        {
+            self.leaf_count -= blocks.count as usize;
         }
     }
 
     /// Takes the 8^3 block at `origin` out of the tiles (splitting its node tile); returns
     /// whether it was whole.
     pub fn remove_leaf(&mut self, origin: Coord) -> bool {
-        if self.leaves.remove(&origin) {
+        let node = node_origin(origin);
+        if let Some(blocks) = self.leaves.get_mut(&node) {
+            if !blocks.remove(block_slot(origin)) {
+                return false;
+            }
+            self.leaf_count -= 1;
+            if blocks.count == 0 {
+                self.leaves.remove(&node);
+            }
             return true;
         }
-        let node = node_origin(origin);
         if !self.nodes.remove(&node) {
             return false;
         }
-        self.leaves
-            .extend(node_leaf_origins(node).filter(|&o| o != origin));
+        let mut blocks = NodeBlocks {
+            bits: Box::new([u64::MAX; NODE_LEAVES / 64]),
+            count: NODE_LEAVES as u32,
+        };
+        blocks.remove(block_slot(origin));
+        self.leaf_count += NODE_LEAVES - 1;
+        self.leaves.insert(node, blocks);
         true
     }
 
@@ -153,22 +234,29 @@ impl Tiles {
 
     /// Replaces every complete group of 4096 leaf tiles by its node tile.
     pub fn promote(&mut self) {
-        let mut per_node: rustc_hash::FxHashMap<Coord, u32> = Default::default();
-        for &o in &self.leaves {
-            *per_node.entry(node_origin(o)).or_default() += 1;
-        }
-        for (node, n) in per_node {
-            if n as usize == NODE_LEAVES {
-                self.insert_node(node);
-            }
-        }
+        let whole: Vec<Coord> = self
+            .leaves
+            .iter()
+            .filter(|(_, b)| b.count as usize == NODE_LEAVES)
+            .map(|(&node, _)| node)
+            .collect();
+        whole.into_iter().for_each(|node| self.insert_node(node));
     }
 
     /// Removes every tile.
     pub fn clear(&mut self) {
         self.leaves.clear();
+        self.leaf_count = 0;
         self.nodes.clear();
     }
+}
+
+/// Bytes at the peak of the tiles of `nodes_with_blocks` nodes holding 8^3 tiles and
+/// `node_tiles` 128^3 tiles.
+pub fn tile_bytes(nodes_with_blocks: u64, node_tiles: u64) -> u64 {
+    nodes_with_blocks
+        .saturating_mul(NODE_BLOCKS_BYTES)
+        .saturating_add(node_tiles.saturating_mul(NODE_TILE_BYTES))
 }
 
 #[cfg(test)]
@@ -192,5 +280,32 @@ mod tests {
         assert_eq!(t.leaf_tiles().count(), 4095);
         assert!(!t.covers([136, -128, 8]));
         assert_eq!(node_origin([-1, 127, 128]), [-128, 0, 128]);
+    }
+
+    #[test]
+    fn leaf_tiles_are_kept_per_node_and_counted_once() {
+        let mut t = Tiles::default();
+        let origins = [
+            [0, 0, 0],
+            [120, 8, 64],
+            [-8, 0, 0],
+            [-128, -8, 120],
+            [0, 0, 0],
+        ];
+        origins.iter().for_each(|&o| t.insert_leaf(o));
+        assert_eq!(t.count(), 4);
+        assert_eq!(t.bytes(), tile_bytes(3, 0));
+        let mut listed: Vec<Coord> = t.leaf_tiles().collect();
+        listed.sort_unstable();
+        let mut expected = origins[..4].to_vec();
+        expected.sort_unstable();
+        assert_eq!(listed, expected);
+        assert!(origins.iter().all(|&o| t.covers(o)));
+        assert!(!t.covers([8, 0, 0]) && !t.remove_leaf([8, 0, 0]));
+        assert!(t.remove_leaf([-8, 0, 0]));
+        assert!(!t.covers([-8, 0, 0]));
+        assert_eq!((t.count(), t.bytes()), (3, tile_bytes(2, 0)));
+        t.insert_node([0, 0, 0]);
+        assert_eq!((t.count(), t.voxel_count()), (2, 512 + 128 * 128 * 128));
     }
 }

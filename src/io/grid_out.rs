@@ -5,7 +5,7 @@
 
 use super::vdb_format::{CHILD_LOG2, NODE_LOG2, ROOT_TILE};
 use crate::error::{Error, Result};
-use crate::grid::{Leaf, SparseGrid};
+use crate::grid::{Coord, Leaf, SparseGrid};
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -80,6 +80,7 @@ impl GridValues<'_> {
 
     /// Hands `put` the active values of `leaf` in offset order, a vector's three components
     /// one after another; a bool grid's leaves store no values.
+    #[inline(always)]
     pub(super) fn for_each_active(self, leaf: &Leaf, mut put: impl FnMut(f32)) {
         match self {
             GridValues::Bool => unreachable!("bool leaves store a mask"),
@@ -226,34 +227,22 @@ pub(super) fn key(path: &Path, origin: [i64; 3]) -> Result<Key> {
 /// refuses vectors on tiles and a tile sharing its place with another node. Errors name
 /// `path`.
 pub(super) fn tree_entries<'g>(path: &Path, g: &GridOut<'g>) -> Result<Vec<(Key, Entry<'g>)>> {
-    let mut entries: Vec<(Key, Entry)> = g
+    let mut leaves: Vec<(Key, Entry)> = g
         .grid
         .leaves()
         .iter()
         .filter(|l| !l.is_empty())
         .map(|l| Ok((key(path, l.origin)?, Entry::Leaf(l))))
         .collect::<Result<_>>()?;
-    let tiles_of = match g.values {
-        GridValues::LevelSet { interior, .. } => interior,
-        _ => g.grid,
-    };
-    for (origin, edge) in tiles_of.tiles().with_edges() {
-        let entry = if edge == 8 {
-            Entry::LeafTile
-        } else {
-            Entry::NodeTile
-        };
-        entries.push((key(path, origin)?, entry));
-    }
-    if g.values.value_type() == ValueType::Vec3
-        && entries.iter().any(|e| !matches!(e.1, Entry::Leaf(_)))
-    {
+    leaves.par_sort_unstable_by_key(|e| e.0);
+    let tiles = sorted_tiles(path, g)?;
+    if g.values.value_type() == ValueType::Vec3 && !tiles.is_empty() {
         return Err(Error::Vdb {
             path: path.to_path_buf(),
             message: format!("grid {}: tiles carry no vectors", g.name),
         });
     }
-    entries.par_sort_unstable_by_key(|e| e.0);
+    let entries = merge_sorted(leaves, tiles);
     // A block is a leaf or a tile, and a 128^3 tile holds nothing else.
     let clash = entries.windows(2).find(|w| {
         w[0].0 == w[1].0
@@ -269,4 +258,49 @@ pub(super) fn tree_entries<'g>(path: &Path, g: &GridOut<'g>) -> Result<Vec<(Key,
         });
     }
     Ok(entries)
+}
+
+/// The grid's tiles (a level set's: its interior's) in tree order: only their nodes are
+/// sorted, as a node lists its 8^3 tiles in its slots' order already.
+fn sorted_tiles<'g>(path: &Path, g: &GridOut<'g>) -> Result<Vec<(Key, Entry<'g>)>> {
+    let tiles = match g.values {
+        GridValues::LevelSet { interior, .. } => interior,
+        _ => g.grid,
+    }
+    .tiles();
+    let mut nodes: Vec<(Key, Option<Vec<Coord>>)> = tiles
+        .node_tiles()
+        .map(|o| Ok((key(path, o)?, None)))
+        .chain(
+            tiles
+                .leaf_tiles_by_node()
+                .map(|(node, origins)| Ok((key(path, node)?, Some(origins.collect())))),
+        )
+        .collect::<Result<_>>()?;
+    nodes.sort_unstable_by_key(|n| n.0);
+    let mut sorted = Vec::with_capacity(tiles.count() as usize);
+    for (node_key, blocks) in nodes {
+        match blocks {
+            None => sorted.push((node_key, Entry::NodeTile)),
+            Some(origins) => {
+                for o in origins {
+                    sorted.push((key(path, o)?, Entry::LeafTile));
+                }
+            }
+        }
+    }
+    Ok(sorted)
+}
+
+/// The entries of two sorted lists in one sorted list.
+fn merge_sorted<'g>(a: Vec<(Key, Entry<'g>)>, b: Vec<(Key, Entry<'g>)>) -> Vec<(Key, Entry<'g>)> {
+    let mut merged = Vec::with_capacity(a.len() + b.len());
+    let (mut a, mut b) = (a.into_iter().peekable(), b.into_iter().peekable());
+    while let (Some(x), Some(y)) = (a.peek(), b.peek()) {
+        let next = if x.0 <= y.0 { a.next() } else { b.next() };
+        merged.extend(next);
+    }
+    merged.extend(a);
+    merged.extend(b);
+    merged
 }

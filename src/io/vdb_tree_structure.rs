@@ -102,8 +102,10 @@ struct Nodes {
     internal: [u64; 2],
     /// Every leaf's active voxel count, in the order OpenVDB reads their buffers.
     leaves: Vec<u16>,
-    /// Active tiles of the internal nodes, each a tile voxelkit keeps once read.
-    tiles: u64,
+    /// Active tiles as voxelkit keeps them once read: the lowest internal nodes holding 8^3
+    /// tiles, and the 128^3 tiles of the nodes above them.
+    nodes_with_blocks: u64,
+    node_tiles: u64,
 }
 
 /// Checks a tree's topology (ending by `block`), then its leaf buffers (ending by `end`).
@@ -129,7 +131,7 @@ pub(super) fn tree(
         .try_for_each(|&active| leaf_buffer(r, format, compression, active, what));
     r.len = file_len;
     buffers?;
-    let tiles = nodes.tiles.saturating_mul(crate::grid::TILE_BYTES);
+    let tiles = crate::grid::tile_bytes(nodes.nodes_with_blocks, nodes.node_tiles);
     Ok(tree_memory(format, nodes.internal, nodes.leaves.len() as u64).saturating_add(tiles))
 }
 
@@ -223,11 +225,16 @@ fn internal_node(
     let value_mask = r.vec(mask_bytes, what)?;
     let slots = 8 * mask_bytes;
     compressed_values(r, format, compression, slots, ones(&value_mask), what)?;
-    nodes.tiles += value_mask
+    let tiles = value_mask
         .iter()
         .zip(&child_mask)
         .map(|(v, c)| (v & !c).count_ones() as u64)
         .sum::<u64>();
+    if depth + 1 == NODE_LOG2.len() {
+        nodes.nodes_with_blocks += u64::from(tiles > 0);
+    } else {
+        nodes.node_tiles += tiles;
+    }
     for _ in 0..ones(&child_mask) {
         if depth + 1 == NODE_LOG2.len() {
             nodes

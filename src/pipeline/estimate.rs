@@ -15,7 +15,7 @@ use super::{
     BrickStage, BrickTask, Fill, Plan, Shape, ShapeTask, SubdivisionOutput, SurfaceMethod,
 };
 use crate::error::{Error, Result};
-use crate::grid::{CoordBox, MAX_DENSE_VOXELS, SparseGrid, TILE_BYTES, Transform};
+use crate::grid::{CoordBox, MAX_DENSE_VOXELS, SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::io::brick_set::brick_voxels;
 use crate::io::vdb::check_voxel_size;
@@ -120,17 +120,32 @@ struct FillCost {
 /// A fill's peak comes after the surface's per-triangle tables are gone: each triangle then
 /// costs what the mesh keeps of it, 65 bytes.
 const FILLED_TRIANGLE_BYTES: f64 = 65.0;
-/// The block flood (the default): the surface, the solid's boundary leaves and the grids
-/// written (1070 bytes per surface leaf), the block states (7 bytes per block of the box) and
-/// the inside's tiles (0.6 bits per inside voxel); no dense volume. Estimate/peak 0.86-1.06
-/// on the five meshes at 1024, 1 and 2 threads.
+/// The block flood (the default for closed meshes by parity): the surface, the solid's
+/// boundary leaves and the grids written (1070 bytes per surface leaf) and the block states
+/// (7 bytes per block of the box); the inside's tiles, a bit per 8^3 block, are small beside
+/// them; no dense volume. Estimate/peak 0.87-1.04 on bunny-closed, igea, horse, armadillo,
+/// skull, scorpion, fandisk, rocker-arm and spot at 1024.
 const BLOCK_FLOOD_COST: FillCost = FillCost {
     bit_volumes: 0.0,
-    inside_volumes: 0.6,
+    inside_volumes: 0.0,
     face_bytes: 0.0,
     leaf_bytes: 1070.0,
     block_bytes: 7.0,
     triangle_bytes: FILLED_TRIANGLE_BYTES,
+};
+/// A solid whose inside the winding number decides (no flood): the surface's per-triangle
+/// tables, still held while the inside is found beside it (200 bytes a triangle), the list
+/// of whole 8^3 blocks (24 bytes each: 0.375 bits per inside voxel), and the surface, the
+/// solid's boundary leaves and the grids written (840 bytes per surface leaf); the crossings
+/// come on top (`winding_plan`). Estimate/peak 0.84-1.19 on the nine meshes above at 1024
+/// and 2 threads.
+const WINDING_SOLID_COST: FillCost = FillCost {
+    bit_volumes: 0.0,
+    inside_volumes: 0.375,
+    face_bytes: 0.0,
+    leaf_bytes: 840.0,
+    block_bytes: 0.0,
+    triangle_bytes: 200.0,
 };
 /// The span flood and FloodingXYZ: two dense volumes (surface and reached) and what scales
 /// with them, the solid's tiles and the scanline queues, half a volume more; the surface's
@@ -157,12 +172,12 @@ const DEPTH_LAYERS_COST: FillCost = FillCost {
     triangle_bytes: TRIANGLE_BYTES,
 };
 /// `measure` of a mesh: the block flood without writing, then components and genus counted
-/// over the solid, whose labels take about two bits per inside voxel and half a bit per
-/// voxel of the box. Estimate/peak 0.87-1.10 (bunny-closed, igea, armadillo, horse at
-/// 1024, 1 and 2 threads).
+/// over the solid, whose labels take about 1.5 bits per inside voxel and half a bit per
+/// voxel of the box. Estimate/peak 0.95-1.03 (bunny-closed, igea, fandisk, skull, armadillo
+/// at 1024).
 const MEASURE_COST: FillCost = FillCost {
     bit_volumes: 0.6,
-    inside_volumes: 2.1,
+    inside_volumes: 1.5,
     face_bytes: 0.0,
     leaf_bytes: 920.0,
     block_bytes: 0.0,
@@ -721,7 +736,7 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
         } => match fill {
             // The winding number decides without a flood.
             Fill::Flood(_) if *inside != InsideRule::Parity => {
-                winding_plan(mesh, fit, &BLOCK_FLOOD_COST)?
+                winding_plan(mesh, fit, &WINDING_SOLID_COST)?
             }
             _ => solid_plan(mesh, fit, *fill)?,
         },
@@ -868,7 +883,7 @@ fn fill_plan(
 
 /// The tiles of a grid.
 fn tile_bytes(grid: &SparseGrid) -> f64 {
-    (grid.tiles().count() * TILE_BYTES) as f64
+    grid.tiles().bytes() as f64
 }
 
 /// A grid's index box (the voxel at the origin when it is empty).
@@ -892,8 +907,8 @@ fn world_box(grid: &SparseGrid) -> Aabb {
 /// taken as 30% of the box: bunny-closed fills 26%, igea 41%) in a dense volume over the
 /// grid's box, allocated whole (it counts against an address-space limit), plus what reading
 /// it left: OpenVDB's float leaves and their copied values (4.3 KB per leaf of a grid with
-/// values, 300 bytes of a bool grid). Estimate/peak 0.93-1.17 on solids' shells and a
-/// surface at 512-1024 (was 5-14). A box past the dense volume's limit is refused here,
+/// values, 300 bytes of a bool grid). Estimate/peak 1.02-1.20 on solids' shells (bunny-closed,
+/// igea, skull, armadillo; armadillo's at 1024 1.36) and a surface at 512-1024 (was 5-14). A box past the dense volume's limit is refused here,
 /// with the input's name.
 fn grid_plan(grid: &SparseGrid, what: &str) -> Result<Plan> {
     let box_cells = cells(&padded(grid_box(grid), 2));
