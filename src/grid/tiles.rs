@@ -135,20 +135,19 @@ impl Tiles {
 
     /// Origins of the 8^3 tiles.
     pub fn leaf_tiles(&self) -> impl Iterator<Item = Coord> + '_ {
-        self.leaf_tiles_by_node().flat_map(|(_, origins)| origins)
+        self.leaf_tiles_by_node()
+            .flat_map(|(node, slots)| slots.map(move |s| slot_origin(node, s)))
     }
 
-    /// The nodes holding 8^3 tiles, each with its tiles' origins in `node_leaf_origins`
-    /// order (OpenVDB's order of a 128^3 node's slots).
+    /// The nodes holding 8^3 tiles, each with its tiles' slots in ascending order: a slot
+    /// numbers the blocks in `node_leaf_origins` order, OpenVDB's order of a 128^3 node's
+    /// children (x, then y, then z, 16 each).
     pub fn leaf_tiles_by_node(
         &self,
-    ) -> impl Iterator<Item = (Coord, impl Iterator<Item = Coord> + '_)> + '_ {
-        self.leaves.iter().map(|(&node, b)| {
-            (
-                node,
-                bits::ones(&b.bits[..]).map(move |s| slot_origin(node, s)),
-            )
-        })
+    ) -> impl Iterator<Item = (Coord, impl Iterator<Item = usize> + '_)> + '_ {
+        self.leaves
+            .iter()
+            .map(|(&node, b)| (node, bits::ones(&b.bits[..])))
     }
 
     /// Origins of the 128^3 tiles.

@@ -5,7 +5,7 @@
 
 use super::vdb_format::{CHILD_LOG2, NODE_LOG2, ROOT_TILE};
 use crate::error::{Error, Result};
-use crate::grid::{Coord, Leaf, SparseGrid};
+use crate::grid::{Leaf, SparseGrid};
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -199,6 +199,13 @@ pub(super) enum Entry<'g> {
 /// order.
 pub(super) type Key = ([i32; 3], u16, u16);
 
+/// `key` as one number that sorts as the key does (a tuple compares field by field).
+#[inline]
+fn packed(key: &Key) -> u128 {
+    let c = key.0.map(|v| u128::from(v as u32 ^ 0x8000_0000));
+    (c[0] << 96) | (c[1] << 64) | (c[2] << 32) | (u128::from(key.1) << 16) | u128::from(key.2)
+}
+
 /// The key of the block at `origin`; errors name `path`.
 pub(super) fn key(path: &Path, origin: [i64; 3]) -> Result<Key> {
     let mut c = [0i32; 3];
@@ -268,13 +275,13 @@ fn sorted_tiles<'g>(path: &Path, g: &GridOut<'g>) -> Result<Vec<(Key, Entry<'g>)
         _ => g.grid,
     }
     .tiles();
-    let mut nodes: Vec<(Key, Option<Vec<Coord>>)> = tiles
+    let mut nodes: Vec<(Key, Option<Vec<usize>>)> = tiles
         .node_tiles()
         .map(|o| Ok((key(path, o)?, None)))
         .chain(
             tiles
                 .leaf_tiles_by_node()
-                .map(|(node, origins)| Ok((key(path, node)?, Some(origins.collect())))),
+                .map(|(node, slots)| Ok((key(path, node)?, Some(slots.collect())))),
         )
         .collect::<Result<_>>()?;
     nodes.sort_unstable_by_key(|n| n.0);
@@ -282,11 +289,12 @@ fn sorted_tiles<'g>(path: &Path, g: &GridOut<'g>) -> Result<Vec<(Key, Entry<'g>)
     for (node_key, blocks) in nodes {
         match blocks {
             None => sorted.push((node_key, Entry::NodeTile)),
-            Some(origins) => {
-                for o in origins {
-                    sorted.push((key(path, o)?, Entry::LeafTile));
-                }
-            }
+            // A block's slot in its node is the key's last part.
+            Some(slots) => sorted.extend(
+                slots
+                    .into_iter()
+                    .map(|s| ((node_key.0, node_key.1, s as u16), Entry::LeafTile)),
+            ),
         }
     }
     Ok(sorted)
@@ -297,7 +305,11 @@ fn merge_sorted<'g>(a: Vec<(Key, Entry<'g>)>, b: Vec<(Key, Entry<'g>)>) -> Vec<(
     let mut merged = Vec::with_capacity(a.len() + b.len());
     let (mut a, mut b) = (a.into_iter().peekable(), b.into_iter().peekable());
     while let (Some(x), Some(y)) = (a.peek(), b.peek()) {
-        let next = if x.0 <= y.0 { a.next() } else { b.next() };
+        let next = if packed(&x.0) <= packed(&y.0) {
+            a.next()
+        } else {
+            b.next()
+        };
         merged.extend(next);
     }
     merged.extend(a);

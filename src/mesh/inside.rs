@@ -115,31 +115,48 @@ impl ColumnCrossings {
                 found
             })
             .collect();
-        let mut crossings = Vec::with_capacity(batches.iter().map(Vec::len).sum());
-        for batch in batches {
-            crossings.extend_from_slice(&batch);
+        // Placed by counting: every column's crossings counted, each crossing written at its
+        // column's next free place, then each column (a handful of crossings) sorted by z.
+        // A comparison sort of them all took a third of the inside's time.
+        let mut at = vec![0u32; nx * ny];
+        for c in batches.iter().flatten() {
+            at[c.ray()] += 1;
         }
-        crossings.par_sort_unstable_by_key(|c| (c.ray(), c.after));
         let mut row_starts = vec![0usize; nx + 1];
-        for c in &crossings {
-            row_starts[c.ray() / ny + 1] += 1;
-        }
-        for x in 0..nx {
-            row_starts[x + 1] += row_starts[x];
-        }
         let mut column_starts = vec![0u32; nx * (ny + 1)];
-        column_starts
-            .par_chunks_mut(ny + 1)
-            .enumerate()
-            .for_each(|(x, starts)| {
-                // A row's crossings number far below 2^32: each takes 16 bytes in memory.
-                for c in &crossings[row_starts[x]..row_starts[x + 1]] {
-                    starts[c.ray() % ny + 1] += 1;
-                }
-                for y in 0..ny {
-                    starts[y + 1] += starts[y];
-                }
-            });
+        for x in 0..nx {
+            // A row's crossings number far below 2^32: each takes 16 bytes in memory.
+            let starts = &mut column_starts[x * (ny + 1)..(x + 1) * (ny + 1)];
+            for y in 0..ny {
+                starts[y + 1] = starts[y] + at[x * ny + y];
+                at[x * ny + y] = starts[y];
+            }
+            row_starts[x + 1] = row_starts[x] + starts[ny] as usize;
+        }
+        let unset = Crossing { key: 0, after: 0 };
+        let mut crossings = vec![unset; row_starts[nx]];
+        for batch in batches {
+            for c in batch {
+                let ray = c.ray();
+                crossings[row_starts[ray / ny] + at[ray] as usize] = c;
+                at[ray] += 1;
+            }
+        }
+        drop(at);
+        let mut rows = Vec::with_capacity(nx);
+        let mut rest = &mut crossings[..];
+        for x in 0..nx {
+            let (row, after) = rest.split_at_mut(row_starts[x + 1] - row_starts[x]);
+            rows.push(row);
+            rest = after;
+        }
+        rows.into_par_iter().enumerate().for_each(|(x, row)| {
+            let starts = &column_starts[x * (ny + 1)..(x + 1) * (ny + 1)];
+            for y in 0..ny {
+                row[starts[y] as usize..starts[y + 1] as usize]
+                    .sort_unstable_by_key(|c| (c.after, c.key));
+            }
+        });
         ColumnCrossings {
             window,
             crossings,
