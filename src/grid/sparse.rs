@@ -239,15 +239,11 @@ impl SparseGrid {
 
     /// Bounding box of the active voxels, `None` for an empty grid.
     pub fn bbox(&self) -> Option<CoordBox> {
-        let mut b: Option<CoordBox> = None;
-        let leaf_boxes = self
-            .leaves
+        self.leaves
             .iter()
-            .filter_map(|leaf| mask_box(leaf.origin, &leaf.mask));
-        for part in leaf_boxes.chain(self.tiles.boxes()) {
-            b = Some(b.map_or(part, |b| b.union(&part)));
-        }
-        b
+            .filter_map(|leaf| mask_box(leaf.origin, &leaf.mask))
+            .chain(self.tiles.bbox())
+            .reduce(|a, b| a.union(&b))
     }
 
     /// Every active voxel (leaves first, then tiles).

@@ -180,6 +180,28 @@ impl Tiles {
         })
     }
 
+    /// The box of the tiles' voxels, `None` without tiles: a node's 8^3 tiles bounded by their
+    /// slots, not box by box.
+    pub fn bbox(&self) -> Option<CoordBox> {
+        let leaf_boxes = self.leaf_tiles_by_node().map(|(node, slots)| {
+            let (mut lo, mut hi) = ([usize::MAX; 3], [0; 3]);
+            for s in slots {
+                let at = [s >> 8, (s >> 4) & 15, s & 15];
+                lo = std::array::from_fn(|a| lo[a].min(at[a]));
+                hi = std::array::from_fn(|a| hi[a].max(at[a]));
+            }
+            CoordBox {
+                min: std::array::from_fn(|a| node[a] + 8 * lo[a] as i64),
+                max: std::array::from_fn(|a| node[a] + 8 * hi[a] as i64 + 7),
+            }
+        });
+        let node_boxes = self.node_tiles().map(|o| CoordBox {
+            min: o,
+            max: o.map(|v| v + NODE_DIM - 1),
+        });
+        leaf_boxes.chain(node_boxes).reduce(|a, b| a.union(&b))
+    }
+
     /// Makes the 8^3 block at `origin` whole.
     pub fn insert_leaf(&mut self, origin: Coord) {
         let node = node_origin(origin);
@@ -304,7 +326,11 @@ mod tests {
         assert!(t.remove_leaf([-8, 0, 0]));
         assert!(!t.covers([-8, 0, 0]));
         assert_eq!((t.count(), t.bytes()), (3, tile_bytes(2, 0)));
+        let boxes = t.boxes().reduce(|a, b| a.union(&b));
+        assert_eq!(t.bbox(), boxes);
+        assert_eq!(t.bbox().unwrap().min, [-128, -8, 0]);
         t.insert_node([0, 0, 0]);
         assert_eq!((t.count(), t.voxel_count()), (2, 512 + 128 * 128 * 128));
+        assert_eq!(t.bbox().unwrap().max, [127, 127, 127]);
     }
 }

@@ -13,6 +13,7 @@
 
 use super::Mesh;
 use glam::DVec3;
+use rustc_hash::FxHashMap;
 use std::collections::HashMap;
 
 pub struct BoundaryCaps {
@@ -87,7 +88,9 @@ fn first_at_same_position(mesh: &Mesh) -> Option<Vec<u32>> {
 fn caps_over(mesh: &Mesh, first: Option<Vec<u32>>) -> BoundaryCaps {
     let id = |v: u32| first.as_ref().map_or(v, |f| f[v as usize]);
     // Each undirected edge's uses from its lower to its upper vertex, less the reverse uses.
-    let mut net: HashMap<(u32, u32), i32> = HashMap::new();
+    // A triangle has three edges and a closed mesh's edges are used twice each.
+    let mut net: FxHashMap<(u32, u32), i32> = FxHashMap::default();
+    net.reserve(3 * mesh.triangle_count() / 2);
     for (_, t) in mesh.triangles() {
         let t = t.map(id);
         for k in 0..3 {
