@@ -1,7 +1,7 @@
 //! Constant active regions of a sparse grid, held as origins without per-voxel storage:
 //! whole 8^3 blocks (OpenVDB's tiles in a level-1 internal node) and whole 128^3 blocks
-//! (tiles in a level-2 node). A solid's inside is mostly such blocks, so it costs a few
-//! hash entries instead of hundreds of thousands of leaves.
+//! (tiles in a level-2 node). A solid's inside is mostly such blocks, so it costs a bit per
+//! block under its 128^3 node instead of hundreds of thousands of leaves.
 
 use super::bits;
 use super::coord::{Coord, CoordBox};
