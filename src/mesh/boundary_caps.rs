@@ -12,8 +12,8 @@
 //! them must resolve. Where welding would make orientations disagree, the vertices stay apart.
 
 use super::Mesh;
+use super::key_groups::group_by_key;
 use glam::DVec3;
-use rustc_hash::FxHashMap;
 use std::collections::HashMap;
 
 pub struct BoundaryCaps {
@@ -87,32 +87,39 @@ fn first_at_same_position(mesh: &Mesh) -> Option<Vec<u32>> {
 /// The caps of `mesh`'s triangles with each vertex taken as `first` names it.
 fn caps_over(mesh: &Mesh, first: Option<Vec<u32>>) -> BoundaryCaps {
     let id = |v: u32| first.as_ref().map_or(v, |f| f[v as usize]);
-    // Each undirected edge's uses from its lower to its upper vertex, less the reverse uses.
-    // A triangle has three edges and a closed mesh's edges are used twice each.
-    let mut net: FxHashMap<(u32, u32), i32> = FxHashMap::default();
-    net.reserve(3 * mesh.triangle_count() / 2);
-    for (_, t) in mesh.triangles() {
-        let t = t.map(id);
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            if a != b {
-                *net.entry((a.min(b), a.max(b))).or_default() += if a < b { 1 } else { -1 };
+    // Each undirected edge's uses from its lower to its upper vertex, less the reverse uses:
+    // the uses grouped by lower vertex (a counting sort), each group sorted by upper vertex.
+    let (start, mut uses) = group_by_key(mesh.positions.len(), |visit| {
+        for (_, t) in mesh.triangles() {
+            let t = t.map(id);
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if a != b {
+                    visit(a.min(b), (a.max(b), if a < b { 1 } else { -1 }));
+                }
             }
         }
-    }
+    });
     let mut inconsistent_edges = 0;
     let mut out: HashMap<u32, Vec<u32>> = HashMap::new();
-    let mut rims: Vec<(u32, u32)> = net
-        .into_iter()
-        .filter(|&(_, n)| n != 0)
-        .map(|((lo, hi), n)| (if n > 0 { (lo, hi) } else { (hi, lo) }, n.unsigned_abs()))
-        .flat_map(|(edge, uses)| {
-            if uses > 1 {
-                inconsistent_edges += 1;
+    let mut rims: Vec<(u32, u32)> = Vec::new();
+    for lo in 0..mesh.positions.len() {
+        let group = &mut uses[start[lo]..start[lo + 1]];
+        group.sort_unstable_by_key(|u| u.0);
+        for edge in group.chunk_by(|x, y| x.0 == y.0) {
+            let (hi, n) = (edge[0].0, edge.iter().map(|u| u.1).sum::<i32>());
+            if n == 0 {
+                continue;
             }
-            std::iter::repeat_n(edge, uses as usize)
-        })
-        .collect();
+            inconsistent_edges += u64::from(n.unsigned_abs() > 1);
+            let directed = if n > 0 {
+                (lo as u32, hi)
+            } else {
+                (hi, lo as u32)
+            };
+            rims.extend(std::iter::repeat_n(directed, n.unsigned_abs() as usize));
+        }
+    }
     // Sorted, so that the same mesh gets the same loops and caps on every run.
     rims.sort_unstable();
     for &(a, b) in &rims {
