@@ -98,11 +98,12 @@ pub fn flooded_mesh(
         let region = index_box(&mesh.bbox(), &t);
         let columns = block_columns(region).len() as u64;
         progress.stage("surface and inside", work_items(mesh) + columns);
+        // The inside's grids are made on its side, while the surface may still be running.
         let (surface, centres) = rayon::join(
             || flood_surface(mesh, t, progress),
-            || winding_inside(mesh, caps, t, region, progress),
+            || Ok(winding_inside(mesh, caps, t, region, progress)?.into_grids(t)),
         );
-        let (centres, ambiguous) = centres?.into_grids(t);
+        let (centres, ambiguous) = centres?;
         return Ok(SurfaceAndInside {
             ambiguous: Some(ambiguous),
             ..SurfaceAndInside::with_inside(surface?, centres)
