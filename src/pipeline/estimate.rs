@@ -134,18 +134,18 @@ const BLOCK_FLOOD_COST: FillCost = FillCost {
     triangle_bytes: FILLED_TRIANGLE_BYTES,
 };
 /// A solid whose inside the winding number decides (no flood): the surface's per-triangle
-/// tables, still held while the inside is found beside it (200 bytes a triangle), the list
+/// tables, still held while the inside is found beside it (210 bytes a triangle), the list
 /// of whole 8^3 blocks (24 bytes each: 0.375 bits per inside voxel), and the surface, the
-/// solid's boundary leaves and the grids written (840 bytes per surface leaf); the crossings
-/// come on top (`winding_plan`). Estimate/peak 0.84-1.19 on the nine meshes above at 1024
-/// and 2 threads.
+/// solid's boundary leaves and the grids written (710 bytes per surface leaf); the crossings
+/// and columns come on top (`winding_plan`). Estimate/peak 0.83-1.21 on the nine meshes above
+/// at 1024 and 2 threads.
 const WINDING_SOLID_COST: FillCost = FillCost {
     bit_volumes: 0.0,
     inside_volumes: 0.375,
     face_bytes: 0.0,
-    leaf_bytes: 840.0,
+    leaf_bytes: 710.0,
     block_bytes: 0.0,
-    triangle_bytes: 200.0,
+    triangle_bytes: 210.0,
 };
 /// The span flood and FloodingXYZ: two dense volumes (surface and reached) and what scales
 /// with them, the solid's tiles and the scanline queues, half a volume more; the surface's
@@ -173,8 +173,8 @@ const DEPTH_LAYERS_COST: FillCost = FillCost {
 };
 /// `measure` of a mesh: the block flood without writing, then components and genus counted
 /// over the solid, whose labels take about 1.5 bits per inside voxel and half a bit per
-/// voxel of the box. Estimate/peak 0.95-1.03 (bunny-closed, igea, fandisk, skull, armadillo
-/// at 1024).
+/// voxel of the box, besides the winding number's crossings and columns. Estimate/peak
+/// 0.96-1.07 (bunny-closed, igea, fandisk, skull, armadillo at 1024).
 const MEASURE_COST: FillCost = FillCost {
     bit_volumes: 0.6,
     inside_volumes: 1.5,
@@ -420,7 +420,7 @@ fn brick_bytes(brick: &BrickTask, t: &Transform) -> f64 {
                 .map(|(_, tri)| tri.map(|v| mesh.p(v)))
                 .filter(over);
             mesh.triangle_count() as f64 * BAND_TRIANGLE_BYTES
-                + crossings_in_voxels(near, t) * WINDING_CROSSING_BYTES
+                + winding_bytes(crossings_in_voxels(near, t), edge * edge)
                 + leaves()
         }
     };
@@ -826,19 +826,26 @@ fn solid_plan(mesh: &Mesh, fit: GridFit, fill: Fill) -> Result<Plan> {
 }
 
 /// The winding number's inside gathers every crossing of a column's ray with the mesh and its
-/// caps (16 bytes each, gathered in batches sized for them, then copied into one sorted
-/// array): 32 bytes a crossing at the peak beside the surface and the solid's grids.
-/// Estimate/peak 0.83-1.23 on bunny-closed, igea, armadillo, skull, horse, spot, scorpion,
-/// fandisk and rocker-arm at 1024, the same from run to run (batches that grew by doubling
-/// made fandisk's 1.19-1.31).
+/// caps (16 bytes each, gathered in batches sized for them, then placed column by column into
+/// one array): 32 bytes a crossing at the peak beside the surface and the solid's grids, and
+/// 8 bytes a column (where its crossings start, and where the next goes while they are
+/// placed). Estimate/peak 0.83-1.21 on bunny-closed, igea, armadillo, skull, horse, spot,
+/// scorpion, fandisk and rocker-arm at 1024 (`WINDING_SOLID_COST`).
 const WINDING_CROSSING_BYTES: f64 = 32.0;
+const WINDING_COLUMN_BYTES: f64 = 8.0;
+
+/// The winding number's crossings and columns (`WINDING_CROSSING_BYTES`).
+fn winding_bytes(crossings: f64, columns: f64) -> f64 {
+    crossings * WINDING_CROSSING_BYTES + columns * WINDING_COLUMN_BYTES
+}
 
 /// A solid or a measure at `cost` (its grids, no flood) whose inside the winding number
-/// decides: the crossings added.
+/// decides: the crossings and columns added.
 fn winding_plan(mesh: &Mesh, fit: GridFit, cost: &FillCost) -> Result<Plan> {
     let mut plan = fill_plan(mesh, fit, cost, |m, _| separating::work_items(m))?;
     let triangles = mesh.triangles().map(|(_, t)| t.map(|v| mesh.p(v)));
-    let bytes = crossings_in_voxels(triangles, &plan.transform) * WINDING_CROSSING_BYTES;
+    let [x, y, _] = box_edges(&crate::mesh::index_box(&mesh.bbox(), &plan.transform));
+    let bytes = winding_bytes(crossings_in_voxels(triangles, &plan.transform), x * y);
     plan.estimated_bytes = plan.estimated_bytes.saturating_add(bytes as u64);
     Ok(plan)
 }
