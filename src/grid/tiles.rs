@@ -98,8 +98,8 @@ pub struct Tiles {
 /// Bytes the tiles of a grid take at the peak: a node's 8^3 blocks (their bits and the map's
 /// entry, at the map's load after growing) and a node tile's set entry, each with its copy
 /// while a grid is read or combined.
-pub const NODE_BLOCKS_BYTES: u64 = 1280;
-pub const NODE_TILE_BYTES: u64 = 64;
+const NODE_BLOCKS_BYTES: u64 = 1280;
+const NODE_TILE_BYTES: u64 = 64;
 
 impl Tiles {
     /// The tiles, 8^3 and 128^3.
