@@ -117,13 +117,17 @@ pub(super) fn write_grids(
         };
         file_out.push(file_header(grids.len()));
         let mut patches = Vec::new();
-        // Each grid's head (its topology: serial in good part) is built while the grid
-        // before it encodes its leaf buffers.
-        let mut following = grids
-            .first()
-            .map(|g| clocks.encode.time(|| grid_head(path, g, encoding)));
+        // The grids' heads (their topologies: serial in good part each) are built side by
+        // side before any leaf buffer.
+        let mut heads = clocks.encode.time(|| {
+            grids
+                .par_iter()
+                .map(|g| grid_head(path, g, encoding))
+                .collect::<Vec<_>>()
+                .into_iter()
+        });
         let encoded = grids.iter().enumerate().try_for_each(|(n, g)| {
-            let head = following.take().expect("each grid's head is built")?;
+            let head = heads.next().expect("a head for each grid")?;
             let mut descriptor = descriptor_names(g, head.half);
             let grid_pos = file_out.pos + descriptor.len() as u64 + 24;
             let block_pos = grid_pos + head.head.len() as u64;
@@ -135,23 +139,16 @@ pub(super) fn write_grids(
             let first = file_out.next;
             file_out.next += head.leaves.len().div_ceil(BATCH);
             let send = &file_out.send;
-            let (size, next) = clocks.encode.time(|| {
-                rayon::join(
-                    || {
-                        let leaves = &head.leaves;
-                        stream_leaf_buffers(
-                            leaves,
-                            g.values,
-                            head.compression,
-                            head.half,
-                            &spent,
-                            |k, b| send.send((first + k, Piece::Bytes(b))).is_ok(),
-                        )
-                    },
-                    || grids.get(n + 1).map(|g| grid_head(path, g, encoding)),
+            let size = clocks.encode.time(|| {
+                stream_leaf_buffers(
+                    &head.leaves,
+                    g.values,
+                    head.compression,
+                    head.half,
+                    &spent,
+                    |k, b| send.send((first + k, Piece::Bytes(b))).is_ok(),
                 )
             });
-            following = next;
             file_out.pos += size;
             patches.push((grid_pos - 8, file_out.pos));
             // A large grid followed by others starts reaching the disk while they are
