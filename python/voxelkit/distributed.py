@@ -6,10 +6,9 @@
     python -m voxelkit.distributed merge OUT.bricks/index.json -o OUT.vdb
 
 The grid is placed as a single run would place it and cut into cubic bricks of ``--brick``
-voxels; without it, of the largest of 2048 (for a surface; a solid's bricks, which hold masks
-over all their voxels, 1024), 1024, 512, 256 and 128 that gives every worker thread at least 8
-bricks with faces (bricks differ in cost: a few each keep every thread busy to the end, and
-larger bricks cost less to merge). The client reads the mesh once and bins its faces: each
+voxels, or without it of the size chosen for the cluster's worker threads (``--brick``'s help
+says how; a few bricks each keep every thread busy to the end, and larger bricks cost less to
+merge). The client reads the mesh once and bins its faces: each
 brick receives only the faces whose box, grown by one voxel, reaches it (the separating
 criterion is local, so this halo is all a brick needs), voxelizes them and writes its part as
 a ``.vdb``.

@@ -111,13 +111,7 @@ impl SparseGrid {
     /// Makes the 8^3 blocks at `origins` whole, as `fill_leaf_block` does one by one, and
     /// each 128^3 node whole in 8^3 tiles a node tile.
     pub fn fill_leaf_blocks(&mut self, origins: Vec<Coord>) {
-        for origin in origins {
-            if self.index.is_empty() || !self.index.contains_key(&origin) {
-                self.tiles.insert_leaf(origin);
-            } else {
-                self.fill_leaf_block(origin);
-            }
-        }
+        origins.into_iter().for_each(|o| self.fill_leaf_block(o));
         self.tiles.promote();
     }
 

@@ -49,28 +49,24 @@ fn push_leaf_values(out: &mut Vec<u8>, leaf: &Leaf, values: GridValues, half: bo
         ValueType::Vec3 => 3,
         _ => 1,
     };
-    // Gathered into one array and converted in one pass: a push per value costs more than
-    // the value.
-    let mut gathered = [0f32; 3 * LEAF_VOXELS];
-    let mut count = 0;
-    values.for_each_active(leaf, |v| {
-        gathered[count] = v;
-        count += 1;
-    });
-    debug_assert_eq!(count, components * leaf.count() as usize);
-    let gathered = &gathered[..count];
+    // Written in place into room made once: a push per value costs more than the value.
+    let width = if half { 2 } else { 4 };
     let start = out.len();
+    out.resize(start + width * components * leaf.count() as usize, 0);
+    let room = &mut out[start..];
+    let mut at = 0;
     if half {
-        out.resize(start + 2 * count, 0);
-        for (slot, v) in out[start..].chunks_exact_mut(2).zip(gathered) {
-            slot.copy_from_slice(&half::f16::from_f32(*v).to_le_bytes());
-        }
+        values.for_each_active(leaf, |v| {
+            room[at..at + 2].copy_from_slice(&half::f16::from_f32(v).to_le_bytes());
+            at += 2;
+        });
     } else {
-        out.resize(start + 4 * count, 0);
-        for (slot, v) in out[start..].chunks_exact_mut(4).zip(gathered) {
-            slot.copy_from_slice(&v.to_le_bytes());
-        }
+        values.for_each_active(leaf, |v| {
+            room[at..at + 4].copy_from_slice(&v.to_le_bytes());
+            at += 4;
+        });
     }
+    debug_assert_eq!(at, room.len(), "a value for every active voxel");
 }
 
 /// `v` as stored: little-endian f32, or f16 when `half`.

@@ -137,8 +137,8 @@ const BLOCK_FLOOD_COST: FillCost = FillCost {
 /// tables, still held while the inside is found beside it (210 bytes a triangle), the list
 /// of whole 8^3 blocks (24 bytes each: 0.375 bits per inside voxel), and the surface, the
 /// solid's boundary leaves and the grids written (710 bytes per surface leaf); the crossings
-/// and columns come on top (`winding_plan`). Estimate/peak 0.83-1.21 on the nine meshes above
-/// at 1024 and 2 threads.
+/// and columns come on top (`winding_plan`). Estimate/peak 0.83-1.09 on the nine meshes above
+/// at 1024 and 2 threads (two runs each).
 const WINDING_SOLID_COST: FillCost = FillCost {
     bit_volumes: 0.0,
     inside_volumes: 0.375,
@@ -829,8 +829,7 @@ fn solid_plan(mesh: &Mesh, fit: GridFit, fill: Fill) -> Result<Plan> {
 /// caps (16 bytes each, gathered in batches sized for them, then placed column by column into
 /// one array): 32 bytes a crossing at the peak beside the surface and the solid's grids, and
 /// 8 bytes a column (where its crossings start, and where the next goes while they are
-/// placed). Estimate/peak 0.83-1.21 on bunny-closed, igea, armadillo, skull, horse, spot,
-/// scorpion, fandisk and rocker-arm at 1024 (`WINDING_SOLID_COST`).
+/// placed). Estimate/peak of the solids: see `WINDING_SOLID_COST`.
 const WINDING_CROSSING_BYTES: f64 = 32.0;
 const WINDING_COLUMN_BYTES: f64 = 8.0;
 
