@@ -3,6 +3,7 @@
 //! leaves cross the bridge as plain arrays.
 
 use super::bits;
+use super::channel_pool::ChannelBox;
 use super::coord::{Coord, CoordBox, LEAF_VOXELS, offset_coord};
 
 /// Which optional per-voxel channels a grid carries.
@@ -33,9 +34,9 @@ pub struct Leaf {
     /// Index of the leaf's (0,0,0) voxel; every component a multiple of 8.
     pub origin: Coord,
     pub mask: [u64; 8],
-    pub value: Option<Box<[f32; LEAF_VOXELS]>>,
-    pub normal: Option<Box<[[f32; 3]; LEAF_VOXELS]>>,
-    pub color: Option<Box<[[f32; 3]; LEAF_VOXELS]>>,
+    pub value: Option<ChannelBox<[f32; LEAF_VOXELS]>>,
+    pub normal: Option<ChannelBox<[[f32; 3]; LEAF_VOXELS]>>,
+    pub color: Option<ChannelBox<[[f32; 3]; LEAF_VOXELS]>>,
 }
 
 impl Leaf {
@@ -44,9 +45,9 @@ impl Leaf {
         Leaf {
             origin,
             mask: [0; 8],
-            value: channels.value.then(|| Box::new([0.0; LEAF_VOXELS])),
-            normal: channels.normal.then(|| Box::new([[0.0; 3]; LEAF_VOXELS])),
-            color: channels.color.then(|| Box::new([[0.0; 3]; LEAF_VOXELS])),
+            value: channels.value.then(ChannelBox::zeroed),
+            normal: channels.normal.then(ChannelBox::zeroed),
+            color: channels.color.then(ChannelBox::zeroed),
         }
     }
 

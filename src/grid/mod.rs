@@ -4,6 +4,7 @@
 
 pub mod attribute_grid;
 pub(crate) mod bits;
+mod channel_pool;
 mod coord;
 mod leaf;
 mod sparse;
@@ -11,6 +12,7 @@ mod tiles;
 mod transform;
 mod up_axis;
 
+pub use channel_pool::ChannelBox;
 pub use coord::{Coord, CoordBox, LEAF_VOXELS, leaf_offset, leaf_origin, offset_coord};
 pub use leaf::{Channels, Leaf, mask_box};
 pub use sparse::{Accessor, Block, SparseGrid};
