@@ -341,6 +341,9 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
         origin, h = plan.origin, plan.voxel_size
         bricks = plan.winding_bricks if solid and plan.winding else plan.bricks
         arrays = {b: plan.faces_of(b) for b in bricks}
+        # Submitted most faces first, so that the bricks left running when the others are done
+        # are short ones, not the one worker's whole last brick.
+        bricks = sorted(bricks, key=lambda b: len(arrays[b][1]), reverse=True)
         files = {b: _brick_file(b) for b in bricks}
         path = {b: os.path.abspath(os.path.join(folder, files[b])) for b in bricks}
         full_bricks = []
@@ -358,7 +361,7 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
         elif solid:
             faces = _run(
                 client,
-                {b: (_brick_faces, (arrays[b], origin, h, b, size, max_memory_mib)) for b in plan.bricks},
+                {b: (_brick_faces, (arrays[b], origin, h, b, size, max_memory_mib)) for b in bricks},
                 "outside labels",
                 show,
                 check,
@@ -368,13 +371,13 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
             full_bricks = [b for b, labels in exterior.items() if b not in arrays and 1 not in labels]
             calls = {
                 b: (_solid_brick, (arrays[b], origin, h, b, size, exterior[b], path[b], max_memory_mib))
-                for b in plan.bricks
+                for b in bricks
             }
             counts = _run(client, calls, "solid", show, check, walk)
         else:
             calls = {
                 b: (_surface_brick, (arrays[b], origin, h, b, size, path[b], separability, max_memory_mib))
-                for b in plan.bricks
+                for b in bricks
             }
             counts = _run(client, calls, "surface", show, check, walk)
         peaks = list(client.run(_peak_rss_mib).values())
