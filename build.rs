@@ -1,5 +1,5 @@
 //! Builds the C++ side of the OpenSubdiv bridge (feature `osd`) and checks for the C
-//! libraries the `.vdb` writer and reader call (feature `vdb`: blosc and zlib). When a library
+//! libraries the `.vdb` writer and reader call (feature `vdb`: blosc, LZ4 and zlib). When a library
 //! is missing the build stops with one line naming the Debian packages to install. OpenVDB
 //! itself is not linked: its own tools, for tests and benchmarks, live in `openvdb/`.
 
@@ -15,8 +15,8 @@ fn main() {
     if vdb {
         require(
             &[],
-            &["blosc", "z"],
-            "blosc or zlib is missing: install them with `apt-get install libblosc-dev zlib1g-dev`, or build with --no-default-features",
+            &["blosc", "lz4", "z"],
+            "blosc, LZ4 or zlib is missing: install them with `apt-get install libblosc-dev liblz4-dev zlib1g-dev`, or build with --no-default-features",
         );
     }
     if osd {

@@ -15,7 +15,7 @@ mkdir -p "$prefix/include/voxelkit"
 install -m 644 include/voxelkit.h "$prefix/include/"
 install -m 644 include/voxelkit/openvdb.hpp "$prefix/include/voxelkit/"
 # What the static library needs besides itself (rustc --print native-static-libs).
-private="-lblosc -lz -losdCPU -lstdc++ -lgcc_s -lutil -lrt -lpthread -lm -ldl"
+private="-lblosc -llz4 -lz -losdCPU -lstdc++ -lgcc_s -lutil -lrt -lpthread -lm -ldl"
 install -m 644 "$target/libvoxelkit.a" "$prefix/lib/"
 strip --strip-debug "$prefix/lib/libvoxelkit.a"
 # The shared library is linked here from the static one, so that it exports the C interface

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what voxelkit needs on Debian 12, saying what it does as it goes:
-# - Debian packages: a C/C++ tool chain and pkg-config; blosc and zlib (build.rs links them for
+# - Debian packages: a C/C++ tool chain and pkg-config; blosc, LZ4 and zlib (build.rs links them for
 #   .vdb files); OpenVDB, Boost headers, TBB and OpenSubdiv (the C++ side, the tests'
 #   independent reader and the benchmarks' reference); pyopenvdb; NanoVDB's headers and tools
 #   (the .nvdb files are checked by them); CMake and valgrind (the C and C++ interface
@@ -20,7 +20,7 @@ fail() { printf '\nsetup-debian.sh: %s\n' "$*" >&2; exit 1; }
 
 packages=(
     build-essential pkg-config cmake valgrind curl ca-certificates
-    libblosc-dev zlib1g-dev
+    libblosc-dev liblz4-dev zlib1g-dev
     libopenvdb-dev libboost-dev libtbb-dev libosd-dev python3-openvdb
     libnanovdb-dev libnanovdb-tools
     blender

@@ -2,6 +2,8 @@
 pub mod atomic;
 pub mod binvox;
 #[cfg(feature = "vdb")]
+mod blosc_chunk;
+#[cfg(feature = "vdb")]
 pub mod brick_set;
 #[cfg(feature = "vdb")]
 pub mod brick_splice;

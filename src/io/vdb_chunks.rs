@@ -3,36 +3,10 @@
 //! These are the layouts OpenVDB reads (`io/Compression.h`); `vdb_tree_structure` checks
 //! the same rules on the way in.
 
-use std::os::raw::{c_char, c_int, c_ulong, c_void};
+use std::os::raw::{c_int, c_ulong, c_void};
 
+use super::blosc_chunk::blosc_chunk;
 use super::vdb_format::{BLOSC_PAD_BYTES, COMPRESS_BLOSC, COMPRESS_ZIP};
-
-/// Blosc's chunk header, in bytes: the most compressing can add.
-const BLOSC_OVERHEAD: usize = 16;
-
-#[link(name = "blosc")]
-unsafe extern "C" {
-    fn blosc_compress_ctx(
-        clevel: c_int,
-        doshuffle: c_int,
-        typesize: usize,
-        nbytes: usize,
-        src: *const c_void,
-        dest: *mut c_void,
-        destsize: usize,
-        compressor: *const c_char,
-        blocksize: usize,
-        numinternalthreads: c_int,
-    ) -> c_int;
-    fn blosc_set_splitmode(splitmode: c_int);
-}
-
-/// Blosc's `BLOSC_NEVER_SPLIT`: compress each block in one stream, not one per byte of a
-/// value. Blosc's default splits a float leaf into four LZ4 streams, and LZ4 clears its
-/// 16 KB state for each: most of the time spent compressing a leaf. Readers (OpenVDB
-/// included) take either form, as the chunk's header says which.
-const BLOSC_NEVER_SPLIT: c_int = 2;
-static BLOSC_SPLIT_MODE: std::sync::Once = std::sync::Once::new();
 
 #[link(name = "z")]
 unsafe extern "C" {
@@ -54,10 +28,11 @@ pub(super) fn push_chunk(out: &mut Vec<u8>, data: &[u8], value_size: usize, comp
     }
     let at = out.len();
     if !data.is_empty() {
-        out.resize(at + 8 + data.len() + BLOSC_OVERHEAD, 0);
+        // Room for a chunk shorter than the data: a longer one is not kept.
+        out.resize(at + 8 + data.len(), 0);
         let room = &mut out[at + 8..];
         let written = if compression & COMPRESS_BLOSC != 0 {
-            blosc(data, value_size, room)
+            blosc_chunk(data, value_size, room)
         } else {
             zip(data, room)
         };
@@ -70,29 +45,6 @@ pub(super) fn push_chunk(out: &mut Vec<u8>, data: &[u8], value_size: usize, comp
     }
     out.extend_from_slice(&(-(data.len() as i64)).to_le_bytes());
     out.extend_from_slice(data);
-}
-
-/// Compresses `data` into `out` as a blosc chunk (LZ4 with byte shuffling by value,
-/// OpenVDB's settings); its length, or `None` when blosc cannot compress it into `out`.
-fn blosc(data: &[u8], value_size: usize, out: &mut [u8]) -> Option<usize> {
-    // SAFETY: sets a global blosc reads when compressing, once, before any compression.
-    BLOSC_SPLIT_MODE.call_once(|| unsafe { blosc_set_splitmode(BLOSC_NEVER_SPLIT) });
-    // SAFETY: both buffers are valid for the lengths given; blosc writes at most `destsize`.
-    let written = unsafe {
-        blosc_compress_ctx(
-            9,
-            1,
-            value_size,
-            data.len(),
-            data.as_ptr().cast(),
-            out.as_mut_ptr().cast(),
-            out.len(),
-            c"lz4".as_ptr(),
-            data.len(),
-            1,
-        )
-    };
-    (written > 0).then_some(written as usize)
 }
 
 /// Compresses `data` into `out` as a zlib stream at zlib's default level; its length, or
