@@ -55,17 +55,20 @@ struct Compressor {
 }
 
 impl Compressor {
-    fn new() -> Compressor {
+    /// A new stream, warmed up; none where LZ4 cannot allocate one.
+    fn new() -> Option<Compressor> {
         // SAFETY: a new stream, freed on drop.
         let stream = unsafe { LZ4_createStream() };
-        assert!(!stream.is_null(), "LZ4 could not allocate a stream");
+        if stream.is_null() {
+            return None;
+        }
         let mut c = Compressor {
             stream,
             shuffled: Vec::new(),
         };
         let mut out = [0u8; MIN_BUFFER];
         c.lz4(&[0; MIN_BUFFER], &mut out);
-        c
+        Some(c)
     }
 
     /// `data` as one LZ4 block into `out`; its length, 0 when it does not fit.
@@ -100,7 +103,8 @@ thread_local! {
 
 /// `data` (values of `value_size` bytes) as a blosc chunk into `out`, when the chunk is shorter
 /// than `data`: its length. `None` where blosc would not compress it either (short buffers,
-/// or bytes that LZ4 does not shrink enough to pay for the framing).
+/// or bytes that LZ4 does not shrink enough to pay for the framing), or where LZ4 has no
+/// memory for a stream: the caller stores the bytes raw.
 pub(super) fn blosc_chunk(data: &[u8], value_size: usize, out: &mut [u8]) -> Option<usize> {
     if data.len() < MIN_BUFFER || data.len() > i32::MAX as usize || value_size > 255 {
         return None;
@@ -108,7 +112,10 @@ pub(super) fn blosc_chunk(data: &[u8], value_size: usize, out: &mut [u8]) -> Opt
     // LZ4's room: what keeps the whole chunk shorter than the data.
     let room = out.len().min(data.len() - 1).checked_sub(FRAMING)?;
     COMPRESSOR.with_borrow_mut(|c| {
-        let c = c.get_or_insert_with(Compressor::new);
+        if c.is_none() {
+            *c = Compressor::new();
+        }
+        let c = c.as_mut()?;
         let mut shuffled = std::mem::take(&mut c.shuffled);
         shuffle(data, value_size, &mut shuffled);
         let packed = c.lz4(&shuffled, &mut out[FRAMING..FRAMING + room]);
