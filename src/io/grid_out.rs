@@ -117,6 +117,21 @@ impl GridValues<'_> {
         }
     }
 
+    /// Looks up what writing `leaf` reads from other grids, so that it is in the cache when
+    /// written (see `WARM_RUN`).
+    #[inline]
+    pub(super) fn warm(self, leaf: &Leaf) {
+        match self {
+            GridValues::LevelSet { interior, .. } => {
+                std::hint::black_box(interior.block_mask(leaf.origin));
+            }
+            GridValues::Fog { band, .. } => {
+                std::hint::black_box(band.leaf(leaf.origin).map(|b| b.mask[0]));
+            }
+            _ => {}
+        }
+    }
+
     /// The inside voxels of a level set's leaf at `origin` (the others are outside).
     pub(super) fn inside(self, origin: [i64; 3]) -> [u64; 8] {
         match self {

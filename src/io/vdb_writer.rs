@@ -25,6 +25,10 @@ use std::sync::OnceLock;
 
 /// Leaves per parallel batch of leaf buffers.
 const BATCH: usize = 2048;
+/// Leaves whose lookups in other grids (a level set's inside, a fog's band) are made one after
+/// another before their buffers: the lookups' memory misses then overlap, where each alone
+/// would wait for its own between two leaves' compression.
+const WARM_RUN: usize = 64;
 
 /// The standard tree's type name of a grid.
 pub(super) fn tree_type_of(values: GridValues) -> String {
@@ -452,16 +456,19 @@ fn stream_leaf_buffers(
         }
         let mut out = spent.take(batches[k].len() * 200);
         let mut scratch = Vec::new();
-        for leaf in batches[k] {
-            leaf_buffer(
-                &mut out,
-                &mut scratch,
-                leaf,
-                values,
-                &constant_chunks,
-                compression,
-                half,
-            );
+        for run in batches[k].chunks(WARM_RUN) {
+            run.iter().for_each(|leaf| values.warm(leaf));
+            for leaf in run {
+                leaf_buffer(
+                    &mut out,
+                    &mut scratch,
+                    leaf,
+                    values,
+                    &constant_chunks,
+                    compression,
+                    half,
+                );
+            }
         }
         size.fetch_add(out.len() as u64, Relaxed);
         if !deliver(k, out) {
