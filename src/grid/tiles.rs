@@ -76,9 +76,15 @@ fn block_slot(leaf_origin: Coord) -> usize {
     (at[0] << 8) | (at[1] << 4) | at[2]
 }
 
+/// Where block `slot` sits in its node, in blocks along x, y and z.
+#[inline]
+fn slot_position(slot: usize) -> [usize; 3] {
+    [slot >> 8, (slot >> 4) & 15, slot & 15]
+}
+
 /// The origin of block `slot` of the node at `node`.
 fn slot_origin(node: Coord, slot: usize) -> Coord {
-    let at = [slot >> 8, (slot >> 4) & 15, slot & 15];
+    let at = slot_position(slot);
     std::array::from_fn(|a| node[a] + 8 * at[a] as i64)
 }
 
@@ -186,7 +192,7 @@ impl Tiles {
         let leaf_boxes = self.leaf_tiles_by_node().map(|(node, slots)| {
             let (mut lo, mut hi) = ([usize::MAX; 3], [0; 3]);
             for s in slots {
-                let at = [s >> 8, (s >> 4) & 15, s & 15];
+                let at = slot_position(s);
                 lo = std::array::from_fn(|a| lo[a].min(at[a]));
                 hi = std::array::from_fn(|a| hi[a].max(at[a]));
             }

@@ -2,7 +2,8 @@
 //! (LZ4, byte shuffle by value, one block) writes, without its per-call costs.
 //!
 //! Blosc builds a context and allocates its buffers for every chunk, and LZ4 clears its 16 KB
-//! table before each: for a 2 KB leaf that is a third of the time spent compressing it. Here
+//! table before each: for a leaf of 300 floats that is a third of the time spent compressing
+//! it (742 ns through blosc, 491 ns here, in a C program). Here
 //! each thread keeps one LZ4 stream, reset in LZ4's fast way between chunks. The chunks are
 //! blosc's (format 2, LZ4 format 1: a 16-byte header, the block's start, the block as one LZ4
 //! stream after its length), so blosc, OpenVDB among its readers, decompresses them.
@@ -24,6 +25,8 @@ const MIN_BUFFER: usize = 128;
 /// `BLOSC_VERSION_FORMAT` and `BLOSC_LZ4_VERSION_FORMAT`.
 const BLOSC_FORMAT: u8 = 2;
 const LZ4_FORMAT: u8 = 1;
+/// LZ4's acceleration at blosc's level 9, OpenVDB's (blosc passes 10 - level).
+const LZ4_ACCELERATION: c_int = 1;
 /// Header flags: byte shuffle (`BLOSC_DOSHUFFLE`), one stream per block
 /// (`BLOSC_DONT_SPLIT`), and LZ4's compressor code (1) in the top three bits.
 const FLAGS: u8 = 0x01 | 0x10 | (1 << 5);
@@ -83,7 +86,7 @@ impl Compressor {
                 out.as_mut_ptr().cast(),
                 data.len() as c_int,
                 out.len() as c_int,
-                1,
+                LZ4_ACCELERATION,
             )
         };
         n.max(0) as usize
@@ -145,19 +148,23 @@ fn shuffle(data: &[u8], value_size: usize, out: &mut Vec<u8>) {
     match value_size {
         4 => shuffle_floats(&data[..whole], &mut out[..whole]),
         2 => shuffle_halves(&data[..whole], &mut out[..whole]),
-        _ => {
-            for (i, value) in data[..whole].chunks_exact(value_size).enumerate() {
-                for (j, &b) in value.iter().enumerate() {
-                    out[j * values + i] = b;
-                }
-            }
-        }
+        _ => shuffle_values(&data[..whole], value_size, &mut out[..whole], 0),
     }
     out[whole..].copy_from_slice(&data[whole..]);
 }
 
+/// `shuffle` of whole values from value `first` on, one value at a time.
+fn shuffle_values(data: &[u8], value_size: usize, out: &mut [u8], first: usize) {
+    let values = data.len() / value_size;
+    for (i, value) in data.chunks_exact(value_size).enumerate().skip(first) {
+        for (j, &b) in value.iter().enumerate() {
+            out[j * values + i] = b;
+        }
+    }
+}
+
 /// `shuffle` for floats: sixteen at a time by SSE2 where there is SSE2 (every x86-64), the
-/// rest one pass over the values, each value's bytes stored to the four planes side by side.
+/// rest one at a time.
 fn shuffle_floats(data: &[u8], out: &mut [u8]) {
     let values = data.len() / 4;
     #[cfg(target_arch = "x86_64")]
@@ -173,11 +180,7 @@ fn shuffle_floats(data: &[u8], out: &mut [u8]) {
     };
     #[cfg(not(target_arch = "x86_64"))]
     let done = 0;
-    for (i, value) in data.chunks_exact(4).enumerate().skip(done) {
-        for (j, &b) in value.iter().enumerate() {
-            out[j * values + i] = b;
-        }
-    }
+    shuffle_values(data, 4, out, done);
 }
 
 /// Floats `16 * block..16 * block + 16` of `data` into the four planes of `out` (each `values`
@@ -211,7 +214,8 @@ unsafe fn shuffle_16_floats(data: &[u8], out: &mut [u8], values: usize, block: u
     }
 }
 
-/// `shuffle` for halves.
+/// `shuffle` for halves, one pass storing to both planes side by side (a `--sdf --half` level
+/// set's encode at 1 thread: 0.263 s through `shuffle_values`, 0.246 s here).
 fn shuffle_halves(data: &[u8], out: &mut [u8]) {
     let (p0, p1) = out.split_at_mut(data.len() / 2);
     for (value, (b0, b1)) in data.chunks_exact(2).zip(p0.iter_mut().zip(p1)) {
@@ -222,6 +226,7 @@ fn shuffle_halves(data: &[u8], out: &mut [u8]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::random::SplitMix64;
     use std::os::raw::c_void;
 
     #[link(name = "blosc")]
@@ -257,20 +262,14 @@ mod tests {
 
     /// Values like a leaf's: a level set's distances, a fog's ones, halves, normals' triples.
     fn samples() -> Vec<(Vec<u8>, usize)> {
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut random = SplitMix64(5);
         let mut samples = Vec::new();
         for count in [32, 100, 300, 512] {
             let distances: Vec<u8> = (0..count)
                 .flat_map(|i| ((i % 7) as f32 * 0.0015 - 0.0045).to_le_bytes())
                 .collect();
             let noise: Vec<u8> = (0..count)
-                .flat_map(|_| ((next() % 10_000) as f32 * 1e-6).to_le_bytes())
+                .flat_map(|_| ((random.next_u64() % 10_000) as f32 * 1e-6).to_le_bytes())
                 .collect();
             let ones: Vec<u8> = (0..count).flat_map(|_| 1.0f32.to_le_bytes()).collect();
             let halves: Vec<u8> = (0..count)
@@ -384,15 +383,8 @@ mod tests {
     #[test]
     fn short_or_incompressible_data_is_left_to_be_stored_raw() {
         assert_eq!(blosc_chunk(&[1u8; 64], 4, &mut [0; 256]), None);
-        let mut state = 0x9E37_79B9_7F4A_7C15u64;
-        let noise: Vec<u8> = (0..2048)
-            .map(|_| {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                state as u8
-            })
-            .collect();
+        let mut random = SplitMix64(9);
+        let noise: Vec<u8> = (0..2048).map(|_| random.next_u64() as u8).collect();
         assert_eq!(blosc_chunk(&noise, 4, &mut vec![0; 4096]), None);
     }
 }

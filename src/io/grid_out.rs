@@ -121,14 +121,9 @@ impl GridValues<'_> {
     /// written (see `WARM_RUN`).
     #[inline]
     pub(super) fn warm(self, leaf: &Leaf) {
-        match self {
-            GridValues::LevelSet { interior, .. } => {
-                std::hint::black_box(interior.block_mask(leaf.origin));
-            }
-            GridValues::Fog { band, .. } => {
-                std::hint::black_box(band.leaf(leaf.origin).map(|b| b.mask[0]));
-            }
-            _ => {}
+        std::hint::black_box(self.inside(leaf.origin));
+        if let GridValues::Fog { band, .. } = self {
+            std::hint::black_box(band.leaf(leaf.origin).map(|b| b.mask[0]));
         }
     }
 

@@ -914,8 +914,8 @@ fn world_box(grid: &SparseGrid) -> Aabb {
 /// grid's box, allocated whole (it counts against an address-space limit), plus what reading
 /// it left: OpenVDB's float leaves and their copied values (4.3 KB per leaf of a grid with
 /// values, 300 bytes of a bool grid). Estimate/peak 1.02-1.20 on solids' shells (bunny-closed,
-/// igea, skull, armadillo; armadillo's at 1024 1.36) and a surface at 512-1024 (was 5-14). A box past the dense volume's limit is refused here,
-/// with the input's name.
+/// igea, skull, armadillo; armadillo's at 1024 1.36) and a surface at 512-1024 (was 5-14). A
+/// box past the dense volume's limit is refused here, with the input's name.
 fn grid_plan(grid: &SparseGrid, what: &str) -> Result<Plan> {
     let box_cells = cells(&padded(grid_box(grid), 2));
     let read_bytes = if grid.channels().value {
