@@ -14,6 +14,12 @@ cd "$(dirname "$0")/.."
 # rustup's cargo, where scripts/setup-debian.sh installed it, before an older system one.
 export PATH="$HOME/.cargo/bin:$PATH"
 python="${PYTHON:-/usr/bin/python3}"
+# The tests build without the release profile's whole-program optimisation (Cargo.toml), which
+# would take minutes for each test program, and into their own folder, so that target/release
+# keeps the optimised build of the README's first command.
+export CARGO_TARGET_DIR="$PWD/target/tests" CARGO_PROFILE_RELEASE_LTO=false \
+    CARGO_PROFILE_RELEASE_CODEGEN_UNITS=16
+export VOXELKIT_CLI="$CARGO_TARGET_DIR/release/voxelkit"
 logs=target/test-logs
 mkdir -p "$logs"
 cargo test --release --no-fail-fast 2>&1 | tee "$logs/cargo.log"
