@@ -21,11 +21,11 @@
 use super::Progress;
 use super::brick_bins::voxelize_in_bricks;
 use super::separating_kernel::{
-    Adjacency, HalfSpace, MARGIN, MOST_HALVES, Primitive, PrimitiveClass, Primitives, SECTOR_SLACK,
-    Triangle, edge_cylinder, face_body, primitives, reach_box, sector_directions, vertex_sphere,
+    Adjacency, HalfSpace, MARGIN, MOST_HALVES, Primitive, PrimitiveClass, Primitives, Triangle,
+    edge_cylinder, face_body, primitives, vertex_sphere,
 };
 use crate::error::{Error, Result};
-use crate::grid::{Channels, CoordBox, SparseGrid, Transform};
+use crate::grid::{Channels, SparseGrid, Transform};
 use crate::mesh::Mesh;
 use glam::DVec3;
 
@@ -76,10 +76,7 @@ pub fn distance_band(
             (PrimitiveClass::Edge, e) => {
                 let edge = found.edge(e);
                 let halves = edge_halves(&edge, adjacency, triangles);
-                let sector = sector_box(&edge, halves.as_slice(), band + MARGIN);
-                if let Some(clip) = clip.intersection(&sector) {
-                    edge_cylinder(&edge, band, &every, halves.as_slice(), &clip, sink)
-                }
+                edge_cylinder(&edge, band, &every, halves.as_slice(), clip, sink)
             }
             (PrimitiveClass::Body, t) => face_body(&triangles[t], slab, clip, sink),
         },
@@ -155,31 +152,6 @@ fn edge_halves(e: &Primitive, adjacency: &Adjacency, triangles: &[Triangle]) -> 
         }
     }
     halves
-}
-
-/// A box holding every voxel centre that edge `e`'s cylinder of radius `r` marks within
-/// `halves`, planes through the edge (`edge_halves`). Across the edge they cut the disc of
-/// radius `r` to a sector: its box is the box of the apex and of the points of the circle
-/// that bound it, along each axis the farthest point of the circle and the ends of the
-/// arc (where a plane meets the circle), each kept where it lies in every half-space.
-fn sector_box(e: &Primitive, halves: &[HalfSpace], r: f64) -> CoordBox {
-    let dn = (e.b - e.a).normalize_or_zero();
-    let across = if dn == DVec3::ZERO {
-        [DVec3::X, DVec3::Y]
-    } else {
-        let e1 = dn.any_orthonormal_vector();
-        [e1, dn.cross(e1)]
-    };
-    // Each axis's farthest direction across the edge.
-    let toward_axes = [DVec3::X, DVec3::Y, DVec3::Z].map(|axis| {
-        (across[0] * axis.dot(across[0]) + across[1] * axis.dot(across[1])).normalize_or_zero()
-    });
-    let (mut lo, mut hi) = (DVec3::ZERO, DVec3::ZERO);
-    for u in sector_directions(dn, halves, toward_axes) {
-        lo = lo.min(u * r);
-        hi = hi.max(u * r);
-    }
-    reach_box(e.a.min(e.b) + lo, e.a.max(e.b) + hi, SECTOR_SLACK)
 }
 
 /// Where vertex `v` can be nearest: behind every edge and fan diagonal leaving it.

@@ -123,38 +123,32 @@ impl AxisCut {
     }
 
     /// `range`, the values of coordinate `axis` with the others as in `x`, narrowed to where
-    /// every half-space holds (widened by `ROW_SLACK`: a candidate range).
+    /// every half-space holds (widened by `ROW_SLACK`: a candidate range); empty where none
+    /// do. The bounds are gathered as floats and rounded once each way, without a branch on
+    /// their values (a short column's cut mispredicted most of them).
     #[inline]
     pub(super) fn range(
         &self,
         range: std::ops::RangeInclusive<i64>,
         mut x: DVec3,
     ) -> std::ops::RangeInclusive<i64> {
-        let (mut lo, mut hi) = (*range.start(), *range.end());
+        let (start, end) = (*range.start(), *range.end());
+        // Kept within a voxel of the range, so that rounding never leaves i64.
+        let (mut lo, mut hi) = (start as f64 - 1.0, end as f64 + 1.0);
+        let mut outside = false;
         x[self.axis] = 0.0;
         for &(base, slope, bounds) in &self.bounds[..self.len] {
             let bound = base + slope.dot(x);
             match bounds {
-                Bounds::Above => {
-                    let bound = bound + ROW_SLACK;
-                    if bound < hi as f64 {
-                        hi = floor_int(bound.max(lo as f64 - 1.0));
-                    }
-                }
-                Bounds::Below => {
-                    let bound = bound - ROW_SLACK;
-                    if bound > lo as f64 {
-                        lo = ceil_int(bound.min(hi as f64 + 1.0));
-                    }
-                }
-                Bounds::Column if bound < 0.0 => return int_range(0.0, -1.0),
-                Bounds::Column => {}
-            }
-            if lo > hi {
-                break;
+                Bounds::Above => hi = hi.min(bound + ROW_SLACK),
+                Bounds::Below => lo = lo.max(bound - ROW_SLACK),
+                Bounds::Column => outside |= bound < 0.0,
             }
         }
-        lo..=hi
+        if outside {
+            return int_range(0.0, -1.0);
+        }
+        ceil_int(lo).max(start)..=floor_int(hi).min(end)
     }
 }
 
@@ -572,13 +566,12 @@ pub(super) fn vertex_sphere<const C: usize>(
                 (*near.start()).max(*column.start()),
                 (*near.end()).min(*column.end()),
             );
-            for z in first..=last {
+            let near = |z: i64| {
                 let c = DVec3::new(x as f64, y as f64, z as f64);
                 let d2 = (c - p).length_squared();
-                if d2 <= r2 && keep(v, c) {
-                    sink.add([x, y, z], || d2.sqrt(), v.normal);
-                }
-            }
+                (d2 <= r2 && keep(v, c)).then_some(d2)
+            };
+            sink.add_column([x, y, 0], 2, first..=last, near, f64::sqrt, v.normal);
         }
     }
 }
@@ -705,14 +698,13 @@ pub(super) fn edge_cylinder<const C: usize>(
             let near = quadratic_range(a, inv_a, b, cc);
             let first = (*near.start()).max(*on_edge.start());
             let last = (*near.end()).min(*on_edge.end());
-            for iv in first..=last {
+            let near = |iv: i64| {
                 let mut x = row;
                 x[v] = iv as f64;
                 let (inside, d2) = test.at(x);
-                if inside && keep(e, x) {
-                    sink.add(to_coord(x), || d2.sqrt(), e.normal);
-                }
-            }
+                (inside && keep(e, x)).then_some(d2)
+            };
+            sink.add_column(to_coord(row), v, first..=last, near, f64::sqrt, e.normal);
         }
     }
 }
@@ -842,11 +834,7 @@ pub(super) fn face_body<const C: usize>(
                 // A cut column is exact to 1e-6 voxels, which moves a plane distance by less
                 // than 1e-12: the distance band needs no test per voxel.
                 let distance = plane_distance_along(n, a, column, w);
-                let mut c = to_coord(column);
-                for k in ks {
-                    c[w] = k;
-                    sink.add(c, || distance(k), tri.normal);
-                }
+                sink.add_column(to_coord(column), w, ks, Some, distance, tri.normal);
                 continue;
             }
             for k in slab {
