@@ -89,7 +89,7 @@ impl<const CLASSES: usize> BrickSink<'_, CLASSES> {
     }
 
     /// Marks the voxels of `column` (a voxel's place with coordinate `axis` taken from `ks`;
-    /// all inside the brick) that `near(k)` accepts, voxel `k` `distance(near(k))` voxels from
+    /// all inside the brick) that `kept(k)` accepts, voxel `k` `distance(kept(k))` voxels from
     /// the primitive whose normal is `normal`, as `add` would one by one. A voxel's place in the
     /// brick's channels is its bit's place in its class (`index`), and along an axis both step
     /// by one stride inside a leaf and by a leaf's stride less 7 from leaf to leaf: found once
@@ -100,7 +100,7 @@ impl<const CLASSES: usize> BrickSink<'_, CLASSES> {
         column: Coord,
         axis: usize,
         ks: std::ops::RangeInclusive<i64>,
-        near: impl Fn(i64) -> Option<T>,
+        kept: impl Fn(i64) -> Option<T>,
         distance: impl Fn(T) -> f64,
         normal: DVec3,
     ) {
@@ -116,7 +116,7 @@ impl<const CLASSES: usize> BrickSink<'_, CLASSES> {
         let mut in_leaf = (first - self.origin[axis]) & 7;
         let normal = normal.as_vec3().into();
         for k in first..=last {
-            if let Some(at) = near(k) {
+            if let Some(at) = kept(k) {
                 self.bits.put(self.class, i, || distance(at), normal);
             }
             in_leaf += 1;

@@ -123,8 +123,8 @@ impl AxisCut {
     }
 
     /// `range`, the values of coordinate `axis` with the others as in `x`, narrowed to where
-    /// every half-space holds (widened by `ROW_SLACK`: a candidate range); empty where none
-    /// do. The bounds are gathered as floats and rounded once each way, without a branch on
+    /// every half-space holds (widened by `ROW_SLACK`: a candidate range), empty where no value
+    /// does. The bounds are gathered as floats and rounded once each way, without a branch on
     /// their values (a short column's cut mispredicted most of them).
     #[inline]
     pub(super) fn range(
@@ -566,12 +566,12 @@ pub(super) fn vertex_sphere<const C: usize>(
                 (*near.start()).max(*column.start()),
                 (*near.end()).min(*column.end()),
             );
-            let near = |z: i64| {
+            let kept = |z: i64| {
                 let c = DVec3::new(x as f64, y as f64, z as f64);
                 let d2 = (c - p).length_squared();
                 (d2 <= r2 && keep(v, c)).then_some(d2)
             };
-            sink.add_column([x, y, 0], 2, first..=last, near, f64::sqrt, v.normal);
+            sink.add_column([x, y, 0], 2, first..=last, kept, f64::sqrt, v.normal);
         }
     }
 }
@@ -698,13 +698,13 @@ pub(super) fn edge_cylinder<const C: usize>(
             let near = quadratic_range(a, inv_a, b, cc);
             let first = (*near.start()).max(*on_edge.start());
             let last = (*near.end()).min(*on_edge.end());
-            let near = |iv: i64| {
+            let kept = |iv: i64| {
                 let mut x = row;
                 x[v] = iv as f64;
                 let (inside, d2) = test.at(x);
                 (inside && keep(e, x)).then_some(d2)
             };
-            sink.add_column(to_coord(row), v, first..=last, near, f64::sqrt, e.normal);
+            sink.add_column(to_coord(row), v, first..=last, kept, f64::sqrt, e.normal);
         }
     }
 }
