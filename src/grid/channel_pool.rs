@@ -4,9 +4,10 @@
 //! A 1024^3 level set's band holds 78,000 value arrays, 159 MB. Allocated one by one, each
 //! 4 KiB page of fresh memory costs a page fault when first written: 39,000 of them. A chunk
 //! of 32 arrays has its pages made present in one call instead (bunny-closed's level set at
-//! 1024, 1 thread: 0.74 -> 0.68 s). (Huge pages would need fewer faults still, but where memory is fragmented
-//! the kernel stalls compacting it for them.) A dropped array's slot is kept for the next
-//! array of its kind; once none is in use, every chunk but the first goes back to the heap.
+//! 1024, 1 thread: 0.74 -> 0.68 s). (Huge pages would need fewer faults still, but where
+//! memory is fragmented the kernel stalls compacting it for them.) A dropped array's slot is
+//! kept for the next array of its kind; once none is in use, every chunk but the first goes
+//! back to the heap.
 
 use std::ptr::NonNull;
 use std::sync::Mutex;

@@ -342,7 +342,7 @@ mod tests {
                 })
                 .collect()
         });
-        // One thread, every sample after the others, twice over in reverse order.
+        // One thread, every sample after the others: all in reverse order, then all in order.
         for (i, (data, value_size)) in samples
             .iter()
             .enumerate()

@@ -55,7 +55,7 @@ impl<const CLASSES: usize> BrickBits<CLASSES> {
     /// Sets voxel `i`'s bit in `class` (`BrickSink::index`) and, when the brick keeps
     /// distances and `distance()` is the nearest yet, keeps it and `normal`.
     #[inline]
-    fn put(&mut self, class: usize, i: usize, distance: impl FnOnce() -> f64, normal: [f32; 3]) {
+    fn put(&mut self, class: usize, i: usize, distance: impl FnOnce() -> f64, normal: DVec3) {
         self.classes[class][i >> 6] |= 1 << (i & 63);
         self.touched[i >> 15] |= 1 << ((i >> 9) & 63);
         if let Some(d) = self.distance.as_deref_mut() {
@@ -63,7 +63,7 @@ impl<const CLASSES: usize> BrickBits<CLASSES> {
             if near < d[i] {
                 d[i] = near;
                 if let Some(normals) = self.normal.as_deref_mut() {
-                    normals[i] = normal;
+                    normals[i] = normal.as_vec3().into();
                 }
             }
         }
@@ -84,8 +84,7 @@ impl<const CLASSES: usize> BrickSink<'_, CLASSES> {
     #[inline]
     pub fn add(&mut self, c: Coord, distance: impl FnOnce() -> f64, normal: DVec3) {
         let i = self.index(c);
-        self.bits
-            .put(self.class, i, distance, normal.as_vec3().into());
+        self.bits.put(self.class, i, distance, normal);
     }
 
     /// Marks the voxels of `column` (a voxel's place with coordinate `axis` taken from `ks`;
@@ -114,7 +113,6 @@ impl<const CLASSES: usize> BrickSink<'_, CLASSES> {
         let step = [64, 8, 1][axis];
         let leaf_step = [EDGE_LEAVES * EDGE_LEAVES, EDGE_LEAVES, 1][axis] * LEAF_VOXELS - 7 * step;
         let mut in_leaf = (first - self.origin[axis]) & 7;
-        let normal = normal.as_vec3().into();
         for k in first..=last {
             if let Some(at) = kept(k) {
                 self.bits.put(self.class, i, || distance(at), normal);
