@@ -111,7 +111,28 @@ impl SparseGrid {
     /// Makes the 8^3 blocks at `origins` whole, as `fill_leaf_block` does one by one, and
     /// each 128^3 node whole in 8^3 tiles a node tile.
     pub fn fill_leaf_blocks(&mut self, origins: Vec<Coord>) {
-        origins.into_iter().for_each(|o| self.fill_leaf_block(o));
+        // Blocks given in runs within one 128^3 node (a column's are) share the node's
+        // lookups: a solid's inside is hundreds of thousands of blocks.
+        let mut tiled = Vec::new();
+        for run in origins.chunk_by(|a, b| node_origin(*a) == node_origin(*b)) {
+            tiled.clear();
+            for &o in run {
+                match self.index.get(&o) {
+                    None => tiled.push(o),
+                    Some(_) if self.tiles.covers(o) => {}
+                    // Channels live in leaves: keep the leaf, whole.
+                    Some(&i) if self.channels != Channels::NONE => {
+                        self.leaves[i as usize].mask = FULL
+                    }
+                    Some(&i) => {
+                        self.leaves[i as usize].mask = [0; 8];
+                        tiled.push(o);
+                    }
+                }
+            }
+            self.tiles
+                .insert_leaves_of_node(node_origin(run[0]), tiled.iter().copied());
+        }
         self.tiles.promote();
     }
 

@@ -210,10 +210,18 @@ impl Tiles {
 
     /// Makes the 8^3 block at `origin` whole.
     pub fn insert_leaf(&mut self, origin: Coord) {
-        let node = node_origin(origin);
+        self.insert_leaves_of_node(node_origin(origin), [origin]);
+    }
+
+    /// Makes the 8^3 blocks at `origins`, all in the 128^3 node at `node`, whole, as
+    /// `insert_leaf` does one by one: the node is looked up once.
+    pub fn insert_leaves_of_node(&mut self, node: Coord, origins: impl IntoIterator<Item = Coord>) {
         if !self.nodes.contains(&node) {
             let blocks = self.leaves.entry(node).or_default();
-            self.leaf_count += usize::from(blocks.insert(block_slot(origin)));
+            for origin in origins {
+                debug_assert_eq!(node_origin(origin), node, "a block of the node");
+                self.leaf_count += usize::from(blocks.insert(block_slot(origin)));
+            }
         }
     }
 
