@@ -330,8 +330,126 @@ fn parse_piece(text: &str, before: Counts) -> Piece {
     piece
 }
 
-/// Parses one line into `piece`.
+/// Parses one line into `piece`: the common forms (`v x y z [r g b]`, and `f` with plain
+/// positive vertex numbers) from their bytes, every other line, and any of these that those
+/// do not take, word by word (`parse_words`), which also names what is wrong with a line.
 fn parse_line(
+    raw: &str,
+    line: usize,
+    before: Counts,
+    piece: &mut Piece,
+) -> std::result::Result<(), LineError> {
+    let taken = match raw.as_bytes() {
+        [b'v', b' ' | b'\t', ..] => plain_vertex(raw, line, piece),
+        [b'f', b' ' | b'\t', ..] => plain_face(raw, line, before, piece),
+        _ => false,
+    };
+    if taken {
+        return Ok(());
+    }
+    parse_words(raw, line, before, piece)
+}
+
+/// The words of `raw` after its statement: runs of bytes between spaces and tabs, when
+/// there are at most `N` and every byte is printable ASCII, a space or a tab (any other
+/// separator is left to `parse_words`' Unicode whitespace).
+fn plain_words<const N: usize>(raw: &str) -> Option<([&str; N], usize)> {
+    let mut words = [""; N];
+    let mut count = 0;
+    let mut start = None;
+    for (i, &b) in raw.as_bytes().iter().enumerate().skip(1) {
+        match b {
+            b' ' | b'\t' => {
+                if let Some(s) = start.take() {
+                    *words.get_mut(count)? = &raw[s..i];
+                    count += 1;
+                }
+            }
+            b'!'..=b'~' => {
+                start.get_or_insert(i);
+            }
+            _ => return None,
+        }
+    }
+    if let Some(s) = start {
+        *words.get_mut(count)? = &raw[s..];
+        count += 1;
+    }
+    Some((words, count))
+}
+
+/// A `v` line of three or six finite numbers into `piece`; whether it took the line.
+fn plain_vertex(raw: &str, line: usize, piece: &mut Piece) -> bool {
+    let Some((words, count)) = plain_words::<6>(raw) else {
+        return false;
+    };
+    if count != 3 && count != 6 {
+        return false;
+    }
+    let mut values = [0.0; 6];
+    for (value, word) in values.iter_mut().zip(&words[..count]) {
+        match word.parse::<f64>() {
+            Ok(x) if x.is_finite() => *value = x,
+            _ => return false,
+        }
+    }
+    let out = &mut piece.parsed;
+    out.positions
+        .push(DVec3::new(values[0], values[1], values[2]));
+    if count == 6 {
+        out.colors
+            .push(DVec3::new(values[3], values[4], values[5]).as_vec3());
+        piece.first_colored.get_or_insert(line);
+    } else {
+        piece.first_plain.get_or_insert(line);
+    }
+    true
+}
+
+/// Corners an `f` line may have for `plain_face`; longer faces are read word by word.
+const PLAIN_FACE_CORNERS: usize = 8;
+
+/// An `f` line of plain vertex numbers (1 to the vertices defined so far) into `piece`;
+/// whether it took the line.
+fn plain_face(raw: &str, line: usize, before: Counts, piece: &mut Piece) -> bool {
+    let Some((words, count)) = plain_words::<PLAIN_FACE_CORNERS>(raw) else {
+        return false;
+    };
+    let out = &mut piece.parsed;
+    let defined = (before.positions + out.positions.len()) as u64;
+    let mut corners = [0u32; PLAIN_FACE_CORNERS];
+    for (corner, word) in corners.iter_mut().zip(&words[..count]) {
+        // At most 10 digits: no overflow in u64.
+        if word.len() > 10 || !word.bytes().all(|b| b.is_ascii_digit()) {
+            return false;
+        }
+        let n = word.bytes().fold(0u64, |n, b| 10 * n + u64::from(b - b'0'));
+        if n == 0 || n > defined {
+            return false;
+        }
+        *corner = (n - 1) as u32;
+    }
+    if count == 0 {
+        return false;
+    }
+    out.indices.extend_from_slice(&corners[..count]);
+    // As a corner naming no `vt` or `vn` would in `corners`.
+    out.texture.take(
+        None,
+        (before.texture + out.texture.values.len()) as i64,
+        line,
+    );
+    out.normals.take(
+        None,
+        (before.normals + out.normals.values.len()) as i64,
+        line,
+    );
+    out.face_starts.push(out.indices.len() as u32);
+    true
+}
+
+/// Parses one line into `piece` word by word.
+fn parse_words(
     raw: &str,
     line: usize,
     before: Counts,
@@ -478,6 +596,60 @@ mod tests {
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 1 2 3\nf 1/4 2/1 3/1\n",
         ] {
             same_in_pieces(text);
+        }
+    }
+
+    /// The lines of `text` parsed word by word alone, as a piece.
+    fn by_words(text: &str) -> String {
+        let mut piece = parse_piece("", Counts::default());
+        for (n, raw) in text.lines().enumerate() {
+            if let Err(e) = parse_words(raw, n + 1, Counts::default(), &mut piece) {
+                piece.error = Some(e);
+                break;
+            }
+        }
+        let Piece {
+            parsed,
+            first_colored,
+            first_plain,
+            error,
+        } = piece;
+        format!("{parsed:?} {first_colored:?} {first_plain:?} {error:?}")
+    }
+
+    /// The byte-level readers of `v` and `f` lines take what reading word by word takes, the
+    /// same way, and leave the rest to it (their messages included).
+    #[test]
+    fn plain_lines_read_as_word_by_word() {
+        let vertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+        for lines in [
+            "f 1 2 3\nf\t4 3  2 \nf 1 2 3 4 1 2 3 4\nf 1 2 3 4 1 2 3 4 1\nf 01 0002 3\n",
+            "f 1 2 5\n",
+            "f 0 1 2\n",
+            "f +1 2 3\n",
+            "f 1 2 3\u{a0}\n",
+            "f 1 2 99999999999\n",
+            "f 1/1 2 3\n",
+            "f -1 -2 -3\n",
+            "f\n",
+            "f \n",
+            "v 1 2 3 4\nv 1 2 3 4 5\nv 1 2 3 0.5 0.5 0.5\nv 1 2 3 4 5 6 7\n",
+            "v 1e3 -2.5 .5\r\nv 1\t2\t3\n",
+            "v 1 2\n",
+            "v 1 2 nan\n",
+            "v 1 2 inf 1 1 1\n",
+            "v 1 2 3 1 1 x\n",
+            "v 1\u{a0}2 3\n",
+            "v 1 2 3\u{0b}\n",
+            "v 1 2 3\rv 4 5 6\n",
+        ] {
+            let text = format!("{vertices}{lines}");
+            let piece = parse_piece(&text, Counts::default());
+            let fast = format!(
+                "{:?} {:?} {:?} {:?}",
+                piece.parsed, piece.first_colored, piece.first_plain, piece.error
+            );
+            assert_eq!(fast, by_words(&text), "{lines:?}");
         }
     }
 
