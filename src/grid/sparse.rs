@@ -94,17 +94,26 @@ impl SparseGrid {
 
     /// Makes the 8^3 block at `origin` (a multiple of 8) whole.
     pub fn fill_leaf_block(&mut self, origin: Coord) {
-        if self.tiles.covers(origin) {
-            return;
+        if self.leaf_block_to_tile(origin) {
+            self.tiles.insert_leaf(origin);
         }
+    }
+
+    /// Readies the 8^3 block at `origin` to be made whole: a leaf there is kept, whole, where
+    /// channels live in leaves, and emptied otherwise. Whether the block is to become a tile
+    /// (one already a tile is left as it is).
+    fn leaf_block_to_tile(&mut self, origin: Coord) -> bool {
         match self.index.get(&origin) {
-            // Channels live in leaves: keep the leaf, whole.
-            Some(&i) if self.channels != Channels::NONE => self.leaves[i as usize].mask = FULL,
+            None => true,
+            Some(_) if self.tiles.covers(origin) => false,
+            Some(&i) if self.channels != Channels::NONE => {
+                self.leaves[i as usize].mask = FULL;
+                false
+            }
             Some(&i) => {
                 self.leaves[i as usize].mask = [0; 8];
-                self.tiles.insert_leaf(origin);
+                true
             }
-            None => self.tiles.insert_leaf(origin),
         }
     }
 
@@ -116,20 +125,7 @@ impl SparseGrid {
         let mut tiled = Vec::new();
         for run in origins.chunk_by(|a, b| node_origin(*a) == node_origin(*b)) {
             tiled.clear();
-            for &o in run {
-                match self.index.get(&o) {
-                    None => tiled.push(o),
-                    Some(_) if self.tiles.covers(o) => {}
-                    // Channels live in leaves: keep the leaf, whole.
-                    Some(&i) if self.channels != Channels::NONE => {
-                        self.leaves[i as usize].mask = FULL
-                    }
-                    Some(&i) => {
-                        self.leaves[i as usize].mask = [0; 8];
-                        tiled.push(o);
-                    }
-                }
-            }
+            tiled.extend(run.iter().filter(|&&o| self.leaf_block_to_tile(o)));
             self.tiles
                 .insert_leaves_of_node(node_origin(run[0]), tiled.iter().copied());
         }

@@ -304,6 +304,32 @@ struct Piece {
     error: Option<LineError>,
 }
 
+impl Piece {
+    /// What is defined up to `line`, after `before`: what the corners' indices may name.
+    fn defined(&self, before: Counts, line: usize) -> Counts {
+        Counts {
+            lines: line,
+            positions: before.positions + self.parsed.positions.len(),
+            texture: before.texture + self.parsed.texture.values.len(),
+            normals: before.normals + self.parsed.normals.values.len(),
+        }
+    }
+
+    /// A `v` statement's position and, where it has one, its colour.
+    fn push_vertex(&mut self, position: DVec3, colour: Option<DVec3>, line: usize) {
+        self.parsed.positions.push(position);
+        match colour {
+            Some(c) => {
+                self.parsed.colors.push(c.as_vec3());
+                self.first_colored.get_or_insert(line);
+            }
+            None => {
+                self.first_plain.get_or_insert(line);
+            }
+        }
+    }
+}
+
 /// Parses the lines of a piece, after the lines and vertex statements of `before`.
 fn parse_piece(text: &str, before: Counts) -> Piece {
     let mut piece = Piece {
@@ -393,16 +419,8 @@ fn plain_vertex(raw: &str, line: usize, piece: &mut Piece) -> bool {
             _ => return false,
         }
     }
-    let out = &mut piece.parsed;
-    out.positions
-        .push(DVec3::new(values[0], values[1], values[2]));
-    if count == 6 {
-        out.colors
-            .push(DVec3::new(values[3], values[4], values[5]).as_vec3());
-        piece.first_colored.get_or_insert(line);
-    } else {
-        piece.first_plain.get_or_insert(line);
-    }
+    let colour = (count == 6).then(|| DVec3::new(values[3], values[4], values[5]));
+    piece.push_vertex(DVec3::new(values[0], values[1], values[2]), colour, line);
     true
 }
 
@@ -415,8 +433,7 @@ fn plain_face(raw: &str, line: usize, before: Counts, piece: &mut Piece) -> bool
     let Some((words, count)) = plain_words::<PLAIN_FACE_CORNERS>(raw) else {
         return false;
     };
-    let out = &mut piece.parsed;
-    let defined = (before.positions + out.positions.len()) as u64;
+    let defined = piece.defined(before, line);
     let mut corners = [0u32; PLAIN_FACE_CORNERS];
     for (corner, word) in corners.iter_mut().zip(&words[..count]) {
         // At most 10 digits: no overflow in u64.
@@ -424,7 +441,7 @@ fn plain_face(raw: &str, line: usize, before: Counts, piece: &mut Piece) -> bool
             return false;
         }
         let n = word.bytes().fold(0u64, |n, b| 10 * n + u64::from(b - b'0'));
-        if n == 0 || n > defined {
+        if n == 0 || n > defined.positions as u64 {
             return false;
         }
         *corner = (n - 1) as u32;
@@ -432,18 +449,11 @@ fn plain_face(raw: &str, line: usize, before: Counts, piece: &mut Piece) -> bool
     if count == 0 {
         return false;
     }
+    let out = &mut piece.parsed;
     out.indices.extend_from_slice(&corners[..count]);
     // As a corner naming no `vt` or `vn` would in `corners`.
-    out.texture.take(
-        None,
-        (before.texture + out.texture.values.len()) as i64,
-        line,
-    );
-    out.normals.take(
-        None,
-        (before.normals + out.normals.values.len()) as i64,
-        line,
-    );
+    out.texture.take(None, defined.texture as i64, line);
+    out.normals.take(None, defined.normals as i64, line);
     out.face_starts.push(out.indices.len() as u32);
     true
 }
@@ -455,27 +465,21 @@ fn parse_words(
     before: Counts,
     piece: &mut Piece,
 ) -> std::result::Result<(), LineError> {
+    let defined = piece.defined(before, line);
     let out = &mut piece.parsed;
     let mut words = raw.split_whitespace();
-    // What is defined up to this line, for the corners' indices.
-    let defined = Counts {
-        lines: line,
-        positions: before.positions + out.positions.len(),
-        texture: before.texture + out.texture.values.len(),
-        normals: before.normals + out.normals.values.len(),
-    };
     match words.next() {
         Some("v") => {
-            out.positions
-                .push(DVec3::from_array(numbers::<3>(&mut words, "vertex", line)?));
-            let rest = [words.next(), words.next(), words.next()];
-            if let [Some(r), Some(g), Some(b)] = rest {
-                let c = numbers::<3>(&mut [r, g, b].into_iter(), "vertex colour", line)?;
-                out.colors.push(DVec3::from_array(c).as_vec3());
-                piece.first_colored.get_or_insert(line);
-            } else {
-                piece.first_plain.get_or_insert(line);
-            }
+            let position = DVec3::from_array(numbers::<3>(&mut words, "vertex", line)?);
+            let colour = match [words.next(), words.next(), words.next()] {
+                [Some(r), Some(g), Some(b)] => Some(DVec3::from_array(numbers::<3>(
+                    &mut [r, g, b].into_iter(),
+                    "vertex colour",
+                    line,
+                )?)),
+                _ => None,
+            };
+            piece.push_vertex(position, colour, line);
         }
         Some("f") => {
             let streams = Some((&mut out.texture, &mut out.normals));
@@ -608,6 +612,11 @@ mod tests {
                 break;
             }
         }
+        described(piece)
+    }
+
+    /// All that a piece holds, to compare.
+    fn described(piece: Piece) -> String {
         let Piece {
             parsed,
             first_colored,
@@ -644,11 +653,7 @@ mod tests {
             "v 1 2 3\rv 4 5 6\n",
         ] {
             let text = format!("{vertices}{lines}");
-            let piece = parse_piece(&text, Counts::default());
-            let fast = format!(
-                "{:?} {:?} {:?} {:?}",
-                piece.parsed, piece.first_colored, piece.first_plain, piece.error
-            );
+            let fast = described(parse_piece(&text, Counts::default()));
             assert_eq!(fast, by_words(&text), "{lines:?}");
         }
     }
