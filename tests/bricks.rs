@@ -231,7 +231,7 @@ fn tree_bytes(path: &std::path::Path) -> Vec<u8> {
 #[test]
 fn node_bricks_splice_into_the_single_writes_tree() {
     use voxelkit::io::brick_set::{BRICK_SET_FORMAT, BrickFile, BrickSet, brick_voxels};
-    use voxelkit::io::brick_splice::{BrickWalker, Walked, splice_brick_set};
+    use voxelkit::io::brick_splice::{EncodedBrick, Spliced, splice_brick_set};
     use voxelkit::io::vdb::write_vdb;
     let mesh = generate::cuboid(DVec3::new(-1.0, -0.7, -0.4), DVec3::new(1.0, 0.8, 0.45));
     let t = voxelkit::mesh::fit_transform(&mesh.bbox(), GridFit::Resolution(1100)).unwrap();
@@ -277,7 +277,7 @@ fn node_bricks_splice_into_the_single_writes_tree() {
     let index = dir.path().join("index.json");
     set.write(&index).unwrap();
     let merged = dir.path().join("merged.vdb");
-    let voxels = splice_brick_set(&set, &index, &merged, &[], Walked::default()).unwrap();
+    let voxels = splice_brick_set(&set, &index, &merged, &[]).unwrap();
     let single = dir.path().join("single.vdb");
     write_vdb(&single, &whole, &[]).unwrap();
     assert_eq!(voxels, whole.voxel_count());
@@ -288,21 +288,51 @@ fn node_bricks_splice_into_the_single_writes_tree() {
         "the single write's tree"
     );
     common::assert_read_as_openvdb_reads(&merged, "density");
-    // Bricks walked beforehand (every other one, in reverse order, one of them changed after
-    // its walk and so walked again) splice into the same tree.
-    let walker = BrickWalker::new();
-    for brick in set.bricks.iter().rev().step_by(2) {
-        walker.walk(dir.path().join(&brick.file));
-    }
-    let walked = walker.finish();
-    let changed = dir.path().join(&set.bricks.last().unwrap().file);
-    let mut part = voxelkit::io::vdb::read_vdb_grid(&changed, None).unwrap();
-    part.compact();
-    write_vdb(&changed, &part, &[("changed", "after its walk".into())]).unwrap();
-    let again = dir.path().join("again.vdb");
-    splice_brick_set(&set, &index, &again, &[], walked).unwrap();
+    // Bricks kept in memory (as workers keep them) write their nodes into place, each brick
+    // from its own thread as from its own worker, giving the same tree.
+    let kept: Vec<EncodedBrick> = set
+        .bricks
+        .iter()
+        .map(|b| {
+            let bytes = std::fs::read(dir.path().join(&b.file)).unwrap();
+            EncodedBrick::new(bytes, std::path::Path::new(&b.file)).unwrap()
+        })
+        .collect();
+    let nodes: Vec<Vec<u8>> = kept.iter().map(EncodedBrick::nodes).collect();
+    let in_place = dir.path().join("in_place.vdb");
+    let spliced = Spliced::in_place(&set, &nodes, &in_place, &[]).unwrap();
+    assert_eq!(spliced.voxels, whole.voxel_count());
+    spliced
+        .write_in_place(&in_place, kept.len(), |tmp, placements| {
+            assert!(placements.iter().any(|p| p.len() > 1), "bricks in pieces");
+            std::thread::scope(|scope| {
+                for (brick, ranges) in kept.iter().zip(&placements) {
+                    scope.spawn(move || brick.write_into(tmp, ranges).unwrap());
+                }
+            });
+            Ok(())
+        })
+        .unwrap();
     assert!(
-        tree_bytes(&again) == tree_bytes(&single),
-        "the single write's tree from walked bricks"
+        tree_bytes(&in_place) == tree_bytes(&single),
+        "the single write's tree from bricks in memory"
+    );
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        set.bricks.len() + 4,
+        "no temporary file left"
+    );
+    // A brick that fails to write leaves no output.
+    let failed = dir.path().join("failed.vdb");
+    let spliced = Spliced::in_place(&set, &nodes, &failed, &[]).unwrap();
+    let refused = spliced.write_in_place(&failed, kept.len(), |_, _| {
+        Err(voxelkit::error::Error::InvalidArgument(
+            "a brick failed".into(),
+        ))
+    });
+    assert!(refused.is_err() && !failed.exists());
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        set.bricks.len() + 4
     );
 }

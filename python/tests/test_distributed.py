@@ -264,6 +264,59 @@ def test_a_killed_worker_is_retried_and_the_result_is_whole(data, dask, tmp_path
     assert voxel_set(voxelkit.read_vdb(out).ijk) == voxel_set(voxelkit.mesh(path, resolution=1024).ijk)
 
 
+@pytest.mark.parametrize("when", ["bricks", "merge"])
+def test_a_worker_killed_holding_bricks_in_memory_is_made_good(data, dask, tmp_path, monkeypatch, when):
+    """Bricks on OpenVDB's nodes stay in their workers' memory until they are written into the
+    merged file: a worker killed (SIGKILL) while the bricks run, or after they all ran and
+    before the merge, takes bricks with it, which Dask runs again; the file is the single
+    run's and nothing is left behind."""
+    from dask.distributed import Client, LocalCluster
+
+    path = data / "meshes" / "igea.obj"
+    out = tmp_path / "igea.vdb"
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
+                           env={"RAYON_NUM_THREADS": "1"})
+    client = Client(cluster)
+    killed = []
+
+    def kill_a_worker():
+        if not killed:
+            pid = next(iter(client.run(os.getpid).values()))
+            os.kill(pid, signal.SIGKILL)
+            killed.append(pid)
+
+    if when == "bricks":
+        results = []
+        original = vd._result
+
+        def result(future, group, stage):
+            results.append(group)
+            if len(results) == 3:
+                kill_a_worker()
+            return original(future, group, stage)
+
+        monkeypatch.setattr(vd, "_result", result)
+    else:
+        original = vd._merge_in_place
+
+        def merge(*args):
+            kill_a_worker()
+            return original(*args)
+
+        monkeypatch.setattr(vd, "_merge_in_place", merge)
+    try:
+        result = vd.run(path, out, resolution=1024, brick=128, client=client)
+    finally:
+        client.close()
+        cluster.close()
+    assert killed, "no worker was killed"
+    assert result["merged_by"] == "splicing" and result["bricks"] > 50
+    single = voxelkit.mesh(path, resolution=1024)
+    single.write(tmp_path / "single.vdb")
+    assert tree_bytes(out) == tree_bytes(tmp_path / "single.vdb")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["igea.vdb", "single.vdb"]
+
+
 def test_a_scheduler_that_never_answers_is_an_error_within_seconds(data, dask, tmp_path):
     import socket
 

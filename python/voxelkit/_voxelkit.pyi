@@ -154,10 +154,10 @@ def brick_surface_file(
     voxel_size: float,
     brick: Index,
     size: int,
-    path: Path,
+    path: Optional[Path],
     separability: int,
     max_memory_mib: Optional[int] = None,
-) -> Tuple[int, int]: ...
+) -> Union[Tuple[int, int], EncodedBrick]: ...
 def brick_faces(
     positions: npt.NDArray[np.float64],
     indices: npt.NDArray[np.uint32],
@@ -177,9 +177,9 @@ def brick_solid_file(
     brick: Index,
     size: int,
     exterior: Sequence[int],
-    path: Path,
+    path: Optional[Path],
     max_memory_mib: Optional[int] = None,
-) -> Tuple[int, int]: ...
+) -> Union[Tuple[int, int], EncodedBrick]: ...
 def brick_winding_file(
     positions: npt.NDArray[np.float64],
     indices: npt.NDArray[np.uint32],
@@ -191,15 +191,19 @@ def brick_winding_file(
     voxel_size: float,
     brick: Index,
     size: int,
-    path: Path,
+    path: Optional[Path],
     max_memory_mib: Optional[int] = None,
-) -> Tuple[int, int]: ...
+) -> Union[Tuple[int, int], EncodedBrick]: ...
 def brick_exterior(
     plan: BrickPlan, faces: Dict[Index, Sequence[npt.NDArray[np.uint32]]]
 ) -> Dict[Index, List[int]]: ...
-class BrickWalker:
-    def __init__(self) -> None: ...
-    def walk(self, path: Path) -> None: ...
+class EncodedBrick:
+    """A brick's file encoded in memory on its worker (the brick functions without a path)."""
+    def __init__(self, bytes: bytes) -> None: ...
+    @property
+    def voxels(self) -> int: ...
+    def nodes(self) -> bytes: ...
+    def write_into(self, path: Path, placements: Sequence[Tuple[int, int, int]]) -> None: ...
 
 def brick_finish(
     plan: BrickPlan,
@@ -207,6 +211,12 @@ def brick_finish(
     full_bricks: Sequence[Index],
     index: Path,
     merged: Optional[Path] = None,
-    walker: Optional[BrickWalker] = None,
 ) -> Optional[str]: ...
+def brick_splice_in_place(
+    plan: BrickPlan,
+    nodes: Dict[Index, bytes],
+    full_bricks: Sequence[Index],
+    output: Path,
+    write_bricks: Callable[[Path, Dict[Index, List[Tuple[int, int, int]]]], None],
+) -> int: ...
 def brick_merge(index: Path, output: Path) -> Tuple[str, int]: ...

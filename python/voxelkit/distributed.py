@@ -24,15 +24,19 @@ brick then writes its surface and the components that are not exterior, and bric
 faces are wholly outside or wholly inside (written as tiles, no task).
 
 The bricks are merged into ``OUT.vdb``. Bricks of a multiple of 128 voxels (every size chosen)
-lie on OpenVDB's 128^3 nodes and each brick file holds its nodes as the merged file does, so the
-client walks each brick file's structure as the brick finishes and, after the last, copies the
-nodes into place in OpenVDB's order without reading a voxel, building only the 4096^3 nodes'
-masks: its memory does not grow with the voxels. Bricks of other sizes are read
-into one grid, and merged only when it fits in the client's memory (each brick reports the
-bytes its leaves and tiles take). With ``--keep-bricks`` (or when that does not fit) the bricks
-stay as ``OUT.bricks/`` with an index ``OUT.bricks/index.json`` that ``voxelkit info`` and
-``voxelkit.read_vdb`` read as one grid. Workers write brick files into
-that folder, so with ``--scheduler`` it must be on a file system every worker sees.
+lie on OpenVDB's 128^3 nodes and each brick holds its nodes as the merged file does, so they
+never go through the disk twice: each worker keeps its bricks encoded in memory and tells the
+client where its nodes lie; the client lays the merged file out in OpenVDB's order, writes only
+the 4096^3 nodes' masks and the heads itself, and each worker writes its bricks' nodes into
+place (a worker lost before that is made good by Dask running its bricks again). The client
+never holds a voxel: its memory does not grow with the voxels. Bricks of other sizes are
+written as files, read into one grid, and merged only when it fits in the client's memory
+(each brick reports the bytes its leaves and tiles take). With ``--keep-bricks`` (or when that
+does not fit) the brick files stay as ``OUT.bricks/`` with an index ``OUT.bricks/index.json``
+that ``voxelkit info`` and ``voxelkit.read_vdb`` read as one grid, and ``merge`` merges later.
+Workers write into the output's folder (brick files, or the merged file in place), so with
+``--scheduler`` it must be on a file system every worker sees. While a run lasts it holds the
+folder ``OUT.bricks/``, and a second run to the same output is refused.
 
 With ``--frames`` the input and output are frame patterns and each frame runs whole on one
 worker, every frame on the grid fitted to the union of their boxes (see ``frames``).
@@ -270,42 +274,85 @@ def _in_turn(calls):
     return results
 
 
-def _run(client, calls, stage, progress, check, done=lambda b: None, grouped=True):
-    """Submits `calls` ({brick: (function, args)}) and gathers {brick: result}, calling
-    `done(brick)` as each finishes. Consecutive bricks share a task (`grouped`; frames do
-    not). A task's arguments travel with it (not scattered to one worker), so that a task
-    whose worker dies runs again elsewhere; a brick that still fails ends the run with an
-    error that names it."""
+def _run(client, calls, stage, progress, check, grouped=True, keep=False):
+    """Submits `calls` ({brick: (function, args)}) and gathers {brick: result}. Consecutive
+    bricks share a task (`grouped`; frames do not). A task's arguments travel with it (not
+    scattered to one worker), so that a task whose worker dies runs again elsewhere; a brick
+    that still fails ends the run with an error that names it. With `keep`, the results (the
+    bricks, encoded) stay on their workers: {brick: (voxels, nodes)} comes back, with the
+    tasks that hold them ([(future, bricks)]), which Dask runs again should a worker holding
+    one die before the merge."""
     from dask.distributed import as_completed
 
     keys = list(calls)
     threads = sum(client.nthreads().values()) if grouped else 0
     size = max(1, -(-len(keys) // (_TASKS_PER_THREAD * threads))) if threads else 1
-    futures = {}
+    futures, held = {}, []
     for i in range(0, len(keys), size):
         group = keys[i:i + size]
         work = [(b, *calls[b]) for b in group]
-        futures[client.submit(_in_turn, work, pure=False, retries=_RETRIES)] = group
+        future = client.submit(_in_turn, work, pure=False, retries=_RETRIES)
+        if keep:
+            held.append((future, group))
+            future = client.submit(_nodes_of, future, pure=False, retries=_RETRIES)
+        futures[future] = group
     results = {}
     progress.show(stage, 0, len(keys))
     for future in as_completed(futures):
         check()
-        group = futures[future]
-        try:
-            results.update(future.result())
-        except (ValueError, MemoryError, OSError):
-            raise
-        except Exception as e:
-            named = f"brick {group[0]}" if len(group) == 1 else f"bricks {group[0]} to {group[-1]}"
-            raise RuntimeError(
-                f"{named} ({stage}) failed on its worker after {_RETRIES} retries: "
-                f"{type(e).__name__}: {e}"
-            ) from None
-        for b in group:
-            done(b)
+        results.update(_result(future, futures[future], stage))
         progress.show(stage, len(results), len(keys))
     check()
-    return results
+    return (results, held) if keep else results
+
+
+def _result(future, group, stage):
+    """A task's result; its failure as an error that names its bricks."""
+    try:
+        return future.result()
+    except (ValueError, MemoryError, OSError):
+        raise
+    except Exception as e:
+        named = f"brick {group[0]}" if len(group) == 1 else f"bricks {group[0]} to {group[-1]}"
+        raise RuntimeError(
+            f"{named} ({stage}) failed on its worker after {_RETRIES} retries: "
+            f"{type(e).__name__}: {e}"
+        ) from None
+
+
+def _nodes_of(results):
+    """What the merge needs of a task's encoded bricks: [(brick, (voxels, nodes))]."""
+    return [(b, (encoded.voxels, encoded.nodes())) for b, encoded in results]
+
+
+def _write_into(results, path, placements):
+    """A task's encoded bricks written into the merged file at `path`."""
+    for b, encoded in results:
+        encoded.write_into(path, placements[b])
+
+
+def _merge_in_place(client, plan, held, nodes, full_bricks, output, progress, check):
+    """The bricks kept on the workers merged into `output`: the client lays the file out and
+    writes its own bytes, each task's worker writes its bricks' nodes into place."""
+    from dask.distributed import as_completed
+
+    def write_bricks(path, placements):
+        tasks = {
+            client.submit(_write_into, future, path, {b: placements[b] for b in group},
+                          pure=False, retries=_RETRIES): group
+            for future, group in held
+        }
+        done = 0
+        progress.show("merge", done, len(nodes))
+        for task in as_completed(tasks):
+            check()
+            _result(task, tasks[task], "merge")
+            done += len(tasks[task])
+            progress.show("merge", done, len(nodes))
+
+    return vk.brick_splice_in_place(
+        plan, {b: n for b, (_, n) in nodes.items()}, full_bricks, output, write_bricks
+    )
 
 
 def _brick_file(b):
@@ -336,6 +383,9 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
             start, check):
     separability, max_memory_mib = plan.separability, plan.max_memory_mib
     show = _Progress(progress)
+    # Bricks on OpenVDB's nodes merged into one file stay in their workers' memory, encoded,
+    # and are written into place from there; the others go through brick files.
+    in_place = plan.splices and not keep_bricks
     with _using(client, scheduler, workers) as client:
         size = plan.fit_to_threads(sum(client.nthreads().values()))
         origin, h = plan.origin, plan.voxel_size
@@ -345,11 +395,9 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
         # are short ones, not the one worker's whole last brick.
         bricks = sorted(bricks, key=lambda b: len(arrays[b][1]), reverse=True)
         files = {b: _brick_file(b) for b in bricks}
-        path = {b: os.path.abspath(os.path.join(folder, files[b])) for b in bricks}
+        path = {b: None if in_place else os.path.abspath(os.path.join(folder, files[b]))
+                for b in bricks}
         full_bricks = []
-        # Bricks on OpenVDB's nodes are walked as they finish, so that the merge only copies.
-        walker = vk.BrickWalker() if plan.splices and not keep_bricks else None
-        walk = (lambda b: walker.walk(path[b])) if walker else (lambda b: None)
         if solid and plan.winding:
             # Every worker holds the mesh once; a worker lost takes no brick's only copy.
             mesh = client.scatter(plan.mesh_arrays(), broadcast=True)
@@ -357,7 +405,7 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
                 b: (_winding_brick, (arrays[b], mesh, origin, h, b, size, path[b], max_memory_mib))
                 for b in bricks
             }
-            counts = _run(client, calls, "solid", show, check, walk)
+            stage = "solid"
         elif solid:
             faces = _run(
                 client,
@@ -373,30 +421,36 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
                 b: (_solid_brick, (arrays[b], origin, h, b, size, exterior[b], path[b], max_memory_mib))
                 for b in bricks
             }
-            counts = _run(client, calls, "solid", show, check, walk)
+            stage = "solid"
         else:
             calls = {
                 b: (_surface_brick, (arrays[b], origin, h, b, size, path[b], separability, max_memory_mib))
                 for b in bricks
             }
-            counts = _run(client, calls, "surface", show, check, walk)
+            stage = "surface"
+        if in_place:
+            counts, held = _run(client, calls, stage, show, check, keep=True)
+            bricks_done = time.perf_counter()
+            _merge_in_place(client, plan, held, counts, full_bricks, output, show, check)
+            del held
+            merged_by = "splicing"
+        else:
+            counts = _run(client, calls, stage, show, check)
+            bricks_done = time.perf_counter()
         peaks = list(client.run(_peak_rss_mib).values())
-    bricks_done = time.perf_counter()
-    # Each brick task gives its voxels and the bytes its leaves and tiles take in a merge that
-    # reads them; bricks on OpenVDB's 128^3 nodes are spliced without reading a voxel.
+    # Each brick task gives its voxels (and, through files, the bytes its leaves and tiles take
+    # in a merge that reads them).
     voxels = sum(v for v, _ in counts.values()) + len(full_bricks) * size**3
-    merged_bytes = sum(b for _, b in counts.values()) + len(full_bricks) * plan.full_brick_bytes
-    available = _available_bytes()
-    merge = not keep_bricks and (plan.splices or available is None or merged_bytes < available)
+    merge = in_place or (not keep_bricks and _fits(plan, counts, full_bricks))
     check()
-    index = os.path.join(folder, "index.json")
+    if not in_place:
+        index = os.path.join(folder, "index.json")
+        if merge:
+            show.show("merge", 0, len(files))
+        merged_by = vk.brick_finish(plan, files, full_bricks, index, merged=output if merge else None)
+        if merge:
+            show.show("merge", len(files), len(files))
     if merge:
-        show.show("merge", 0, len(files))
-    merged_by = vk.brick_finish(
-        plan, files, full_bricks, index, merged=output if merge else None, walker=walker
-    )
-    if merge:
-        show.show("merge", len(files), len(files))
         shutil.rmtree(folder)
     return {
         "output": output if merge else index,
@@ -411,6 +465,13 @@ def _run_in(plan, folder, output, solid, scheduler, workers, keep_bricks, progre
         "merge_seconds": time.perf_counter() - bricks_done,
         "worker_peak_mib": peaks,
     }
+
+
+def _fits(plan, counts, full_bricks):
+    """Whether brick files off OpenVDB's nodes, read into one grid to merge, fit in memory."""
+    merged_bytes = sum(b for _, b in counts.values()) + len(full_bricks) * plan.full_brick_bytes
+    available = _available_bytes()
+    return available is None or merged_bytes < available
 
 
 def frames(inputs, outputs, frames, solid=False, scheduler=None, workers=2, progress=False,

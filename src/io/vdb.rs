@@ -13,7 +13,7 @@ use super::grid_out::{GridOut, GridValues};
 use super::nvdb_writer::write_nvdb_grids;
 use super::vdb_format::{COVARIANT_NORMALIZE, FOG_VOLUME, LEVEL_SET};
 pub use super::vdb_format::{Compression, MetaValue};
-use super::vdb_writer::{Encoding, write_grids};
+use super::vdb_writer::{Encoding, encode_grids_to_memory, write_grids};
 use crate::contour::{Meaning, ScalarField};
 use crate::error::{Error, Result};
 use crate::grid::attribute_grid::{AttributeGrid, AttributeKind};
@@ -163,15 +163,37 @@ pub fn write_contents_timed(
             write_nvdb_grids(tmp, path, &grids, &mut clocks)
         })?;
     } else {
-        let encoding = Encoding {
-            compression: options.compression.flags(),
-            half: options.half,
-        };
+        let encoding = encoding(options);
         write_atomic_timed(path, &mut fsync, |tmp| {
             write_grids(tmp, path, &grids, encoding, &mut clocks)
         })?;
     }
     Ok([clocks.encode.stage(), clocks.write.stage(), fsync.stage()])
+}
+
+/// The bytes of the `.vdb` file `write_contents` would write, in memory (a brick kept by its
+/// worker until it is written into the merged file); errors name `what`.
+pub fn encode_contents(
+    what: &Path,
+    contents: &Contents,
+    metadata: &[(&str, MetaValue)],
+    options: &WriteOptions,
+) -> Result<Vec<u8>> {
+    let meta = meta_entries(metadata);
+    let grids = chosen(what, candidates(what, contents, &meta, options)?, options)?;
+    let mut clocks = WriteClocks {
+        encode: StageClock::new("encode"),
+        write: StageClock::new("write"),
+    };
+    encode_grids_to_memory(what, &grids, encoding(options), &mut clocks)
+}
+
+/// How `options` ask a `.vdb`'s values to be encoded.
+pub(super) fn encoding(options: &WriteOptions) -> Encoding {
+    Encoding {
+        compression: options.compression.flags(),
+        half: options.half,
+    }
 }
 
 /// The time a writer spends encoding grids and writing their bytes, grid by grid.

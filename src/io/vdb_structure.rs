@@ -11,9 +11,15 @@ use crate::error::{Error, Result};
 use std::path::Path;
 
 pub(super) struct Reader {
-    input: BlockReader,
+    input: Input,
     pub(super) pos: u64,
     pub(super) len: u64,
+}
+
+/// What a `Reader` reads: a file, or a file's bytes in memory.
+enum Input {
+    File(BlockReader),
+    Bytes(Vec<u8>),
 }
 
 impl Reader {
@@ -32,13 +38,43 @@ impl Reader {
     fn open_block_wise(path: &Path, direct: bool) -> Result<Reader> {
         let input = BlockReader::open(path, 1 << 20, direct).map_err(|e| Error::io(path, e))?;
         let len = input.len().map_err(|e| Error::io(path, e))?;
-        Ok(Reader { input, pos: 0, len })
+        Ok(Reader {
+            input: Input::File(input),
+            pos: 0,
+            len,
+        })
+    }
+
+    /// A file's `bytes`, handed back by `into_bytes`.
+    pub(super) fn from_bytes(bytes: Vec<u8>) -> Reader {
+        Reader {
+            len: bytes.len() as u64,
+            input: Input::Bytes(bytes),
+            pos: 0,
+        }
+    }
+
+    /// The bytes of a reader made `from_bytes`.
+    pub(super) fn into_bytes(self) -> Option<Vec<u8>> {
+        match self.input {
+            Input::Bytes(bytes) => Some(bytes),
+            Input::File(_) => None,
+        }
     }
 
     fn read(&mut self, out: &mut [u8]) -> std::result::Result<(), String> {
-        self.input
-            .read_exact_at(self.pos, out)
-            .map_err(|e| e.to_string())?;
+        match &mut self.input {
+            Input::File(file) => file
+                .read_exact_at(self.pos, out)
+                .map_err(|e| e.to_string())?,
+            Input::Bytes(bytes) => {
+                let at = usize::try_from(self.pos).unwrap_or(usize::MAX);
+                let source = bytes
+                    .get(at..at.saturating_add(out.len()))
+                    .ok_or("it ends early")?;
+                out.copy_from_slice(source);
+            }
+        }
         self.pos += out.len() as u64;
         Ok(())
     }

@@ -101,8 +101,79 @@ pub(super) fn write_grids(
     encoding: Encoding,
     clocks: &mut WriteClocks,
 ) -> Result<()> {
+    let out = DirectFile::create(file).map_err(|e| Error::io(path, e))?;
+    encode_grids(out, path, grids, encoding, clocks)
+}
+
+/// The bytes of the `.vdb` file that `write_grids` writes, in memory; errors name `path`.
+pub(super) fn encode_grids_to_memory(
+    path: &Path,
+    grids: &[GridOut],
+    encoding: Encoding,
+    clocks: &mut WriteClocks,
+) -> Result<Vec<u8>> {
+    encode_grids(Vec::new(), path, grids, encoding, clocks)
+}
+
+/// Where a `.vdb`'s bytes go, front to back, then the grids' end offsets patched in.
+pub(super) trait Output: Send {
+    type Done;
+    fn write_all(&mut self, bytes: &[u8]) -> std::io::Result<()>;
+    /// Makes the bytes so far durable, where that means anything.
+    fn sync_data(&mut self) -> std::io::Result<()>;
+    /// Ends the writing with each `(at, value)` of `patches` written as 8 bytes at `at`.
+    fn finish(self, patches: &[(u64, u64)]) -> std::io::Result<Self::Done>;
+}
+
+impl Output for DirectFile {
+    type Done = ();
+
+    fn write_all(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        DirectFile::write_all(self, bytes)
+    }
+
+    fn sync_data(&mut self) -> std::io::Result<()> {
+        DirectFile::sync_data(self)
+    }
+
+    fn finish(self, patches: &[(u64, u64)]) -> std::io::Result<()> {
+        use std::os::unix::fs::FileExt;
+        let file = DirectFile::finish(self)?;
+        patches
+            .iter()
+            .try_for_each(|&(at, end)| file.write_all_at(&(end as i64).to_le_bytes(), at))
+    }
+}
+
+impl Output for Vec<u8> {
+    type Done = Vec<u8>;
+
+    fn write_all(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        self.extend_from_slice(bytes);
+        Ok(())
+    }
+
+    fn sync_data(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    fn finish(mut self, patches: &[(u64, u64)]) -> std::io::Result<Vec<u8>> {
+        for &(at, end) in patches {
+            self[at as usize..at as usize + 8].copy_from_slice(&(end as i64).to_le_bytes());
+        }
+        Ok(self)
+    }
+}
+
+/// Encodes `grids` into `out`; errors name `path`.
+fn encode_grids<O: Output>(
+    out: O,
+    path: &Path,
+    grids: &[GridOut],
+    encoding: Encoding,
+    clocks: &mut WriteClocks,
+) -> Result<O::Done> {
     let io_error = |e| Error::io(path, e);
-    let out = DirectFile::create(file).map_err(io_error)?;
     // Every piece goes to a writer thread as soon as it is encoded, numbered in file order;
     // a grid's end is known only once its last buffer is, so it is patched in afterwards.
     // The write clock counts only the time spent waiting for the writer at the end.
@@ -166,16 +237,7 @@ pub(super) fn write_grids(
         (out, encoded.and(written.map_err(io_error)), patches)
     });
     done?;
-    clocks
-        .write
-        .time(|| {
-            let file = out.finish()?;
-            use std::os::unix::fs::FileExt;
-            patches
-                .iter()
-                .try_for_each(|&(at, end)| file.write_all_at(&(end as i64).to_le_bytes(), at))
-        })
-        .map_err(io_error)
+    clocks.write.time(|| out.finish(&patches)).map_err(io_error)
 }
 
 /// The numbered pieces of a file on their way to the writer thread, and the file's length
@@ -238,11 +300,11 @@ impl SpentBuffers {
 
 /// Writes the numbered pieces to `out` in their order, whatever order they arrive in;
 /// stops at the first error, closing the channel so that the encoders stop too.
-fn write_in_order(
-    mut out: Output,
+fn write_in_order<O: Output>(
+    mut out: O,
     pieces: std::sync::mpsc::Receiver<(usize, Piece)>,
     spent: &SpentBuffers,
-) -> (Output, std::io::Result<()>) {
+) -> (O, std::io::Result<()>) {
     let mut waiting = BTreeMap::new();
     let mut next = 0;
     for (n, piece) in pieces {
@@ -264,9 +326,6 @@ fn write_in_order(
     }
     (out, Ok(()))
 }
-
-/// The file a `.vdb` is written through.
-type Output = DirectFile;
 
 /// The size from which a grid that other grids follow is synced as soon as it is written.
 const EARLY_SYNC_BYTES: u64 = 16 << 20;

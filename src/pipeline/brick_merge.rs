@@ -5,7 +5,7 @@
 use super::Outcome;
 use crate::error::Result;
 use crate::io::brick_set::BrickSet;
-use crate::io::brick_splice::{Walked, splice_brick_set, splices};
+use crate::io::brick_splice::{splice_brick_set, splices};
 use crate::io::vdb::{MetaValue, WriteOptions};
 use std::path::Path;
 
@@ -27,22 +27,21 @@ impl MergedBy {
     }
 }
 
-/// Writes the brick set of the index at `index` to the `.vdb` `output` (atomically), its
-/// metadata naming `source` as what was voxelized; a splice takes the bricks already
-/// `walked` as they are. Returns how it merged and the voxels.
-pub fn merge_brick_set(
-    index: &Path,
-    output: &Path,
-    source: &str,
-    walked: Walked,
-) -> Result<(MergedBy, u64)> {
-    let metadata: [(&str, MetaValue); 2] = [
+/// The metadata of a merged brick set: made of bricks, of `source`.
+pub fn brick_metadata(source: &str) -> [(&'static str, MetaValue); 2] {
+    [
         ("method", "voxelkit bricks".into()),
         ("source_file", source.into()),
-    ];
+    ]
+}
+
+/// Writes the brick set of the index at `index` to the `.vdb` `output` (atomically), its
+/// metadata naming `source` as what was voxelized. Returns how it merged and the voxels.
+pub fn merge_brick_set(index: &Path, output: &Path, source: &str) -> Result<(MergedBy, u64)> {
+    let metadata = brick_metadata(source);
     let set = BrickSet::read(index)?;
     if splices(set.brick_size) {
-        let voxels = splice_brick_set(&set, index, output, &metadata, walked)?;
+        let voxels = splice_brick_set(&set, index, output, &metadata)?;
         return Ok((MergedBy::Splicing, voxels));
     }
     let mut outcome = Outcome::read_vdb(index, None)?;

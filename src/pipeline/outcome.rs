@@ -19,7 +19,7 @@ use crate::io::grid_export::ExportedGrid;
 use crate::io::preview::Scene;
 use crate::io::vdb::{
     Contents, MetaValue, NORMAL_GRID, SHELL_GRID, WriteOptions, content_grid_count,
-    export_contents, is_nvdb, read_vdb_grid, write_contents_timed,
+    encode_contents, export_contents, is_nvdb, read_vdb_grid, write_contents_timed,
 };
 use crate::io::vox::write_vox;
 use crate::mesh::attributes::{AttributeChoice, AttributeGrid};
@@ -317,6 +317,14 @@ impl Outcome {
         self.write_timed(path, inputs, options).map(|_| ())
     }
 
+    /// The `.vdb` file `write` would write with `options`, in memory; errors name `what`.
+    pub fn encode_vdb(&self, what: &Path, options: &WriteOptions) -> Result<Vec<u8>> {
+        let meta = self.metadata_entries();
+        on_threads(self.threads, || {
+            encode_contents(what, &self.contents(), &meta, options)
+        })
+    }
+
     /// `write_files`, returning where the time went: encoding, writing and syncing a `.vdb`
     /// or `.nvdb` (a `.binvox` or `.vox`: its writing alone).
     fn write_timed(
@@ -418,7 +426,6 @@ fn write_to_stdout<T>(write: impl FnOnce(&Path) -> Result<T>) -> Result<T> {
     result
 }
 
-/// `method`, `source_file` and the grid's fit, the metadata every output carries.
 /// A control mesh's crease and corner counts in a grid's metadata.
 pub(super) fn tag_metadata(meta: &mut Vec<(&'static str, MetaValue)>, tags: &Option<TagSummary>) {
     if let Some(t) = tags {
@@ -427,6 +434,7 @@ pub(super) fn tag_metadata(meta: &mut Vec<(&'static str, MetaValue)>, tags: &Opt
     }
 }
 
+/// `method`, `source_file` and the grid's fit, the metadata every output carries.
 pub(super) fn provenance(
     method: &str,
     source: &str,

@@ -10,11 +10,12 @@ use crate::choice::Choice;
 use crate::error::Result;
 use crate::grid::Transform;
 use crate::io::brick_set::BrickSet;
+use crate::io::brick_splice::Spliced;
 use crate::io::vdb::WriteOptions;
 use crate::mesh::GridFit;
 use crate::mesh::Mesh;
 use crate::pipeline::brick_exterior::{FaceRuns, exterior_labels};
-use crate::pipeline::brick_merge::merge_brick_set;
+use crate::pipeline::brick_merge::{brick_metadata, merge_brick_set};
 use crate::pipeline::bricks::{BrickIndex, BrickRun, sub_mesh};
 use crate::pipeline::request::{BricksRequest, mib_limit};
 use crate::pipeline::{BrickStage, BrickTask, Details, Job, Limits, Outcome, Task, merged_bytes};
@@ -25,7 +26,7 @@ use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBytes, PyDict, PyType};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -247,16 +248,87 @@ type BrickArrays<'py> = (
     PyReadonlyArray1<'py, u32>,
 );
 
-/// Writes a brick's grid to `path` (atomically) and returns its voxel count and the bytes
-/// it takes in a merge (`merged_bytes`).
-fn write_brick(py: Python<'_>, mut outcome: Outcome, path: &Path) -> PyResult<(u64, u64)> {
-    py.detach(|| outcome.write(path, &[], &WriteOptions::default()))
+/// A brick's grid written to `path` (atomically): its voxel count and the bytes it takes in
+/// a merge that reads it (`merged_bytes`); without a path, kept encoded in memory for a merge
+/// in place (an `EncodedBrick`).
+fn finish_brick(
+    py: Python<'_>,
+    mut outcome: Outcome,
+    path: Option<PathBuf>,
+    brick: PyBrick,
+) -> PyResult<Py<PyAny>> {
+    let options = WriteOptions::default();
+    let Some(path) = path else {
+        let what = PathBuf::from(format!("brick {brick:?}"));
+        let encoded = py
+            .detach(|| {
+                let bytes = outcome.encode_vdb(&what, &options)?;
+                crate::io::brick_splice::EncodedBrick::new(bytes, &what)
+            })
+            .map_err(to_py_err)?;
+        return Ok(Py::new(py, EncodedBrick(encoded))?.into_any());
+    };
+    py.detach(|| outcome.write(&path, &[], &options))
         .map_err(to_py_err)?;
-    Ok((outcome.grid.voxel_count(), merged_bytes(&outcome.grid)))
+    let counts = (outcome.grid.voxel_count(), merged_bytes(&outcome.grid));
+    Ok(counts.into_pyobject(py)?.into_any().unbind())
 }
 
-/// A brick's part of the separating surface, written to `path`; returns its voxel count and
-/// merge bytes.
+/// A brick's file encoded in memory on the worker that made it, until its nodes are written
+/// into the merged file (`brick_splice_in_place`); pickled as the file's bytes.
+#[pyclass(module = "voxelkit._voxelkit", frozen)]
+pub struct EncodedBrick(crate::io::brick_splice::EncodedBrick);
+
+#[pymethods]
+impl EncodedBrick {
+    /// The brick file `bytes`, walked.
+    #[new]
+    fn new(py: Python<'_>, bytes: Vec<u8>) -> PyResult<Self> {
+        let what = Path::new("an encoded brick");
+        py.detach(|| crate::io::brick_splice::EncodedBrick::new(bytes, what))
+            .map(EncodedBrick)
+            .map_err(to_py_err)
+    }
+
+    #[getter]
+    fn voxels(&self) -> u64 {
+        self.0.voxels()
+    }
+
+    /// The memory it holds, by which Dask counts a worker's results and spills them to its
+    /// disk beyond the worker's memory limit.
+    fn __sizeof__(&self) -> usize {
+        std::mem::size_of::<Self>() + self.0.bytes().len()
+    }
+
+    /// What the merge needs to know of the brick's nodes (`brick_splice_in_place`).
+    fn nodes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        PyBytes::new(py, &self.0.nodes())
+    }
+
+    /// Writes the brick's ranges `placements` ((start, end, at): bytes start..end of its
+    /// file at `at`) into the existing file `path`, and syncs it.
+    fn write_into(
+        &self,
+        py: Python<'_>,
+        path: PathBuf,
+        placements: Vec<(u64, u64, u64)>,
+    ) -> PyResult<()> {
+        let placements: Vec<_> = placements
+            .into_iter()
+            .map(|(a, b, at)| (a..b, at))
+            .collect();
+        py.detach(|| self.0.write_into(&path, &placements))
+            .map_err(to_py_err)
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> (Bound<'py, PyType>, (Bound<'py, PyBytes>,)) {
+        let bytes = PyBytes::new(slf.py(), slf.get().0.bytes());
+        (slf.get_type(), (bytes,))
+    }
+}
+
+/// A brick's part of the separating surface, written to `path` or kept (`finish_brick`).
 #[pyfunction]
 #[pyo3(signature = (positions, indices, starts, origin, voxel_size, brick, size, path,
     separability, max_memory_mib = None))]
@@ -270,10 +342,10 @@ pub fn brick_surface_file(
     voxel_size: f64,
     brick: PyBrick,
     size: i64,
-    path: PathBuf,
+    path: Option<PathBuf>,
     separability: u32,
     max_memory_mib: Option<u64>,
-) -> PyResult<(u64, u64)> {
+) -> PyResult<Py<PyAny>> {
     let separability =
         Separability::from_number(i64::from(separability)).map_err(PyValueError::new_err)?;
     let arrays = (positions, indices, starts);
@@ -284,7 +356,7 @@ pub fn brick_surface_file(
         stage,
         (origin, voxel_size, brick, size, max_memory_mib),
     )?;
-    write_brick(py, outcome, &path)
+    finish_brick(py, outcome, path, brick)
 }
 
 /// The labels of a brick's outside components on its six faces (-x, +x, -y, +y, -z, +z),
@@ -329,7 +401,7 @@ pub fn brick_faces<'py>(
 }
 
 /// A brick of the solid (its surface and the components not in `exterior`), written to
-/// `path`; returns its voxel count and merge bytes.
+/// `path` or kept (`finish_brick`).
 #[pyfunction]
 #[pyo3(signature = (positions, indices, starts, origin, voxel_size, brick, size, exterior,
     path, max_memory_mib = None))]
@@ -344,9 +416,9 @@ pub fn brick_solid_file(
     brick: PyBrick,
     size: i64,
     exterior: Vec<u32>,
-    path: PathBuf,
+    path: Option<PathBuf>,
     max_memory_mib: Option<u64>,
-) -> PyResult<(u64, u64)> {
+) -> PyResult<Py<PyAny>> {
     let arrays = (positions, indices, starts);
     let stage = BrickStage::Solid { exterior };
     let outcome = run_brick(
@@ -355,12 +427,12 @@ pub fn brick_solid_file(
         stage,
         (origin, voxel_size, brick, size, max_memory_mib),
     )?;
-    write_brick(py, outcome, &path)
+    finish_brick(py, outcome, path, brick)
 }
 
 /// A brick of a solid whose inside is the winding number of the whole mesh (`mesh_*`, as
-/// `BrickPlan.mesh_arrays` gives it): its surface and the centres inside, written to `path`;
-/// returns its voxel count and merge bytes.
+/// `BrickPlan.mesh_arrays` gives it): its surface and the centres inside, written to `path`
+/// or kept (`finish_brick`).
 #[pyfunction]
 #[pyo3(signature = (positions, indices, starts, mesh_positions, mesh_indices, mesh_starts,
     origin, voxel_size, brick, size, path, max_memory_mib = None))]
@@ -377,9 +449,9 @@ pub fn brick_winding_file(
     voxel_size: f64,
     brick: PyBrick,
     size: i64,
-    path: PathBuf,
+    path: Option<PathBuf>,
     max_memory_mib: Option<u64>,
-) -> PyResult<(u64, u64)> {
+) -> PyResult<Py<PyAny>> {
     let mesh = from_arrays(
         (mesh_positions, mesh_indices, mesh_starts),
         "the run's mesh",
@@ -392,7 +464,7 @@ pub fn brick_winding_file(
         stage,
         (origin, voxel_size, brick, size, max_memory_mib),
     )?;
-    write_brick(py, outcome, &path)
+    finish_brick(py, outcome, path, brick)
 }
 
 /// The exterior labels of every brick of `plan`, from the face labels of the bricks that
@@ -423,31 +495,11 @@ pub fn brick_exterior(
     Ok(exterior.into_iter().map(|(b, l)| (to_py(b), l)).collect())
 }
 
-/// Brick files walked (their nodes found) in the background as they are finished, for the
-/// merge that follows (`brick_finish`).
-#[pyclass(module = "voxelkit._voxelkit")]
-pub struct BrickWalker(Option<crate::io::brick_splice::BrickWalker>);
-
-#[pymethods]
-impl BrickWalker {
-    #[new]
-    fn new() -> Self {
-        BrickWalker(Some(Default::default()))
-    }
-
-    /// Walks the finished brick file at `path` on the walker's thread.
-    fn walk(&self, path: PathBuf) {
-        if let Some(w) = &self.0 {
-            w.walk(path);
-        }
-    }
-}
-
 /// Writes the brick-set index `index` (brick files named relative to it); with `merged`, also
-/// merges the bricks into that one `.vdb` (see `pipeline::brick_merge`), taking the bricks
-/// `walker` walked as they are, and returns how (`"splicing"` or `"reading"`).
+/// merges the bricks into that one `.vdb` (see `pipeline::brick_merge`) and returns how
+/// (`"splicing"` or `"reading"`).
 #[pyfunction]
-#[pyo3(signature = (plan, files, full_bricks, index, merged = None, walker = None))]
+#[pyo3(signature = (plan, files, full_bricks, index, merged = None))]
 pub fn brick_finish(
     py: Python<'_>,
     plan: &BrickPlan,
@@ -455,10 +507,28 @@ pub fn brick_finish(
     full_bricks: Vec<PyBrick>,
     index: PathBuf,
     merged: Option<PathBuf>,
-    walker: Option<&mut BrickWalker>,
 ) -> PyResult<Option<&'static str>> {
-    let walker = walker.and_then(|w| w.0.take());
-    let set = BrickSet {
+    let set = brick_set(plan, files, full_bricks);
+    let source = plan.0.mesh.source.display().to_string();
+    py.detach(|| -> Result<Option<&'static str>> {
+        set.write(&index)?;
+        let Some(out) = merged else {
+            return Ok(None);
+        };
+        let (by, _) = merge_brick_set(&index, &out, &source)?;
+        Ok(Some(by.name()))
+    })
+    .map_err(to_py_err)
+}
+
+/// The brick set of `plan`'s run: its bricks (in files named `files`, or kept) and the bricks
+/// wholly inside.
+fn brick_set(
+    plan: &BrickPlan,
+    files: BTreeMap<PyBrick, String>,
+    full_bricks: Vec<PyBrick>,
+) -> BrickSet {
+    BrickSet {
         format: crate::io::brick_set::BRICK_SET_FORMAT.into(),
         voxel_size: plan.0.layout.transform.voxel_size,
         origin: plan.0.layout.transform.origin.to_array(),
@@ -471,18 +541,58 @@ pub fn brick_finish(
             })
             .collect(),
         full_bricks: full_bricks.into_iter().map(from_py).collect(),
-    };
+    }
+}
+
+/// Merges bricks kept in the workers' memory into the one `.vdb` `output`, atomically: from
+/// each brick's `nodes` (`EncodedBrick.nodes`) it lays the file out, writes its own bytes
+/// (the heads and the 4096^3 nodes' masks), and calls `write_bricks(temporary, placements)`
+/// to have every brick write its ranges into place (`placements`: {brick: [(start, end,
+/// at)]}; `EncodedBrick.write_into`), then syncs and renames the file. Returns the voxels.
+#[pyfunction]
+pub fn brick_splice_in_place(
+    py: Python<'_>,
+    plan: &BrickPlan,
+    nodes: BTreeMap<PyBrick, Vec<u8>>,
+    full_bricks: Vec<PyBrick>,
+    output: PathBuf,
+    write_bricks: Py<PyAny>,
+) -> PyResult<u64> {
+    let bricks: Vec<PyBrick> = nodes.keys().copied().collect();
+    let named = bricks.iter().map(|&b| (b, String::new())).collect();
+    let set = brick_set(plan, named, full_bricks);
     let source = plan.0.mesh.source.display().to_string();
-    py.detach(|| -> Result<Option<&'static str>> {
-        set.write(&index)?;
-        let walked = walker.map(|w| w.finish()).unwrap_or_default();
-        let Some(out) = merged else {
-            return Ok(None);
-        };
-        let (by, _) = merge_brick_set(&index, &out, &source, walked)?;
-        Ok(Some(by.name()))
-    })
-    .map_err(to_py_err)
+    let nodes: Vec<Vec<u8>> = nodes.into_values().collect();
+    // A Python error from `write_bricks` (a brick that failed for good, a signal) is raised
+    // again as it was.
+    let mut raised = None;
+    let merged = py.detach(|| {
+        let spliced = Spliced::in_place(&set, &nodes, &output, &brick_metadata(&source))?;
+        let voxels = spliced.voxels;
+        spliced.write_in_place(&output, bricks.len(), |tmp, placements| {
+            Python::attach(|py| {
+                let by_brick = PyDict::new(py);
+                for (b, ranges) in bricks.iter().zip(placements) {
+                    let ranges: Vec<(u64, u64, u64)> = ranges
+                        .into_iter()
+                        .map(|(r, at)| (r.start, r.end, at))
+                        .collect();
+                    by_brick.set_item(b, ranges)?;
+                }
+                write_bricks.call1(py, (tmp, by_brick)).map(|_| ())
+            })
+            .map_err(|e| {
+                let message = e.to_string();
+                raised = Some(e);
+                crate::error::Error::InvalidArgument(message)
+            })
+        })?;
+        Ok(voxels)
+    });
+    match (merged, raised) {
+        (_, Some(e)) => Err(e),
+        (merged, None) => merged.map_err(to_py_err),
+    }
 }
 
 /// Merges the brick set of the index at `index` into the one `.vdb` `output` (see
@@ -494,14 +604,14 @@ pub fn brick_merge(
     output: PathBuf,
 ) -> PyResult<(&'static str, u64)> {
     let source = index.display().to_string();
-    py.detach(|| merge_brick_set(&index, &output, &source, Default::default()))
+    py.detach(|| merge_brick_set(&index, &output, &source))
         .map(|(by, voxels)| (by.name(), voxels))
         .map_err(to_py_err)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<BrickPlan>()?;
-    m.add_class::<BrickWalker>()?;
+    m.add_class::<EncodedBrick>()?;
     m.add_function(wrap_pyfunction!(brick_plan, m)?)?;
     m.add_function(wrap_pyfunction!(brick_surface_file, m)?)?;
     m.add_function(wrap_pyfunction!(brick_faces, m)?)?;
@@ -510,5 +620,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(brick_exterior, m)?)?;
     m.add_function(wrap_pyfunction!(brick_finish, m)?)?;
     m.add_function(wrap_pyfunction!(brick_merge, m)?)?;
+    m.add_function(wrap_pyfunction!(brick_splice_in_place, m)?)?;
     Ok(())
 }
