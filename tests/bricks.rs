@@ -231,7 +231,7 @@ fn tree_bytes(path: &std::path::Path) -> Vec<u8> {
 #[test]
 fn node_bricks_splice_into_the_single_writes_tree() {
     use voxelkit::io::brick_set::{BRICK_SET_FORMAT, BrickFile, BrickSet, brick_voxels};
-    use voxelkit::io::brick_splice::{EncodedBrick, Spliced, splice_brick_set};
+    use voxelkit::io::brick_splice::{EncodedBrick, Spliced, splice_brick_set, write_bricks_into};
     use voxelkit::io::vdb::write_vdb;
     let mesh = generate::cuboid(DVec3::new(-1.0, -0.7, -0.4), DVec3::new(1.0, 0.8, 0.45));
     let t = voxelkit::mesh::fit_transform(&mesh.bbox(), GridFit::Resolution(1100)).unwrap();
@@ -307,7 +307,8 @@ fn node_bricks_splice_into_the_single_writes_tree() {
             assert!(placements.iter().any(|p| p.len() > 1), "bricks in pieces");
             std::thread::scope(|scope| {
                 for (brick, ranges) in kept.iter().zip(&placements) {
-                    scope.spawn(move || brick.write_into(tmp, ranges).unwrap());
+                    scope
+                        .spawn(move || write_bricks_into(tmp, &[(brick, ranges.clone())]).unwrap());
                 }
             });
             Ok(())

@@ -203,7 +203,6 @@ class EncodedBrick:
     @property
     def voxels(self) -> int: ...
     def nodes(self) -> bytes: ...
-    def write_into(self, path: Path, placements: Sequence[Tuple[int, int, int]]) -> None: ...
 
 def brick_finish(
     plan: BrickPlan,
@@ -212,6 +211,9 @@ def brick_finish(
     index: Path,
     merged: Optional[Path] = None,
 ) -> Optional[str]: ...
+def write_bricks_into(
+    path: Path, bricks: Sequence[Tuple[EncodedBrick, Sequence[Tuple[int, int, int]]]]
+) -> None: ...
 def brick_splice_in_place(
     plan: BrickPlan,
     nodes: Dict[Index, bytes],

@@ -327,8 +327,7 @@ def _nodes_of(results):
 
 def _write_into(results, path, placements):
     """A task's encoded bricks written into the merged file at `path`."""
-    for b, encoded in results:
-        encoded.write_into(path, placements[b])
+    vk.write_bricks_into(path, [(encoded, placements[b]) for b, encoded in results])
 
 
 def _merge_in_place(client, plan, held, nodes, full_bricks, output, progress, check):

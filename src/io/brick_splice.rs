@@ -35,6 +35,9 @@ use std::path::{Path, PathBuf};
 /// OpenVDB's order.
 type NodeKey = ([i32; 3], u16);
 
+/// A byte range of a brick's file and where it goes in the merged file.
+pub type Placement = (Range<u64>, u64);
+
 /// A 128^3 node in one brick file: the bytes of its topology and of its leaves' buffers.
 struct NodeBytes {
     brick: usize,
@@ -118,11 +121,10 @@ impl EncodedBrick {
         self.nodes.to_bytes()
     }
 
-    /// Writes each `(range, at)` of `placements` (byte ranges of the brick's file) at `at`
-    /// in the existing file `file`, and syncs it.
-    pub fn write_into(&self, file: &Path, placements: &[(Range<u64>, u64)]) -> Result<()> {
+    /// The brick file's byte ranges of `placements` with where each goes.
+    fn pieces<'a>(&'a self, placements: &[Placement]) -> Result<Vec<(&'a [u8], u64)>> {
         let len = self.bytes.len() as u64;
-        let pieces = placements
+        placements
             .iter()
             .map(|(range, at)| {
                 if range.start > range.end || range.end > len {
@@ -132,9 +134,18 @@ impl EncodedBrick {
                 }
                 Ok((&self.bytes[range.start as usize..range.end as usize], *at))
             })
-            .collect::<Result<Vec<_>>>()?;
-        write_pieces_at(file, &pieces).map_err(|e| Error::io(file, e))
+            .collect()
     }
+}
+
+/// Writes the ranges of each brick of `bricks` (`(brick, placements)`: byte ranges of its file
+/// and where each goes) into place in the existing file `file`, and syncs it once.
+pub fn write_bricks_into(file: &Path, bricks: &[(&EncodedBrick, Vec<Placement>)]) -> Result<()> {
+    let mut pieces = Vec::new();
+    for (brick, placements) in bricks {
+        pieces.extend(brick.pieces(placements)?);
+    }
+    write_pieces_at(file, &pieces).map_err(|e| Error::io(file, e))
 }
 
 /// The merged file laid out: the bytes it makes itself and the brick ranges it copies, in
@@ -155,7 +166,7 @@ enum Piece {
 /// brick the ranges of its file with their offsets.
 struct Placements {
     own: Vec<(Vec<u8>, u64)>,
-    bricks: Vec<Vec<(Range<u64>, u64)>>,
+    bricks: Vec<Vec<Placement>>,
 }
 
 impl Spliced {
@@ -301,12 +312,12 @@ impl Spliced {
     /// Writes the merged file of in-memory bricks (`in_place`) to `output`, atomically: the
     /// file made at its length, its own pieces written, then `write_bricks` handed the
     /// temporary file and each of the `bricks` bricks' placements (the bricks' ranges and
-    /// where they go) to write them where the bricks are held (`EncodedBrick::write_into`).
+    /// where they go) to write them where the bricks are held (`write_bricks_into`).
     pub fn write_in_place(
         self,
         output: &Path,
         bricks: usize,
-        write_bricks: impl FnOnce(&Path, Vec<Vec<(Range<u64>, u64)>>) -> Result<()>,
+        write_bricks: impl FnOnce(&Path, Vec<Vec<Placement>>) -> Result<()>,
     ) -> Result<()> {
         let len = self.len;
         let placed = self.placements(bricks);

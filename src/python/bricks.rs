@@ -306,22 +306,6 @@ impl EncodedBrick {
         PyBytes::new(py, &self.0.nodes())
     }
 
-    /// Writes the brick's ranges `placements` ((start, end, at): bytes start..end of its
-    /// file at `at`) into the existing file `path`, and syncs it.
-    fn write_into(
-        &self,
-        py: Python<'_>,
-        path: PathBuf,
-        placements: Vec<(u64, u64, u64)>,
-    ) -> PyResult<()> {
-        let placements: Vec<_> = placements
-            .into_iter()
-            .map(|(a, b, at)| (a..b, at))
-            .collect();
-        py.detach(|| self.0.write_into(&path, &placements))
-            .map_err(to_py_err)
-    }
-
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> (Bound<'py, PyType>, (Bound<'py, PyBytes>,)) {
         let bytes = PyBytes::new(slf.py(), slf.get().0.bytes());
         (slf.get_type(), (bytes,))
@@ -521,6 +505,28 @@ pub fn brick_finish(
     .map_err(to_py_err)
 }
 
+/// Bytes start..end of a brick's file and where they go in the merged file: (start, end, at).
+type PyPlacement = (u64, u64, u64);
+
+/// Writes the ranges of each brick of `bricks` ((brick, placements): (start, end, at) for
+/// bytes start..end of its file at `at`) into the existing file `path`, and syncs it.
+#[pyfunction]
+pub fn write_bricks_into(
+    py: Python<'_>,
+    path: PathBuf,
+    bricks: Vec<(PyRef<'_, EncodedBrick>, Vec<PyPlacement>)>,
+) -> PyResult<()> {
+    let bricks: Vec<_> = bricks
+        .iter()
+        .map(|(brick, placements)| {
+            let ranges = placements.iter().map(|&(a, b, at)| (a..b, at)).collect();
+            (&brick.0, ranges)
+        })
+        .collect();
+    py.detach(|| crate::io::brick_splice::write_bricks_into(&path, &bricks))
+        .map_err(to_py_err)
+}
+
 /// The brick set of `plan`'s run: its bricks (in files named `files`, or kept) and the bricks
 /// wholly inside.
 fn brick_set(
@@ -548,7 +554,7 @@ fn brick_set(
 /// each brick's `nodes` (`EncodedBrick.nodes`) it lays the file out, writes its own bytes
 /// (the heads and the 4096^3 nodes' masks), and calls `write_bricks(temporary, placements)`
 /// to have every brick write its ranges into place (`placements`: {brick: [(start, end,
-/// at)]}; `EncodedBrick.write_into`), then syncs and renames the file. Returns the voxels.
+/// at)]}; `write_bricks_into`), then syncs and renames the file. Returns the voxels.
 #[pyfunction]
 pub fn brick_splice_in_place(
     py: Python<'_>,
@@ -573,7 +579,7 @@ pub fn brick_splice_in_place(
             Python::attach(|py| {
                 let by_brick = PyDict::new(py);
                 for (b, ranges) in bricks.iter().zip(placements) {
-                    let ranges: Vec<(u64, u64, u64)> = ranges
+                    let ranges: Vec<PyPlacement> = ranges
                         .into_iter()
                         .map(|(r, at)| (r.start, r.end, at))
                         .collect();
@@ -621,5 +627,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(brick_finish, m)?)?;
     m.add_function(wrap_pyfunction!(brick_merge, m)?)?;
     m.add_function(wrap_pyfunction!(brick_splice_in_place, m)?)?;
+    m.add_function(wrap_pyfunction!(write_bricks_into, m)?)?;
     Ok(())
 }
