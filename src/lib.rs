@@ -10,6 +10,7 @@ pub mod grid;
 pub mod huge_pages;
 pub mod implicit;
 pub mod io;
+pub mod mapped_bytes;
 pub mod mesh;
 pub mod ops;
 #[cfg(feature = "vdb")]

@@ -323,6 +323,20 @@ fn node_bricks_splice_into_the_single_writes_tree() {
         set.bricks.len() + 4,
         "no temporary file left"
     );
+    // A brick's description of its nodes cut short, or with its slots garbled, is refused,
+    // naming the brick.
+    for garble in [
+        |n: &mut Vec<u8>| n.truncate(n.len() - 3),
+        |n: &mut Vec<u8>| n[88..].iter_mut().for_each(|b| *b = 0xff),
+    ] {
+        let mut bad = nodes.clone();
+        garble(&mut bad[0]);
+        let message = Spliced::in_place(&set, &bad, &in_place, &[])
+            .err()
+            .expect("refused")
+            .to_string();
+        assert!(message.contains("brick ["), "{message}");
+    }
     // A brick that fails to write leaves no output.
     let failed = dir.path().join("failed.vdb");
     let spliced = Spliced::in_place(&set, &nodes, &failed, &[]).unwrap();

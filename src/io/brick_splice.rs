@@ -24,6 +24,7 @@ use super::vdb_writer::{
 };
 use crate::error::{Error, Result};
 use crate::grid::{Channels, CoordBox, NODE_DIM, SparseGrid, Transform, bits, mask_box};
+use crate::mapped_bytes::MappedBytes;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -34,6 +35,9 @@ use std::path::{Path, PathBuf};
 /// Where a 128^3 slot lies: its root child's origin and its slot there. Sorting by key gives
 /// OpenVDB's order.
 type NodeKey = ([i32; 3], u16);
+
+/// The 128^3 slots of a root child (32^3).
+const ROOT_SLOTS: u16 = 1 << (3 * NODE_LOG2[0]);
 
 /// A byte range of a brick's file and where it goes in the merged file.
 pub type Placement = (Range<u64>, u64);
@@ -91,9 +95,10 @@ pub fn splice_brick_set(
 
 /// A brick's file encoded in memory, its nodes walked: what a worker keeps until it writes
 /// the nodes into their places in the merged file (`Spliced::placements`), so that no brick
-/// goes through the disk twice.
+/// goes through the disk twice; in a mapping of its own (`MappedBytes`), so that the memory
+/// goes back to the kernel when the brick is dropped.
 pub struct EncodedBrick {
-    bytes: Vec<u8>,
+    bytes: MappedBytes,
     nodes: BrickNodes,
 }
 
@@ -103,6 +108,7 @@ impl EncodedBrick {
         let mut r = Reader::from_bytes(bytes);
         let nodes = walk_brick(&mut r, 0, &Layout::voxel_set()?).map_err(|m| damaged(what, m))?;
         let bytes = r.into_bytes().expect("a reader of bytes");
+        let bytes = MappedBytes::copy_of(&bytes).map_err(|e| Error::io(what, e))?;
         Ok(EncodedBrick { bytes, nodes })
     }
 
@@ -152,7 +158,7 @@ pub fn write_bricks_into(file: &Path, bricks: &[(&EncodedBrick, Vec<Placement>)]
 /// file order, and its length and voxels.
 pub struct Spliced {
     pieces: Vec<Piece>,
-    pub len: u64,
+    len: u64,
     pub voxels: u64,
 }
 
@@ -575,12 +581,20 @@ impl BrickNodes {
                 *v = i32::from_le_bytes(r.take()?);
             }
             let slot = u16::from_le_bytes(r.take()?);
+            if origin.iter().any(|v| v.rem_euclid(ROOT_TILE) != 0) || slot >= ROOT_SLOTS {
+                return Err(format!(
+                    "a node at {origin:?}, slot {slot}, off the lattice"
+                ));
+            }
             let node = match r.take::<1>()?[0] {
                 0 => None,
                 1 => {
                     let mut v = [0u64; 5];
                     for x in &mut v {
                         *x = u64::from_le_bytes(r.take()?);
+                    }
+                    if v[0] > v[1] || v[2] > v[3] {
+                        return Err(format!("a node's ranges {v:?} run backwards"));
                     }
                     Some(NodeBytes {
                         brick: 0,
