@@ -1,11 +1,14 @@
 //! A brick set merged into one `.vdb` without decoding a voxel. A brick whose edge is a
 //! multiple of 128 voxels holds whole 128^3 nodes of OpenVDB's tree, and its file holds each
 //! of them as the merged file does: the node's topology (masks, tile values, its leaves'
-//! masks) and its leaves' compressed buffers, byte for byte. The merge walks each brick file's
+//! masks) and its leaves' compressed buffers, byte for byte. The merge walks each brick's
 //! structure (masks and chunk sizes, never a value), sorts the nodes of all bricks into
-//! OpenVDB's order and copies their bytes into place, building only the root's children
-//! (4096^3 nodes: which of their slots hold a node or a tile) itself. It holds a few dozen
-//! bytes per 128^3 node and no voxel, so its memory does not grow with the voxels merged.
+//! OpenVDB's order and lays the file out (`Spliced`), building only the root's children
+//! (4096^3 nodes: which of their slots hold a node or a tile) itself. Then either it copies
+//! the bricks' bytes into place from their files (`splice_brick_set`), or the workers that
+//! hold the bricks encoded in memory (`EncodedBrick`) write them into place themselves
+//! (`Spliced::write_in_place`). It holds a few dozen bytes per 128^3 node and no voxel, so
+//! its memory does not grow with the voxels merged.
 
 use super::atomic::{check_output, write_atomic};
 use super::brick_set::{BrickSet, brick_voxels};
