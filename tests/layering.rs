@@ -7,7 +7,14 @@ use std::path::Path;
 /// The top-level modules from the bottom up; modules on one rank may not use each other.
 const LAYERS: [&[&str]; 14] = [
     &["error"],
-    &["system", "huge_pages", "mapped_bytes", "progress", "random", "choice"],
+    &[
+        "system",
+        "huge_pages",
+        "mapped_bytes",
+        "progress",
+        "random",
+        "choice",
+    ],
     &["grid"],
     &["contour"],
     &["ffi"],
