@@ -179,7 +179,9 @@ pub(super) fn write_pieces_at(path: &Path, pieces: &[(&[u8], u64)]) -> io::Resul
                         .iter()
                         .step_by(writers)
                         .try_for_each(|&(bytes, at)| out.write(bytes, at));
-                    SPARE_BLOCKS.lock().map(|mut b| b.push(out.block)).ok();
+                    if let Ok(mut spare) = SPARE_BLOCKS.lock() {
+                        spare.push(out.block);
+                    }
                     written
                 })
             })

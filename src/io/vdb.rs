@@ -13,7 +13,7 @@ use super::grid_out::{GridOut, GridValues};
 use super::nvdb_writer::write_nvdb_grids;
 use super::vdb_format::{COVARIANT_NORMALIZE, FOG_VOLUME, LEVEL_SET};
 pub use super::vdb_format::{Compression, MetaValue};
-use super::vdb_writer::{Encoding, encode_grids_to_memory, write_grids};
+use super::vdb_writer::{Encoding, encode_grids, write_grids};
 use crate::contour::{Meaning, ScalarField};
 use crate::error::{Error, Result};
 use crate::grid::attribute_grid::{AttributeGrid, AttributeKind};
@@ -145,12 +145,18 @@ pub fn write_contents_timed(
     metadata: &[(&str, MetaValue)],
     options: &WriteOptions,
 ) -> Result<[StageTime; 3]> {
-    let meta = meta_entries(metadata);
-    let grids = chosen(path, candidates(path, contents, &meta, options)?, options)?;
-    let mut clocks = WriteClocks {
-        encode: StageClock::new("encode"),
-        write: StageClock::new("write"),
-    };
+    with_chosen_grids(path, contents, metadata, options, |grids| {
+        write_chosen_grids(path, grids, options)
+    })
+}
+
+/// Writes the chosen `grids` to `path` (`.vdb` or `.nvdb`) atomically; where the time went.
+fn write_chosen_grids(
+    path: &Path,
+    grids: &[GridOut],
+    options: &WriteOptions,
+) -> Result<[StageTime; 3]> {
+    let mut clocks = WriteClocks::new();
     let mut fsync = StageClock::new("fsync");
     if is_nvdb(path) {
         if options.half {
@@ -160,12 +166,12 @@ pub fn write_contents_timed(
             )));
         }
         write_atomic_timed(path, &mut fsync, |tmp| {
-            write_nvdb_grids(tmp, path, &grids, &mut clocks)
+            write_nvdb_grids(tmp, path, grids, &mut clocks)
         })?;
     } else {
         let encoding = encoding(options);
         write_atomic_timed(path, &mut fsync, |tmp| {
-            write_grids(tmp, path, &grids, encoding, &mut clocks)
+            write_grids(tmp, path, grids, encoding, &mut clocks)
         })?;
     }
     Ok([clocks.encode.stage(), clocks.write.stage(), fsync.stage()])
@@ -179,13 +185,32 @@ pub fn encode_contents(
     metadata: &[(&str, MetaValue)],
     options: &WriteOptions,
 ) -> Result<Vec<u8>> {
+    with_chosen_grids(what, contents, metadata, options, |grids| {
+        encode_grids(
+            Vec::new(),
+            what,
+            grids,
+            encoding(options),
+            &mut WriteClocks::new(),
+        )
+    })
+}
+
+/// Calls `f` with the grids a write of `contents` with `metadata` makes, as `options` choose
+/// them; errors name `what`.
+fn with_chosen_grids<T>(
+    what: &Path,
+    contents: &Contents,
+    metadata: &[(&str, MetaValue)],
+    options: &WriteOptions,
+    f: impl FnOnce(&[GridOut]) -> Result<T>,
+) -> Result<T> {
     let meta = meta_entries(metadata);
-    let grids = chosen(what, candidates(what, contents, &meta, options)?, options)?;
-    let mut clocks = WriteClocks {
-        encode: StageClock::new("encode"),
-        write: StageClock::new("write"),
-    };
-    encode_grids_to_memory(what, &grids, encoding(options), &mut clocks)
+    f(&chosen(
+        what,
+        candidates(what, contents, &meta, options)?,
+        options,
+    )?)
 }
 
 /// How `options` ask a `.vdb`'s values to be encoded.
@@ -202,6 +227,15 @@ pub(super) struct WriteClocks {
     pub write: StageClock,
 }
 
+impl WriteClocks {
+    fn new() -> WriteClocks {
+        WriteClocks {
+            encode: StageClock::new("encode"),
+            write: StageClock::new("write"),
+        }
+    }
+}
+
 /// The grids a write of `contents` makes (only the one at index `which` when given), as plain
 /// arrays for another library to build its own from (see `grid_export`); errors name `what`,
 /// where they are bound.
@@ -212,16 +246,16 @@ pub fn export_contents(
     options: &WriteOptions,
     which: Option<usize>,
 ) -> Result<Vec<ExportedGrid>> {
-    let meta = meta_entries(metadata);
-    let grids = chosen(what, candidates(what, contents, &meta, options)?, options)?;
-    let count = grids.len();
-    let grids = match which {
-        Some(i) => grids.get(i..=i).ok_or_else(|| {
-            Error::InvalidArgument(format!("grid {i} is out of range: the write makes {count}"))
-        })?,
-        None => &grids[..],
-    };
-    grids.iter().map(|g| export_grid(what, g)).collect()
+    with_chosen_grids(what, contents, metadata, options, |grids| {
+        let count = grids.len();
+        let grids = match which {
+            Some(i) => grids.get(i..=i).ok_or_else(|| {
+                Error::InvalidArgument(format!("grid {i} is out of range: the write makes {count}"))
+            })?,
+            None => grids,
+        };
+        grids.iter().map(|g| export_grid(what, g)).collect()
+    })
 }
 
 /// How many grids a write of `contents` makes, as `options` choose them.

@@ -105,16 +105,6 @@ pub(super) fn write_grids(
     encode_grids(out, path, grids, encoding, clocks)
 }
 
-/// The bytes of the `.vdb` file that `write_grids` writes, in memory; errors name `path`.
-pub(super) fn encode_grids_to_memory(
-    path: &Path,
-    grids: &[GridOut],
-    encoding: Encoding,
-    clocks: &mut WriteClocks,
-) -> Result<Vec<u8>> {
-    encode_grids(Vec::new(), path, grids, encoding, clocks)
-}
-
 /// Where a `.vdb`'s bytes go, front to back, then the grids' end offsets patched in.
 pub(super) trait Output: Send {
     type Done;
@@ -165,8 +155,8 @@ impl Output for Vec<u8> {
     }
 }
 
-/// Encodes `grids` into `out`; errors name `path`.
-fn encode_grids<O: Output>(
+/// Encodes `grids` into `out` (a file, or memory: `Vec<u8>`); errors name `path`.
+pub(super) fn encode_grids<O: Output>(
     out: O,
     path: &Path,
     grids: &[GridOut],
