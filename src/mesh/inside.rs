@@ -1,7 +1,9 @@
 //! Which voxel centres lie inside a closed mesh, by ray parity along z: every column of
 //! centres `(i, j)` casts one ray along +z (exact crossings, see `crossings`), and a centre is
 //! inside when it lies between crossings 2m and 2m+1 (sorted); a centre on a crossing lies on
-//! the side the shared tie rule puts it (`crossings`), as depth layers put it.
+//! the side the shared tie rule puts it (`crossings`), as depth layers put it. The same
+//! crossings, signed, count a closed and consistently oriented mesh's winding number
+//! (`ColumnRule::Winding`).
 
 use super::crossings::{RayFrame, RayWindow, for_each_crossing};
 use crate::error::Result;
@@ -32,8 +34,47 @@ impl Crossing {
     }
 }
 
-/// The crossings of a mesh with the z rays of a box's columns, sorted by column, then z.
+/// Which centres of a column its crossings put inside.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColumnRule {
+    /// Those between crossings 2m and 2m+1: ray parity.
+    Parity,
+    /// Those whose integer winding number, the signed count of the crossings below them (read
+    /// reversed where `orientation` is -1), is at least 1: a closed, consistently oriented
+    /// mesh's generalized winding number is that integer (`solids::winding_inside`).
+    Winding { orientation: i32 },
+}
+
+/// The inside centres of one column with crossings `column` (ascending in z), by `rule`, as
+/// inclusive z spans `span(first, last)`, ascending; some may be empty (`first > last`).
+#[inline]
+fn column_spans(column: &[Crossing], rule: ColumnRule, mut span: impl FnMut(i64, i64)) {
+    match rule {
+        ColumnRule::Parity => {
+            for pair in column.chunks_exact(2) {
+                span(pair[0].after, pair[1].after - 1);
+            }
+        }
+        ColumnRule::Winding { orientation } => {
+            let (mut k, mut first) = (0, 0);
+            for c in column {
+                // Going up through a surface that faces down enters it.
+                let next = k - c.direction();
+                match (k * orientation >= 1, next * orientation >= 1) {
+                    (false, true) => first = c.after,
+                    (true, false) => span(first, c.after - 1),
+                    _ => {}
+                }
+                k = next;
+            }
+        }
+    }
+}
+
+/// The crossings of a mesh with the z rays of a box's columns, sorted by column, then z, and
+/// the rule that reads inside centres from them.
 pub struct ColumnCrossings {
+    rule: ColumnRule,
     window: RayWindow,
     crossings: Vec<Crossing>,
     /// Where each x row of columns starts in `crossings` (and where the last ends).
@@ -158,11 +199,17 @@ impl ColumnCrossings {
             }
         });
         ColumnCrossings {
+            rule: ColumnRule::Parity,
             window,
             crossings,
             row_starts,
             column_starts,
         }
+    }
+
+    /// The same crossings with their inside centres read by `rule` (ray parity unless told).
+    pub fn read_by(self, rule: ColumnRule) -> Self {
+        ColumnCrossings { rule, ..self }
     }
 
     /// The crossings of columns `(x, y)` for `y` in `ys`, which must lie in the window.
@@ -186,12 +233,10 @@ impl ColumnCrossings {
         self.columns_of(x, y..=y)
     }
 
-    /// The inside centres of column `(x, y)` (inside the box's columns) as inclusive z spans,
-    /// ascending; some may be empty (`first > last`).
-    pub fn spans(&self, x: i64, y: i64) -> impl Iterator<Item = (i64, i64)> + '_ {
-        self.columns_of(x, y..=y)
-            .chunks_exact(2)
-            .map(|pair| (pair[0].after, pair[1].after - 1))
+    /// The inside centres of column `(x, y)` (inside the box's columns) as inclusive z spans
+    /// `span(first, last)`, ascending; some may be empty (`first > last`).
+    pub fn spans(&self, x: i64, y: i64, span: impl FnMut(i64, i64)) {
+        column_spans(self.columns_of(x, y..=y), self.rule, span);
     }
 
     /// The spans of inside centres of the `count` columns `(x, y0 + i)`, as `span(i, first z,
@@ -210,28 +255,18 @@ impl ColumnCrossings {
             .chunk_by(|a, b| a.ray() == b.ray())
         {
             let i = (column[0].ray() - first) + (ys - y0) as usize;
-            for pair in column.chunks_exact(2) {
-                span(i, pair[0].after, pair[1].after - 1);
-            }
+            column_spans(column, self.rule, |z0, z1| span(i, z0, z1));
         }
     }
 
-    /// Every column's spans of inside centres, as `(x, y, first z, last z)`.
-    pub fn all_spans(&self) -> impl Iterator<Item = (i64, i64, i64, i64)> + '_ {
+    /// Every column's spans of inside centres, as `span(x, y, first z, last z)`.
+    pub fn all_spans(&self, mut span: impl FnMut(i64, i64, i64, i64)) {
         let height = self.window.height;
-        self.crossings
-            .chunk_by(|a, b| a.ray() == b.ray())
-            .flat_map(move |column| {
-                let (x, y) = (column[0].ray() / height, column[0].ray() % height);
-                column.chunks_exact(2).map(move |pair| {
-                    (
-                        self.window.a0 + x as i64,
-                        self.window.b0 + y as i64,
-                        pair[0].after,
-                        pair[1].after - 1,
-                    )
-                })
-            })
+        for column in self.crossings.chunk_by(|a, b| a.ray() == b.ray()) {
+            let (x, y) = (column[0].ray() / height, column[0].ray() % height);
+            let (x, y) = (self.window.a0 + x as i64, self.window.b0 + y as i64);
+            column_spans(column, self.rule, |z0, z1| span(x, y, z0, z1));
+        }
     }
 
     /// The columns' x range and y range, inclusive.
@@ -248,12 +283,56 @@ impl ColumnCrossings {
 pub fn inside_centres(mesh: &Mesh, transform: &Transform, bbox: CoordBox) -> Result<DenseMask> {
     let mut inside = DenseMask::new(bbox)?;
     let columns = ColumnCrossings::new(mesh, transform, bbox);
-    for (x, y, z0, z1) in columns.all_spans() {
+    columns.all_spans(|x, y, z0, z1| {
         let (z0, z1) = (z0.max(bbox.min[2]), z1.min(bbox.max[2]));
         if z0 <= z1 {
             let first = inside.index([x, y, z0]);
             inside.set_index_range(first, first + (z1 - z0) as usize);
         }
-    }
+    });
     Ok(inside)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A column's crossings at `after`, rising (the surface faces +z) or not.
+    fn column(crossings: &[(i64, bool)]) -> Vec<Crossing> {
+        crossings
+            .iter()
+            .map(|&(after, rising)| Crossing {
+                key: 7 << 1 | rising as usize,
+                after,
+            })
+            .collect()
+    }
+
+    fn spans(column: &[Crossing], rule: ColumnRule) -> Vec<(i64, i64)> {
+        let mut found = Vec::new();
+        column_spans(column, rule, |z0, z1| found.push((z0, z1)));
+        found
+    }
+
+    #[test]
+    fn winding_counts_overlaps_in_and_reversed_shells_out_where_parity_pairs_crossings() {
+        let outward = ColumnRule::Winding { orientation: 1 };
+        // Two overlapping outward shells: in at 0 and 4, out at 8 and 12 (winding 2 between).
+        let overlap = column(&[(0, false), (4, false), (8, true), (12, true)]);
+        assert_eq!(spans(&overlap, ColumnRule::Parity), [(0, 3), (8, 11)]);
+        assert_eq!(spans(&overlap, outward), [(0, 11)]);
+        // An outward shell holding an inward one (a hollow): winding 0 in the hollow.
+        let hollow = column(&[(0, false), (4, true), (8, false), (12, true)]);
+        assert_eq!(spans(&hollow, outward), [(0, 3), (8, 11)]);
+        assert_eq!(spans(&hollow, ColumnRule::Parity), [(0, 3), (8, 11)]);
+        // A mesh read reversed: its inward shells bound the inside.
+        let inward = column(&[(0, true), (4, false)]);
+        assert_eq!(spans(&inward, outward), []);
+        assert_eq!(
+            spans(&inward, ColumnRule::Winding { orientation: -1 }),
+            [(0, 3)]
+        );
+        // Centres on no crossing's inside: none.
+        assert_eq!(spans(&[], outward), []);
+    }
 }

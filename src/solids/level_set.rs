@@ -10,10 +10,10 @@
 //! band), so one centre decides it.
 
 use super::inside_rule::Inside;
-use super::winding_inside::{block_columns, winding_inside};
+use super::winding_inside::{block_columns, closed_by_caps, winding_inside, winds_reversed};
 use crate::error::Result;
 use crate::grid::{Channels, Coord, Leaf, SparseGrid, Transform};
-use crate::mesh::inside::ColumnCrossings;
+use crate::mesh::inside::{ColumnCrossings, ColumnRule};
 use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
 use crate::progress::Progress;
@@ -51,8 +51,27 @@ pub fn level_set(
     let reach = band.ceil() as i64;
     let columns_box = padded(index_box(&mesh.bbox(), &transform), reach);
     let caps = match inside {
+        Inside::Parity => {
+            mesh.require_closed(SIGN_NEEDS_CLOSED)?;
+            return columns_level_set(mesh, transform, band, progress, || {
+                ColumnCrossings::new(mesh, &transform, columns_box)
+            });
+        }
+        // Closed and consistently oriented: the winding number is the signed count of
+        // crossings, which the band's leaves and blocks read as parity's do.
+        Inside::Winding(caps) if caps.is_empty() => {
+            return columns_level_set(mesh, transform, band, progress, || {
+                let (points, triangles) = closed_by_caps(mesh, caps);
+                let orientation = if winds_reversed(&points, &triangles) {
+                    -1
+                } else {
+                    1
+                };
+                ColumnCrossings::of_triangles(&points, &triangles, &transform, columns_box)
+                    .read_by(ColumnRule::Winding { orientation })
+            });
+        }
         Inside::Winding(caps) => caps,
-        Inside::Parity => return parity_level_set(mesh, transform, band, columns_box, progress),
     };
     let columns = block_columns(columns_box).len() as u64;
     progress.stage("distances and inside", work_items(mesh) + columns);
@@ -123,19 +142,18 @@ const SIGN_FLIPS: [[u32; 4]; 16] = {
     flips
 };
 
-/// The level set of a closed mesh signed by ray parity.
-fn parity_level_set(
+/// The level set of a closed mesh signed by the inside its columns' crossings give
+/// (`crossings`, made beside the band): read only in the band's leaves and at one centre of
+/// each block without band voxels, not in every block.
+fn columns_level_set(
     mesh: &Mesh,
     transform: Transform,
     band: f64,
-    columns_box: crate::grid::CoordBox,
     progress: &Progress,
+    crossings: impl FnOnce() -> ColumnCrossings + Send,
 ) -> Result<LevelSet> {
-    mesh.require_closed(SIGN_NEEDS_CLOSED)?;
-    let (grid, columns) = rayon::join(
-        || distance_band(mesh, transform, band, progress),
-        || ColumnCrossings::new(mesh, &transform, columns_box),
-    );
+    progress.stage("distances and inside", work_items(mesh));
+    let (grid, columns) = rayon::join(|| distance_band(mesh, transform, band, progress), crossings);
     let mut grid = grid?;
     if grid.leaf_count() == 0 {
         return Ok(LevelSet {
@@ -194,13 +212,13 @@ fn inside_blocks(columns: &ColumnCrossings, band: &SparseGrid) -> Vec<Coord> {
         .flat_map_iter(|&x| {
             let mut found = Vec::new();
             for y in (first(y0)..=y1).step_by(8) {
-                for (z0, z1) in columns.spans(x, y) {
+                columns.spans(x, y, |z0, z1| {
                     for z in (first(z0)..=z1).step_by(8) {
                         if band.leaf([x, y, z]).is_none() {
                             found.push([x, y, z]);
                         }
                     }
-                }
+                });
             }
             found
         })
