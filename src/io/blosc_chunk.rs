@@ -8,6 +8,12 @@
 //! blosc's (format 2, LZ4 format 1: a 16-byte header, the block's start, the block as one LZ4
 //! stream after its length), so blosc, OpenVDB among its readers, decompresses them.
 //!
+//! A block of 128 values or more may instead be one stream per byte plane (blosc's split
+//! mode, which its reader knows from the header). That is how a chunk skips LZ4 where it
+//! cannot help: the low mantissa bytes of computed distances look random, LZ4 finds nothing in
+//! them and takes as long as on the bytes it shrinks. Such a plane is stored raw (a stream as
+//! long as its plane, as blosc stores a stream that did not shrink), the others compressed.
+//!
 //! A fast reset leaves the previous chunks' entries in the table, but LZ4 takes no match
 //! from them (each reset moves the stream 64 KiB further on, out of reach), so a chunk's bytes
 //! depend on its values alone, whichever thread wrote what before. A stream's first chunk
@@ -29,9 +35,17 @@ const BLOSC_FORMAT: u8 = 2;
 const LZ4_FORMAT: u8 = 1;
 /// LZ4's acceleration at blosc's level 9, OpenVDB's (blosc passes 10 - level).
 const LZ4_ACCELERATION: c_int = 1;
-/// Header flags: byte shuffle (`BLOSC_DOSHUFFLE`), one stream per block
-/// (`BLOSC_DONT_SPLIT`), and LZ4's compressor code (1) in the top three bits.
-const FLAGS: u8 = 0x01 | 0x10 | (1 << 5);
+/// Header flags: byte shuffle (`BLOSC_DOSHUFFLE`) and LZ4's compressor code (1) in the top
+/// three bits; with `BLOSC_DONT_SPLIT`, one stream per block.
+const SPLIT_FLAGS: u8 = 0x01 | (1 << 5);
+const FLAGS: u8 = SPLIT_FLAGS | 0x10;
+/// Blosc splits a block into planes for values of at most this many bytes (`MAX_SPLITS`).
+const MOST_PLANES: usize = 16;
+/// Bytes a plane's look at itself samples, and how many distinct ones mark it as random: LZ4
+/// shrinks bytes by repeats of four, which a plane of a few distinct bytes holds and one whose
+/// sample is nearly all distinct almost never does.
+const SAMPLES: usize = 16;
+const RANDOM_DISTINCT: u32 = 13;
 
 #[repr(C)]
 struct Lz4Stream {
@@ -102,6 +116,46 @@ impl Compressor {
     }
 }
 
+impl Compressor {
+    /// The shuffled block as one LZ4 stream after the header and the block's start in `out`
+    /// (its room): the chunk's length, `None` when it does not fit.
+    fn stream(&mut self, shuffled: &[u8], out: &mut [u8]) -> Option<usize> {
+        let packed = self.lz4(shuffled, &mut out[FRAMING..]);
+        if packed == 0 {
+            return None;
+        }
+        out[FRAMING - 4..FRAMING].copy_from_slice(&(packed as u32).to_le_bytes());
+        Some(FRAMING + packed)
+    }
+
+    /// The shuffled block as one stream per plane, each behind its length: compressed where
+    /// the plane does not look random and LZ4 shrinks it, raw (its length the plane's) where
+    /// not. The chunk's length, `None` when it does not fit `out`.
+    fn planes(&mut self, shuffled: &[u8], value_size: usize, out: &mut [u8]) -> Option<usize> {
+        let plane_len = shuffled.len() / value_size;
+        let mut at = FRAMING - 4;
+        for plane in shuffled.chunks_exact(plane_len) {
+            let room = out.len().checked_sub(at + 4)?;
+            let stream = &mut out[at + 4..];
+            // A compressed stream as long as its plane would read as raw: LZ4 gets one less.
+            let packed = if looks_random(plane) {
+                0
+            } else {
+                self.lz4(plane, &mut stream[..room.min(plane_len - 1)])
+            };
+            let len = if packed == 0 {
+                stream.get_mut(..plane_len)?.copy_from_slice(plane);
+                plane_len
+            } else {
+                packed
+            };
+            out[at..at + 4].copy_from_slice(&(len as u32).to_le_bytes());
+            at += 4 + len;
+        }
+        Some(at)
+    }
+}
+
 impl Drop for Compressor {
     fn drop(&mut self) {
         // SAFETY: the stream was made by LZ4_createStream and is not used again.
@@ -130,21 +184,46 @@ pub(super) fn blosc_chunk(data: &[u8], value_size: usize, out: &mut [u8]) -> Opt
         let c = c.as_mut()?;
         let mut shuffled = std::mem::take(&mut c.shuffled);
         shuffle(data, value_size, &mut shuffled);
-        let packed = c.lz4(&shuffled, &mut out[FRAMING..FRAMING + room]);
+        let split = splits(data.len(), value_size)
+            && shuffled
+                .chunks_exact(data.len() / value_size)
+                .any(looks_random);
+        let written = if split {
+            c.planes(&shuffled, value_size, &mut out[..FRAMING + room])
+        } else {
+            c.stream(&shuffled, &mut out[..FRAMING + room])
+        };
         c.shuffled = shuffled;
-        if packed == 0 {
-            return None;
-        }
+        let total = written?;
         let nbytes = data.len() as u32;
-        let total = FRAMING + packed;
-        out[..4].copy_from_slice(&[BLOSC_FORMAT, LZ4_FORMAT, FLAGS, value_size as u8]);
+        let flags = if split { SPLIT_FLAGS } else { FLAGS };
+        out[..4].copy_from_slice(&[BLOSC_FORMAT, LZ4_FORMAT, flags, value_size as u8]);
         out[4..8].copy_from_slice(&nbytes.to_le_bytes());
         out[8..12].copy_from_slice(&nbytes.to_le_bytes());
         out[12..16].copy_from_slice(&(total as u32).to_le_bytes());
         out[16..20].copy_from_slice(&(HEADER as u32 + 4).to_le_bytes());
-        out[20..24].copy_from_slice(&(packed as u32).to_le_bytes());
         Some(total)
     })
+}
+
+/// Whether blosc's reader splits a one-block chunk of `len` bytes of `value_size`-byte values
+/// into planes when its header allows (`blosc_d`), each plane whole.
+fn splits(len: usize, value_size: usize) -> bool {
+    value_size > 1
+        && value_size <= MOST_PLANES
+        && len.is_multiple_of(value_size)
+        && len / value_size >= MIN_BUFFER
+}
+
+/// Whether a plane's sample is nearly all distinct bytes (see `RANDOM_DISTINCT`).
+fn looks_random(plane: &[u8]) -> bool {
+    let stride = plane.len() / SAMPLES;
+    let mut seen = [0u64; 4];
+    for i in 0..SAMPLES {
+        let b = plane[i * stride];
+        seen[usize::from(b >> 6)] |= 1 << (b & 63);
+    }
+    seen.iter().map(|w| w.count_ones()).sum::<u32>() >= RANDOM_DISTINCT
 }
 
 /// Blosc's byte shuffle: byte `j` of every value together, for each `j` in turn; the bytes
@@ -293,10 +372,8 @@ mod tests {
 
     #[test]
     fn chunks_are_blosc_chunks_of_the_same_bytes() {
-        // Blosc's chunks to compare headers with: one stream per block, as these are.
-        // SAFETY: sets a global that only this test's calls read.
-        unsafe { blosc_set_splitmode(2) };
         let mut compressed = 0;
+        let mut split = 0;
         for (data, value_size) in samples() {
             let mut out = vec![0u8; data.len() + 64];
             let Some(n) = blosc_chunk(&data, value_size, &mut out) else {
@@ -309,6 +386,12 @@ mod tests {
                 data,
                 "{value_size}-byte values"
             );
+            // Blosc's chunks to compare headers with: split into planes or not, as this is
+            // (its modes: 1 always, 2 never).
+            let planes = out[2] & 0x10 == 0;
+            split += usize::from(planes);
+            // SAFETY: sets a global that only this test's calls read.
+            unsafe { blosc_set_splitmode(if planes { 1 } else { 2 }) };
             // Blosc's own chunk of the same values has the same header (its sizes aside).
             let mut theirs = vec![0u8; data.len() + 64];
             // SAFETY: blosc reads `data` and writes at most `theirs.len()` bytes.
@@ -333,6 +416,36 @@ mod tests {
             }
         }
         assert!(compressed >= 12, "most samples compress ({compressed})");
+        // The noise of 300 and 512 values (whose low bytes look random) is split.
+        assert!(split >= 2, "{split} chunks split into planes");
+    }
+
+    #[test]
+    fn random_planes_are_stored_raw_and_the_rest_compressed() {
+        // Distances of a leaf: a smooth exponent byte, random low bytes.
+        let mut random = SplitMix64(3);
+        let data: Vec<u8> = (0..400)
+            .flat_map(|i| {
+                (0.001 * (1.0 + i as f32 / 400.0) + random.range(0.0, 1e-5) as f32).to_le_bytes()
+            })
+            .collect();
+        let mut out = vec![0u8; data.len()];
+        let n = blosc_chunk(&data, 4, &mut out).expect("the exponent plane compresses");
+        assert_eq!(out[2] & 0x10, 0, "split into planes");
+        let mut at = FRAMING - 4;
+        let mut lengths = Vec::new();
+        for _ in 0..4 {
+            let len = u32::from_le_bytes(out[at..at + 4].try_into().unwrap()) as usize;
+            lengths.push(len);
+            at += 4 + len;
+        }
+        assert_eq!(at, n, "four streams fill the chunk");
+        assert_eq!(lengths[..2], [400, 400], "the low bytes raw");
+        assert!(
+            lengths[3] < 100,
+            "the exponent bytes compressed: {lengths:?}"
+        );
+        assert_eq!(unpack(&out[..n], data.len()), data);
     }
 
     #[test]
