@@ -25,7 +25,7 @@ use crate::error::Result;
 use crate::grid::{Channels, Coord, CoordBox, Leaf, SparseGrid, Transform};
 use crate::mesh::Mesh;
 use crate::mesh::boundary_caps::BoundaryCaps;
-use crate::mesh::inside::{ColumnCrossings, Crossing};
+use crate::mesh::inside::{ColumnCrossings, ColumnRule, Crossing};
 use crate::mesh::winding::{RimBound, WindingBounds, WindingTree};
 use crate::mesh::winding_split::{SplitWinding, Splitter};
 use crate::progress::Progress;
@@ -71,7 +71,8 @@ enum Block {
 /// The largest ball `settle_by_model` asks about: half an 8^3 block's diagonal.
 const MODEL_REACH: f64 = 4.0 * 1.7320508075688772;
 
-/// Blocks decided by threshold 1 are not listed: the default far from any cap.
+/// Blocks decided by threshold 1 are not listed: the default far from any cap, which the
+/// columns' own reading of the integer winding applies (`ColumnRule::Winding`).
 const DEFAULT_THRESHOLD: i32 = 1;
 
 /// The edge of the coarsest blocks the caps' range is bounded over.
@@ -131,7 +132,10 @@ pub fn winding_inside(
         orientation,
     };
     let (columns, (special, surface)) = rayon::join(
-        || ColumnCrossings::of_triangles(&points, &triangles, &transform, region),
+        || {
+            ColumnCrossings::of_triangles(&points, &triangles, &transform, region)
+                .read_by(ColumnRule::Winding { orientation })
+        },
         || {
             if caps.is_empty() {
                 (BTreeMap::new(), WindingTree::of_triangles(Vec::new()))
@@ -413,30 +417,28 @@ impl Context<'_> {
         let mut windings = vec![[OUTSIDE_REGION; 512]; special.len()];
         let mut out = BlockColumn::default();
         for x in bx.max(r.min[0])..=(bx + 7).min(r.max[0]) {
+            let lx = (x - bx) as usize;
+            // Blocks of the default threshold: runs of centres with winding >= 1, which the
+            // columns read (`ColumnRule::Winding`).
+            self.columns.row_spans(x, by, 8, |ly, first, last| {
+                let (first, last) = (first.max(r.min[2]), last.min(r.max[2]));
+                let mut z = first;
+                while z <= last {
+                    let bz = z & !7;
+                    let end = last.min(bz + 7);
+                    if !is_special(bz) {
+                        let run = (1u64 << (end - z + 1)) - 1;
+                        masks[slot(bz)][lx] |= run << (ly * 8 + (z - bz) as usize);
+                    }
+                    z = end + 1;
+                }
+            });
+            if special.is_empty() {
+                continue;
+            }
             for y in by.max(r.min[1])..=(by + 7).min(r.max[1]) {
-                let crossings = self.columns.column(x, y);
-                if crossings.is_empty() && special.is_empty() {
-                    continue;
-                }
-                let stretches = stretches(crossings, self.caps.orientation);
-                let (lx, ly) = ((x - bx) as usize, (y - by) as usize);
-                // Blocks of the default threshold: runs of centres with winding >= 1.
-                for &(first, last, k) in &stretches {
-                    if k < DEFAULT_THRESHOLD {
-                        continue;
-                    }
-                    let (first, last) = (first.max(r.min[2]), last.min(r.max[2]));
-                    let mut z = first;
-                    while z <= last {
-                        let bz = z & !7;
-                        let end = last.min(bz + 7);
-                        if !is_special(bz) {
-                            let run = (1u64 << (end - z + 1)) - 1;
-                            masks[slot(bz)][lx] |= run << (ly * 8 + (z - bz) as usize);
-                        }
-                        z = end + 1;
-                    }
-                }
+                let stretches = stretches(self.columns.column(x, y), self.caps.orientation);
+                let ly = (y - by) as usize;
                 for (&(bz, _), block) in special.iter().zip(&mut windings) {
                     for z in bz.max(r.min[2])..=(bz + 7).min(r.max[2]) {
                         block[lx * 64 + ly * 8 + (z - bz) as usize] = stretches
