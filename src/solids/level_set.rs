@@ -175,10 +175,16 @@ fn columns_level_set(
             ((!inside.is_empty()).then_some(inside), count)
         })
         .unzip();
-    let inside: Vec<Leaf> = inside.into_iter().flatten().collect();
-    let mut interior = SparseGrid::from_distinct_leaves(transform, Channels::NONE, inside);
+    // The inside leaves' index is made (on one thread) while the whole blocks are found.
+    let (mut interior, blocks) = rayon::join(
+        || {
+            let inside: Vec<Leaf> = inside.into_iter().flatten().collect();
+            SparseGrid::from_distinct_leaves(transform, Channels::NONE, inside)
+        },
+        || inside_blocks(&columns, &grid),
+    );
     // Band leaves stay leaves, even wholly inside: the level set writes its tiles.
-    interior.fill_leaf_blocks(inside_blocks(&columns, &grid));
+    interior.fill_leaf_blocks(blocks);
     Ok(LevelSet {
         band: grid,
         interior,
