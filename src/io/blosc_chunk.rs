@@ -114,9 +114,7 @@ impl Compressor {
         };
         n.max(0) as usize
     }
-}
 
-impl Compressor {
     /// The shuffled block as one LZ4 stream after the header and the block's start in `out`
     /// (its room): the chunk's length, `None` when it does not fit.
     fn stream(&mut self, shuffled: &[u8], out: &mut [u8]) -> Option<usize> {

@@ -332,7 +332,7 @@ mod tests {
             spans(&inward, ColumnRule::Winding { orientation: -1 }),
             [(0, 3)]
         );
-        // Centres on no crossing's inside: none.
+        // A column that crosses nothing holds no inside.
         assert_eq!(spans(&[], outward), []);
     }
 }
