@@ -17,7 +17,7 @@ use voxelkit::progress::Unobserved;
 use voxelkit::solids::csg_leaves;
 use voxelkit::solids::exterior_flood::FloodMethod;
 use voxelkit::solids::flooded_mesh::flooded_mesh;
-use voxelkit::solids::inside_rule::{Inside, InsideRule, choose_inside};
+use voxelkit::solids::inside_rule::{Inside, InsideRule};
 use voxelkit::solids::level_set::level_set;
 
 mod common;
@@ -279,17 +279,16 @@ fn the_union_of_overlapping_parts_is_the_union_of_their_solids() {
     let t = voxelkit::mesh::fit_transform(&both.bbox(), voxelkit::mesh::GridFit::Resolution(64))
         .unwrap();
     let solid = |mesh: &Mesh| {
-        let choice = choose_inside(InsideRule::Auto, mesh, "").unwrap();
-        assert_eq!(choice.name(), "winding");
-        flooded_mesh(
+        let (choice, parts) = flooded_mesh(
             mesh,
             t,
             FloodMethod::Blocks,
-            &choice.inside,
+            InsideRule::Auto,
             &Progress::none(),
         )
-        .unwrap()
-        .whole
+        .unwrap();
+        assert_eq!(choice.name(), "winding");
+        parts.whole
     };
     let union = solid(&both);
     let mut parts = solid(&a);

@@ -27,7 +27,7 @@ use crate::solids::depth_layers::{
     DepthLayerOptions, DepthLayerSolid, DepthLayerStats, Layers, depth_layer_solid, depth_layers_of,
 };
 use crate::solids::exterior_flood::{FloodMethod, Solid};
-use crate::solids::flooded_mesh::{self, FLOOD_NEEDS_CLOSED, SurfaceAndInside};
+use crate::solids::flooded_mesh::{self, SurfaceAndInside};
 use crate::solids::formula_rays::FormulaRays;
 use crate::solids::inside_rule::{Inside, InsideChoice, InsideRule, choose_inside};
 use crate::solids::level_set::{SIGN_NEEDS_CLOSED, level_set, unsigned_distance};
@@ -180,8 +180,7 @@ pub(super) fn mesh_solid(
     let meta = |method: &str| provenance(method, &source, fit);
     let outcome = match fill {
         Fill::Flood(flood) => {
-            let choice = choose_inside(inside, mesh, FLOOD_NEEDS_CLOSED)?;
-            let parts = flooded_mesh::flooded_mesh(mesh, t, flood, &choice.inside, progress)?;
+            let (choice, parts) = flooded_mesh::flooded_mesh(mesh, t, flood, inside, progress)?;
             let mut method = meta(match choice.inside {
                 Inside::Winding(_) => "huang-26-separating-surface+winding-number",
                 Inside::Parity => "huang-26-separating-surface+exterior-flood",
@@ -406,8 +405,7 @@ pub(super) fn measure_mesh(
     progress: &Progress,
 ) -> Result<Outcome> {
     let start = Instant::now();
-    let choice = choose_inside(inside, mesh, FLOOD_NEEDS_CLOSED)?;
-    let parts = flooded_mesh::flooded_mesh(mesh, t, flood, &choice.inside, progress)?;
+    let (choice, parts) = flooded_mesh::flooded_mesh(mesh, t, flood, inside, progress)?;
     let mut meta = vec![
         (
             "method",

@@ -6,9 +6,9 @@
 
 use super::cavities::remove_cavities;
 use super::exterior_flood::{FloodMethod, Solid, solid_from_surface};
-use super::inside_rule::Inside;
+use super::inside_rule::{Inside, InsideChoice, InsideRule, choose_inside};
 use super::winding_inside::{block_columns, winding_inside};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::grid::{Adjacency, DenseMask, SparseGrid, Transform};
 use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
@@ -86,35 +86,66 @@ pub fn flood_surface(mesh: &Mesh, t: Transform, progress: &Progress) -> Result<S
 
 /// A mesh's solid: its 26-separating surface and, by winding number, the centres inside it;
 /// by parity, the surface of the closed mesh flooded by `flood`, less the enclosed regions its
-/// winding number says are cavities.
+/// winding number says are cavities. The rule is chosen from `rule` (`choose_inside`) while
+/// the surface, which either rule needs, is voxelized: grouping the mesh's edges for the
+/// choice then takes no time of its own. Returns the choice with the parts.
 pub fn flooded_mesh(
     mesh: &Mesh,
     t: Transform,
     flood: FloodMethod,
-    inside: &Inside,
+    rule: InsideRule,
+    progress: &Progress,
+) -> Result<(InsideChoice, SurfaceAndInside)> {
+    if rule == InsideRule::Parity {
+        let choice = choose_inside(rule, mesh, FLOOD_NEEDS_CLOSED)?;
+        let surface = flood_surface(mesh, t, progress)?;
+        return Ok((choice, flooded_by_parity(mesh, surface, flood, progress)?));
+    }
+    let region = index_box(&mesh.bbox(), &t);
+    let columns = block_columns(region).len() as u64;
+    progress.stage("surface and inside", work_items(mesh) + columns);
+    // The inside's grids are made on its side, while the surface may still be running.
+    let (surface, inside) = rayon::join(
+        || flood_surface(mesh, t, progress),
+        || {
+            let choice = choose_inside(rule, mesh, FLOOD_NEEDS_CLOSED)?;
+            let centres = match &choice.inside {
+                Inside::Winding(caps) => {
+                    Some(winding_inside(mesh, caps, t, region, progress)?.into_grids(t))
+                }
+                // Orientations disagree on a closed mesh: the flood fills it (below).
+                Inside::Parity => {
+                    progress.advance(columns);
+                    None
+                }
+            };
+            Ok::<_, Error>((choice, centres))
+        },
+    );
+    let (choice, centres) = inside?;
+    let surface = surface?;
+    let parts = match centres {
+        Some((centres, ambiguous)) => SurfaceAndInside {
+            ambiguous: Some(ambiguous),
+            ..SurfaceAndInside::with_inside(surface, centres)
+        },
+        None => flooded_by_parity(mesh, surface, flood, progress)?,
+    };
+    Ok((choice, parts))
+}
+
+/// The closed mesh's `surface` flooded by `flood`, less the cavities.
+fn flooded_by_parity(
+    mesh: &Mesh,
+    surface: SparseGrid,
+    flood: FloodMethod,
     progress: &Progress,
 ) -> Result<SurfaceAndInside> {
-    if let Inside::Winding(caps) = inside {
-        let region = index_box(&mesh.bbox(), &t);
-        let columns = block_columns(region).len() as u64;
-        progress.stage("surface and inside", work_items(mesh) + columns);
-        // The inside's grids are made on its side, while the surface may still be running.
-        let (surface, centres) = rayon::join(
-            || flood_surface(mesh, t, progress),
-            || Ok(winding_inside(mesh, caps, t, region, progress)?.into_grids(t)),
-        );
-        let (centres, ambiguous) = centres?;
-        return Ok(SurfaceAndInside {
-            ambiguous: Some(ambiguous),
-            ..SurfaceAndInside::with_inside(surface?, centres)
-        });
-    }
-    mesh.require_closed(FLOOD_NEEDS_CLOSED)?;
-    let surface = flood_surface(mesh, t, progress)?;
     let mut solid = solid_from_surface(&surface, flood, progress)?;
     if remove_cavities(mesh, &mut solid.inside)? > 0 {
         let inside = solid.inside.voxel_count();
-        solid.measures = SolidMeasures::of(inside, surface.voxel_count(), t.voxel_size);
+        solid.measures =
+            SolidMeasures::of(inside, surface.voxel_count(), surface.transform.voxel_size);
     }
     Ok(SurfaceAndInside::of(surface, solid))
 }
