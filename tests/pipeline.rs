@@ -326,19 +326,10 @@ fn every_stage_of_a_fill_is_heard_and_counted_to_its_total() {
     // A closed cube with one face turned over: its orientations disagree, so the inside
     // chosen beside its surface is the flood's.
     let flipped = dir.path().join("flipped.obj");
-    let box_mesh = generate::cuboid(DVec3::splat(-1.0), DVec3::ONE);
-    let faces: Vec<Vec<u32>> = (0..box_mesh.face_count())
-        .map(|f| {
-            let mut face = box_mesh.face(f).to_vec();
-            if f == 0 {
-                face.reverse();
-            }
-            face
-        })
-        .collect();
-    voxelkit::mesh::Mesh::from_polygons("flipped", box_mesh.positions.clone(), &faces)
-        .write_obj(&flipped)
-        .unwrap();
+    let mut box_mesh = generate::cuboid(DVec3::splat(-1.0), DVec3::ONE);
+    let first_face = box_mesh.face_starts[0] as usize..box_mesh.face_starts[1] as usize;
+    box_mesh.indices[first_face].reverse();
+    box_mesh.write_obj(&flipped).unwrap();
     let mesh = || MeshSource::File(torus.clone());
     let solid = |fill, inside| Task::Solid {
         mesh: mesh(),
