@@ -127,16 +127,23 @@ impl Compressor {
     }
 
     /// The shuffled block as one stream per plane, each behind its length: compressed where
-    /// the plane does not look random and LZ4 shrinks it, raw (its length the plane's) where
-    /// not. The chunk's length, `None` when it does not fit `out`.
-    fn planes(&mut self, shuffled: &[u8], value_size: usize, out: &mut [u8]) -> Option<usize> {
+    /// the plane is not among the `random` ones (bit `j` for plane `j`) and LZ4 shrinks it, raw
+    /// (its length the plane's) where not. The chunk's length, `None` when it does not fit
+    /// `out`.
+    fn planes(
+        &mut self,
+        shuffled: &[u8],
+        value_size: usize,
+        random: u16,
+        out: &mut [u8],
+    ) -> Option<usize> {
         let plane_len = shuffled.len() / value_size;
         let mut at = FRAMING - 4;
-        for plane in shuffled.chunks_exact(plane_len) {
+        for (j, plane) in shuffled.chunks_exact(plane_len).enumerate() {
             let room = out.len().checked_sub(at + 4)?;
             let stream = &mut out[at + 4..];
             // A compressed stream as long as its plane would read as raw: LZ4 gets one less.
-            let packed = if looks_random(plane) {
+            let packed = if random >> j & 1 == 1 {
                 0
             } else {
                 self.lz4(plane, &mut stream[..room.min(plane_len - 1)])
@@ -182,12 +189,20 @@ pub(super) fn blosc_chunk(data: &[u8], value_size: usize, out: &mut [u8]) -> Opt
         let c = c.as_mut()?;
         let mut shuffled = std::mem::take(&mut c.shuffled);
         shuffle(data, value_size, &mut shuffled);
-        let split = splits(data.len(), value_size)
-            && shuffled
+        // The planes that look random, each sampled once (at most `MOST_PLANES`: a bit each).
+        let random = if splits(data.len(), value_size) {
+            shuffled
                 .chunks_exact(data.len() / value_size)
-                .any(looks_random);
+                .enumerate()
+                .fold(0u16, |bits, (j, plane)| {
+                    bits | u16::from(looks_random(plane)) << j
+                })
+        } else {
+            0
+        };
+        let split = random != 0;
         let written = if split {
-            c.planes(&shuffled, value_size, &mut out[..FRAMING + room])
+            c.planes(&shuffled, value_size, random, &mut out[..FRAMING + room])
         } else {
             c.stream(&shuffled, &mut out[..FRAMING + room])
         };
