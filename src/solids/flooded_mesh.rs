@@ -5,11 +5,13 @@
 //! of the whole solid's shape, its components and genus.
 
 use super::cavities::remove_cavities;
+use super::column_inside::{interior, leaf_inside, winding_columns};
 use super::exterior_flood::{FloodMethod, Solid, solid_from_surface};
 use super::inside_rule::{Inside, InsideChoice, InsideRule, choose_inside};
 use super::winding_inside::{block_columns, winding_inside};
 use crate::error::{Error, Result};
-use crate::grid::{Adjacency, DenseMask, SparseGrid, Transform};
+use crate::grid::{Adjacency, Channels, DenseMask, Leaf, SparseGrid, Transform};
+use crate::mesh::inside::ColumnCrossings;
 use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
 use crate::ops::measure::SolidMeasures;
@@ -17,6 +19,7 @@ use crate::ops::topology::{components, euler_characteristic};
 use crate::progress::Progress;
 use crate::voxelize::Separability;
 use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh, work_items};
+use rayon::prelude::*;
 
 /// Why the flood needs a closed mesh, for the error that refuses an open one.
 pub const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it and leave the solid hollow \
@@ -104,19 +107,25 @@ pub fn flooded_mesh(
     let region = index_box(&mesh.bbox(), &t);
     let columns = block_columns(region).len() as u64;
     progress.stage("surface and inside", work_items(mesh) + columns);
-    // The inside's grids are made on its side, while the surface may still be running.
+    // The inside's grids (or a closed mesh's columns) are made on its side, while the surface
+    // may still be running.
     let (surface, inside) = rayon::join(
         || flood_surface(mesh, t, progress),
         || {
             let choice = choose_inside(rule, mesh, FLOOD_NEEDS_CLOSED)?;
             let centres = match &choice.inside {
-                Inside::Winding(caps) => {
-                    Some(winding_inside(mesh, caps, t, region, progress)?.into_grids(t))
+                Inside::Winding(caps) if caps.is_empty() => {
+                    let crossings = winding_columns(mesh, caps, &t, region);
+                    progress.advance(columns);
+                    Centres::Columns(crossings)
                 }
+                Inside::Winding(caps) => Centres::Grids(Box::new(
+                    winding_inside(mesh, caps, t, region, progress)?.into_grids(t),
+                )),
                 // Orientations disagree on a closed mesh: the flood fills it (below).
                 Inside::Parity => {
                     progress.advance(columns);
-                    None
+                    Centres::Flood
                 }
             };
             Ok::<_, Error>((choice, centres))
@@ -124,14 +133,45 @@ pub fn flooded_mesh(
     );
     let (choice, centres) = inside?;
     let surface = surface?;
-    let parts = match centres {
-        Some((centres, ambiguous)) => SurfaceAndInside {
-            ambiguous: Some(ambiguous),
-            ..SurfaceAndInside::with_inside(surface, centres)
-        },
-        None => flooded_by_parity(mesh, surface, flood, progress)?,
+    let (centres, ambiguous) = match centres {
+        // Every voxel the mesh passes through belongs to its 26-separating surface (the
+        // slabs reach a voxel's extent along the normal, Huang's full spheres and cylinders
+        // its half diagonal), as `column_inside` needs: the columns are read at the surface's
+        // leaves and at one centre of each other block.
+        Centres::Columns(columns) => {
+            let leaves: Vec<Leaf> = surface
+                .leaves()
+                .par_iter()
+                .map(|l| {
+                    let mut inside = Leaf::new(l.origin, Channels::NONE);
+                    inside.mask = leaf_inside(&columns, l.origin);
+                    inside
+                })
+                .filter(|l| !l.is_empty())
+                .collect();
+            let centres = interior(&columns, &surface, leaves, t);
+            (centres, SparseGrid::new(t, Channels::NONE))
+        }
+        Centres::Grids(grids) => *grids,
+        Centres::Flood => {
+            return Ok((choice, flooded_by_parity(mesh, surface, flood, progress)?));
+        }
+    };
+    let parts = SurfaceAndInside {
+        ambiguous: Some(ambiguous),
+        ..SurfaceAndInside::with_inside(surface, centres)
     };
     Ok((choice, parts))
+}
+
+/// How a solid's inside centres are found once its surface is known.
+enum Centres {
+    /// A closed, consistently oriented mesh's columns, to read near the surface.
+    Columns(ColumnCrossings),
+    /// Every centre decided already (inside, and ambiguous).
+    Grids(Box<(SparseGrid, SparseGrid)>),
+    /// The surface flooded from outside.
+    Flood,
 }
 
 /// The closed mesh's `surface` flooded by `flood`, less the cavities.

@@ -9,11 +9,12 @@
 //! voxels holds no surface (any surface in it lies within sqrt(3)/2 of a centre, inside the
 //! band), so one centre decides it.
 
+use super::column_inside::{interior, leaf_inside, winding_columns};
 use super::inside_rule::Inside;
-use super::winding_inside::{block_columns, closed_by_caps, winding_inside, winds_reversed};
+use super::winding_inside::{block_columns, winding_inside};
 use crate::error::Result;
 use crate::grid::{Channels, Coord, Leaf, SparseGrid, Transform};
-use crate::mesh::inside::{ColumnCrossings, ColumnRule};
+use crate::mesh::inside::ColumnCrossings;
 use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
 use crate::progress::Progress;
@@ -61,14 +62,7 @@ pub fn level_set(
         // crossings, which the band's leaves and blocks read as parity's do.
         Inside::Winding(caps) if caps.is_empty() => {
             return columns_level_set(mesh, transform, band, progress, || {
-                let (points, triangles) = closed_by_caps(mesh, caps);
-                let orientation = if winds_reversed(&points, &triangles) {
-                    -1
-                } else {
-                    1
-                };
-                ColumnCrossings::of_triangles(&points, &triangles, &transform, columns_box)
-                    .read_by(ColumnRule::Winding { orientation })
+                winding_columns(mesh, caps, &transform, columns_box)
             });
         }
         Inside::Winding(caps) => caps,
@@ -168,67 +162,21 @@ fn columns_level_set(
         .leaves_mut()
         .par_iter_mut()
         .map(|leaf| {
-            let mask = inside_mask(&columns, leaf.origin);
+            let mask = leaf_inside(&columns, leaf.origin);
             let count = sign_leaf(leaf, &mask, h);
             let mut inside = Leaf::new(leaf.origin, Channels::NONE);
             inside.mask = mask;
             ((!inside.is_empty()).then_some(inside), count)
         })
         .unzip();
-    // The inside leaves' index is made (on one thread) while the whole blocks are found.
-    let (mut interior, blocks) = rayon::join(
-        || {
-            let inside: Vec<Leaf> = inside.into_iter().flatten().collect();
-            SparseGrid::from_distinct_leaves(transform, Channels::NONE, inside)
-        },
-        || inside_blocks(&columns, &grid),
-    );
     // Band leaves stay leaves, even wholly inside: the level set writes its tiles.
-    interior.fill_leaf_blocks(blocks);
+    let interior = interior(&columns, &grid, inside.into_iter().flatten(), transform);
     Ok(LevelSet {
         band: grid,
         interior,
         ambiguous: SparseGrid::new(transform, Channels::NONE),
         inside_band_voxels: counts.iter().sum(),
     })
-}
-
-/// The inside centres of the leaf at `origin`, as a leaf mask.
-fn inside_mask(columns: &ColumnCrossings, origin: Coord) -> [u64; 8] {
-    let mut mask = [0u64; 8];
-    for (x, word) in mask.iter_mut().enumerate() {
-        columns.row_spans(origin[0] + x as i64, origin[1], 8, |y, z0, z1| {
-            let (z0, z1) = ((z0 - origin[2]).max(0), (z1 - origin[2]).min(7));
-            if z0 <= z1 {
-                let run = (1u64 << (z1 - z0 + 1)) - 1;
-                *word |= run << (y * 8 + z0 as usize);
-            }
-        });
-    }
-    mask
-}
-
-/// The origins of the 8^3 blocks wholly inside: those without band voxels whose first
-/// centre is inside (only blocks in the columns' box can be).
-fn inside_blocks(columns: &ColumnCrossings, band: &SparseGrid) -> Vec<Coord> {
-    let ([x0, x1], [y0, y1]) = columns.columns();
-    let first = |v: i64| (v + 7) & !7;
-    let xs: Vec<i64> = (first(x0)..=x1).step_by(8).collect();
-    xs.par_iter()
-        .flat_map_iter(|&x| {
-            let mut found = Vec::new();
-            for y in (first(y0)..=y1).step_by(8) {
-                columns.spans(x, y, |z0, z1| {
-                    for z in (first(z0)..=z1).step_by(8) {
-                        if band.leaf([x, y, z]).is_none() {
-                            found.push([x, y, z]);
-                        }
-                    }
-                });
-            }
-            found
-        })
-        .collect()
 }
 
 /// Unsigned distances (world units) on every voxel within `band` voxels of `mesh`, open or

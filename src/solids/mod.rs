@@ -4,6 +4,7 @@
 
 pub mod beam;
 pub mod cavities;
+pub mod column_inside;
 #[cfg(feature = "vdb")]
 pub mod csg_exact;
 pub mod csg_leaves;

@@ -1,0 +1,90 @@
+//! The inside centres of a closed mesh read from its columns' crossings (`ColumnCrossings`)
+//! only where a grid near its surface has leaves: the narrow band of a level set, the
+//! 26-separating surface of a solid. Such a grid has a voxel in every 8^3 block the surface
+//! passes through, so a block without one holds centres on one side only, and its first
+//! centre decides it whole: the columns are read at each leaf's 64 rows and at one centre of
+//! each other block, not at every block of the box.
+
+use super::winding_inside::{closed_by_caps, winds_reversed};
+use crate::grid::{Channels, Coord, CoordBox, Leaf, SparseGrid, Transform};
+use crate::mesh::Mesh;
+use crate::mesh::boundary_caps::BoundaryCaps;
+use crate::mesh::inside::{ColumnCrossings, ColumnRule};
+use rayon::prelude::*;
+
+/// The columns of `bbox` of a closed, consistently oriented mesh (closed by `caps`, none on
+/// a closed mesh), read by its winding number: the signed count of crossings below a centre,
+/// taken in the mesh's orientation.
+pub fn winding_columns(
+    mesh: &Mesh,
+    caps: &BoundaryCaps,
+    transform: &Transform,
+    bbox: CoordBox,
+) -> ColumnCrossings {
+    let (points, triangles) = closed_by_caps(mesh, caps);
+    let orientation = if winds_reversed(&points, &triangles) {
+        -1
+    } else {
+        1
+    };
+    ColumnCrossings::of_triangles(&points, &triangles, transform, bbox)
+        .read_by(ColumnRule::Winding { orientation })
+}
+
+/// The inside centres of the leaf at `origin`, as a leaf mask.
+pub fn leaf_inside(columns: &ColumnCrossings, origin: Coord) -> [u64; 8] {
+    let mut mask = [0u64; 8];
+    for (x, word) in mask.iter_mut().enumerate() {
+        columns.row_spans(origin[0] + x as i64, origin[1], 8, |y, z0, z1| {
+            let (z0, z1) = ((z0 - origin[2]).max(0), (z1 - origin[2]).min(7));
+            if z0 <= z1 {
+                let run = (1u64 << (z1 - z0 + 1)) - 1;
+                *word |= run << (y * 8 + z0 as usize);
+            }
+        });
+    }
+    mask
+}
+
+/// The inside centres: `leaves` (those of `near`'s blocks, found by `leaf_inside`) and every
+/// block of `near`'s columns without a leaf of `near` whose first centre is inside, as a tile.
+pub fn interior(
+    columns: &ColumnCrossings,
+    near: &SparseGrid,
+    leaves: impl IntoIterator<Item = Leaf> + Send,
+    transform: Transform,
+) -> SparseGrid {
+    // The leaves' index is made (on one thread) while the whole blocks are found.
+    let (mut interior, blocks) = rayon::join(
+        || {
+            let leaves = leaves.into_iter().collect();
+            SparseGrid::from_distinct_leaves(transform, Channels::NONE, leaves)
+        },
+        || inside_blocks(columns, near),
+    );
+    interior.fill_leaf_blocks(blocks);
+    interior
+}
+
+/// The origins of the 8^3 blocks wholly inside: those without a leaf of `near` whose first
+/// centre is inside (only blocks in the columns' box can be).
+fn inside_blocks(columns: &ColumnCrossings, near: &SparseGrid) -> Vec<Coord> {
+    let ([x0, x1], [y0, y1]) = columns.columns();
+    let first = |v: i64| (v + 7) & !7;
+    let xs: Vec<i64> = (first(x0)..=x1).step_by(8).collect();
+    xs.par_iter()
+        .flat_map_iter(|&x| {
+            let mut found = Vec::new();
+            for y in (first(y0)..=y1).step_by(8) {
+                columns.spans(x, y, |z0, z1| {
+                    for z in (first(z0)..=z1).step_by(8) {
+                        if near.leaf([x, y, z]).is_none() {
+                            found.push([x, y, z]);
+                        }
+                    }
+                });
+            }
+            found
+        })
+        .collect()
+}
