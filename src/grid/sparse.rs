@@ -120,14 +120,21 @@ impl SparseGrid {
     /// Makes the 8^3 blocks at `origins` whole, as `fill_leaf_block` does one by one, and
     /// each 128^3 node whole in 8^3 tiles a node tile.
     pub fn fill_leaf_blocks(&mut self, origins: Vec<Coord>) {
+        let free: Vec<Coord> = origins
+            .into_iter()
+            .filter(|&o| self.leaf_block_to_tile(o))
+            .collect();
+        self.fill_free_leaf_blocks(free);
+    }
+
+    /// `fill_leaf_blocks` for blocks where the grid holds no leaf: none is looked up.
+    pub fn fill_free_leaf_blocks(&mut self, origins: Vec<Coord>) {
+        debug_assert!(origins.iter().all(|o| !self.index.contains_key(o)));
         // Blocks given in runs within one 128^3 node (a column's are) share the node's
         // lookups: a solid's inside is hundreds of thousands of blocks.
-        let mut tiled = Vec::new();
         for run in origins.chunk_by(|a, b| node_origin(*a) == node_origin(*b)) {
-            tiled.clear();
-            tiled.extend(run.iter().filter(|&&o| self.leaf_block_to_tile(o)));
             self.tiles
-                .insert_leaves_of_node(node_origin(run[0]), tiled.iter().copied());
+                .insert_leaves_of_node(node_origin(run[0]), run.iter().copied());
         }
         self.tiles.promote();
     }

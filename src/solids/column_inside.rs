@@ -62,7 +62,7 @@ pub fn interior(
         },
         || inside_blocks(columns, near),
     );
-    interior.fill_leaf_blocks(blocks);
+    interior.fill_free_leaf_blocks(blocks);
     interior
 }
 

@@ -86,7 +86,7 @@ pub fn level_set(
         leaf
     }));
     let mut interior = SparseGrid::from_distinct_leaves(transform, Channels::NONE, leaves);
-    interior.fill_leaf_blocks(full_free);
+    interior.fill_free_leaf_blocks(full_free);
     let h = transform.voxel_size as f32;
     let inside_band_voxels = grid
         .leaves_mut()

@@ -53,7 +53,7 @@ impl WindingInside {
     /// The inside as one grid (leaves, and whole blocks as tiles), and the ambiguous centres.
     pub fn into_grids(self, t: Transform) -> (SparseGrid, SparseGrid) {
         let mut grid = SparseGrid::from_distinct_leaves(t, Channels::NONE, self.leaves);
-        grid.fill_leaf_blocks(self.full_blocks);
+        grid.fill_free_leaf_blocks(self.full_blocks);
         (grid, self.ambiguous)
     }
 }
