@@ -5,7 +5,7 @@
 
 use super::vdb_format::{CHILD_LOG2, NODE_LOG2, ROOT_TILE};
 use crate::error::{Error, Result};
-use crate::grid::{Leaf, SparseGrid};
+use crate::grid::{LEAF_VOXELS, Leaf, SparseGrid};
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -82,30 +82,14 @@ impl GridValues<'_> {
     /// one after another; a bool grid's leaves store no values.
     #[inline(always)]
     pub(super) fn for_each_active(self, leaf: &Leaf, mut put: impl FnMut(f32)) {
-        match self {
-            GridValues::Bool => unreachable!("bool leaves store a mask"),
-            GridValues::Constant(v) => leaf.offsets().for_each(|_| put(v)),
-            GridValues::Distances { .. } | GridValues::LevelSet { .. } => {
-                let d = leaf
-                    .value
-                    .as_deref()
-                    .expect("a distance grid's leaves carry values");
-                leaf.offsets().for_each(|n| put(d[n]));
+        match self.value_type() {
+            ValueType::Bool => unreachable!("bool leaves store a mask"),
+            ValueType::Float => {
+                let mut values = [0.0; LEAF_VOXELS];
+                let count = self.active_floats(leaf, &mut values);
+                values[..count].iter().for_each(|&v| put(v));
             }
-            GridValues::Fog { band, background } => match band.leaf(leaf.origin) {
-                None => leaf.offsets().for_each(|_| put(1.0)),
-                Some(b) => {
-                    let d = b.value.as_deref().expect("distances");
-                    leaf.offsets().for_each(|n| {
-                        put(if b.is_on(n) {
-                            (-d[n] / background).clamp(0.0, 1.0)
-                        } else {
-                            1.0
-                        })
-                    });
-                }
-            },
-            GridValues::Normals | GridValues::Colors => {
+            ValueType::Vec3 => {
                 let vectors = match self {
                     GridValues::Normals => leaf.normal.as_deref(),
                     _ => leaf.color.as_deref(),
@@ -117,6 +101,51 @@ impl GridValues<'_> {
         }
     }
 
+    /// The active values of a float grid's `leaf` in offset order, at the start of `out`; how
+    /// many.
+    #[inline]
+    pub(super) fn active_floats(self, leaf: &Leaf, out: &mut [f32; LEAF_VOXELS]) -> usize {
+        let ones = |out: &mut [f32; LEAF_VOXELS], v: f32| {
+            let count = leaf.count() as usize;
+            out[..count].fill(v);
+            count
+        };
+        match self {
+            GridValues::Constant(v) => ones(out, v),
+            GridValues::Distances { .. } | GridValues::LevelSet { .. } => {
+                let d = leaf
+                    .value
+                    .as_deref()
+                    .expect("a distance grid's leaves carry values");
+                gather(&leaf.mask, out, d)
+            }
+            GridValues::Fog { band, background } => match band.leaf(leaf.origin) {
+                None => ones(out, 1.0),
+                Some(b) => {
+                    let d = b.value.as_deref().expect("distances");
+                    // The fog of a word's band voxels computed whole (the division in vector
+                    // lanes), then 1 at its other active voxels.
+                    let mut fog = [1.0; LEAF_VOXELS];
+                    for (w, (&active, &on)) in leaf.mask.iter().zip(&b.mask).enumerate() {
+                        if active & on == 0 {
+                            continue;
+                        }
+                        let word = &mut fog[64 * w..64 * w + 64];
+                        for (f, &d) in word.iter_mut().zip(&d[64 * w..]) {
+                            *f = (-d / background).clamp(0.0, 1.0);
+                        }
+                        let mut off = active & !on;
+                        while off != 0 {
+                            word[off.trailing_zeros() as usize] = 1.0;
+                            off &= off - 1;
+                        }
+                    }
+                    gather(&leaf.mask, out, &fog)
+                }
+            },
+            _ => unreachable!("not a float grid"),
+        }
+    }
     /// Looks up what writing `leaf` reads from other grids, so that it is in the cache when
     /// written (see `WARM_RUN`).
     #[inline]
@@ -165,6 +194,28 @@ impl GridValues<'_> {
             component += 1;
         });
     }
+}
+
+/// The values of `values` at the set bits of `mask`, in offset order, at the start of `out`;
+/// how many. A mask word at a time, a whole word as one copy.
+#[inline(always)]
+fn gather(mask: &[u64; 8], out: &mut [f32; LEAF_VOXELS], values: &[f32; LEAF_VOXELS]) -> usize {
+    let mut at = 0;
+    for (w, &bits) in mask.iter().enumerate() {
+        let word = &values[64 * w..64 * w + 64];
+        if bits == u64::MAX {
+            out[at..at + 64].copy_from_slice(word);
+            at += 64;
+            continue;
+        }
+        let mut b = bits;
+        while b != 0 {
+            out[at] = word[b.trailing_zeros() as usize];
+            at += 1;
+            b &= b - 1;
+        }
+    }
+    at
 }
 
 /// The origin of the node or tile at `key`: its root child's, plus its 128^3 slot, plus (for

@@ -43,43 +43,42 @@ pub(super) fn tree_type_of(values: GridValues) -> String {
 fn push_tile_value(out: &mut Vec<u8>, values: GridValues, half: bool) {
     match values.value_type() {
         ValueType::Bool => out.push(1),
-        _ => push_real(out, values.tile_value(), half),
+        _ => push_reals(out, &[values.tile_value()], half),
     }
 }
 
 /// The active values of `leaf`, in offset order, as stored.
 fn push_leaf_values(out: &mut Vec<u8>, leaf: &Leaf, values: GridValues, half: bool) {
-    let components = match values.value_type() {
-        ValueType::Vec3 => 3,
-        _ => 1,
-    };
-    // Written in place into room made once: a push per value costs more than the value.
-    let width = if half { 2 } else { 4 };
-    let start = out.len();
-    out.resize(start + width * components * leaf.count() as usize, 0);
-    let room = &mut out[start..];
-    let mut at = 0;
-    if half {
-        values.for_each_active(leaf, |v| {
-            room[at..at + 2].copy_from_slice(&half::f16::from_f32(v).to_le_bytes());
-            at += 2;
-        });
+    if values.value_type() == ValueType::Float {
+        let mut floats = [0.0; LEAF_VOXELS];
+        let count = values.active_floats(leaf, &mut floats);
+        push_reals(out, &floats[..count], half);
     } else {
+        let mut components = [0.0; 3 * LEAF_VOXELS];
+        let mut count = 0;
         values.for_each_active(leaf, |v| {
-            room[at..at + 4].copy_from_slice(&v.to_le_bytes());
-            at += 4;
+            components[count] = v;
+            count += 1;
         });
+        push_reals(out, &components[..count], half);
     }
-    debug_assert_eq!(at, room.len(), "a value for every active voxel");
 }
 
-/// `v` as stored: little-endian f32, or f16 when `half`.
-#[inline]
-fn push_real(out: &mut Vec<u8>, v: f32, half: bool) {
+/// `values` as stored, one after another, written in place into room made once (a push per
+/// value costs more than the value).
+fn push_reals(out: &mut Vec<u8>, values: &[f32], half: bool) {
+    let width = if half { 2 } else { 4 };
+    let start = out.len();
+    out.resize(start + width * values.len(), 0);
+    let room = out[start..].chunks_exact_mut(width);
     if half {
-        out.extend_from_slice(&half::f16::from_f32(v).to_le_bytes());
+        for (bytes, v) in room.zip(values) {
+            bytes.copy_from_slice(&half::f16::from_f32(*v).to_le_bytes());
+        }
     } else {
-        out.extend_from_slice(&v.to_le_bytes());
+        for (bytes, v) in room.zip(values) {
+            bytes.copy_from_slice(&v.to_le_bytes());
+        }
     }
 }
 
