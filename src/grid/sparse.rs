@@ -6,6 +6,7 @@ use super::coord::{Coord, CoordBox, leaf_offset, leaf_origin, offset_coord};
 use super::leaf::{Channels, Leaf, mask_box};
 use super::tiles::{NODE_DIM, Tiles, node_leaf_origins, node_origin};
 use super::transform::Transform;
+use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
 
 #[derive(Clone, Debug, Default)]
@@ -257,9 +258,14 @@ impl SparseGrid {
 
     /// Bounding box of the active voxels, `None` for an empty grid.
     pub fn bbox(&self) -> Option<CoordBox> {
-        self.leaves
-            .iter()
+        // On all threads: the writers ask for it once a grid, while nothing else runs.
+        let leaves = self
+            .leaves
+            .par_iter()
             .filter_map(|leaf| mask_box(leaf.origin, &leaf.mask))
+            .reduce_with(|a, b| a.union(&b));
+        leaves
+            .into_iter()
             .chain(self.tiles.bbox())
             .reduce(|a, b| a.union(&b))
     }

@@ -298,7 +298,7 @@ pub(super) fn tree_entries<'g>(path: &Path, g: &GridOut<'g>) -> Result<Vec<(Key,
     let mut leaves: Vec<(Key, Entry)> = g
         .grid
         .leaves()
-        .iter()
+        .par_iter()
         .filter(|l| !l.is_empty())
         .map(|l| Ok((key(path, l.origin)?, Entry::Leaf(l))))
         .collect::<Result<_>>()?;

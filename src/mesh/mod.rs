@@ -33,6 +33,7 @@ pub use fit::{DEFAULT_RESOLUTION, GridFit, fit_transform, index_box};
 
 use crate::error::{Error, Result};
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// A polygon mesh: shared positions and faces of any size (kept as in the file).
@@ -70,6 +71,22 @@ pub struct Aabb {
 impl Aabb {
     pub fn extent(&self) -> DVec3 {
         self.max - self.min
+    }
+
+    /// The box around nothing (the empty box's min above its max).
+    pub fn empty() -> Aabb {
+        Aabb {
+            min: DVec3::splat(f64::INFINITY),
+            max: DVec3::splat(f64::NEG_INFINITY),
+        }
+    }
+
+    /// The box around `self` and `p`.
+    pub fn with(self, p: DVec3) -> Aabb {
+        Aabb {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
     }
 }
 
@@ -220,16 +237,17 @@ impl Mesh {
 
     /// The box around every vertex a face or polyline uses.
     pub fn bbox(&self) -> Aabb {
-        let mut b = Aabb {
-            min: DVec3::splat(f64::INFINITY),
-            max: DVec3::splat(f64::NEG_INFINITY),
-        };
-        for &i in self.indices.iter().chain(self.polylines.iter().flatten()) {
-            let p = self.positions[i as usize];
-            b.min = b.min.min(p);
-            b.max = b.max.max(p);
-        }
-        b
+        // Taken on all threads: a large mesh's box is asked for several times a run, while
+        // nothing else runs.
+        let faces = self
+            .indices
+            .par_iter()
+            .fold(Aabb::empty, |b, &i| b.with(self.p(i)))
+            .reduce(Aabb::empty, |a, b| a.with(b.min).with(b.max));
+        self.polylines
+            .iter()
+            .flatten()
+            .fold(faces, |b, &i| b.with(self.p(i)))
     }
 
     /// Fan triangulation of every face: `(face, [a, b, c])`.
@@ -284,17 +302,10 @@ impl Mesh {
 
     /// The box of the corners of the faces `faces`.
     pub fn bbox_of(&self, faces: &[u32]) -> Aabb {
-        let mut b = Aabb {
-            min: DVec3::splat(f64::INFINITY),
-            max: DVec3::splat(f64::NEG_INFINITY),
-        };
-        for &f in faces {
-            for &v in self.face(f as usize) {
-                b.min = b.min.min(self.p(v));
-                b.max = b.max.max(self.p(v));
-            }
-        }
-        b
+        faces
+            .iter()
+            .flat_map(|&f| self.face(f as usize))
+            .fold(Aabb::empty(), |b, &v| b.with(self.p(v)))
     }
 
     /// The signed volume of `triangles`' cones from the centre of `b` (near the triangles,

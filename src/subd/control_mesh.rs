@@ -283,15 +283,10 @@ impl ControlMesh {
     }
 
     pub fn bbox(&self) -> crate::mesh::Aabb {
-        let mut b = crate::mesh::Aabb {
-            min: DVec3::splat(f64::INFINITY),
-            max: DVec3::splat(f64::NEG_INFINITY),
-        };
-        for &p in &self.mesh.points {
-            b.min = b.min.min(p);
-            b.max = b.max.max(p);
-        }
-        b
+        self.mesh
+            .points
+            .iter()
+            .fold(crate::mesh::Aabb::empty(), |b, &p| b.with(p))
     }
 
     /// Quadtree nodes that semi-sharp tags add to the patches, for a voxel of `voxel_size`:
