@@ -137,8 +137,10 @@ const BLOCK_FLOOD_COST: FillCost = FillCost {
 /// tables, still held while the inside is found beside it (210 bytes a triangle), the list
 /// of whole 8^3 blocks (24 bytes each: 0.375 bits per inside voxel), and the surface, the
 /// solid's boundary leaves and the grids written (710 bytes per surface leaf); the crossings
-/// and columns come on top (`winding_plan`). Estimate/peak 0.83-1.09 on the nine meshes above
-/// at 1024 and 2 threads (two runs each).
+/// and columns come on top (`winding_plan`). Estimate/peak 0.99-1.22 on the nine closed
+/// meshes above and 0.90-1.17 on the open stanford-bunny, teapot and ogre, at 1024 and 2
+/// threads (two runs each); a closed mesh's inside, read only near its surface
+/// (`column_inside`), peaks below an open one's, which every block column decides.
 const WINDING_SOLID_COST: FillCost = FillCost {
     bit_volumes: 0.0,
     inside_volumes: 0.375,
