@@ -244,12 +244,14 @@ impl SparseGrid {
     }
 
     pub fn voxel_count(&self) -> u64 {
-        self.leaves.iter().map(|l| l.count() as u64).sum::<u64>() + self.tiles.voxel_count()
+        // Counted on all threads, as `bbox` is: reports ask while nothing else runs.
+        let leaves: u64 = self.leaves.par_iter().map(|l| l.count() as u64).sum();
+        leaves + self.tiles.voxel_count()
     }
 
     /// Number of leaves holding at least one active voxel.
     pub fn leaf_count(&self) -> usize {
-        self.leaves.iter().filter(|l| !l.is_empty()).count()
+        self.leaves.par_iter().filter(|l| !l.is_empty()).count()
     }
 
     pub fn is_empty(&self) -> bool {
@@ -258,7 +260,7 @@ impl SparseGrid {
 
     /// Bounding box of the active voxels, `None` for an empty grid.
     pub fn bbox(&self) -> Option<CoordBox> {
-        // On all threads: the writers ask for it once a grid, while nothing else runs.
+        // On all threads: the writers and reports ask for it while nothing else runs.
         let leaves = self
             .leaves
             .par_iter()
