@@ -88,6 +88,14 @@ impl Aabb {
             max: self.max.max(p),
         }
     }
+
+    /// The box around `self` and `other` (either may be empty).
+    pub fn union(self, other: Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+        }
+    }
 }
 
 impl Mesh {
@@ -243,7 +251,7 @@ impl Mesh {
             .indices
             .par_iter()
             .fold(Aabb::empty, |b, &i| b.with(self.p(i)))
-            .reduce(Aabb::empty, |a, b| a.with(b.min).with(b.max));
+            .reduce(Aabb::empty, Aabb::union);
         self.polylines
             .iter()
             .flatten()
@@ -352,5 +360,53 @@ impl Mesh {
         crate::io::atomic::write_atomic(path, |tmp| {
             std::fs::write(tmp, s.as_bytes()).map_err(|e| Error::io(tmp, e))
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::SplitMix64;
+
+    /// The box taken on all threads is the box of every used vertex, taken one by one, with
+    /// faces alone, polylines alone, both, and neither.
+    #[test]
+    fn the_box_is_that_of_the_used_vertices() {
+        let mut random = SplitMix64(3);
+        let positions: Vec<DVec3> = (0..5000)
+            .map(|_| {
+                DVec3::new(
+                    random.range(-9.0, 9.0),
+                    random.range(-1.0, 1.0),
+                    random.range(0.0, 5.0),
+                )
+            })
+            .collect();
+        let faces: Vec<Vec<u32>> = (0..3000)
+            .map(|_| (0..3).map(|_| (random.next_u64() % 4000) as u32).collect())
+            .collect();
+        let lines: Vec<Vec<u32>> = (0..40)
+            .map(|_| {
+                (0..5)
+                    .map(|_| 4000 + (random.next_u64() % 1000) as u32)
+                    .collect()
+            })
+            .collect();
+        for (faces, lines) in [
+            (&faces[..], &lines[..]),
+            (&faces[..], &[][..]),
+            (&[][..], &lines[..]),
+            (&[][..], &[][..]),
+        ] {
+            let mut mesh = Mesh::from_polygons("box", positions.clone(), faces);
+            mesh.polylines = lines.to_vec();
+            let used = faces.iter().chain(lines).flatten();
+            let expected = used.fold(Aabb::empty(), |b, &i| Aabb {
+                min: b.min.min(positions[i as usize]),
+                max: b.max.max(positions[i as usize]),
+            });
+            let b = mesh.bbox();
+            assert_eq!((b.min, b.max), (expected.min, expected.max));
+        }
     }
 }
