@@ -105,13 +105,13 @@ impl GridValues<'_> {
     /// many.
     #[inline]
     pub(super) fn active_floats(self, leaf: &Leaf, out: &mut [f32; LEAF_VOXELS]) -> usize {
-        let ones = |out: &mut [f32; LEAF_VOXELS], v: f32| {
+        let constant = |out: &mut [f32; LEAF_VOXELS], v: f32| {
             let count = leaf.count() as usize;
             out[..count].fill(v);
             count
         };
         match self {
-            GridValues::Constant(v) => ones(out, v),
+            GridValues::Constant(v) => constant(out, v),
             GridValues::Distances { .. } | GridValues::LevelSet { .. } => {
                 let d = leaf
                     .value
@@ -120,7 +120,7 @@ impl GridValues<'_> {
                 gather(&leaf.mask, out, d)
             }
             GridValues::Fog { band, background } => match band.leaf(leaf.origin) {
-                None => ones(out, 1.0),
+                None => constant(out, 1.0),
                 Some(b) => {
                     let d = b.value.as_deref().expect("distances");
                     // The fog of a word's band voxels computed whole (the division in vector
@@ -146,6 +146,7 @@ impl GridValues<'_> {
             _ => unreachable!("not a float grid"),
         }
     }
+
     /// Looks up what writing `leaf` reads from other grids, so that it is in the cache when
     /// written (see `WARM_RUN`).
     #[inline]
