@@ -51,6 +51,14 @@ impl Leaf {
         }
     }
 
+    /// A leaf without channels whose active voxels are `mask`'s.
+    pub fn with_mask(origin: Coord, mask: [u64; 8]) -> Self {
+        Leaf {
+            mask,
+            ..Leaf::new(origin, Channels::NONE)
+        }
+    }
+
     #[inline]
     pub fn is_on(&self, n: usize) -> bool {
         bits::get(&self.mask, n)

@@ -89,16 +89,18 @@ impl GridValues<'_> {
                 let count = self.active_floats(leaf, &mut values);
                 values[..count].iter().for_each(|&v| put(v));
             }
-            ValueType::Vec3 => {
-                let vectors = match self {
-                    GridValues::Normals => leaf.normal.as_deref(),
-                    _ => leaf.color.as_deref(),
-                };
-                let vectors = vectors.expect("a vector grid's leaves carry its channel");
-                leaf.offsets()
-                    .for_each(|n| vectors[n].iter().for_each(|&c| put(c)));
-            }
+            ValueType::Vec3 => self.active_vectors(leaf).flatten().for_each(put),
         }
+    }
+
+    /// The active vectors of a vector grid's `leaf`, in offset order.
+    pub(super) fn active_vectors<'l>(self, leaf: &'l Leaf) -> impl Iterator<Item = [f32; 3]> + 'l {
+        let vectors = match self {
+            GridValues::Normals => leaf.normal.as_deref(),
+            _ => leaf.color.as_deref(),
+        };
+        let vectors = vectors.expect("a vector grid's leaves carry its channel");
+        leaf.offsets().map(move |n| vectors[n])
     }
 
     /// The active values of a float grid's `leaf` in offset order, at the start of `out`; how

@@ -43,7 +43,7 @@ pub(super) fn tree_type_of(values: GridValues) -> String {
 fn push_tile_value(out: &mut Vec<u8>, values: GridValues, half: bool) {
     match values.value_type() {
         ValueType::Bool => out.push(1),
-        _ => push_reals(out, &[values.tile_value()], half),
+        _ => push_reals(out, std::iter::once(values.tile_value()), 1, half),
     }
 }
 
@@ -52,28 +52,23 @@ fn push_leaf_values(out: &mut Vec<u8>, leaf: &Leaf, values: GridValues, half: bo
     if values.value_type() == ValueType::Float {
         let mut floats = [0.0; LEAF_VOXELS];
         let count = values.active_floats(leaf, &mut floats);
-        push_reals(out, &floats[..count], half);
+        push_reals(out, floats[..count].iter().copied(), count, half);
     } else {
-        let mut components = [0.0; 3 * LEAF_VOXELS];
-        let mut count = 0;
-        values.for_each_active(leaf, |v| {
-            components[count] = v;
-            count += 1;
-        });
-        push_reals(out, &components[..count], half);
+        let components = 3 * leaf.count() as usize;
+        push_reals(out, values.active_vectors(leaf).flatten(), components, half);
     }
 }
 
-/// `values` as stored, one after another, written in place into room made once (a push per
-/// value costs more than the value).
-fn push_reals(out: &mut Vec<u8>, values: &[f32], half: bool) {
+/// The `count` `values` as stored, one after another, written in place into room made once
+/// (a push per value costs more than the value).
+fn push_reals(out: &mut Vec<u8>, values: impl Iterator<Item = f32>, count: usize, half: bool) {
     let width = if half { 2 } else { 4 };
     let start = out.len();
-    out.resize(start + width * values.len(), 0);
+    out.resize(start + width * count, 0);
     let room = out[start..].chunks_exact_mut(width);
     if half {
         for (bytes, v) in room.zip(values) {
-            bytes.copy_from_slice(&half::f16::from_f32(*v).to_le_bytes());
+            bytes.copy_from_slice(&half::f16::from_f32(v).to_le_bytes());
         }
     } else {
         for (bytes, v) in room.zip(values) {

@@ -66,6 +66,17 @@ pub fn interior(
     interior
 }
 
+/// The inside centres near `near` (`interior`), each of its leaves' found by `leaf_inside`.
+pub fn interior_near(columns: &ColumnCrossings, near: &SparseGrid) -> SparseGrid {
+    let leaves: Vec<Leaf> = near
+        .leaves()
+        .par_iter()
+        .map(|l| Leaf::with_mask(l.origin, leaf_inside(columns, l.origin)))
+        .filter(|l| !l.is_empty())
+        .collect();
+    interior(columns, near, leaves, near.transform)
+}
+
 /// The origins of the 8^3 blocks wholly inside: those without a leaf of `near` whose first
 /// centre is inside (only blocks in the columns' box can be).
 fn inside_blocks(columns: &ColumnCrossings, near: &SparseGrid) -> Vec<Coord> {

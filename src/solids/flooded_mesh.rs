@@ -5,12 +5,12 @@
 //! of the whole solid's shape, its components and genus.
 
 use super::cavities::remove_cavities;
-use super::column_inside::{interior, leaf_inside, winding_columns};
+use super::column_inside::{interior_near, winding_columns};
 use super::exterior_flood::{FloodMethod, Solid, solid_from_surface};
 use super::inside_rule::{Inside, InsideChoice, InsideRule, choose_inside};
 use super::winding_inside::{block_columns, winding_inside};
 use crate::error::{Error, Result};
-use crate::grid::{Adjacency, Channels, DenseMask, Leaf, SparseGrid, Transform};
+use crate::grid::{Adjacency, Channels, DenseMask, SparseGrid, Transform};
 use crate::mesh::inside::ColumnCrossings;
 use crate::mesh::{Mesh, index_box};
 use crate::ops::flood::padded;
@@ -19,7 +19,6 @@ use crate::ops::topology::{components, euler_characteristic};
 use crate::progress::Progress;
 use crate::voxelize::Separability;
 use crate::voxelize::separating::{SeparatingOptions, voxelize_mesh, work_items};
-use rayon::prelude::*;
 
 /// Why the flood needs a closed mesh, for the error that refuses an open one.
 pub const FLOOD_NEEDS_CLOSED: &str = "the exterior flood would leak through it and leave the solid hollow \
@@ -138,20 +137,10 @@ pub fn flooded_mesh(
         // slabs reach a voxel's extent along the normal, Huang's full spheres and cylinders
         // its half diagonal), as `column_inside` needs: the columns are read at the surface's
         // leaves and at one centre of each other block.
-        Centres::Columns(columns) => {
-            let leaves: Vec<Leaf> = surface
-                .leaves()
-                .par_iter()
-                .map(|l| {
-                    let mut inside = Leaf::new(l.origin, Channels::NONE);
-                    inside.mask = leaf_inside(&columns, l.origin);
-                    inside
-                })
-                .filter(|l| !l.is_empty())
-                .collect();
-            let centres = interior(&columns, &surface, leaves, t);
-            (centres, SparseGrid::new(t, Channels::NONE))
-        }
+        Centres::Columns(columns) => (
+            interior_near(&columns, &surface),
+            SparseGrid::new(t, Channels::NONE),
+        ),
         Centres::Grids(grids) => *grids,
         Centres::Flood => {
             return Ok((choice, flooded_by_parity(mesh, surface, flood, progress)?));

@@ -164,8 +164,7 @@ fn columns_level_set(
         .map(|leaf| {
             let mask = leaf_inside(&columns, leaf.origin);
             let count = sign_leaf(leaf, &mask, h);
-            let mut inside = Leaf::new(leaf.origin, Channels::NONE);
-            inside.mask = mask;
+            let inside = Leaf::with_mask(leaf.origin, mask);
             ((!inside.is_empty()).then_some(inside), count)
         })
         .unzip();

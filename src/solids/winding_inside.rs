@@ -475,18 +475,14 @@ impl Context<'_> {
             }
             masks[slot(bz)] = decided.inside;
             if decided.ambiguous.iter().any(|&w| w != 0) {
-                let mut leaf = Leaf::new(origin, Channels::NONE);
-                leaf.mask = decided.ambiguous;
-                ambiguous.push(leaf);
+                ambiguous.push(Leaf::with_mask(origin, decided.ambiguous));
             }
         }
         for (bz, mask) in (z0..).step_by(8).zip(masks) {
             if mask.iter().all(|&w| w == u64::MAX) {
                 out.full_blocks.push([bx, by, bz]);
             } else if mask.iter().any(|&w| w != 0) {
-                let mut leaf = Leaf::new([bx, by, bz], Channels::NONE);
-                leaf.mask = mask;
-                out.leaves.push(leaf);
+                out.leaves.push(Leaf::with_mask([bx, by, bz], mask));
             }
         }
         out.ambiguous = ambiguous;
