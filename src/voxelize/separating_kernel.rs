@@ -632,18 +632,36 @@ pub(super) fn edge_cylinder<const C: usize>(
     // point c when moved back along the edge by rho q_w / dn_w, which puts it rho q.f from
     // c along u, for f = e_u - (dn_u / dn_w) e_w (itself across the edge, |f| r = reach):
     // so the sector's rows lie within r [min q.f, max q.f] of c, 0 (the axis) included.
-    let (reach_lo, reach_hi) = if halves.is_empty() {
-        (-reach, reach)
+    // Along w the sector reaches r [min q_w, max q_w] beyond the edge's ends, where the
+    // whole disc's caps reach `cap` both ways: a thin sector's planes are about half.
+    let cap = r * (1.0 - dn[w] * dn[w]).max(0.0).sqrt() + ROW_SLACK;
+    let (reach_lo, reach_hi, cap_lo, cap_hi) = if halves.is_empty() {
+        (-reach, reach, -cap, cap)
     } else {
         let mut f = DVec3::ZERO;
         f[u] = 1.0;
         f[w] = -dn[u] / dn[w];
-        let (lo, hi) = sector_directions(dn, halves, [f.normalize()])
-            .map(|q| q.dot(f))
-            .fold((0.0f64, 0.0f64), |(lo, hi), l| (lo.min(l), hi.max(l)));
-        (r * lo - SECTOR_SLACK, r * hi + SECTOR_SLACK)
+        // e_w less its part along the edge: across it, where q_w is extreme on the disc.
+        let mut g = -dn * dn[w];
+        g[w] += 1.0;
+        let ([f_lo, f_hi], [w_lo, w_hi]) =
+            sector_directions(dn, halves, [f.normalize(), g.normalize_or_zero()]).fold(
+                ([0.0f64; 2], [0.0f64; 2]),
+                |(f_range, w_range), q| {
+                    let (l, m) = (q.dot(f), q[w]);
+                    (
+                        [f_range[0].min(l), f_range[1].max(l)],
+                        [w_range[0].min(m), w_range[1].max(m)],
+                    )
+                },
+            );
+        (
+            r * f_lo - SECTOR_SLACK,
+            r * f_hi + SECTOR_SLACK,
+            r * w_lo - SECTOR_SLACK,
+            r * w_hi + SECTOR_SLACK,
+        )
     };
-    let cap = r * (1.0 - dn[w] * dn[w]).max(0.0).sqrt() + ROW_SLACK;
     let tau_margin = MARGIN / len2.sqrt();
     let test = EdgeTest::new(e, r);
     // The quadratic's leading coefficient is the edge's: 1 - dn_v^2 >= 2/3, as v is not
@@ -657,7 +675,7 @@ pub(super) fn edge_cylinder<const C: usize>(
     let columns = clip.min[v]..=clip.max[v];
     let cut = AxisCut::new(halves, v);
     for k in clipped(
-        int_range(p[w].min(e.b[w]) - cap, p[w].max(e.b[w]) + cap),
+        int_range(p[w].min(e.b[w]) + cap_lo, p[w].max(e.b[w]) + cap_hi),
         clip,
         w,
     ) {
