@@ -78,6 +78,22 @@ impl CoordBox {
     }
 }
 
+/// `floor(x)` as an integer, by truncation plus a fix-up (see `ceil_int`); saturating as
+/// `as i64` is.
+#[inline]
+pub fn floor_int(x: f64) -> i64 {
+    let h = x as i64;
+    if (h as f64) > x { h - 1 } else { h }
+}
+
+/// `ceil(x)` as an integer, by truncation plus a fix-up: `f64::ceil` and `floor` are libm
+/// calls without SSE4.1, which the x86-64 baseline lacks.
+#[inline]
+pub fn ceil_int(x: f64) -> i64 {
+    let l = x as i64;
+    if (l as f64) < x { l + 1 } else { l }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

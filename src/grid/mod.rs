@@ -13,7 +13,9 @@ mod transform;
 mod up_axis;
 
 pub use channel_pool::ChannelBox;
-pub use coord::{Coord, CoordBox, LEAF_VOXELS, leaf_offset, leaf_origin, offset_coord};
+pub use coord::{
+    Coord, CoordBox, LEAF_VOXELS, ceil_int, floor_int, leaf_offset, leaf_origin, offset_coord,
+};
 pub use leaf::{Channels, Leaf, mask_box};
 pub use sparse::{Accessor, Block, SparseGrid};
 pub use tiles::{NODE_DIM, Tiles, node_origin, tile_bytes};

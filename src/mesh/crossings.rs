@@ -14,6 +14,7 @@
 //! (`RayCrossing::after`): a centre on a face lies inside or outside as a point just off it, in the
 //! same place whichever direction looks at it, so the methods agree on surface voxels too.
 
+use crate::grid::{ceil_int, floor_int};
 use glam::{DVec2, DVec3};
 
 /// The rays `a0 ..= a0 + width - 1` by `b0 ..= b0 + height - 1`, numbered
@@ -195,10 +196,10 @@ pub fn for_each_crossing(
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         let lo = q[0].min(q[1]).min(q[2]);
         let hi = q[0].max(q[1]).max(q[2]);
-        let a0 = (lo.x.ceil() as i64).max(window.a0);
-        let a1 = (hi.x.floor() as i64).min(a_last);
-        let b0 = (lo.y.ceil() as i64).max(window.b0);
-        let b1 = (hi.y.floor() as i64).min(b_last);
+        let a0 = ceil_int(lo.x).max(window.a0);
+        let a1 = floor_int(hi.x).min(a_last);
+        let b0 = ceil_int(lo.y).max(window.b0);
+        let b1 = floor_int(hi.y).min(b_last);
         let beyond = frame.beyond(n);
         for a in a0..=a1 {
             for b in b0..=b1 {
@@ -210,10 +211,11 @@ pub fn for_each_crossing(
                 if inside {
                     // The plane through p[0] with normal n, solved for t at (a, b).
                     let depth = p[0].z - (n.x * (c.x - p[0].x) + n.y * (c.y - p[0].y)) / n.z;
-                    let after = if depth == depth.ceil() && !beyond {
+                    let up = ceil_int(depth);
+                    let after = if up as f64 == depth && !beyond {
                         depth as i64 + 1
                     } else {
-                        depth.ceil() as i64
+                        up
                     };
                     cross(RayCrossing {
                         ray: window.ray(a, b),

@@ -9,6 +9,7 @@ use super::Separability;
 use super::brick_bins::BrickSink;
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, Transform};
+pub(super) use crate::grid::{ceil_int, floor_int};
 use crate::huge_pages::vec_to_fill;
 use crate::mesh::Mesh;
 use crate::mesh::key_groups::group_by_key;
@@ -303,12 +304,13 @@ pub(super) fn primitives(mesh: &Mesh, transform: Transform, normals: bool) -> Re
     })
 }
 
-/// The voxels within `reach` of the box from `lo` to `hi`.
+/// The voxels within `reach` of the box from `lo` to `hi` (rounded without libm calls: every
+/// primitive's box is found when binning).
 pub(super) fn reach_box(lo: DVec3, hi: DVec3, reach: f64) -> CoordBox {
     let (lo, hi) = (lo - DVec3::splat(reach), hi + DVec3::splat(reach));
     CoordBox {
-        min: [lo.x, lo.y, lo.z].map(|v| v.floor() as i64),
-        max: [hi.x, hi.y, hi.z].map(|v| v.ceil() as i64),
+        min: [lo.x, lo.y, lo.z].map(floor_int),
+        max: [hi.x, hi.y, hi.z].map(ceil_int),
     }
 }
 
@@ -493,20 +495,6 @@ pub(super) fn is_planar(face: &[u32], pos: &[DVec3], n: DVec3) -> bool {
 #[inline]
 pub(super) fn int_range(lo: f64, hi: f64) -> std::ops::RangeInclusive<i64> {
     ceil_int(lo)..=floor_int(hi)
-}
-
-/// `floor(x)` by truncation plus a fix-up (see `ceil_int`).
-#[inline]
-pub(super) fn floor_int(x: f64) -> i64 {
-    let h = x as i64;
-    if (h as f64) > x { h - 1 } else { h }
-}
-
-/// `ceil(x)` by truncation plus a fix-up: `f64::ceil`/`floor` are libm calls without SSE4.1.
-#[inline]
-pub(super) fn ceil_int(x: f64) -> i64 {
-    let l = x as i64;
-    if (l as f64) < x { l + 1 } else { l }
 }
 
 /// Integer range `ceil(lo)..ceil(hi)`: the integers `v` with `lo <= v < hi`.
