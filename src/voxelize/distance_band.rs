@@ -169,3 +169,90 @@ fn vertex_halves(v: &Primitive, adjacency: &Adjacency, triangles: &[Triangle]) -
     }
     halves
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::grid::{leaf_offset, leaf_origin};
+    use crate::mesh::generate::{self, SplitMix64};
+    use crate::mesh::triangle_distance::triangle_distance;
+    use crate::mesh::{GridFit, fit_transform};
+
+    const BAND: f64 = 3.0;
+
+    /// Every voxel of the box around `mesh` (at `resolution`) against the least distance to
+    /// its triangles, brute force: active at that distance (to f32 rounding) where it is
+    /// within the band, inactive beyond it (a millionth of a voxel either side may go
+    /// either way). The regions' cuts (edge sectors, vertex cones, face prisms) leave out no
+    /// voxel and keep none past the band.
+    fn check(name: &str, mesh: &Mesh, resolution: u32) {
+        let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
+        let grid = distance_band(mesh, t, BAND, &Progress::none()).unwrap();
+        let triangles: Vec<[DVec3; 3]> = mesh
+            .triangles()
+            .map(|(_, tri)| tri.map(|i| t.world_to_index(mesh.p(i))))
+            .collect();
+        let reach = BAND as i64 + 1;
+        let (mut inside, mut checked) = (0, 0);
+        for x in -reach..resolution as i64 + reach {
+            for y in -reach..resolution as i64 + reach {
+                for z in -reach..resolution as i64 + reach {
+                    let c = DVec3::new(x as f64, y as f64, z as f64);
+                    let exact = triangles
+                        .iter()
+                        .map(|&tri| triangle_distance(c, tri))
+                        .fold(f64::INFINITY, f64::min);
+                    let value = grid.leaf(leaf_origin([x, y, z])).and_then(|l| {
+                        let n = leaf_offset([x, y, z]);
+                        l.is_on(n).then(|| l.value.as_ref().unwrap()[n])
+                    });
+                    match value {
+                        Some(v) => assert!(
+                            (f64::from(v) - exact).abs() <= 1e-5 * exact.max(1.0),
+                            "{name}: voxel {:?} holds {v}, the exact distance is {exact}",
+                            [x, y, z]
+                        ),
+                        None => assert!(
+                            exact > BAND - 1e-6,
+                            "{name}: voxel {:?} at {exact} is not in the band",
+                            [x, y, z]
+                        ),
+                    }
+                    if let Some(v) = value {
+                        assert!(exact <= BAND + 1e-6, "{name}: {v} beyond the band");
+                        inside += 1;
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert!(
+            inside > 1000 && inside < checked,
+            "{name}: {inside} of {checked} in the band"
+        );
+        assert_eq!(grid.voxel_count(), inside, "{name}: voxels outside the box");
+    }
+
+    #[test]
+    fn the_band_is_every_voxel_within_it_at_its_exact_distance() {
+        for seed in [1, 2] {
+            check("random closed", &generate::random_closed(seed), 20);
+        }
+        // Jagged: every vertex moved at random, so that edges fold sharply and vertices
+        // have wide cones of their own.
+        let mut jagged = generate::icosphere(DVec3::ZERO, 1.0, 2);
+        let mut random = SplitMix64(5);
+        for p in &mut jagged.positions {
+            *p *= random.range(0.75, 1.25);
+        }
+        check("jagged", &jagged, 20);
+        // Open: a torus with every fifth face gone (boundary edges and vertices).
+        let torus = generate::torus(DVec3::ZERO, 1.0, 0.4, 24, 12);
+        let kept: Vec<Vec<u32>> = (0..torus.face_count())
+            .filter(|f| f % 5 != 0)
+            .map(|f| torus.face(f).to_vec())
+            .collect();
+        let open = Mesh::from_polygons("open torus", torus.positions.clone(), &kept);
+        check("open torus", &open, 20);
+    }
+}
