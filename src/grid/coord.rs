@@ -78,8 +78,8 @@ impl CoordBox {
     }
 }
 
-/// `floor(x)` as an integer, by truncation plus a fix-up (see `ceil_int`); saturating as
-/// `as i64` is.
+/// `floor(x)` as an integer, by truncation plus a fix-up (see `ceil_int`), for `x` within
+/// i64's range: a planned grid's coordinates (the plan refuses grids it cannot index).
 #[inline]
 pub fn floor_int(x: f64) -> i64 {
     let h = x as i64;
