@@ -69,11 +69,13 @@ pub fn distance_band(
         candidates,
         |_, i, clip, sink| match found.numbered(i) {
             (PrimitiveClass::Vertex, v) => {
+                found.warm(PrimitiveClass::Vertex, v + 1, adjacency);
                 let vertex = found.vertex(v);
                 let halves = vertex_halves(&vertex, adjacency, triangles);
                 vertex_sphere(&vertex, band, &every, halves.as_slice(), clip, sink)
             }
             (PrimitiveClass::Edge, e) => {
+                found.warm(PrimitiveClass::Edge, e + 1, adjacency);
                 let edge = found.edge(e);
                 let halves = edge_halves(&edge, adjacency, triangles);
                 edge_cylinder(&edge, band, &every, halves.as_slice(), clip, sink)

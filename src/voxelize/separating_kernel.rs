@@ -226,6 +226,29 @@ impl Primitives {
         self.primitive(&self.vertices[n])
     }
 
+    /// Asks the cache for what voxelizing edge or vertex `n` of `class` reads first: its ends'
+    /// points and the triangles of its faces, found by number through two lookups (each a
+    /// memory miss on a large mesh). Called a feature ahead, so that the misses overlap the
+    /// feature before.
+    pub(super) fn warm(&self, class: PrimitiveClass, n: usize, adjacency: &Adjacency) {
+        let features = match class {
+            PrimitiveClass::Vertex => &self.vertices,
+            PrimitiveClass::Edge => &self.edges,
+            PrimitiveClass::Body => return,
+        };
+        let Some(f) = features.get(n) else { return };
+        for end in f.ends {
+            prefetch(&self.points[end as usize]);
+        }
+        for &face in &adjacency.faces[f.faces.clone()] {
+            if let Some(&first) = adjacency.triangle_starts.get(face as usize)
+                && let Some(tri) = self.triangles.get(first)
+            {
+                prefetch(tri);
+            }
+        }
+    }
+
     fn primitive(&self, f: &Feature) -> Primitive {
         Primitive {
             a: self.points[f.ends[0] as usize],
@@ -892,4 +915,18 @@ pub(super) fn within_edge_planes(sides: &[(DVec3, DVec3); 3], x: DVec3) -> bool 
 #[inline]
 pub(super) fn to_coord(x: DVec3) -> [i64; 3] {
     [x.x as i64, x.y as i64, x.z as i64]
+}
+
+/// A hint that `x` will be read soon; nothing where the target has no such hint.
+#[inline]
+fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch reads nothing and cannot fault; the pointer is a valid reference's.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+            (x as *const T).cast(),
+        );
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
 }
