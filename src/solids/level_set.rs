@@ -80,11 +80,11 @@ pub fn level_set(
         .into_iter()
         .partition(|&o| grid.leaf(o).is_some());
     let mut leaves = inside.leaves;
-    leaves.extend(full_band.into_iter().map(|o| {
-        let mut leaf = Leaf::new(o, Channels::NONE);
-        leaf.mask = [u64::MAX; 8];
-        leaf
-    }));
+    leaves.extend(
+        full_band
+            .into_iter()
+            .map(|o| Leaf::with_mask(o, [u64::MAX; 8])),
+    );
     let mut interior = SparseGrid::from_distinct_leaves(transform, Channels::NONE, leaves);
     interior.fill_free_leaf_blocks(full_free);
     let h = transform.voxel_size as f32;

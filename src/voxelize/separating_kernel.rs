@@ -8,8 +8,7 @@
 use super::Separability;
 use super::brick_bins::BrickSink;
 use crate::error::{Error, Result};
-use crate::grid::{CoordBox, Transform};
-pub(super) use crate::grid::{ceil_int, floor_int};
+use crate::grid::{CoordBox, Transform, ceil_int, floor_int};
 use crate::huge_pages::vec_to_fill;
 use crate::mesh::Mesh;
 use crate::mesh::key_groups::group_by_key;
@@ -634,10 +633,9 @@ pub(super) fn edge_cylinder<const C: usize>(
     let (u, v) = ((w + 1) % 3, (w + 2) % 3);
     let r = r + MARGIN;
     let dn = d / len2.sqrt();
-    // In a plane across axis w the cylinder's section is an ellipse reaching
-    // r sqrt(1 - dn_v^2) / |dn_w| from the axis along u; the caps, discs of radius r across
-    // the edge, reach r sqrt(1 - dn_w^2) beyond its ends along w.
-    let reach = r * (1.0 - dn[v] * dn[v]).sqrt() / dn[w].abs() + ROW_SLACK;
+    // In a plane across axis w the whole cylinder's section is an ellipse reaching
+    // `reach` = r sqrt(1 - dn_v^2) / |dn_w| from the axis along u; the caps, discs of radius r
+    // across the edge, reach `cap` = r sqrt(1 - dn_w^2) beyond its ends along w.
     // Planes through the edge (`halves`) cut the disc across it to a sector. A point rho q
     // off the axis (q across the edge) lies in the plane across axis w through the axis's
     // point c when moved back along the edge by rho q_w / dn_w, which puts it rho q.f from
@@ -645,8 +643,9 @@ pub(super) fn edge_cylinder<const C: usize>(
     // so the sector's rows lie within r [min q.f, max q.f] of c, 0 (the axis) included.
     // Along w the sector reaches r [min q_w, max q_w] beyond the edge's ends, where the
     // whole disc's caps reach `cap` both ways: a thin sector's planes are about half.
-    let cap = r * (1.0 - dn[w] * dn[w]).max(0.0).sqrt() + ROW_SLACK;
     let (reach_lo, reach_hi, cap_lo, cap_hi) = if halves.is_empty() {
+        let reach = r * (1.0 - dn[v] * dn[v]).sqrt() / dn[w].abs() + ROW_SLACK;
+        let cap = r * (1.0 - dn[w] * dn[w]).max(0.0).sqrt() + ROW_SLACK;
         (-reach, reach, -cap, cap)
     } else {
         let mut f = DVec3::ZERO;
