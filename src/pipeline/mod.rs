@@ -491,7 +491,14 @@ impl Job {
         warnings.extend(work.unwritten_attributes());
         let reading = StageTime::since("read", begun);
         let planning_begun = StageTime::now();
-        let plan = estimate::price(&work, self.fit, &self.describe_input())?;
+        let mut plan = estimate::price(&work, self.fit, &self.describe_input())?;
+        let threads = self
+            .limits
+            .threads
+            .map_or_else(rayon::current_num_threads, |n| n.clamp(1, MAX_THREADS));
+        plan.estimated_bytes = plan
+            .estimated_bytes
+            .saturating_add(threads as u64 * estimate::thread_bytes(&work));
         let limit = self.limits.max_memory;
         crate::system::check_fits(
             plan.estimated_bytes,

@@ -1,4 +1,4 @@
-//! Surface voxelization in 64^3 bricks. Primitives are binned by the bricks their candidate
+//! Surface voxelization in 128^3 bricks. Primitives are binned by the bricks their candidate
 //! boxes overlap; each brick is then voxelized on its own thread, clipped to the brick, into
 //! dense bit sets (one per class of primitive) and, with channels, dense nearest distances and
 //! normals, from which its leaves are cut. Bricks never
@@ -13,8 +13,9 @@ use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
 /// Brick edge in voxels (a power of two, a multiple of the leaf's 8).
-const BRICK_LOG2: u32 = 6;
+const BRICK_LOG2: u32 = 7;
 const BRICK: i64 = 1 << BRICK_LOG2;
+const _: () = assert!(BRICK <= 128, "a brick's column fits a u128 (`add_z_run`)");
 /// Leaves per brick edge, and per brick.
 const EDGE_LEAVES: usize = (BRICK / 8) as usize;
 const BRICK_LEAVES: usize = EDGE_LEAVES * EDGE_LEAVES * EDGE_LEAVES;
@@ -133,8 +134,8 @@ impl<const CLASSES: usize> BrickSink<'_, CLASSES> {
     }
 
     /// Marks voxels `(x, y, z + i)` for the set bits `i` of `run` (all inside the brick; a
-    /// brick is 64 voxels long, so one word holds a column). Only for a brick that keeps
-    /// voxel bits alone. Along z a leaf's voxels are consecutive bits of one word: a run
+    /// brick is at most 128 voxels long, so a `u128` holds a column). Only for a brick that
+    /// keeps voxel bits alone. Along z a leaf's voxels are consecutive bits of one word: a run
     /// costs a word per leaf it crosses, not a mark per voxel.
     #[inline]
     pub fn add_z_run(&mut self, x: i64, y: i64, z: i64, run: u64) {
@@ -145,13 +146,13 @@ impl<const CLASSES: usize> BrickSink<'_, CLASSES> {
                 && (run == 0 || lz + (64 - run.leading_zeros() as i64) <= BRICK),
             "clipped to the brick"
         );
-        let column = (u128::from(run) << lz) as u64;
+        let column = u128::from(run) << lz;
         let row = ((lx >> 3) as usize * EDGE_LEAVES + (ly >> 3) as usize) * EDGE_LEAVES;
         let shift = (ly & 7) << 3;
         let mut groups = column;
         while groups != 0 {
             let g = groups.trailing_zeros() as usize / 8;
-            let byte = (column >> (8 * g)) & 0xff;
+            let byte = ((column >> (8 * g)) & 0xff) as u64;
             groups &= !(0xff << (8 * g));
             let leaf = row + g;
             self.bits.classes[self.class][leaf * 8 + (lx & 7) as usize] |= byte << shift;
@@ -177,6 +178,14 @@ impl<const CLASSES: usize> BrickSink<'_, CLASSES> {
             + (l[2] >> 3) as usize;
         leaf * LEAF_VOXELS + (l[0] & 7) as usize * 64 + (((l[1] & 7) << 3) | (l[2] & 7)) as usize
     }
+}
+
+/// Bytes of the dense scratch each worker thread keeps for its bricks (`BrickBits`) with
+/// `channels` and `classes` classes of primitive: memory a job's plan counts per thread.
+pub(crate) fn scratch_bytes(channels: Channels, classes: usize) -> u64 {
+    let voxels = (BRICK_LEAVES * LEAF_VOXELS) as u64;
+    let per_voxel = 4 * u64::from(channels.value) + 12 * u64::from(channels.normal);
+    voxels / 8 * classes as u64 + voxels * per_voxel
 }
 
 /// The bricks a box of voxels overlaps.
@@ -212,7 +221,7 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
         .with_max_len(1)
         .map(|bin| {
             // Each worker keeps its own scratch (rayon may split the work into many more
-            // tasks than workers, and a brick's scratch is a megabyte with distances).
+            // tasks than workers, and a brick's scratch is 8 MiB with distances).
             let mut scratch = scratch[rayon::current_thread_index().unwrap_or(0)]
                 .lock()
                 .unwrap_or_else(|poisoned| poisoned.into_inner());

@@ -30,7 +30,7 @@ use crate::mesh::Mesh;
 use glam::DVec3;
 
 /// Unsigned distances in voxels (value channel) on every voxel within `band` voxels of
-/// `mesh`, computed in 64^3 bricks on all threads; `progress` counts vertices, edges and
+/// `mesh`, computed in 128^3 bricks on all threads; `progress` counts vertices, edges and
 /// triangles (`separating::work_items`).
 pub fn distance_band(
     mesh: &Mesh,

@@ -181,14 +181,14 @@ pub fn voxelize_mesh(
 /// tests one by one.
 const SMALL_BOX_CELLS: i64 = 256;
 
-/// `lo..=hi` by axis, clipped to `clip`, when it holds at most `SMALL_BOX_CELLS` voxels.
+/// `lo..=hi` by axis, clipped to `clip`, when it holds at most `SMALL_BOX_CELLS` voxels and
+/// at most 64 along z (`mark_box`'s runs are words).
 fn small_box(lo: DVec3, hi: DVec3, clip: &CoordBox) -> Option<[std::ops::RangeInclusive<i64>; 3]> {
     let ranges = [0, 1, 2].map(|a| clipped(int_range(lo[a], hi[a]), clip, a));
-    let cells = ranges
-        .iter()
-        .map(|range| (range.end() - range.start() + 1).max(0))
-        .product::<i64>();
-    (cells <= SMALL_BOX_CELLS).then_some(ranges)
+    let lengths = ranges
+        .clone()
+        .map(|range| (range.end() - range.start() + 1).max(0));
+    (lengths.iter().product::<i64>() <= SMALL_BOX_CELLS && lengths[2] <= 64).then_some(ranges)
 }
 
 /// Marks, column by column along z, the voxels of the box (within one brick) that `inside`
