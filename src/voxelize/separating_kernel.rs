@@ -743,7 +743,7 @@ pub(super) fn edge_cylinder<const C: usize>(
 pub(super) struct EdgeTest {
     p: DVec3,
     d: DVec3,
-    len2: f64,
+    inv_len2: f64,
     tau_margin: f64,
     r2: f64,
 }
@@ -755,16 +755,17 @@ impl EdgeTest {
         EdgeTest {
             p: e.a,
             d,
-            len2,
+            inv_len2: 1.0 / len2,
             tau_margin: MARGIN / len2.sqrt(),
             r2: r * r,
         }
     }
 
-    /// Whether `x` is in, and its squared distance to the edge's line; without a branch.
+    /// Whether `x` is in, and its squared distance to the edge's line; without a branch or
+    /// a division (a division per voxel took a twentieth of a surface's voxelizing).
     #[inline]
     pub(super) fn at(&self, x: DVec3) -> (bool, f64) {
-        let tau = (x - self.p).dot(self.d) / self.len2;
+        let tau = (x - self.p).dot(self.d) * self.inv_len2;
         let d2 = (x - self.p - self.d * tau).length_squared();
         let inside = (tau >= -self.tau_margin) & (tau <= 1.0 + self.tau_margin) & (d2 <= self.r2);
         (inside, d2)
