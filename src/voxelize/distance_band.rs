@@ -186,9 +186,12 @@ mod tests {
     /// its triangles, brute force: active at that distance (to f32 rounding) where it is
     /// within the band, inactive beyond it (a millionth of a voxel either side may go
     /// either way). The regions' cuts (edge sectors, vertex cones, face prisms) leave out no
-    /// voxel and keep none past the band.
+    /// voxel and keep none past the band. The mesh is centred on a corner of eight bricks, so
+    /// that every brick a primitive reaches must have been found for it.
     fn check(name: &str, mesh: &Mesh, resolution: u32) {
-        let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
+        let fit = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
+        let half = i64::from(resolution / 2);
+        let t = Transform::new(fit.origin + fit.voxel_size * half as f64, fit.voxel_size);
         let grid = distance_band(mesh, t, BAND, &Progress::none()).unwrap();
         let triangles: Vec<[DVec3; 3]> = mesh
             .triangles()
@@ -196,9 +199,10 @@ mod tests {
             .collect();
         let reach = BAND as i64 + 1;
         let (mut inside, mut checked) = (0, 0);
-        for x in -reach..resolution as i64 + reach {
-            for y in -reach..resolution as i64 + reach {
-                for z in -reach..resolution as i64 + reach {
+        let along = -half - reach..resolution as i64 - half + reach;
+        for x in along.clone() {
+            for y in along.clone() {
+                for z in along.clone() {
                     let c = DVec3::new(x as f64, y as f64, z as f64);
                     let exact = triangles
                         .iter()

@@ -45,8 +45,8 @@ use super::Progress;
 use super::Separability;
 use super::brick_bins::{BrickSink, voxelize_in_bricks};
 use super::separating_kernel::{
-    EdgeTest, MARGIN, Primitive, PrimitiveClass, Primitives, ROW_SLACK, Triangle, clipped,
-    edge_cylinder, edge_planes, face_body, int_range, primitives, slab_bounds, turned,
+    EdgeTest, MARGIN, Primitive, PrimitiveClass, Primitives, Triangle, clipped, cylinder_reach,
+    edge_cylinder, edge_planes, face_body, int_range, primitives, slab_bounds, slab_reach, turned,
     vertex_sphere, within_edge_planes,
 };
 use super::sink::nearest_channels;
@@ -225,14 +225,14 @@ fn short_edge_cylinder<const C: usize>(
     sink: &mut BrickSink<C>,
 ) -> bool {
     let (p, d) = (e.a, e.b - e.a);
-    let r = r + MARGIN;
-    let reach = DVec3::splat(r + ROW_SLACK);
-    let Some(cells) = small_box(p.min(e.b) - reach, p.max(e.b) + reach, clip) else {
-        return false;
-    };
     if d.length_squared() == 0.0 {
         return true; // both ends are one vertex: its sphere covers it
     }
+    let r = r + MARGIN;
+    let reach = cylinder_reach(d, r);
+    let Some(cells) = small_box(p.min(e.b) - reach, p.max(e.b) + reach, clip) else {
+        return false;
+    };
     let test = EdgeTest::new(e, r);
     mark_box(cells, |c| test.at(c).0, sink);
     true
@@ -249,11 +249,11 @@ fn small_face_body<const C: usize>(
     sink: &mut BrickSink<C>,
 ) -> bool {
     let [a, b, c] = tri.corners;
-    let reach = DVec3::splat((-d_lo).max(d_hi) + ROW_SLACK);
+    let n = turned(tri.normal);
+    let reach = slab_reach(n, (-d_lo).max(d_hi));
     let Some(cells) = small_box(a.min(b).min(c) - reach, a.max(b).max(c) + reach, clip) else {
         return false;
     };
-    let n = turned(tri.normal);
     let sides = edge_planes(tri);
     mark_box(
         cells,

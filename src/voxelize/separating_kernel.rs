@@ -262,15 +262,20 @@ impl Primitives {
         match class {
             PrimitiveClass::Vertex => {
                 let a = self.points[self.vertices[n].ends[0] as usize];
-                reach_box(a, a, reach)
+                reach_box(a, a, DVec3::splat(reach))
             }
             PrimitiveClass::Edge => {
                 let e = self.edge(n);
-                reach_box(e.a.min(e.b), e.a.max(e.b), reach)
+                reach_box(e.a.min(e.b), e.a.max(e.b), cylinder_reach(e.b - e.a, reach))
             }
             PrimitiveClass::Body => {
-                let [a, b, c] = self.triangles[n].corners;
-                reach_box(a.min(b).min(c), a.max(b).max(c), reach)
+                let tri = &self.triangles[n];
+                let [a, b, c] = tri.corners;
+                reach_box(
+                    a.min(b).min(c),
+                    a.max(b).max(c),
+                    slab_reach(tri.normal, reach),
+                )
             }
         }
     }
@@ -326,14 +331,35 @@ pub(super) fn primitives(mesh: &Mesh, transform: Transform, normals: bool) -> Re
     })
 }
 
-/// The voxels within `reach` of the box from `lo` to `hi` (rounded without libm calls: every
-/// primitive's box is found when binning).
-pub(super) fn reach_box(lo: DVec3, hi: DVec3, reach: f64) -> CoordBox {
-    let (lo, hi) = (lo - DVec3::splat(reach), hi + DVec3::splat(reach));
+/// The voxels within `reach` (by axis) of the box from `lo` to `hi` (rounded without libm
+/// calls: every primitive's box is found when binning).
+pub(super) fn reach_box(lo: DVec3, hi: DVec3, reach: DVec3) -> CoordBox {
+    let (lo, hi) = (lo - reach, hi + reach);
     CoordBox {
         min: [lo.x, lo.y, lo.z].map(floor_int),
         max: [hi.x, hi.y, hi.z].map(ceil_int),
     }
+}
+
+/// How far, by axis, a slab of half thickness `half` along the unit normal `n` reaches beyond
+/// its triangle's box: `half |n_a|`, with room for rounding. A prism's box, not a cube's:
+/// along a smooth mesh's in-plane axes it is several voxels narrower.
+pub(super) fn slab_reach(n: DVec3, half: f64) -> DVec3 {
+    n.abs() * half + DVec3::splat(ROW_SLACK)
+}
+
+/// How far, by axis, the cylinder of radius `r` around the edge `d` (caps flat, across the
+/// edge) reaches beyond the box of its ends: `r sqrt(1 - dn_a^2)`, the root taken of the
+/// other two components' squares (no cancellation), with room for rounding; `r` all round
+/// for an edge of no length.
+pub(super) fn cylinder_reach(d: DVec3, r: f64) -> DVec3 {
+    let len2 = d.length_squared();
+    if len2 == 0.0 {
+        return DVec3::splat(r + ROW_SLACK);
+    }
+    let dn2 = d * d / len2;
+    let across = DVec3::new(dn2.y + dn2.z, dn2.z + dn2.x, dn2.x + dn2.y);
+    DVec3::new(across.x.sqrt(), across.y.sqrt(), across.z.sqrt()) * r + DVec3::splat(ROW_SLACK)
 }
 
 /// Twice the vector area of a polygon's fan (its normal, weighted by area).
@@ -796,8 +822,8 @@ pub(super) fn face_body<const C: usize>(
         h: m.dot(p) - MARGIN,
     });
     let column_cut = ((d_hi - d_lo) / n[w] > 4.0).then(|| AxisCut::new(&inside_sides, w));
-    let lo = a.min(b).min(c) - DVec3::splat(t);
-    let hi = a.max(b).max(c) + DVec3::splat(t);
+    let reach = slab_reach(n, t);
+    let (lo, hi) = (a.min(b).min(c) - reach, a.max(b).max(c) + reach);
     let half = t / n[w].abs();
     let inv_nw = 1.0 / n[w];
     // Clip each row to the columns whose slab segment can reach inside every edge plane: the
