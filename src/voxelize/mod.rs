@@ -14,6 +14,7 @@ mod separating_kernel;
 pub mod sign_change;
 mod sink;
 pub mod step_certificate;
+mod vertex_cone;
 
 pub use crate::progress::Progress;
 

@@ -7,6 +7,7 @@
 
 use super::Separability;
 use super::brick_bins::BrickSink;
+use super::vertex_cone::{ConeReach, cone_reach};
 use crate::error::{Error, Result};
 use crate::grid::{CoordBox, Transform, ceil_int, floor_int};
 use crate::huge_pages::vec_to_fill;
@@ -574,7 +575,8 @@ pub(super) fn clipped(
     (*range.start()).max(clip.min[axis])..=(*range.end()).min(clip.max[axis])
 }
 
-/// S_v: voxel centres within `r` of the vertex (that `keep` accepts), in `clip`.
+/// S_v: voxel centres within `r` of the vertex (that `keep` accepts) and, with `halves`, in
+/// the cone they leave (`vertex_cone`), in `clip`.
 pub(super) fn vertex_sphere<const C: usize>(
     v: &Primitive,
     r: f64,
@@ -585,9 +587,12 @@ pub(super) fn vertex_sphere<const C: usize>(
 ) {
     let p = v.a;
     let r2 = (r + MARGIN) * (r + MARGIN);
+    let ConeReach::Within(lo, hi) = cone_reach(halves, r + MARGIN) else {
+        return;
+    };
     let cut = AxisCut::new(halves, 2);
-    for x in clipped(int_range(p.x - r - MARGIN, p.x + r + MARGIN), clip, 0) {
-        for y in clipped(int_range(p.y - r - MARGIN, p.y + r + MARGIN), clip, 1) {
+    for x in clipped(int_range(p.x + lo.x, p.x + hi.x), clip, 0) {
+        for y in clipped(int_range(p.y + lo.y, p.y + hi.y), clip, 1) {
             let column = cut.range(
                 clip.min[2]..=clip.max[2],
                 DVec3::new(x as f64, y as f64, 0.0),
@@ -614,7 +619,7 @@ pub(super) fn vertex_sphere<const C: usize>(
 
 /// Angle (radians) by which a boundary ray of a sector may break a half-space and still
 /// bound it: a sector narrower than this keeps both its sides.
-const SECTOR_ANGLE_SLACK: f64 = 1e-6;
+pub(super) const SECTOR_ANGLE_SLACK: f64 = 1e-6;
 
 /// Slack on bounds taken from `sector_directions`: the half-spaces' margins widen the exact
 /// sector by at most 2 MARGIN / SECTOR_ANGLE_SLACK = 0.002 voxels.
