@@ -41,22 +41,28 @@ pub(super) fn cone_reach(halves: &[HalfSpace], r: f64) -> ConeReach {
     for (i, a) in halves.iter().enumerate() {
         for b in &halves[i + 1..] {
             let u = a.g.cross(b.g);
-            let len = u.length();
-            if len < LEAST_CROSS {
+            let len2 = u.length_squared();
+            if len2 < LEAST_CROSS * LEAST_CROSS {
                 return ball;
             }
-            let (lo, hi) = halves
-                .iter()
-                .map(|h| h.g.dot(u))
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
-                    (lo.min(s), hi.max(s))
-                });
-            let slack = SECTOR_ANGLE_SLACK * len;
-            let (along, against) = (hi <= slack, lo >= -slack);
+            // g·u within SECTOR_ANGLE_SLACK |u| of the half-space, without a root for the
+            // pairs (most) that no half-space keeps.
+            let slack2 = SECTOR_ANGLE_SLACK * SECTOR_ANGLE_SLACK * len2;
+            let (mut along, mut against) = (true, true);
+            for h in halves {
+                let s = h.g.dot(u);
+                let small = s * s <= slack2;
+                along &= s <= 0.0 || small;
+                against &= s >= 0.0 || small;
+            }
             if along && against {
                 return ball; // the line through both ways lies in the cone
             }
-            for (kept, ray) in [(along, u / len), (against, -u / len)] {
+            if !(along || against) {
+                continue;
+            }
+            let u = u / len2.sqrt();
+            for (kept, ray) in [(along, u), (against, -u)] {
                 if kept {
                     if count == MOST_RAYS {
                         return ball;
