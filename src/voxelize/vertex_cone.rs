@@ -1,8 +1,8 @@
 //! Where a vertex can be the nearest point of a mesh: the cone its half-spaces leave (behind
 //! every edge and fan diagonal leaving it, `distance_band`), within a radius. On a smooth mesh
 //! that cone is thin where the surface is convex or concave and only its apex at a saddle, so
-//! bounding it spares most of the ball's columns (igea at 1024: 41% of its vertices are
-//! saddles).
+//! bounding it spares most of the ball's columns (igea at 1024: 41% of its (brick, vertex) pairs
+//! have no cone beyond the apex).
 //!
 //! A cone holding no line is the conic hull of its extreme rays, each where two of its planes
 //! meet, and lies within the circular cone around their mean direction that reaches the
