@@ -15,7 +15,7 @@ use super::{
     BrickStage, BrickTask, Fill, Plan, Shape, ShapeTask, SubdivisionOutput, SurfaceMethod,
 };
 use crate::error::{Error, Result};
-use crate::grid::{Channels, CoordBox, MAX_DENSE_VOXELS, SparseGrid, Transform};
+use crate::grid::{CoordBox, MAX_DENSE_VOXELS, SparseGrid, Transform};
 use crate::implicit::Formula;
 use crate::io::brick_set::brick_voxels;
 use crate::io::vdb::check_voxel_size;
@@ -29,9 +29,9 @@ use crate::solids::csg_tree::CsgNode;
 use crate::solids::exterior_flood::FloodMethod;
 use crate::solids::inside_rule::InsideRule;
 use crate::subd::ControlMesh;
+use crate::voxelize::distance_band;
 use crate::voxelize::projective::{self, Coloring};
 use crate::voxelize::separating;
-use crate::voxelize::{brick_scratch_bytes, nearest_channels};
 use glam::DVec3;
 use std::path::Path;
 
@@ -812,25 +812,18 @@ pub(super) fn price(work: &Work, fit: GridFit, what: &str) -> Result<Plan> {
 /// normals with a surface's normals, voxel bits alone otherwise), for the works that
 /// voxelize a mesh's surface.
 pub(super) fn thread_bytes(work: &Work) -> u64 {
-    let (channels, classes) = match work {
+    match work {
         Work::MeshSurface {
             method: SurfaceMethod::Separating(o),
             ..
-        } => (nearest_channels(o.normals), 3),
-        Work::SeparationCheck { options, .. } => (nearest_channels(options.normals), 3),
-        Work::DistanceBand { .. } => (
-            Channels {
-                value: true,
-                ..Channels::NONE
-            },
-            1,
-        ),
+        } => separating::thread_scratch_bytes(o.normals),
+        Work::SeparationCheck { options, .. } => separating::thread_scratch_bytes(options.normals),
+        Work::DistanceBand { .. } => distance_band::thread_scratch_bytes(),
         Work::Solid { .. } | Work::MeasureMesh { .. } | Work::CsgTree(_) | Work::Brick(_) => {
-            (Channels::NONE, 3)
+            separating::thread_scratch_bytes(false)
         }
-        _ => return 0,
-    };
-    brick_scratch_bytes(channels, classes)
+        _ => 0,
+    }
 }
 
 /// A plan over `bbox` on `transform` needing `bytes` besides the process itself.

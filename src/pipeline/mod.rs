@@ -492,10 +492,7 @@ impl Job {
         let reading = StageTime::since("read", begun);
         let planning_begun = StageTime::now();
         let mut plan = estimate::price(&work, self.fit, &self.describe_input())?;
-        let threads = self
-            .limits
-            .threads
-            .map_or_else(rayon::current_num_threads, |n| n.clamp(1, MAX_THREADS));
+        let threads = worker_count(self.limits.threads).unwrap_or_else(rayon::current_num_threads);
         plan.estimated_bytes = plan
             .estimated_bytes
             .saturating_add(threads as u64 * estimate::thread_bytes(&work));
@@ -565,13 +562,19 @@ impl Job {
     }
 }
 
+/// The workers a job asking for `threads` runs on: 1 to `MAX_THREADS`, or the global pool's
+/// (all cores) when it asks for none.
+fn worker_count(threads: Option<usize>) -> Option<usize> {
+    threads.map(|n| n.clamp(1, MAX_THREADS))
+}
+
 /// Runs `work` on a pool of `threads` workers (1 to `MAX_THREADS`), or without one on the
 /// global pool (all cores).
 pub fn on_threads<T: Send>(
     threads: Option<usize>,
     work: impl FnOnce() -> Result<T> + Send,
 ) -> Result<T> {
-    match threads.map(|n| n.clamp(1, MAX_THREADS)) {
+    match worker_count(threads) {
         None => work(),
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n)

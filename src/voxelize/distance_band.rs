@@ -19,7 +19,7 @@
 //! within the band of each voxel on igea at 1024) costs about one distance per voxel.
 
 use super::Progress;
-use super::brick_bins::voxelize_in_bricks;
+use super::brick_bins::{scratch_bytes, voxelize_in_bricks};
 use super::separating_kernel::{
     Adjacency, HalfSpace, MARGIN, MOST_HALVES, Primitive, PrimitiveClass, Primitives, Triangle,
     edge_cylinder, face_body, primitives, vertex_sphere,
@@ -28,6 +28,17 @@ use crate::error::{Error, Result};
 use crate::grid::{Channels, SparseGrid, Transform};
 use crate::mesh::Mesh;
 use glam::DVec3;
+
+/// What a brick of the band keeps per voxel: its least distance.
+const BAND_CHANNELS: Channels = Channels {
+    value: true,
+    ..Channels::NONE
+};
+
+/// Bytes of the brick scratch each thread of `distance_band` keeps.
+pub fn thread_scratch_bytes() -> u64 {
+    scratch_bytes(BAND_CHANNELS, 1)
+}
 
 /// Unsigned distances in voxels (value channel) on every voxel within `band` voxels of
 /// `mesh`, computed in 128^3 bricks on all threads; `progress` counts vertices, edges and
@@ -49,10 +60,7 @@ pub fn distance_band(
         adjacency,
         ..
     } = &found;
-    let channels = Channels {
-        value: true,
-        ..Channels::NONE
-    };
+    let channels = BAND_CHANNELS;
     // A closed slab: plane distances up to the band on both sides.
     let slab = (-band - MARGIN, band + MARGIN);
     let every = |_: &Primitive, _: DVec3| true;

@@ -1,8 +1,6 @@
 //! Voxelization methods, one file each, named for what they do.
 
 mod brick_bins;
-pub(crate) use brick_bins::scratch_bytes as brick_scratch_bytes;
-pub(crate) use sink::nearest_channels;
 pub mod distance_band;
 pub mod interval_octree;
 pub mod parametric;

@@ -43,7 +43,7 @@
 
 use super::Progress;
 use super::Separability;
-use super::brick_bins::{BrickSink, voxelize_in_bricks};
+use super::brick_bins::{BrickSink, scratch_bytes, voxelize_in_bricks};
 use super::separating_kernel::{
     EdgeTest, MARGIN, Primitive, PrimitiveClass, Primitives, Triangle, clipped, cylinder_reach,
     edge_cylinder, edge_planes, face_body, int_range, primitives, slab_bounds, slab_reach, turned,
@@ -106,6 +106,11 @@ impl SeparatingStats {
 /// half the face corners, exact for closed meshes).
 pub fn work_items(mesh: &Mesh) -> u64 {
     (mesh.positions.len() + mesh.indices.len() / 2 + mesh.triangle_count()) as u64
+}
+
+/// Bytes of the brick scratch each thread of `voxelize_mesh` keeps, with normals or not.
+pub fn thread_scratch_bytes(normals: bool) -> u64 {
+    scratch_bytes(nearest_channels(normals), PrimitiveClass::ALL.len())
 }
 
 /// Voxelizes `mesh` (world units) into a grid with `transform`.

@@ -676,7 +676,7 @@ pub(super) fn edge_cylinder<const C: usize>(
     // whole disc's caps reach `cap` both ways: a thin sector's planes are about half.
     let (reach_lo, reach_hi, cap_lo, cap_hi) = if halves.is_empty() {
         let reach = r * (1.0 - dn[v] * dn[v]).sqrt() / dn[w].abs() + ROW_SLACK;
-        let cap = r * (1.0 - dn[w] * dn[w]).max(0.0).sqrt() + ROW_SLACK;
+        let cap = cylinder_reach(d, r)[w];
         (-reach, reach, -cap, cap)
     } else {
         let mut f = DVec3::ZERO;
