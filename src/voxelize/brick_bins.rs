@@ -61,10 +61,15 @@ impl<const CLASSES: usize> BrickBits<CLASSES> {
         self.touched[i >> 15] |= 1 << ((i >> 9) & 63);
         if let Some(d) = self.distance.as_deref_mut() {
             let near = distance() as f32;
-            if near < d[i] {
-                d[i] = near;
-                if let Some(normals) = self.normal.as_deref_mut() {
-                    normals[i] = normal.as_vec3().into();
+            match self.normal.as_deref_mut() {
+                // Without normals the least distance is a min, not a branch on each voxel's
+                // value (which primitive is nearer is not predictable).
+                None => d[i] = d[i].min(near),
+                Some(normals) => {
+                    if near < d[i] {
+                        d[i] = near;
+                        normals[i] = normal.as_vec3().into();
+                    }
                 }
             }
         }
@@ -268,7 +273,7 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
 
 /// A brick in use and its primitives.
 struct Bin {
-    /// Brick coordinate (origin / 64).
+    /// Brick coordinate (origin / 128).
     brick: Coord,
     /// The primitives overlapping it, packed with their class.
     entries: Vec<u32>,
