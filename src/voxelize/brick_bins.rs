@@ -219,12 +219,17 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
     let scratch: Vec<std::sync::Mutex<BrickBits<CLASSES>>> = (0..rayon::current_num_threads())
         .map(|_| std::sync::Mutex::new(BrickBits::new(channels)))
         .collect();
-    let work: Vec<(Vec<Leaf>, [u64; CLASSES])> = bins
+    // The busiest bricks first, so that the last bricks a thread takes are short ones and no
+    // thread waits long for another's at the end; the leaves are joined in the bins' order.
+    let mut busiest_first: Vec<usize> = (0..bins.len()).collect();
+    busiest_first.sort_by_key(|&b| std::cmp::Reverse(bins[b].entries.len()));
+    let work: Vec<(Vec<Leaf>, [u64; CLASSES])> = busiest_first
         .par_iter()
         // One brick per task: bricks differ in cost by orders of magnitude, and rayon's
         // default halving leaves a thread idle while the other works through a long run.
         .with_max_len(1)
-        .map(|bin| {
+        .map(|&b| {
+            let bin = &bins[b];
             // Each worker keeps its own scratch (rayon may split the work into many more
             // tasks than workers, and a brick's scratch is 8 MiB with distances).
             let mut scratch = scratch[rayon::current_thread_index().unwrap_or(0)]
@@ -261,10 +266,15 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
     progress.check()?;
     let mut totals = [0u64; CLASSES];
     let mut leaves = Vec::with_capacity(work.iter().map(|w| w.0.len()).sum());
-    for (brick_leaves, counts) in work {
-        leaves.extend(brick_leaves);
+    let mut in_bin_order: Vec<Option<Vec<Leaf>>> = (0..bins.len()).map(|_| None).collect();
+    for (&b, (brick_leaves, counts)) in busiest_first.iter().zip(work) {
+        in_bin_order[b] = Some(brick_leaves);
         (0..CLASSES).for_each(|k| totals[k] += counts[k]);
     }
+    in_bin_order
+        .into_iter()
+        .flatten()
+        .for_each(|brick_leaves| leaves.extend(brick_leaves));
     Ok((
         SparseGrid::from_distinct_leaves(transform, channels, leaves),
         totals,
