@@ -149,10 +149,10 @@ mod tests {
     #[test]
     fn biased_rounding_matches_truncation() {
         let by_truncation = |x: f64| {
-            let (h, l) = (x as i64, x as i64);
+            let t = x as i64;
             (
-                if (h as f64) > x { h - 1 } else { h },
-                if (l as f64) < x { l + 1 } else { l },
+                if (t as f64) > x { t - 1 } else { t },
+                if (t as f64) < x { t + 1 } else { t },
             )
         };
         let mut values = vec![

@@ -266,15 +266,12 @@ pub(crate) fn voxelize_in_bricks<const CLASSES: usize>(
     progress.check()?;
     let mut totals = [0u64; CLASSES];
     let mut leaves = Vec::with_capacity(work.iter().map(|w| w.0.len()).sum());
-    let mut in_bin_order: Vec<Option<Vec<Leaf>>> = (0..bins.len()).map(|_| None).collect();
+    let mut in_bin_order: Vec<Vec<Leaf>> = (0..bins.len()).map(|_| Vec::new()).collect();
     for (&b, (brick_leaves, counts)) in busiest_first.iter().zip(work) {
-        in_bin_order[b] = Some(brick_leaves);
+        in_bin_order[b] = brick_leaves;
         (0..CLASSES).for_each(|k| totals[k] += counts[k]);
     }
-    in_bin_order
-        .into_iter()
-        .flatten()
-        .for_each(|brick_leaves| leaves.extend(brick_leaves));
+    leaves.extend(in_bin_order.into_iter().flatten());
     Ok((
         SparseGrid::from_distinct_leaves(transform, channels, leaves),
         totals,
