@@ -74,6 +74,20 @@ fn take(pool: &Mutex<Pool>) -> NonNull<u8> {
     pool.take().expect("a slot in the chunk just added")
 }
 
+impl ChannelBox<[f32; super::LEAF_VOXELS]> {
+    /// The values `value(n)` for `n` in `0..512`, each written once (no zeroing first).
+    #[inline]
+    pub fn from_fn(mut value: impl FnMut(usize) -> f32) -> Self {
+        let slot = take(<[f32; super::LEAF_VOXELS]>::pool()).cast::<f32>();
+        for n in 0..super::LEAF_VOXELS {
+            // SAFETY: the slot is unused, sized and aligned for 512 floats; every one is
+            // written before the box hands out a reference.
+            unsafe { slot.as_ptr().add(n).write(value(n)) };
+        }
+        ChannelBox(slot.cast())
+    }
+}
+
 impl<T: Channel> std::ops::Deref for ChannelBox<T> {
     type Target = T;
 

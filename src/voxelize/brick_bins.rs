@@ -6,7 +6,9 @@
 //! grid-per-thread fold it replaces spent most of its time looking up and merging leaves.
 
 use crate::error::{Error, Result};
-use crate::grid::{Channels, Coord, CoordBox, LEAF_VOXELS, Leaf, SparseGrid, Transform};
+use crate::grid::{
+    ChannelBox, Channels, Coord, CoordBox, LEAF_VOXELS, Leaf, SparseGrid, Transform,
+};
 use crate::progress::Progress;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -421,13 +423,19 @@ fn cut_leaves<const CLASSES: usize>(
             ];
             let mut leaf = Leaf::new(
                 std::array::from_fn(|a| origin[a] + 8 * at[a] as i64),
-                channels,
+                Channels {
+                    value: false,
+                    ..channels
+                },
             );
             leaf.mask = mask;
             let first = usize::from(bits.slot_of[l]) * LEAF_VOXELS;
-            if let (Some(d), Some(v)) = (bits.distance.as_deref(), leaf.value.as_deref_mut()) {
-                crate::grid::bits::ones(&mask).for_each(|n| v[n] = d[first + n]);
-            }
+            // A voxel holds a finite distance exactly where a class marked it (`put`): the
+            // values are read whole, inactive ones 0, with no pass over the mask's bits.
+            leaf.value = bits.distance.as_deref().map(|d| {
+                let d = &d[first..first + LEAF_VOXELS];
+                ChannelBox::from_fn(|n| if d[n] < f32::INFINITY { d[n] } else { 0.0 })
+            });
             if let (Some(d), Some(v)) = (bits.normal.as_deref(), leaf.normal.as_deref_mut()) {
                 crate::grid::bits::ones(&mask).for_each(|n| v[n] = d[first + n]);
             }
