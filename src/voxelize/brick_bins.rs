@@ -37,12 +37,10 @@ pub(crate) struct BrickBits<const CLASSES: usize> {
     /// brick's few hundred leaves lie anywhere in 8 MiB, and a voxel's first touch missed the
     /// cache (the band's most-sampled load).
     slot_of: Box<[u16]>,
-    /// Places taken.
+    /// Places taken. A place's distances are made infinite when it is taken, so the channels
+    /// start untouched and a thread's scratch is as large in memory as its busiest brick
+    /// needs, not 8 MiB.
     slots: u16,
-    /// Places made ready (their distances infinite): the channels start zeroed, untouched,
-    /// and a place is readied when first taken, so that a thread's scratch is as large in
-    /// memory as its busiest brick needs, not 8 MiB.
-    ready: u16,
     distance: Option<Box<[f32]>>,
     normal: Option<Box<[[f32; 3]]>>,
 }
@@ -66,30 +64,11 @@ impl<const CLASSES: usize> BrickBits<CLASSES> {
             touched: [0; BRICK_LEAVES / 64],
             slot_of: vec![NO_SLOT; BRICK_LEAVES].into_boxed_slice(),
             slots: 0,
-            ready: 0,
             distance: channels.value.then(|| vec![0.0; voxels].into_boxed_slice()),
             normal: channels
                 .normal
                 .then(|| vec![[0.0; 3]; voxels].into_boxed_slice()),
         }
-    }
-
-    /// Voxel `i`'s place in the channels, its leaf given the next place if it has none.
-    #[inline]
-    fn place(&mut self, i: usize) -> usize {
-        let slot = &mut self.slot_of[i / LEAF_VOXELS];
-        if *slot == NO_SLOT {
-            *slot = self.slots;
-            self.slots += 1;
-            if self.slots > self.ready {
-                let first = usize::from(self.ready) * LEAF_VOXELS;
-                if let Some(d) = self.distance.as_deref_mut() {
-                    d[first..first + LEAF_VOXELS].fill(f32::INFINITY);
-                }
-                self.ready += 1;
-            }
-        }
-        usize::from(*slot) * LEAF_VOXELS + i % LEAF_VOXELS
     }
 
     /// The touched leaves, ascending.
@@ -103,9 +82,8 @@ impl<const CLASSES: usize> BrickBits<CLASSES> {
     fn put(&mut self, class: usize, i: usize, distance: impl FnOnce() -> f64, normal: DVec3) {
         self.classes[class][i >> 6] |= 1 << (i & 63);
         self.touched[i >> 15] |= 1 << ((i >> 9) & 63);
-        if self.distance.is_some() {
-            let i = self.place(i);
-            let d = self.distance.as_deref_mut().expect("checked above");
+        if let Some(d) = self.distance.as_deref_mut() {
+            let i = place(&mut self.slot_of, &mut self.slots, d, i);
             let near = distance() as f32;
             match self.normal.as_deref_mut() {
                 // Without normals the least distance is a min, not a branch on each voxel's
@@ -120,6 +98,20 @@ impl<const CLASSES: usize> BrickBits<CLASSES> {
             }
         }
     }
+}
+
+/// Voxel `i`'s place in the channels (`slot_of` and the `slots` taken, `BrickBits`), its leaf
+/// given the next place, its `distance`s made infinite, if it has none.
+#[inline]
+fn place(slot_of: &mut [u16], slots: &mut u16, distance: &mut [f32], i: usize) -> usize {
+    let slot = &mut slot_of[i / LEAF_VOXELS];
+    if *slot == NO_SLOT {
+        *slot = *slots;
+        *slots += 1;
+        let first = usize::from(*slot) * LEAF_VOXELS;
+        distance[first..first + LEAF_VOXELS].fill(f32::INFINITY);
+    }
+    usize::from(*slot) * LEAF_VOXELS + i % LEAF_VOXELS
 }
 
 /// Where a primitive's voxels go: its class's bits in a brick, and with channels the nearest
@@ -482,8 +474,7 @@ fn clear<const CLASSES: usize>(bits: &mut BrickBits<CLASSES>) {
             class[8 * l..8 * l + 8].fill(0);
         }
     }
-    if let Some(d) = bits.distance.as_deref_mut() {
-        d[..usize::from(bits.slots) * LEAF_VOXELS].fill(f32::INFINITY);
+    if bits.distance.is_some() {
         for &l in &touched {
             bits.slot_of[l] = NO_SLOT;
         }
