@@ -200,9 +200,25 @@ impl GridValues<'_> {
 }
 
 /// The values of `values` at the set bits of `mask`, in offset order, at the start of `out`;
-/// how many. A mask word at a time, a whole word as one copy.
+/// how many. Eight values at a time by AVX2 where the CPU has it (igea's level set band at
+/// 1024: 25 -> 12 ms a pass over its leaves), else a mask word at a time.
 #[inline(always)]
 fn gather(mask: &[u64; 8], out: &mut [f32; LEAF_VOXELS], values: &[f32; LEAF_VOXELS]) -> usize {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2.
+        return unsafe { gather_by_eights(mask, out, values) };
+    }
+    gather_by_words(mask, out, values)
+}
+
+/// `gather` a mask word at a time, a whole word as one copy.
+#[inline(always)]
+fn gather_by_words(
+    mask: &[u64; 8],
+    out: &mut [f32; LEAF_VOXELS],
+    values: &[f32; LEAF_VOXELS],
+) -> usize {
     let mut at = 0;
     for (w, &bits) in mask.iter().enumerate() {
         let word = &values[64 * w..64 * w + 64];
@@ -217,6 +233,56 @@ fn gather(mask: &[u64; 8], out: &mut [f32; LEAF_VOXELS], values: &[f32; LEAF_VOX
             at += 1;
             b &= b - 1;
         }
+    }
+    at
+}
+
+/// For each byte mask, the lanes of its set bits in order (the rest 0): the permutation that
+/// packs those of eight values to the front.
+#[cfg(target_arch = "x86_64")]
+const PACKED_LANES: [[u32; 8]; 256] = {
+    let mut lanes = [[0; 8]; 256];
+    let mut byte = 0;
+    while byte < 256 {
+        let (mut lane, mut at) = (0, 0);
+        while lane < 8 {
+            if byte >> lane & 1 == 1 {
+                lanes[byte][at] = lane as u32;
+                at += 1;
+            }
+            lane += 1;
+        }
+        byte += 1;
+    }
+    lanes
+};
+
+/// `gather` eight values at a time: each eight permuted by their mask byte's packing and
+/// stored whole at the next place (the lanes past its count are overwritten by the next
+/// store, or left past the count).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn gather_by_eights(
+    mask: &[u64; 8],
+    out: &mut [f32; LEAF_VOXELS],
+    values: &[f32; LEAF_VOXELS],
+) -> usize {
+    use std::arch::x86_64::*;
+    let bytes = mask.iter().flat_map(|word| word.to_le_bytes());
+    let mut at = 0;
+    for (first, byte) in (0..LEAF_VOXELS).step_by(8).zip(bytes) {
+        // SAFETY: AVX2 is enabled. The load reads `values[first..first + 8]` (`first` at most
+        // 504); the store writes `out[at..at + 8]`, in bounds as `at` (the values before
+        // `first` that were kept) is at most `first`. The table's row is 8 u32s.
+        unsafe {
+            let eight = _mm256_loadu_ps(values.as_ptr().add(first));
+            let lanes = _mm256_loadu_si256(PACKED_LANES[usize::from(byte)].as_ptr().cast());
+            _mm256_storeu_ps(
+                out.as_mut_ptr().add(at),
+                _mm256_permutevar8x32_ps(eight, lanes),
+            );
+        }
+        at += byte.count_ones() as usize;
     }
     at
 }
@@ -379,4 +445,39 @@ fn merge_sorted<'g>(a: Vec<(Key, Entry<'g>)>, b: Vec<(Key, Entry<'g>)>) -> Vec<(
     merged.extend(a);
     merged.extend(b);
     merged
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::SplitMix64;
+
+    /// Both ways of gathering against the values picked bit by bit, on masks empty, full,
+    /// with whole words and at random densities.
+    #[test]
+    fn gathers_pick_the_active_values_in_order() {
+        let values: [f32; LEAF_VOXELS] = std::array::from_fn(|n| n as f32 * 0.5 - 7.0);
+        let mut random = SplitMix64(3);
+        let mut masks = vec![[0u64; 8], [u64::MAX; 8]];
+        for density in [1, 2, 4, 8] {
+            for _ in 0..50 {
+                masks.push(std::array::from_fn(|_| {
+                    (0..density).fold(u64::MAX, |m, _| m & random.next_u64())
+                }));
+            }
+        }
+        masks.push([u64::MAX, 0, 1 << 63, u64::MAX, 5, u64::MAX, 0, u64::MAX]);
+        for mask in masks {
+            let expected: Vec<f32> = (0..LEAF_VOXELS)
+                .filter(|&n| mask[n / 64] >> (n % 64) & 1 == 1)
+                .map(|n| values[n])
+                .collect();
+            let mut out = [f32::NAN; LEAF_VOXELS];
+            let n = gather(&mask, &mut out, &values);
+            assert_eq!(&out[..n], &expected[..], "mask {mask:x?}");
+            let mut out = [f32::NAN; LEAF_VOXELS];
+            let n = gather_by_words(&mask, &mut out, &values);
+            assert_eq!(&out[..n], &expected[..], "mask {mask:x?} by words");
+        }
+    }
 }
