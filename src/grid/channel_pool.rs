@@ -164,6 +164,9 @@ pub struct Pool {
     uncut_end: usize,
     /// Chunks cut since the pool was last emptied.
     chunks: usize,
+    /// Chunks cut and not yet added (their pages being made present outside the lock): the
+    /// reservations stay while there are any.
+    cutting: usize,
     dropped: Vec<NonNull<u8>>,
     /// The newest chunk's first slot never handed out, and its end.
     fresh: usize,
@@ -182,6 +185,7 @@ impl Pool {
             uncut: 0,
             uncut_end: 0,
             chunks: 0,
+            cutting: 0,
             dropped: Vec::new(),
             fresh: 0,
             fresh_end: 0,
@@ -226,12 +230,14 @@ impl Pool {
         let chunk = unsafe { NonNull::new_unchecked(self.uncut as *mut u8) };
         self.uncut += len;
         self.chunks += 1;
+        self.cutting += 1;
         (chunk, len)
     }
 
     /// Takes a new chunk into use. Another thread may have added one meanwhile: what is left
     /// of that one is kept with the dropped slots.
     fn add_chunk(&mut self, chunk: NonNull<u8>, len: usize) {
+        self.cutting -= 1;
         while self.fresh + self.slot <= self.fresh_end {
             // SAFETY: a place inside a chunk, not null.
             self.dropped
@@ -248,7 +254,7 @@ impl Pool {
         // Once none is in use, the first chunk stays, so that making and dropping one array
         // at a time does not map and unmap memory each time. Every slot of it has been handed
         // out (a later chunk is cut only then), so all are among those dropped.
-        if self.in_use == 0 && self.chunks > 1 {
+        if self.in_use == 0 && self.cutting == 0 && self.chunks > 1 {
             for (start, size) in self.reservations.drain(1..) {
                 // SAFETY: a reservation of this pool, none of it in use.
                 unsafe { libc::munmap(start.as_ptr().cast(), size) };
@@ -342,5 +348,35 @@ mod tests {
         let mut normals = ChannelBox::<[[f32; 3]; LEAF_VOXELS]>::zeroed();
         normals[511] = [1.0, 2.0, 3.0];
         assert_eq!(normals.clone()[511], [1.0, 2.0, 3.0]);
+    }
+
+    /// Threads making and dropping arrays at once, each round's arrays all dropped before the
+    /// next (so the pool empties, gives memory back and cuts chunks again while other threads
+    /// are cutting theirs): every array keeps its own values until it is dropped.
+    #[test]
+    fn arrays_stay_their_own_across_threads() {
+        std::thread::scope(|scope| {
+            for t in 0..4u32 {
+                scope.spawn(move || {
+                    for round in 0..50u32 {
+                        let value = |i: usize| (t * 1_000_000 + round * 1000 + i as u32) as f32;
+                        let held: Vec<ChannelBox<[f32; LEAF_VOXELS]>> = (0..CHUNK_SLOTS * 3
+                            + t as usize)
+                            .map(|i| {
+                                let mut a = ChannelBox::<[f32; LEAF_VOXELS]>::zeroed();
+                                a.fill(value(i));
+                                a
+                            })
+                            .collect();
+                        for (i, a) in held.iter().enumerate() {
+                            assert!(
+                                a.iter().all(|&v| v == value(i)),
+                                "thread {t}, round {round}: array {i} changed"
+                            );
+                        }
+                    }
+                });
+            }
+        });
     }
 }
