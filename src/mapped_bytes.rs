@@ -4,6 +4,7 @@
 //! process after the run (skull's surface at 32768: 5.9 GB a worker).
 
 use std::ops::Deref;
+use std::ptr::NonNull;
 
 pub struct MappedBytes {
     ptr: *mut u8,
@@ -24,22 +25,7 @@ impl MappedBytes {
                 len: 0,
             });
         }
-        // SAFETY: a new private anonymous mapping of `bytes.len()` bytes; no file, no fixed
-        // address.
-        let ptr = unsafe {
-            libc::mmap(
-                std::ptr::null_mut(),
-                bytes.len(),
-                libc::PROT_READ | libc::PROT_WRITE,
-                libc::MAP_PRIVATE | libc::MAP_ANONYMOUS,
-                -1,
-                0,
-            )
-        };
-        if ptr == libc::MAP_FAILED {
-            return Err(std::io::Error::last_os_error());
-        }
-        let ptr = ptr.cast::<u8>();
+        let ptr = map_anonymous(bytes.len(), 0)?.as_ptr();
         // SAFETY: the mapping is `bytes.len()` writable bytes and does not overlap `bytes`.
         unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), ptr, bytes.len()) };
         Ok(MappedBytes {
@@ -47,6 +33,26 @@ impl MappedBytes {
             len: bytes.len(),
         })
     }
+}
+
+/// A new private anonymous mapping of `len` (non-zero) readable and writable bytes, with
+/// `flags` beside `MAP_PRIVATE | MAP_ANONYMOUS`; its pages are made when first used.
+pub(crate) fn map_anonymous(len: usize, flags: libc::c_int) -> std::io::Result<NonNull<u8>> {
+    // SAFETY: a new private anonymous mapping; no file, no fixed address.
+    let ptr = unsafe {
+        libc::mmap(
+            std::ptr::null_mut(),
+            len,
+            libc::PROT_READ | libc::PROT_WRITE,
+            libc::MAP_PRIVATE | libc::MAP_ANONYMOUS | flags,
+            -1,
+            0,
+        )
+    };
+    if ptr == libc::MAP_FAILED {
+        return Err(std::io::Error::last_os_error());
+    }
+    NonNull::new(ptr.cast()).ok_or_else(|| std::io::Error::other("mmap returned null"))
 }
 
 impl Deref for MappedBytes {

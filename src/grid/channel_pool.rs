@@ -162,8 +162,6 @@ pub struct Pool {
     /// Where the next chunk is cut from the newest reservation, and that reservation's end.
     uncut: usize,
     uncut_end: usize,
-    /// Chunks cut since the pool was last emptied.
-    chunks: usize,
     /// Chunks cut and not yet added (their pages being made present outside the lock): the
     /// reservations stay while there are any.
     cutting: usize,
@@ -184,7 +182,6 @@ impl Pool {
             reservations: Vec::new(),
             uncut: 0,
             uncut_end: 0,
-            chunks: 0,
             cutting: 0,
             dropped: Vec::new(),
             fresh: 0,
@@ -229,7 +226,6 @@ impl Pool {
         // SAFETY: a place inside a reservation, not null.
         let chunk = unsafe { NonNull::new_unchecked(self.uncut as *mut u8) };
         self.uncut += len;
-        self.chunks += 1;
         self.cutting += 1;
         (chunk, len)
     }
@@ -254,14 +250,20 @@ impl Pool {
         // Once none is in use, the first chunk stays, so that making and dropping one array
         // at a time does not map and unmap memory each time. Every slot of it has been handed
         // out (a later chunk is cut only then), so all are among those dropped.
-        if self.in_use == 0 && self.cutting == 0 && self.chunks > 1 {
+        if self.in_use > 0 || self.cutting > 0 {
+            return;
+        }
+        let Some(&(first, size)) = self.reservations.first() else {
+            return;
+        };
+        let first = first.as_ptr() as usize;
+        let kept = first..first + self.slot * CHUNK_SLOTS;
+        // More than the first chunk was cut: a later reservation, or the first past its first.
+        if self.reservations.len() > 1 || self.uncut > kept.end {
             for (start, size) in self.reservations.drain(1..) {
                 // SAFETY: a reservation of this pool, none of it in use.
                 unsafe { libc::munmap(start.as_ptr().cast(), size) };
             }
-            let (first, size) = self.reservations[0];
-            let first = first.as_ptr() as usize;
-            let kept = first..first + self.slot * CHUNK_SLOTS;
             // SAFETY: the first reservation past its first chunk, none of it in use: its pages
             // go back to the kernel and read as zeros when used again.
             unsafe {
@@ -276,30 +278,17 @@ impl Pool {
             self.dropped.shrink_to_fit();
             (self.uncut, self.uncut_end) = (kept.end, first + size);
             (self.fresh, self.fresh_end) = (0, 0);
-            self.chunks = 1;
         }
     }
 }
 
 /// `size` bytes of fresh address space, readable and writable, its pages made only when used.
 fn reserve(size: usize) -> NonNull<u8> {
-    // SAFETY: a new private anonymous mapping; no file, no fixed address.
-    let start = unsafe {
-        libc::mmap(
-            std::ptr::null_mut(),
-            size,
-            libc::PROT_READ | libc::PROT_WRITE,
-            libc::MAP_PRIVATE | libc::MAP_ANONYMOUS | libc::MAP_NORESERVE,
-            -1,
-            0,
-        )
-    };
-    match NonNull::new(start.cast::<u8>()) {
-        Some(start) if start.as_ptr() != libc::MAP_FAILED.cast() => start,
-        _ => std::alloc::handle_alloc_error(
+    crate::mapped_bytes::map_anonymous(size, libc::MAP_NORESERVE).unwrap_or_else(|_| {
+        std::alloc::handle_alloc_error(
             std::alloc::Layout::from_size_align(size, 4096).expect("a reservation's layout"),
-        ),
-    }
+        )
+    })
 }
 
 /// Makes a chunk's pages present in one call where the kernel can (Linux 5.14 on); elsewhere
