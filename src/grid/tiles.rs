@@ -141,19 +141,15 @@ impl Tiles {
 
     /// Origins of the 8^3 tiles.
     pub fn leaf_tiles(&self) -> impl Iterator<Item = Coord> + '_ {
-        self.leaf_tiles_by_node()
-            .flat_map(|(node, slots)| slots.map(move |s| slot_origin(node, s)))
+        self.leaf_tile_masks()
+            .flat_map(|(node, mask)| bits::ones(&mask[..]).map(move |s| slot_origin(node, s)))
     }
 
-    /// The nodes holding 8^3 tiles, each with its tiles' slots in ascending order: a slot
-    /// numbers the blocks in `node_leaf_origins` order, OpenVDB's order of a 128^3 node's
-    /// children (x, then y, then z, 16 each).
-    pub fn leaf_tiles_by_node(
-        &self,
-    ) -> impl Iterator<Item = (Coord, impl Iterator<Item = usize> + '_)> + '_ {
-        self.leaves
-            .iter()
-            .map(|(&node, b)| (node, bits::ones(&b.bits[..])))
+    /// The nodes holding 8^3 tiles, each with its tiles as a bit per slot: a slot numbers the
+    /// blocks in `node_leaf_origins` order, OpenVDB's order of a 128^3 node's children (x,
+    /// then y, then z, 16 each).
+    pub fn leaf_tile_masks(&self) -> impl Iterator<Item = (Coord, &[u64; NODE_LEAVES / 64])> + '_ {
+        self.leaves.iter().map(|(&node, b)| (node, &*b.bits))
     }
 
     /// Origins of the 128^3 tiles.
@@ -189,9 +185,9 @@ impl Tiles {
     /// The box of the tiles' voxels, `None` without tiles: a node's 8^3 tiles bounded by their
     /// slots, not box by box.
     pub fn bbox(&self) -> Option<CoordBox> {
-        let leaf_boxes = self.leaf_tiles_by_node().map(|(node, slots)| {
+        let leaf_boxes = self.leaf_tile_masks().map(|(node, mask)| {
             let (mut lo, mut hi) = ([usize::MAX; 3], [0; 3]);
-            for s in slots {
+            for s in bits::ones(&mask[..]) {
                 let at = slot_position(s);
                 lo = std::array::from_fn(|a| lo[a].min(at[a]));
                 hi = std::array::from_fn(|a| hi[a].max(at[a]));

@@ -3,7 +3,7 @@
 //! writes them with OpenVDB's own `io::File`): the same grids, values, tiles, classes and
 //! metadata the `.vdb` writer writes.
 
-use super::grid_out::{Entry, GridOut, ValueType, block_origin, tree_entries};
+use super::grid_out::{GridOut, ValueType, block_origin, tree};
 use super::vdb_format::MetaValue;
 use crate::error::Result;
 use crate::grid::LEAF_VOXELS;
@@ -43,18 +43,15 @@ pub struct ExportedGrid {
 
 /// The arrays of `g`; errors name `path`.
 pub(super) fn export_grid(path: &Path, g: &GridOut) -> Result<ExportedGrid> {
-    let entries = tree_entries(path, g)?;
+    let tree = tree(path, g)?;
     let value_type = g.values.value_type();
     let components = match value_type {
         ValueType::Bool => 0,
         ValueType::Float => 1,
         ValueType::Vec3 => 3,
     };
-    let leaves = entries
-        .iter()
-        .filter(|e| matches!(e.1, Entry::Leaf(_)))
-        .count();
-    let tiles = entries.len() - leaves;
+    let leaves = tree.leaves.len();
+    let tiles: usize = tree.nodes.iter().map(|n| n.tile_count()).sum();
     crate::system::check_fits(
         (leaves * (12 + 64 + 4 * components * LEAF_VOXELS) + tiles * 16) as u64,
         None,
@@ -88,22 +85,25 @@ pub(super) fn export_grid(path: &Path, g: &GridOut) -> Result<ExportedGrid> {
     let mut values = out
         .values
         .chunks_exact_mut((components * LEAF_VOXELS).max(1));
-    for (key, entry) in &entries {
-        match entry {
-            Entry::Leaf(leaf) => {
-                out.leaf_origins
-                    .extend(leaf.origin.iter().map(|&v| v as i32));
-                out.masks.extend_from_slice(&leaf.mask);
-                if components > 0 {
-                    let dense = values.next().expect("values for every leaf");
-                    g.values.dense_values(leaf, dense);
-                }
-            }
-            Entry::LeafTile | Entry::NodeTile => {
-                let leaf_level = matches!(entry, Entry::LeafTile);
-                out.tiles.extend(block_origin(key, leaf_level));
-                out.tiles.push(if leaf_level { 8 } else { 128 });
-            }
+    for &(_, leaf) in &tree.leaves {
+        out.leaf_origins
+            .extend(leaf.origin.iter().map(|&v| v as i32));
+        out.masks.extend_from_slice(&leaf.mask);
+        if components > 0 {
+            let dense = values.next().expect("values for every leaf");
+            g.values.dense_values(leaf, dense);
+        }
+    }
+    for node in &tree.nodes {
+        let key = (node.root, node.slot, 0);
+        if node.tile {
+            out.tiles.extend(block_origin(&key, false));
+            out.tiles.push(128);
+        }
+        for slot in crate::grid::bits::ones(&node.tiles[..]) {
+            out.tiles
+                .extend(block_origin(&(key.0, key.1, slot as u16), true));
+            out.tiles.push(8);
         }
     }
     Ok(out)

@@ -5,7 +5,7 @@
 
 use super::vdb_format::{CHILD_LOG2, NODE_LOG2, ROOT_TILE};
 use crate::error::{Error, Result};
-use crate::grid::{LEAF_VOXELS, Leaf, SparseGrid};
+use crate::grid::{LEAF_VOXELS, Leaf, NODE_LEAVES, SparseGrid};
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -316,24 +316,85 @@ pub(super) struct GridOut<'g> {
     pub metadata: &'g [(String, super::vdb_format::MetaValue)],
 }
 
-/// Something held by a 128^3 or an 8^3 slot of an internal node.
-#[derive(Clone, Copy)]
-pub(super) enum Entry<'g> {
-    NodeTile,
-    LeafTile,
-    Leaf(&'g Leaf),
-}
-
-/// Where an entry sits: its root child's origin, its slot in that child (32^3 slots of
-/// 128^3), its slot in the 128^3 node (16^3 slots of 8^3). Sorting by key gives OpenVDB's
-/// order.
+/// Where a block sits: its root child's origin, its slot in that child (32^3 slots of
+/// 128^3), its slot in the 128^3 node (16^3 slots of 8^3).
 pub(super) type Key = ([i32; 3], u16, u16);
 
-/// `key` as one number that sorts as the key does (a tuple compares field by field).
+/// The words of a 128^3 node's mask of 8^3 slots.
+pub(super) const NODE_WORDS: usize = NODE_LEAVES / 64;
+
+/// No 8^3 tiles in a node.
+const NO_TILES: [u64; NODE_WORDS] = [0; NODE_WORDS];
+
+/// A grid's tree in OpenVDB's order (root children, then their 128^3 slots, then 8^3 slots,
+/// each ascending), node by node: 8^3 tiles are a node's mask, not one entry each (a solid
+/// has hundreds of thousands of them in a few hundred nodes).
+pub(super) struct Tree<'g> {
+    /// The non-empty leaves in tree order, each with its slot in its node.
+    pub leaves: Vec<(u16, &'g Leaf)>,
+    /// The 128^3 nodes and tiles in tree order.
+    pub nodes: Vec<TreeNode<'g>>,
+}
+
+/// A 128^3 slot of a root child: a tile, or a node of 8^3 tiles and leaves.
+pub(super) struct TreeNode<'g> {
+    /// Its root child's origin.
+    pub root: [i32; 3],
+    /// Its slot in the root child.
+    pub slot: u16,
+    /// Whether the slot holds a 128^3 tile (then nothing else).
+    pub tile: bool,
+    /// Its 8^3 tiles, a bit per slot.
+    pub tiles: &'g [u64; NODE_WORDS],
+    /// Its leaves: a range of the tree's.
+    pub leaves: std::ops::Range<usize>,
+}
+
+impl<'g> TreeNode<'g> {
+    /// Its tiles: the 128^3 one, or its 8^3 ones.
+    pub fn tile_count(&self) -> usize {
+        let leaf_tiles: u32 = self.tiles.iter().map(|w| w.count_ones()).sum();
+        usize::from(self.tile) + leaf_tiles as usize
+    }
+
+    /// Its leaves' slots as a mask (`leaves`: the tree's).
+    pub fn children(&self, leaves: &[(u16, &Leaf)]) -> [u64; NODE_WORDS] {
+        let mut mask = [0u64; NODE_WORDS];
+        for &(slot, _) in &leaves[self.leaves.clone()] {
+            mask[usize::from(slot) / 64] |= 1 << (slot % 64);
+        }
+        mask
+    }
+
+    /// Its 8^3 slots in use, ascending: each a leaf, or a tile (`None`).
+    pub fn blocks<'t>(
+        &'t self,
+        tree: &'t Tree<'g>,
+    ) -> impl Iterator<Item = (u16, Option<&'g Leaf>)> + 't {
+        let mut leaves = tree.leaves[self.leaves.clone()].iter().peekable();
+        let mut tiles = crate::grid::bits::ones(&self.tiles[..]).peekable();
+        std::iter::from_fn(move || {
+            let tile = tiles.peek().map(|&t| t as u16);
+            match (leaves.peek(), tile) {
+                (Some(&&(slot, leaf)), t) if t.is_none_or(|t| slot < t) => {
+                    leaves.next();
+                    Some((slot, Some(leaf)))
+                }
+                (_, Some(t)) => {
+                    tiles.next();
+                    Some((t, None))
+                }
+                _ => None,
+            }
+        })
+    }
+}
+
+/// A root child's origin and a 128^3 slot as one number that sorts as the pair does.
 #[inline]
-fn packed(key: &Key) -> u128 {
-    let c = key.0.map(|v| u128::from(v as u32 ^ 0x8000_0000));
-    (c[0] << 96) | (c[1] << 64) | (c[2] << 32) | (u128::from(key.1) << 16) | u128::from(key.2)
+fn node_order(root: [i32; 3], slot: u16) -> u128 {
+    let c = root.map(|v| u128::from(v as u32 ^ 0x8000_0000));
+    (c[0] << 96) | (c[1] << 64) | (c[2] << 32) | (u128::from(slot) << 16)
 }
 
 /// The key of the block at `origin`; errors name `path`.
@@ -360,97 +421,234 @@ pub(super) fn key(path: &Path, origin: [i64; 3]) -> Result<Key> {
     ))
 }
 
-/// The grid's non-empty leaves and its tiles (a level set's: its interior's) in tree order;
+/// The grid's tree: its non-empty leaves and its tiles (a level set's: its interior's);
 /// refuses vectors on tiles and a tile sharing its place with another node. Errors name
 /// `path`.
-pub(super) fn tree_entries<'g>(path: &Path, g: &GridOut<'g>) -> Result<Vec<(Key, Entry<'g>)>> {
-    let mut leaves: Vec<(Key, Entry)> = g
+pub(super) fn tree<'g>(path: &Path, g: &GridOut<'g>) -> Result<Tree<'g>> {
+    let mut keyed: Vec<(u128, u16, &Leaf)> = g
         .grid
         .leaves()
         .par_iter()
         .filter(|l| !l.is_empty())
-        .map(|l| Ok((key(path, l.origin)?, Entry::Leaf(l))))
+        .map(|l| {
+            let (root, node, slot) = key(path, l.origin)?;
+            Ok((node_order(root, node) | u128::from(slot), slot, l))
+        })
         .collect::<Result<_>>()?;
-    leaves.par_sort_unstable_by_key(|e| e.0);
-    let tiles = sorted_tiles(path, g)?;
+    keyed.par_sort_unstable_by_key(|e| e.0);
+    let tiles = match g.values {
+        GridValues::LevelSet { interior, .. } => interior,
+        _ => g.grid,
+    }
+    .tiles();
     if g.values.value_type() == ValueType::Vec3 && !tiles.is_empty() {
         return Err(Error::Vdb {
             path: path.to_path_buf(),
             message: format!("grid {}: tiles carry no vectors", g.name),
         });
     }
-    let entries = merge_sorted(leaves, tiles);
-    // A block is a leaf or a tile, and a 128^3 tile holds nothing else.
-    let clash = entries.windows(2).find(|w| {
-        w[0].0 == w[1].0
-            || (w[0].0.0 == w[1].0.0 && w[0].0.1 == w[1].0.1 && matches!(w[0].1, Entry::NodeTile))
-    });
-    if let Some(w) = clash {
-        return Err(Error::Vdb {
-            path: path.to_path_buf(),
-            message: format!(
-                "grid {}: a tile and another node in one place (root child {:?}, slot {})",
-                g.name, w[0].0.0, w[0].0.1
-            ),
-        });
-    }
-    Ok(entries)
-}
-
-/// The grid's tiles (a level set's: its interior's) in tree order: only their nodes are
-/// sorted, as a node lists its 8^3 tiles in its slots' order already.
-fn sorted_tiles<'g>(path: &Path, g: &GridOut<'g>) -> Result<Vec<(Key, Entry<'g>)>> {
-    let tiles = match g.values {
-        GridValues::LevelSet { interior, .. } => interior,
-        _ => g.grid,
-    }
-    .tiles();
-    let mut nodes: Vec<(Key, Option<Vec<usize>>)> = tiles
-        .node_tiles()
-        .map(|o| Ok((key(path, o)?, None)))
-        .chain(
-            tiles
-                .leaf_tiles_by_node()
-                .map(|(node, slots)| Ok((key(path, node)?, Some(slots.collect())))),
-        )
-        .collect::<Result<_>>()?;
-    nodes.sort_unstable_by_key(|n| n.0);
-    let mut sorted = Vec::with_capacity(tiles.count() as usize);
-    for (node_key, blocks) in nodes {
-        match blocks {
-            None => sorted.push((node_key, Entry::NodeTile)),
-            // A block's slot in its node is the key's last part.
-            Some(slots) => sorted.extend(
-                slots
-                    .into_iter()
-                    .map(|s| ((node_key.0, node_key.1, s as u16), Entry::LeafTile)),
-            ),
+    // The nodes holding leaves, in order, then those of tiles joined in.
+    let mut nodes: Vec<TreeNode> = Vec::new();
+    for (n, &(order, _, leaf)) in keyed.iter().enumerate() {
+        let same_node = |node: &TreeNode| node_order(node.root, node.slot) == order & !0xffff;
+        match nodes.last_mut() {
+            Some(node) if same_node(node) => node.leaves.end = n + 1,
+            _ => {
+                let (root, slot, _) = key(path, leaf.origin)?;
+                nodes.push(TreeNode {
+                    root,
+                    slot,
+                    tile: false,
+                    tiles: &NO_TILES,
+                    leaves: n..n + 1,
+                });
+            }
         }
     }
-    Ok(sorted)
-}
-
-/// The entries of two sorted lists in one sorted list.
-fn merge_sorted<'g>(a: Vec<(Key, Entry<'g>)>, b: Vec<(Key, Entry<'g>)>) -> Vec<(Key, Entry<'g>)> {
-    let mut merged = Vec::with_capacity(a.len() + b.len());
-    let (mut a, mut b) = (a.into_iter().peekable(), b.into_iter().peekable());
-    while let (Some(x), Some(y)) = (a.peek(), b.peek()) {
-        let next = if packed(&x.0) <= packed(&y.0) {
-            a.next()
-        } else {
-            b.next()
-        };
-        merged.extend(next);
+    let leaves: Vec<(u16, &Leaf)> = keyed
+        .into_iter()
+        .map(|(_, slot, leaf)| (slot, leaf))
+        .collect();
+    let mut tile_nodes: Vec<TreeNode> = Vec::new();
+    for (origin, mask) in tiles.leaf_tile_masks() {
+        let (root, slot, _) = key(path, origin)?;
+        tile_nodes.push(TreeNode {
+            root,
+            slot,
+            tile: false,
+            tiles: mask,
+            leaves: 0..0,
+        });
     }
-    merged.extend(a);
-    merged.extend(b);
-    merged
+    for origin in tiles.node_tiles() {
+        let (root, slot, _) = key(path, origin)?;
+        tile_nodes.push(TreeNode {
+            root,
+            slot,
+            tile: true,
+            tiles: &NO_TILES,
+            leaves: 0..0,
+        });
+    }
+    let order = |n: &TreeNode| node_order(n.root, n.slot);
+    tile_nodes.sort_unstable_by_key(order);
+    let mut joined: Vec<TreeNode> = Vec::with_capacity(nodes.len() + tile_nodes.len());
+    let (mut a, mut b) = (
+        nodes.into_iter().peekable(),
+        tile_nodes.into_iter().peekable(),
+    );
+    while let Some(next) = match (a.peek(), b.peek()) {
+        (Some(x), Some(y)) if order(y) < order(x) => b.next(),
+        (Some(_), _) => a.next(),
+        (None, _) => b.next(),
+    } {
+        match joined.last_mut() {
+            // A node's leaves come first, then its 8^3 tiles join them; anything more in one
+            // place is a clash.
+            Some(last) if order(last) == order(&next) => {
+                let overlap =
+                    |c: [u64; NODE_WORDS]| c.iter().zip(next.tiles).any(|(c, t)| c & t != 0);
+                if last.tile
+                    || next.tile
+                    || last.tile_count() > 0
+                    || overlap(last.children(&leaves))
+                {
+                    return Err(Error::Vdb {
+                        path: path.to_path_buf(),
+                        message: format!(
+                            "grid {}: a tile and another node in one place (root child {:?}, \
+                             slot {})",
+                            g.name, last.root, last.slot
+                        ),
+                    });
+                }
+                last.tiles = next.tiles;
+            }
+            _ => joined.push(next),
+        }
+    }
+    Ok(Tree {
+        leaves,
+        nodes: joined,
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::random::SplitMix64;
+
+    fn voxels_grid() -> SparseGrid {
+        SparseGrid::new(
+            crate::grid::Transform::default(),
+            crate::grid::Channels::NONE,
+        )
+    }
+
+    /// Leaves and tiles across two root children and several nodes come out in OpenVDB's
+    /// order: nodes by root child and slot, a node's leaves and 8^3 tiles by slot between.
+    #[test]
+    fn the_tree_is_in_order_node_by_node() {
+        let mut grid = voxels_grid();
+        // Leaves in two nodes of the root child at 0 and one of the child at -4096, given
+        // out of order; 8^3 tiles between the first node's leaves; a 128^3 tile.
+        for c in [[136, 0, 0], [16, 8, 0], [-8, 0, 0], [0, 0, 8], [0, 0, 0]] {
+            grid.insert(c);
+        }
+        for o in [[0, 0, 16], [8, 0, 0], [0, 8, 0]] {
+            grid.fill_leaf_block(o);
+        }
+        grid.fill_node_block([0, 128, 0]);
+        let out = GridOut {
+            name: "g".into(),
+            grid: &grid,
+            values: GridValues::Bool,
+            class: None,
+            vector_type: None,
+            metadata: &[],
+        };
+        let tree = tree(Path::new("t.vdb"), &out).expect("a tree");
+        let order: Vec<([i32; 3], u16, bool)> = tree
+            .nodes
+            .iter()
+            .map(|n| (n.root, n.slot, n.tile))
+            .collect();
+        assert_eq!(
+            order,
+            [
+                ([-4096, 0, 0], 31 << 10, false),
+                ([0, 0, 0], 0, false),
+                ([0, 0, 0], 1 << 5, true),
+                ([0, 0, 0], 1 << 10, false),
+            ]
+        );
+        let first = &tree.nodes[1];
+        let blocks: Vec<(u16, bool)> = first
+            .blocks(&tree)
+            .map(|(slot, leaf)| (slot, leaf.is_some()))
+            .collect();
+        // Slots x << 8 | y << 4 | z of the 8^3 blocks: (0,0,0) and (0,0,1) leaves, (0,0,2),
+        // (0,1,0) and (1,0,0) tiles, (2,1,0) a leaf.
+        assert_eq!(
+            blocks,
+            [
+                (0, true),
+                (1, true),
+                (2, false),
+                (16, false),
+                (256, false),
+                (528, true)
+            ]
+        );
+        assert_eq!(first.tile_count(), 3);
+        let leaves: Vec<[i64; 3]> = tree.leaves.iter().map(|(_, l)| l.origin).collect();
+        assert_eq!(
+            leaves,
+            [[-8, 0, 0], [0, 0, 0], [0, 0, 8], [16, 8, 0], [136, 0, 0]]
+        );
+        for node in &tree.nodes {
+            for &(slot, leaf) in &tree.leaves[node.leaves.clone()] {
+                let origin = block_origin(&(node.root, node.slot, slot), true);
+                assert_eq!(
+                    leaf.origin,
+                    origin.map(i64::from),
+                    "a leaf in its node's range"
+                );
+            }
+        }
+    }
+
+    /// A level set whose interior holds a tile where the band holds a leaf, 8^3 or 128^3, is
+    /// refused.
+    #[test]
+    fn a_tile_on_a_leaf_is_refused() {
+        let mut band = voxels_grid();
+        band.insert([3, 3, 3]);
+        let (mut block, mut node) = (voxels_grid(), voxels_grid());
+        block.fill_leaf_block([0, 0, 0]);
+        node.fill_node_block([0, 0, 0]);
+        for interior in [&block, &node] {
+            let out = GridOut {
+                name: "surface".into(),
+                grid: &band,
+                values: GridValues::LevelSet {
+                    background: 3.0,
+                    interior,
+                },
+                class: None,
+                vector_type: None,
+                metadata: &[],
+            };
+            let Err(e) = tree(Path::new("t.vdb"), &out) else {
+                panic!("a clash refused");
+            };
+            assert!(
+                e.to_string()
+                    .contains("a tile and another node in one place"),
+                "{e}"
+            );
+        }
+    }
 
     /// Both ways of gathering against the values picked bit by bit, on masks empty, full,
     /// with whole words and at random densities.

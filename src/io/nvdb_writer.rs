@@ -17,7 +17,7 @@
 //! parallel; grids are written one after another and the header last.
 
 use super::direct_file::DirectFile;
-use super::grid_out::{Entry, GridOut, GridValues, Key, ValueType, block_origin, tree_entries};
+use super::grid_out::{GridOut, GridValues, TreeNode, ValueType, block_origin, tree};
 use super::vdb::WriteClocks;
 use super::vdb_format::{FOG_VOLUME, LEVEL_SET};
 use crate::error::{Error, Result};
@@ -269,34 +269,25 @@ fn fill_leaf(
     span
 }
 
-/// Where a node or tile sits in its parent's table, from its key.
-fn slot(key: &Key, upper: bool) -> usize {
-    if upper {
-        key.1 as usize
-    } else {
-        key.2 as usize
-    }
-}
-
-/// Fills an internal node (`upper`: a 4096^3 one, else a 128^3 one) from its entries: its
-/// children, whose byte offsets from this node and spans `child_offsets` gives in order, and
-/// its tiles. Returns what it spans and its active tile count.
+/// Fills an internal node (`upper`: a 4096^3 one, else a 128^3 one) from its slots in use,
+/// ascending: each a tile (with its origin) or a child, whose byte offsets from this node and
+/// spans `child_offsets` gives in order. Returns what it spans and its active tile count.
 fn fill_internal(
     buf: &mut [u8],
     upper: bool,
-    entries: &[(Key, Entry)],
+    slots: impl Iterator<Item = (usize, Option<[i32; 3]>)>,
     child_offsets: &mut dyn Iterator<Item = (i64, Span)>,
     values: GridValues,
     sizes: Sizes,
     delta: Option<f32>,
 ) -> (Span, u32) {
     let (log2, child_edge) = if upper { (5, LOWER_EDGE) } else { (4, 8) };
-    let slots = 1usize << (3 * log2);
+    let table_slots = 1usize << (3 * log2);
     let (stats_at, table) = sizes.internal_offsets(log2);
     let value_mask = 32;
-    let child_mask = 32 + slots / 8;
+    let child_mask = 32 + table_slots / 8;
     let background = values.background();
-    for n in 0..slots {
+    for n in 0..table_slots {
         put_value(
             buf,
             table + n * sizes.slot,
@@ -306,29 +297,23 @@ fn fill_internal(
     }
     let mut span = Span::EMPTY;
     let mut active_tiles = 0;
-    // One entry per slot for an upper node's children (they group the leaves below them).
-    let mut last_slot = None;
-    for (key, entry) in entries {
-        let n = slot(key, upper);
-        let is_tile = match entry {
-            Entry::NodeTile => upper,
-            Entry::LeafTile => !upper,
-            Entry::Leaf(_) => false,
-        };
-        if is_tile {
-            let v = values.tile_value();
-            put_value(buf, table + n * sizes.slot, sizes.value_type, &[v; 3]);
-            if values.active_tiles() {
-                set_bit(buf, value_mask, n);
-                active_tiles += 1;
-                span = span.add(&Span::block(block_origin(key, !upper), child_edge, v));
+    for (n, tile) in slots {
+        match tile {
+            Some(origin) => {
+                let v = values.tile_value();
+                put_value(buf, table + n * sizes.slot, sizes.value_type, &[v; 3]);
+                if values.active_tiles() {
+                    set_bit(buf, value_mask, n);
+                    active_tiles += 1;
+                    span = span.add(&Span::block(origin, child_edge, v));
+                }
             }
-        } else if last_slot != Some(n) {
-            last_slot = Some(n);
-            let (offset, child) = child_offsets.next().expect("one child per child slot");
-            set_bit(buf, child_mask, n);
-            put(buf, table + n * sizes.slot, offset.to_le_bytes());
-            span = span.add(&child);
+            None => {
+                let (offset, child) = child_offsets.next().expect("one child per child slot");
+                set_bit(buf, child_mask, n);
+                put(buf, table + n * sizes.slot, offset.to_le_bytes());
+                span = span.add(&child);
+            }
         }
     }
     put_box(buf, 0, &span);
@@ -356,20 +341,10 @@ fn build(path: &Path, g: &GridOut) -> Result<GridBuffer> {
             message: format!("grid name `{}` is longer than NanoVDB's 255 bytes", g.name),
         });
     }
-    let entries = tree_entries(path, g)?;
-    let uppers: Vec<&[(Key, Entry)]> = entries.chunk_by(|a, b| a.0.0 == b.0.0).collect();
-    let lowers: Vec<&[(Key, Entry)]> = uppers
-        .iter()
-        .flat_map(|u| u.chunk_by(|a, b| a.0.1 == b.0.1))
-        .filter(|node| !matches!(node[0].1, Entry::NodeTile))
-        .collect();
-    let leaves: Vec<&Leaf> = entries
-        .iter()
-        .filter_map(|e| match e.1 {
-            Entry::Leaf(l) => Some(l),
-            _ => None,
-        })
-        .collect();
+    let tree = tree(path, g)?;
+    let uppers: Vec<&[TreeNode]> = tree.nodes.chunk_by(|a, b| a.root == b.root).collect();
+    let lowers: Vec<&TreeNode> = tree.nodes.iter().filter(|node| !node.tile).collect();
+    let leaves: Vec<&Leaf> = tree.leaves.iter().map(|&(_, leaf)| leaf).collect();
     let root_at = GRID_BYTES + TREE_BYTES;
     let upper_at = root_at + sizes.root + uppers.len() * ROOT_TILE_BYTES;
     let lower_at = upper_at + uppers.len() * sizes.upper;
@@ -392,48 +367,44 @@ fn build(path: &Path, g: &GridOut) -> Result<GridBuffer> {
         .zip(&leaves)
         .map(|(buf, leaf)| fill_leaf(buf, leaf, g.values, sizes, delta))
         .collect();
-    // The first leaf of each lower node, then each lower node filled.
-    let mut first_leaf = Vec::with_capacity(lowers.len());
-    let mut count = 0;
-    for node in &lowers {
-        first_leaf.push(count);
-        count += node
-            .iter()
-            .filter(|e| matches!(e.1, Entry::Leaf(_)))
-            .count();
-    }
+    // Each lower node filled, its leaves a range of the tree's.
     let lower_spans: Vec<(Span, u32)> = lower_bytes
         .par_chunks_mut(sizes.lower)
         .zip(lowers.par_iter())
-        .zip(first_leaf.par_iter())
         .enumerate()
-        .map(|(i, ((buf, node), &first))| {
+        .map(|(i, (buf, node))| {
             let here = lower_at + i * sizes.lower;
-            let mut children =
-                (first..).map(|l| ((leaf_at + l * sizes.leaf - here) as i64, leaf_spans[l]));
-            fill_internal(buf, false, node, &mut children, g.values, sizes, delta)
+            let mut children = node
+                .leaves
+                .clone()
+                .map(|l| ((leaf_at + l * sizes.leaf - here) as i64, leaf_spans[l]));
+            let slots = node.blocks(&tree).map(|(slot, leaf)| {
+                let origin = block_origin(&(node.root, node.slot, slot), true);
+                (usize::from(slot), leaf.is_none().then_some(origin))
+            });
+            fill_internal(buf, false, slots, &mut children, g.values, sizes, delta)
         })
         .collect();
     let mut first_lower = 0;
     let mut upper_spans = Vec::with_capacity(uppers.len());
-    for (i, (buf, node)) in upper_bytes.chunks_mut(sizes.upper).zip(&uppers).enumerate() {
+    for (i, (buf, nodes)) in upper_bytes.chunks_mut(sizes.upper).zip(&uppers).enumerate() {
         let here = upper_at + i * sizes.upper;
         let mut children =
             (first_lower..).map(|l| ((lower_at + l * sizes.lower - here) as i64, lower_spans[l].0));
-        let kids = node
-            .chunk_by(|a, b| a.0.1 == b.0.1)
-            .filter(|n| !matches!(n[0].1, Entry::NodeTile))
-            .count();
+        let slots = nodes.iter().map(|node| {
+            let origin = block_origin(&(node.root, node.slot, 0), false);
+            (usize::from(node.slot), node.tile.then_some(origin))
+        });
         upper_spans.push(fill_internal(
             buf,
             true,
-            node,
+            slots,
             &mut children,
             g.values,
             sizes,
             delta,
         ));
-        first_lower += kids;
+        first_lower += nodes.iter().filter(|node| !node.tile).count();
     }
 
     // The root: its box, table size, background and range, then one tile per child.
@@ -445,7 +416,7 @@ fn build(path: &Path, g: &GridOut) -> Result<GridBuffer> {
     put_range(root, 28 + sizes.value, sizes, &span);
     for (i, node) in uppers.iter().enumerate() {
         let tile = sizes.root + i * ROOT_TILE_BYTES;
-        let o = node[0].0.0.map(|v| u64::from(v as u32 >> 12));
+        let o = node[0].root.map(|v| u64::from(v as u32 >> 12));
         put(root, tile, (o[2] | o[1] << 21 | o[0] << 42).to_le_bytes());
         let child = (upper_at + i * sizes.upper - root_at) as i64;
         put(root, tile + 8, child.to_le_bytes());

@@ -9,7 +9,7 @@
 //! their leaves and 8^3 tiles; then every leaf's buffer in the same order.
 
 use super::direct_file::DirectFile;
-use super::grid_out::{Entry, GridOut, GridValues, Key, ValueType, tree_entries};
+use super::grid_out::{GridOut, GridValues, Tree, TreeNode, ValueType, tree};
 use super::vdb::WriteClocks;
 use super::vdb_chunks::{compression_name, push_chunk};
 use super::vdb_format::{
@@ -385,19 +385,19 @@ struct GridHead<'g> {
 }
 
 fn grid_head<'g>(path: &Path, g: &GridOut<'g>, encoding: Encoding) -> Result<GridHead<'g>> {
-    let entries = tree_entries(path, g)?;
+    let tree = tree(path, g)?;
     let half = encoding.half && (g.values.value_type() != ValueType::Bool);
     let compression = encoding.compression | COMPRESS_ACTIVE_MASK;
-    // Each root child's topology on its own thread, with its leaves in buffer order.
-    let roots: Vec<&[(Key, Entry)]> = entries.chunk_by(|a, b| a.0.0 == b.0.0).collect();
-    let encoded: Vec<(Vec<u8>, Vec<&Leaf>, [u64; 2])> = roots
+    // Each root child's topology on its own thread.
+    let roots: Vec<&[TreeNode]> = tree.nodes.chunk_by(|a, b| a.root == b.root).collect();
+    let encoded: Vec<(Vec<u8>, [u64; 2])> = roots
         .par_iter()
-        .map(|child| root_child_topology(child, g.values, compression, half))
+        .map(|nodes| root_child_topology(&tree, nodes, g.values, compression, half))
         .collect();
-    let leaves: Vec<&Leaf> = encoded.iter().flat_map(|e| e.1.iter().copied()).collect();
+    let leaves: Vec<&Leaf> = tree.leaves.iter().map(|&(_, leaf)| leaf).collect();
     let internal = encoded
         .iter()
-        .fold([0u64; 2], |a, e| [a[0] + e.2[0], a[1] + e.2[1]]);
+        .fold([0u64; 2], |a, e| [a[0] + e.1[0], a[1] + e.1[1]]);
     let stats = TreeStats {
         bbox: g.grid.bbox(),
         voxels: g.grid.voxel_count(),
@@ -413,7 +413,7 @@ fn grid_head<'g>(path: &Path, g: &GridOut<'g>, encoding: Encoding) -> Result<Gri
         g.grid.transform,
         roots.len(),
     );
-    for (bytes, _, _) in &encoded {
+    for (bytes, _) in &encoded {
         head.extend_from_slice(bytes);
     }
     Ok(GridHead {
@@ -521,47 +521,28 @@ fn stream_leaf_buffers(
     size.into_inner()
 }
 
-/// One root child (a 4096^3 node): its origin, then its node topology; its leaves in order,
-/// and its count of internal nodes at each depth.
-fn root_child_topology<'g>(
-    entries: &[(Key, Entry<'g>)],
+/// One root child (a 4096^3 node, its slots `nodes` of `tree`): its origin, then its node
+/// topology; its count of internal nodes at each depth.
+fn root_child_topology(
+    tree: &Tree,
+    nodes: &[TreeNode],
     values: GridValues,
     compression: u32,
     half: bool,
-) -> (Vec<u8>, Vec<&'g Leaf>, [u64; 2]) {
+) -> (Vec<u8>, [u64; 2]) {
     let mut out = Vec::new();
-    let mut leaves = Vec::new();
-    let nodes: Vec<&[(Key, Entry)]> = entries.chunk_by(|a, b| a.0.1 == b.0.1).collect();
-    let slots = nodes
-        .iter()
-        .map(|node| (node[0].0.1, matches!(node[0].1, Entry::NodeTile)));
-    push_root_child(&mut out, entries[0].0.0, slots, values, compression, half);
+    let slots = nodes.iter().map(|node| (node.slot, node.tile));
+    push_root_child(&mut out, nodes[0].root, slots, values, compression, half);
     let mut lower = 0;
-    for node in nodes {
-        if matches!(node[0].1, Entry::NodeTile) {
-            continue;
-        }
+    for node in nodes.iter().filter(|node| !node.tile) {
         lower += 1;
-        let mut children = vec![0u64; 16 * 16 * 16 / 64];
-        let mut tiles = vec![0u64; 16 * 16 * 16 / 64];
-        for (key, entry) in node {
-            let slot = key.2 as usize;
-            let mask = if let Entry::Leaf(leaf) = entry {
-                leaves.push(*leaf);
-                &mut children
-            } else {
-                &mut tiles
-            };
-            mask[slot / 64] |= 1 << (slot % 64);
-        }
-        push_internal_values(&mut out, &children, &tiles, values, compression, half);
-        for (_, entry) in node {
-            if let Entry::Leaf(leaf) = entry {
-                push_mask(&mut out, &leaf.mask);
-            }
+        let children = node.children(&tree.leaves);
+        push_internal_values(&mut out, &children, node.tiles, values, compression, half);
+        for (_, leaf) in &tree.leaves[node.leaves.clone()] {
+            push_mask(&mut out, &leaf.mask);
         }
     }
-    (out, leaves, [1, lower])
+    (out, [1, lower])
 }
 
 /// An internal node's child and value masks, then its tile values: every non-child slot
