@@ -137,16 +137,18 @@ const BLOCK_FLOOD_COST: FillCost = FillCost {
 /// A solid whose inside the winding number decides (no flood): the surface's per-triangle
 /// tables, still held while the inside is found beside it (210 bytes a triangle), the list
 /// of whole 8^3 blocks (24 bytes each: 0.375 bits per inside voxel), and the surface, the
-/// solid's boundary leaves and the grids written (710 bytes per surface leaf); the crossings
-/// and columns come on top (`winding_plan`). Estimate/peak 0.99-1.22 on the nine closed
-/// meshes above and 0.90-1.17 on the open stanford-bunny, teapot and ogre, at 1024 and 2
-/// threads (two runs each); a closed mesh's inside, read only near its surface
+/// solid's boundary leaves and the grids written (300 bytes per surface leaf); the crossings
+/// and columns come on top (`winding_plan`). The leaf's share was 710 bytes while the writers
+/// listed every 8^3 tile twice (32 bytes each time), which made the peak of a large inside
+/// (bunny-closed's solid at 1024: 107 MiB then, 80-93 MiB since). Estimate/peak 0.90-1.25 on
+/// the nine closed meshes above and 0.83-0.96 on the open stanford-bunny, teapot, ogre and
+/// cube_no_bottom, at 1024 and 2 threads; a closed mesh's inside, read only near its surface
 /// (`column_inside`), peaks below an open one's, which every block column decides.
 const WINDING_SOLID_COST: FillCost = FillCost {
     bit_volumes: 0.0,
     inside_volumes: 0.375,
     face_bytes: 0.0,
-    leaf_bytes: 710.0,
+    leaf_bytes: 300.0,
     block_bytes: 0.0,
     triangle_bytes: 210.0,
 };
@@ -376,14 +378,14 @@ fn tessellation_bytes(control: &ControlMesh, t: &Transform) -> f64 {
 }
 
 /// A distance band's leaf with its values and encoded buffers: 2.4 KB; a level set's also
-/// holds its interior's leaf and the fog volume's buffers, 2.6 KB. Each triangle 150 bytes
+/// holds its interior's leaf and the fog volume's buffers, 2.45 KB. Each triangle 150 bytes
 /// (its corners, the bins). Fitted on bunny-closed (`--sdf`) and igea (`--udf`) at 1024; the
 /// unsigned leaf refitted by `voxelkit-bench calibrate` on the five meshes (factor 1.15), the
-/// signed one when the writer began streaming its buffers (factor 0.87; estimate/peak
-/// 0.92-1.01 on bunny-closed, igea, horse, armadillo and skull, 0.99-1.23 on fandisk,
-/// scorpion, rocker-arm and spot).
+/// signed one when the writer began streaming its buffers (factor 0.87) and when it stopped
+/// listing the interior's 8^3 tiles one by one (2600 -> 2450 bytes; estimate/peak 1.05 on
+/// bunny-closed, 1.08-1.26 on scorpion, rocker-arm, spot and fandisk).
 const UNSIGNED_BAND_LEAF_BYTES: f64 = 2400.0;
-const SIGNED_BAND_LEAF_BYTES: f64 = 2600.0;
+const SIGNED_BAND_LEAF_BYTES: f64 = 2450.0;
 const BAND_TRIANGLE_BYTES: f64 = 150.0;
 
 /// `check`: the surface and its word-wise span floods, about 2.2 dense volumes over the box
