@@ -321,7 +321,7 @@ pub(super) struct GridOut<'g> {
 pub(super) type Key = ([i32; 3], u16, u16);
 
 /// The words of a 128^3 node's mask of 8^3 slots.
-pub(super) const NODE_WORDS: usize = NODE_LEAVES / 64;
+const NODE_WORDS: usize = NODE_LEAVES / 64;
 
 /// No 8^3 tiles in a node.
 const NO_TILES: [u64; NODE_WORDS] = [0; NODE_WORDS];
@@ -351,6 +351,18 @@ pub(super) struct TreeNode<'g> {
 }
 
 impl<'g> TreeNode<'g> {
+    /// The node at `origin` (its key's first parts), with nothing in it yet.
+    fn at(path: &Path, origin: [i64; 3]) -> Result<Self> {
+        let (root, slot, _) = key(path, origin)?;
+        Ok(TreeNode {
+            root,
+            slot,
+            tile: false,
+            tiles: &NO_TILES,
+            leaves: 0..0,
+        })
+    }
+
     /// Its tiles: the 128^3 one, or its 8^3 ones.
     pub fn tile_count(&self) -> usize {
         let leaf_tiles: u32 = self.tiles.iter().map(|w| w.count_ones()).sum();
@@ -447,64 +459,42 @@ pub(super) fn tree<'g>(path: &Path, g: &GridOut<'g>) -> Result<Tree<'g>> {
             message: format!("grid {}: tiles carry no vectors", g.name),
         });
     }
-    // The nodes holding leaves, in order, then those of tiles joined in.
+    // The nodes holding leaves, then those holding tiles, in one list sorted by place: a
+    // stable sort keeps a node's leaves before its tiles, which then join them.
     let mut nodes: Vec<TreeNode> = Vec::new();
     for (n, &(order, _, leaf)) in keyed.iter().enumerate() {
-        let same_node = |node: &TreeNode| node_order(node.root, node.slot) == order & !0xffff;
         match nodes.last_mut() {
-            Some(node) if same_node(node) => node.leaves.end = n + 1,
-            _ => {
-                let (root, slot, _) = key(path, leaf.origin)?;
-                nodes.push(TreeNode {
-                    root,
-                    slot,
-                    tile: false,
-                    tiles: &NO_TILES,
-                    leaves: n..n + 1,
-                });
+            Some(node) if node_order(node.root, node.slot) == order & !0xffff => {
+                node.leaves.end = n + 1
             }
+            _ => nodes.push(TreeNode {
+                leaves: n..n + 1,
+                ..TreeNode::at(path, leaf.origin)?
+            }),
         }
     }
     let leaves: Vec<(u16, &Leaf)> = keyed
         .into_iter()
         .map(|(_, slot, leaf)| (slot, leaf))
         .collect();
-    let mut tile_nodes: Vec<TreeNode> = Vec::new();
     for (origin, mask) in tiles.leaf_tile_masks() {
-        let (root, slot, _) = key(path, origin)?;
-        tile_nodes.push(TreeNode {
-            root,
-            slot,
-            tile: false,
+        nodes.push(TreeNode {
             tiles: mask,
-            leaves: 0..0,
+            ..TreeNode::at(path, origin)?
         });
     }
     for origin in tiles.node_tiles() {
-        let (root, slot, _) = key(path, origin)?;
-        tile_nodes.push(TreeNode {
-            root,
-            slot,
+        nodes.push(TreeNode {
             tile: true,
-            tiles: &NO_TILES,
-            leaves: 0..0,
+            ..TreeNode::at(path, origin)?
         });
     }
     let order = |n: &TreeNode| node_order(n.root, n.slot);
-    tile_nodes.sort_unstable_by_key(order);
-    let mut joined: Vec<TreeNode> = Vec::with_capacity(nodes.len() + tile_nodes.len());
-    let (mut a, mut b) = (
-        nodes.into_iter().peekable(),
-        tile_nodes.into_iter().peekable(),
-    );
-    while let Some(next) = match (a.peek(), b.peek()) {
-        (Some(x), Some(y)) if order(y) < order(x) => b.next(),
-        (Some(_), _) => a.next(),
-        (None, _) => b.next(),
-    } {
+    nodes.sort_by_key(order);
+    let mut joined: Vec<TreeNode> = Vec::with_capacity(nodes.len());
+    for next in nodes {
         match joined.last_mut() {
-            // A node's leaves come first, then its 8^3 tiles join them; anything more in one
-            // place is a clash.
+            // Anything more in a place than a node's leaves and its 8^3 tiles is a clash.
             Some(last) if order(last) == order(&next) => {
                 let overlap =
                     |c: [u64; NODE_WORDS]| c.iter().zip(next.tiles).any(|(c, t)| c & t != 0);

@@ -379,8 +379,8 @@ fn build(path: &Path, g: &GridOut) -> Result<GridBuffer> {
                 .clone()
                 .map(|l| ((leaf_at + l * sizes.leaf - here) as i64, leaf_spans[l]));
             let slots = node.blocks(&tree).map(|(slot, leaf)| {
-                let origin = block_origin(&(node.root, node.slot, slot), true);
-                (usize::from(slot), leaf.is_none().then_some(origin))
+                let tile = || block_origin(&(node.root, node.slot, slot), true);
+                (usize::from(slot), leaf.is_none().then(tile))
             });
             fill_internal(buf, false, slots, &mut children, g.values, sizes, delta)
         })
@@ -392,8 +392,8 @@ fn build(path: &Path, g: &GridOut) -> Result<GridBuffer> {
         let mut children =
             (first_lower..).map(|l| ((lower_at + l * sizes.lower - here) as i64, lower_spans[l].0));
         let slots = nodes.iter().map(|node| {
-            let origin = block_origin(&(node.root, node.slot, 0), false);
-            (usize::from(node.slot), node.tile.then_some(origin))
+            let tile = || block_origin(&(node.root, node.slot, 0), false);
+            (usize::from(node.slot), node.tile.then(tile))
         });
         upper_spans.push(fill_internal(
             buf,
