@@ -137,18 +137,18 @@ const BLOCK_FLOOD_COST: FillCost = FillCost {
 /// A solid whose inside the winding number decides (no flood): the surface's per-triangle
 /// tables, still held while the inside is found beside it (210 bytes a triangle), the list
 /// of whole 8^3 blocks (24 bytes each: 0.375 bits per inside voxel), and the surface, the
-/// solid's boundary leaves and the grids written (300 bytes per surface leaf); the crossings
+/// solid's boundary leaves and the grids written (230 bytes per surface leaf); the crossings
 /// and columns come on top (`winding_plan`). The leaf's share was 710 bytes while the writers
 /// listed every 8^3 tile twice (32 bytes each time), which made the peak of a large inside
-/// (bunny-closed's solid at 1024: 107 MiB then, 80-93 MiB since). Estimate/peak 0.90-1.25 on
-/// the nine closed meshes above and 0.83-0.96 on the open stanford-bunny, teapot, ogre and
-/// cube_no_bottom, at 1024 and 2 threads; a closed mesh's inside, read only near its surface
+/// (bunny-closed's solid at 1024: 107 MiB then, 80-93 MiB since). Estimate/peak 0.88-1.19 on
+/// the nine closed meshes above and 0.82-0.85 on the open teapot, ogre and cube_no_bottom, at
+/// 1024 and 2 threads (at 300 bytes fandisk's was 1.25-1.31, past the tests' bound once); a closed mesh's inside, read only near its surface
 /// (`column_inside`), peaks below an open one's, which every block column decides.
 const WINDING_SOLID_COST: FillCost = FillCost {
     bit_volumes: 0.0,
     inside_volumes: 0.375,
     face_bytes: 0.0,
-    leaf_bytes: 300.0,
+    leaf_bytes: 230.0,
     block_bytes: 0.0,
     triangle_bytes: 210.0,
 };
