@@ -282,6 +282,34 @@ impl Pool {
     }
 }
 
+/// Hands the memory of every pool back to the kernel on the current rayon pool's threads, for
+/// a process about to end: the kernel frees a dying process's memory on one thread (a 1024^3
+/// level set's band, 160 MB, took about 20 ms after the exit at 2 threads).
+///
+/// # Safety
+/// No array of any pool may be used afterwards: the process ends with them leaked.
+pub unsafe fn release_before_exit() {
+    use rayon::prelude::*;
+    // Pieces small enough to share among the threads: a few reservations hold a large band.
+    const PIECE: usize = 8 << 20;
+    let pieces: Vec<(usize, usize)> = [
+        <[f32; super::LEAF_VOXELS]>::pool(),
+        <[[f32; 3]; super::LEAF_VOXELS]>::pool(),
+    ]
+    .iter()
+    .flat_map(|pool| lock(pool).reservations.clone())
+    .flat_map(|(start, size)| {
+        let start = start.as_ptr() as usize;
+        (0..size.div_ceil(PIECE)).map(move |k| (start + k * PIECE, PIECE.min(size - k * PIECE)))
+    })
+    .collect();
+    pieces.par_iter().with_max_len(1).for_each(|&(start, len)| {
+        // SAFETY: a range of a pool's reservation, whose arrays the caller will not use again;
+        // its pages read as zeros if touched.
+        unsafe { libc::madvise(start as *mut libc::c_void, len, libc::MADV_DONTNEED) };
+    });
+}
+
 /// `size` bytes of fresh address space, readable and writable, its pages made only when used.
 fn reserve(size: usize) -> NonNull<u8> {
     crate::mapped_bytes::map_anonymous(size, libc::MAP_NORESERVE).unwrap_or_else(|_| {

@@ -12,7 +12,7 @@ mod tiles;
 mod transform;
 mod up_axis;
 
-pub use channel_pool::ChannelBox;
+pub use channel_pool::{ChannelBox, release_before_exit};
 pub use coord::{
     Coord, CoordBox, LEAF_VOXELS, ceil_int, floor_int, leaf_offset, leaf_origin, offset_coord,
 };

@@ -242,7 +242,7 @@ fn looks_random(plane: &[u8]) -> bool {
 /// Blosc's byte shuffle: byte `j` of every value together, for each `j` in turn; the bytes
 /// after the last whole value as they are.
 fn shuffle(data: &[u8], value_size: usize, out: &mut Vec<u8>) {
-    out.clear();
+    // Every byte is written below: only new room is zeroed, not the whole buffer each time.
     out.resize(data.len(), 0);
     let values = data.len() / value_size;
     let whole = values * value_size;

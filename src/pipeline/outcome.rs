@@ -115,6 +115,22 @@ pub fn check_output_path(path: &Path, inputs: &[&Path]) -> Result<()> {
 }
 
 impl Outcome {
+    /// Ends the outcome with the process, which must end next: its memory is left to the
+    /// kernel, sooner than freeing every leaf one by one (a level set at 1024 holds hundreds of
+    /// thousands), and its leaves' arrays are handed back on the job's threads first.
+    ///
+    /// # Safety
+    /// No other grid's leaf arrays may be used afterwards either (`release_before_exit`).
+    pub unsafe fn end_with_process(self) {
+        let threads = self.threads;
+        std::mem::forget(self);
+        let _ = on_threads(threads, || {
+            // SAFETY: the caller's promise.
+            unsafe { crate::grid::release_before_exit() };
+            Ok(())
+        });
+    }
+
     pub(super) fn new(
         grid: SparseGrid,
         metadata: Vec<(&str, MetaValue)>,
