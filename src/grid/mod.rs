@@ -18,7 +18,7 @@ pub use coord::{
 };
 pub use leaf::{Channels, Leaf, mask_box};
 pub use sparse::{Accessor, Block, SparseGrid};
-pub use tiles::{NODE_DIM, NODE_LEAVES, Tiles, node_origin, tile_bytes};
+pub use tiles::{NODE_DIM, NODE_LEAVES, NodeMask, Tiles, node_origin, tile_bytes};
 pub use transform::Transform;
 pub use up_axis::UpAxis;
 

@@ -4,7 +4,7 @@
 
 use super::coord::{Coord, CoordBox, leaf_offset, leaf_origin, offset_coord};
 use super::leaf::{Channels, Leaf, mask_box};
-use super::tiles::{NODE_DIM, Tiles, node_leaf_origins, node_origin};
+use super::tiles::{NODE_DIM, NodeMask, Tiles, node_leaf_origins, node_origin};
 use super::transform::Transform;
 use rayon::prelude::*;
 use rustc_hash::{FxHashMap, FxHashSet};
@@ -116,6 +116,14 @@ impl SparseGrid {
                 true
             }
         }
+    }
+
+    /// `fill_free_leaf_blocks` for the blocks of each 128^3 node given as its mask.
+    pub fn fill_free_node_masks(&mut self, masks: &[NodeMask]) {
+        for mask in masks {
+            self.tiles.insert_node_mask(mask);
+        }
+        self.tiles.promote();
     }
 
     /// Makes the 8^3 blocks at `origins` whole, as `fill_leaf_block` does one by one, and

@@ -88,6 +88,35 @@ fn slot_origin(node: Coord, slot: usize) -> Coord {
     std::array::from_fn(|a| node[a] + 8 * at[a] as i64)
 }
 
+/// Some 8^3 blocks of one 128^3 node, a bit per block as `Tiles` keeps them: made apart (on
+/// any thread) and then made whole together (`Tiles::insert_node_mask`).
+pub struct NodeMask {
+    node: Coord,
+    bits: [u64; NODE_LEAVES / 64],
+}
+
+impl NodeMask {
+    /// No block of the node at `node` (a multiple of 128).
+    pub fn new(node: Coord) -> Self {
+        debug_assert_eq!(node_origin(node), node, "a node's origin");
+        NodeMask {
+            node,
+            bits: [0; NODE_LEAVES / 64],
+        }
+    }
+
+    pub fn node(&self) -> Coord {
+        self.node
+    }
+
+    /// Adds the 8^3 block at `leaf_origin`, which must lie in the node.
+    #[inline]
+    pub fn insert(&mut self, leaf_origin: Coord) {
+        debug_assert_eq!(node_origin(leaf_origin), self.node, "a block of the node");
+        bits::set(&mut self.bits[..], block_slot(leaf_origin));
+    }
+}
+
 /// Whole 8^3 blocks are kept as a bit per block under their 128^3 node (a solid's inside has
 /// hundreds of thousands of them in a few hundred nodes: setting, testing and copying bits is
 /// what keeps making and combining solids cheap), whole 128^3 blocks by their origin.
@@ -218,6 +247,20 @@ impl Tiles {
                 debug_assert_eq!(node_origin(origin), node, "a block of the node");
                 self.leaf_count += usize::from(blocks.insert(block_slot(origin)));
             }
+        }
+    }
+
+    /// Makes the 8^3 blocks of `mask` whole, as `insert_leaves_of_node` does.
+    pub fn insert_node_mask(&mut self, mask: &NodeMask) {
+        if !self.nodes.contains(&mask.node) {
+            let blocks = self.leaves.entry(mask.node).or_default();
+            let mut added = 0;
+            for (word, &new) in blocks.bits.iter_mut().zip(&mask.bits) {
+                added += (new & !*word).count_ones();
+                *word |= new;
+            }
+            blocks.count += added;
+            self.leaf_count += added as usize;
         }
     }
 
