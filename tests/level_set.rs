@@ -17,7 +17,7 @@ use voxelkit::io::vdb::read_vdb_grid;
 use voxelkit::mesh::{GridFit, Mesh, fit_transform, generate};
 use voxelkit::progress::Progress;
 use voxelkit::random::SplitMix64;
-use voxelkit::solids::inside_rule::Inside;
+use voxelkit::solids::inside_rule::InsideRule;
 use voxelkit::solids::level_set::level_set;
 
 const BAND: f64 = 3.0;
@@ -90,8 +90,9 @@ fn winding(mesh: &Mesh, p: DVec3) -> f64 {
 fn check(name: &str, mesh: &Mesh, resolution: u32) {
     let t = fit_transform(&mesh.bbox(), GridFit::Resolution(resolution)).unwrap();
     let h = t.voxel_size;
-    let grid = level_set(mesh, t, BAND, &Inside::Parity, &Progress::none())
+    let grid = level_set(mesh, t, BAND, InsideRule::Parity, &Progress::none())
         .unwrap()
+        .1
         .band;
     let active: Vec<([i64; 3], f32)> = grid
         .leaves()

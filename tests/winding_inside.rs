@@ -17,7 +17,7 @@ use voxelkit::progress::Unobserved;
 use voxelkit::solids::csg_leaves;
 use voxelkit::solids::exterior_flood::FloodMethod;
 use voxelkit::solids::flooded_mesh::flooded_mesh;
-use voxelkit::solids::inside_rule::{Inside, InsideRule};
+use voxelkit::solids::inside_rule::InsideRule;
 use voxelkit::solids::level_set::level_set;
 
 mod common;
@@ -307,13 +307,15 @@ fn the_union_of_overlapping_parts_is_the_union_of_their_solids() {
         .filter(|&c| (winding_number(&both, t.index_to_world(c)) - 2.0).abs() < 0.1)
         .collect();
     assert!(!overlap.is_empty());
-    let interior = |inside: &Inside| {
-        level_set(&both, t, 3.0, inside, &Progress::none())
-            .unwrap()
-            .interior
+    let interior = |rule: InsideRule, name: &str| {
+        let (choice, set) = level_set(&both, t, 3.0, rule, &Progress::none()).unwrap();
+        assert_eq!(choice.name(), name);
+        set.interior
     };
-    let caps = voxelkit::mesh::boundary_caps::boundary_caps(&both);
-    let (parity, winding) = (interior(&Inside::Parity), interior(&Inside::Winding(caps)));
+    let (parity, winding) = (
+        interior(InsideRule::Parity, "parity"),
+        interior(InsideRule::Winding, "winding"),
+    );
     assert!(overlap.iter().all(|&c| winding.contains(c)));
     assert!(overlap.iter().all(|&c| !parity.contains(c)));
 }

@@ -29,8 +29,8 @@ use crate::solids::depth_layers::{
 use crate::solids::exterior_flood::{FloodMethod, Solid};
 use crate::solids::flooded_mesh::{self, SurfaceAndInside};
 use crate::solids::formula_rays::FormulaRays;
-use crate::solids::inside_rule::{Inside, InsideChoice, InsideRule, choose_inside};
-use crate::solids::level_set::{SIGN_NEEDS_CLOSED, level_set, unsigned_distance};
+use crate::solids::inside_rule::{Inside, InsideChoice, InsideRule};
+use crate::solids::level_set::{level_set, unsigned_distance};
 use crate::solids::subdivision::{self, Filled};
 use crate::subd::ControlMesh;
 use crate::voxelize::parametric::ParametricOptions;
@@ -337,8 +337,7 @@ pub(super) fn distance_band(
     } = asked;
     // Unsigned distances have no inside.
     let (grid, interior, choice, ambiguous, inside_band_voxels) = if signed {
-        let choice = choose_inside(inside, mesh, SIGN_NEEDS_CLOSED)?;
-        let set = level_set(mesh, t, band, &choice.inside, progress)?;
+        let (choice, set) = level_set(mesh, t, band, inside, progress)?;
         let ambiguous = matches!(choice.inside, Inside::Winding(_)).then_some(set.ambiguous);
         let inside_band_voxels = set.inside_band_voxels;
         (

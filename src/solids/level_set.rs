@@ -10,9 +10,9 @@
 //! band), so one centre decides it.
 
 use super::column_inside::{interior, leaf_inside, winding_columns};
-use super::inside_rule::Inside;
-use super::winding_inside::{block_columns, winding_inside};
-use crate::error::Result;
+use super::inside_rule::{Inside, InsideChoice, InsideRule, choose_inside};
+use super::winding_inside::{WindingInside, block_columns, winding_inside};
+use crate::error::{Error, Result};
 use crate::grid::{Channels, Coord, Leaf, SparseGrid, Transform};
 use crate::mesh::inside::ColumnCrossings;
 use crate::mesh::{Mesh, index_box};
@@ -39,41 +39,73 @@ pub struct LevelSet {
 }
 
 /// Signed distances (world units, negative inside) on every voxel within `band` voxels of
-/// `mesh`, signed by `inside`, and its interior.
+/// `mesh`, signed by the inside rule `rule` comes to (`choose_inside`), and its interior; the
+/// rule chosen with it. The rule is chosen beside the band, which does not depend on it:
+/// grouping the mesh's edges for the choice then takes no time of its own.
 pub fn level_set(
     mesh: &Mesh,
     transform: Transform,
     band: f64,
-    inside: &Inside,
+    rule: InsideRule,
     progress: &Progress,
-) -> Result<LevelSet> {
+) -> Result<(InsideChoice, LevelSet)> {
     // The inside covers the band's columns: the mesh's box widened by the band. It is found
     // beside the band, filling the threads in its serial steps.
     let reach = band.ceil() as i64;
     let columns_box = padded(index_box(&mesh.bbox(), &transform), reach);
-    let caps = match inside {
-        Inside::Parity => {
-            mesh.require_closed(SIGN_NEEDS_CLOSED)?;
-            return columns_level_set(mesh, transform, band, progress, || {
-                ColumnCrossings::new(mesh, &transform, columns_box)
-            });
-        }
-        // Closed and consistently oriented: the winding number is the signed count of
-        // crossings, which the band's leaves and blocks read as parity's do.
-        Inside::Winding(caps) if caps.is_empty() => {
-            return columns_level_set(mesh, transform, band, progress, || {
-                winding_columns(mesh, caps, &transform, columns_box)
-            });
-        }
-        Inside::Winding(caps) => caps,
-    };
     let columns = block_columns(columns_box).len() as u64;
     progress.stage("distances and inside", work_items(mesh) + columns);
     let (grid, inside) = rayon::join(
         || distance_band(mesh, transform, band, progress),
-        || winding_inside(mesh, caps, transform, columns_box, progress),
+        || {
+            let choice = choose_inside(rule, mesh, SIGN_NEEDS_CLOSED)?;
+            let signs = match &choice.inside {
+                // Parity's crossings, or on a closed and consistently oriented mesh the
+                // winding number as the signed count of crossings: the band's leaves and
+                // blocks read them.
+                Inside::Parity => {
+                    progress.advance(columns);
+                    Signs::Columns(ColumnCrossings::new(mesh, &transform, columns_box))
+                }
+                Inside::Winding(caps) if caps.is_empty() => {
+                    progress.advance(columns);
+                    Signs::Columns(winding_columns(mesh, caps, &transform, columns_box))
+                }
+                Inside::Winding(caps) => Signs::Winding(winding_inside(
+                    mesh,
+                    caps,
+                    transform,
+                    columns_box,
+                    progress,
+                )?),
+            };
+            Ok::<_, Error>((choice, signs))
+        },
     );
-    let (mut grid, inside) = (grid?, inside?);
+    let (choice, signs) = inside?;
+    let grid = grid?;
+    let set = match signs {
+        Signs::Columns(columns) => signed_by_columns(grid, &columns, transform),
+        Signs::Winding(inside) => signed_by_winding(grid, inside, transform),
+    };
+    Ok((choice, set))
+}
+
+/// How a level set's band is signed once it is known.
+enum Signs {
+    /// A closed mesh's columns, read in the band's leaves and at one centre of each block
+    /// without band voxels, not in every block.
+    Columns(ColumnCrossings),
+    /// Every centre decided already by the winding number (an open mesh's).
+    Winding(WindingInside),
+}
+
+/// The level set of `grid`'s unsigned distances signed by the winding number's `inside`.
+fn signed_by_winding(
+    mut grid: SparseGrid,
+    inside: WindingInside,
+    transform: Transform,
+) -> LevelSet {
     // Band leaves stay leaves, even wholly inside: the level set writes its tiles.
     let (full_band, full_free): (Vec<Coord>, Vec<Coord>) = inside
         .full_blocks
@@ -93,12 +125,47 @@ pub fn level_set(
         .par_iter_mut()
         .map(|leaf| sign_leaf(leaf, &interior.block_mask(leaf.origin), h))
         .sum();
-    Ok(LevelSet {
+    LevelSet {
         band: grid,
         interior,
         ambiguous: inside.ambiguous,
         inside_band_voxels,
-    })
+    }
+}
+
+/// The level set of `grid`'s unsigned distances signed by the inside `columns` give.
+fn signed_by_columns(
+    mut grid: SparseGrid,
+    columns: &ColumnCrossings,
+    transform: Transform,
+) -> LevelSet {
+    if grid.leaf_count() == 0 {
+        return LevelSet {
+            band: grid,
+            interior: SparseGrid::new(transform, Channels::NONE),
+            ambiguous: SparseGrid::new(transform, Channels::NONE),
+            inside_band_voxels: 0,
+        };
+    }
+    let h = transform.voxel_size as f32;
+    let (inside, counts): (Vec<Option<Leaf>>, Vec<u64>) = grid
+        .leaves_mut()
+        .par_iter_mut()
+        .map(|leaf| {
+            let mask = leaf_inside(columns, leaf.origin);
+            let count = sign_leaf(leaf, &mask, h);
+            let inside = Leaf::with_mask(leaf.origin, mask);
+            ((!inside.is_empty()).then_some(inside), count)
+        })
+        .unzip();
+    // Band leaves stay leaves, even wholly inside: the level set writes its tiles.
+    let interior = interior(columns, &grid, inside.into_iter().flatten(), transform);
+    LevelSet {
+        band: grid,
+        interior,
+        ambiguous: SparseGrid::new(transform, Channels::NONE),
+        inside_band_voxels: counts.iter().sum(),
+    }
 }
 
 /// Negates the distances of `leaf`'s voxels in `inside` and scales all to world units; how
@@ -135,48 +202,6 @@ const SIGN_FLIPS: [[u32; 4]; 16] = {
     }
     flips
 };
-
-/// The level set of a closed mesh signed by the inside its columns' crossings give
-/// (`crossings`, made beside the band): read only in the band's leaves and at one centre of
-/// each block without band voxels, not in every block.
-fn columns_level_set(
-    mesh: &Mesh,
-    transform: Transform,
-    band: f64,
-    progress: &Progress,
-    crossings: impl FnOnce() -> ColumnCrossings + Send,
-) -> Result<LevelSet> {
-    progress.stage("distances and inside", work_items(mesh));
-    let (grid, columns) = rayon::join(|| distance_band(mesh, transform, band, progress), crossings);
-    let mut grid = grid?;
-    if grid.leaf_count() == 0 {
-        return Ok(LevelSet {
-            band: grid,
-            interior: SparseGrid::new(transform, Channels::NONE),
-            ambiguous: SparseGrid::new(transform, Channels::NONE),
-            inside_band_voxels: 0,
-        });
-    }
-    let h = transform.voxel_size as f32;
-    let (inside, counts): (Vec<Option<Leaf>>, Vec<u64>) = grid
-        .leaves_mut()
-        .par_iter_mut()
-        .map(|leaf| {
-            let mask = leaf_inside(&columns, leaf.origin);
-            let count = sign_leaf(leaf, &mask, h);
-            let inside = Leaf::with_mask(leaf.origin, mask);
-            ((!inside.is_empty()).then_some(inside), count)
-        })
-        .unzip();
-    // Band leaves stay leaves, even wholly inside: the level set writes its tiles.
-    let interior = interior(&columns, &grid, inside.into_iter().flatten(), transform);
-    Ok(LevelSet {
-        band: grid,
-        interior,
-        ambiguous: SparseGrid::new(transform, Channels::NONE),
-        inside_band_voxels: counts.iter().sum(),
-    })
-}
 
 /// Unsigned distances (world units) on every voxel within `band` voxels of `mesh`, open or
 /// closed.
