@@ -382,10 +382,11 @@ fn tessellation_bytes(control: &ControlMesh, t: &Transform) -> f64 {
 /// (its corners, the bins). Fitted on bunny-closed (`--sdf`) and igea (`--udf`) at 1024; the
 /// unsigned leaf refitted by `voxelkit-bench calibrate` on the five meshes (factor 1.15), the
 /// signed one when the writer began streaming its buffers (factor 0.87) and when it stopped
-/// listing the interior's 8^3 tiles one by one (2600 -> 2450 bytes; estimate/peak 1.05 on
-/// bunny-closed, 1.08-1.26 on scorpion, rocker-arm, spot and fandisk).
+/// listing the interior's 8^3 tiles one by one (2600 -> 2450 bytes), and when the inside's
+/// whole blocks were kept as node masks rather than listed (2450 -> 2300 bytes; estimate/peak
+/// 1.05 on bunny-closed, 0.98 on igea, 1.03-1.26 on scorpion, rocker-arm, spot and fandisk).
 const UNSIGNED_BAND_LEAF_BYTES: f64 = 2400.0;
-const SIGNED_BAND_LEAF_BYTES: f64 = 2450.0;
+const SIGNED_BAND_LEAF_BYTES: f64 = 2300.0;
 const BAND_TRIANGLE_BYTES: f64 = 150.0;
 
 /// `check`: the surface and its word-wise span floods, about 2.2 dense volumes over the box
