@@ -10,7 +10,7 @@
 //!   already read; counts are triangles (OpenVDB's quads as two).
 
 use crate::bench::data_folder;
-use crate::json::Json;
+use crate::json::{Json, Value};
 use crate::openvdb_reference;
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
@@ -186,6 +186,27 @@ fn ours(
     Ok((seconds, report))
 }
 
+/// A run's stage profile from its report, as one line: each stage's seconds and threads
+/// busy (stages under a millisecond left out).
+fn stage_profile(stages: &serde_json::Value) -> String {
+    let stages: Vec<String> = stages
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|stage| {
+            let seconds = stage["seconds"].as_f64()?;
+            (seconds >= 0.001).then(|| {
+                format!(
+                    "{} {seconds:.3} s ({:.1})",
+                    stage["stage"].as_str().unwrap_or("?"),
+                    stage["threads_busy"].as_f64().unwrap_or(f64::NAN)
+                )
+            })
+        })
+        .collect();
+    format!("stages (seconds, threads busy): {}", stages.join(", "))
+}
+
 /// The level set of `mesh` at `res` by `voxelkit mesh --sdf`, for `to-mesh` to start from.
 fn level_set(mesh: &Path, res: u32, band: f32) -> Result<PathBuf> {
     let this = std::env::current_exe().map_err(|e| Error::io("voxelkit-bench", e))?;
@@ -308,13 +329,15 @@ pub fn run(args: &WholeBenchArgs, json: bool) -> Result<()> {
                             .int("openvdb_voxels", vdb_voxels)
                             .num("file_mb", file_mb)
                             .num("peak_mib", peak)
-                            .num("openvdb_peak_mib", vdb_peak),
+                            .num("openvdb_peak_mib", vdb_peak)
+                            .put("stages", Value::Raw(report["stages"].to_string())),
                     );
                 } else {
                     println!(
                         "{name:<14} {res:>5} {threads:>3} {ours_s:>8.3} {vdb_s:>10.3} {:>6.2}x {voxels:>11} {vdb_voxels:>11} {file_mb:>8.1} {peak:>9.0} {vdb_peak:>9.0}",
                         vdb_s / ours_s
                     );
+                    println!("  {}", stage_profile(&report["stages"]));
                 }
             }
             if let Some(made) = &level_set {
@@ -338,7 +361,8 @@ pub fn run(args: &WholeBenchArgs, json: bool) -> Result<()> {
         };
         println!(
             "ours: the whole voxelkit process (read, compute, write its output); openvdb: \
-             {reference}; peaks: each process's maximum resident set"
+             {reference}; peaks: each process's maximum resident set; under each row, the stage \
+             profile of our best run"
         );
     }
     Ok(())
