@@ -557,30 +557,64 @@ fn join_pieces(pieces: Vec<Piece>) -> std::result::Result<Parsed, LineError> {
         (Some(e), None) | (None, Some(e)) => return Err(e),
         (None, None) => {}
     }
-    let total = |f: fn(&Parsed) -> usize| pieces.iter().map(|p| f(&p.parsed)).sum::<usize>();
+    let positions: Vec<&[DVec3]> = pieces.iter().map(|p| &p.parsed.positions[..]).collect();
+    let colors: Vec<&[Vec3]> = pieces.iter().map(|p| &p.parsed.colors[..]).collect();
+    let indices: Vec<&[u32]> = pieces.iter().map(|p| &p.parsed.indices[..]).collect();
+    // A face's end is where it ends in all the indices: after the pieces before its own.
+    let shifts: Vec<u32> = std::iter::once(0)
+        .chain(indices.iter().scan(0, |before, part| {
+            let at = *before;
+            *before += part.len() as u32;
+            Some(at)
+        }))
+        .collect();
+    let mut face_starts: Vec<&[u32]> = vec![&[0]];
+    face_starts.extend(pieces.iter().map(|p| &p.parsed.face_starts[..]));
     let mut out = Parsed {
-        positions: vec_to_fill(total(|p| p.positions.len())),
-        colors: vec_to_fill(total(|p| p.colors.len())),
-        indices: vec_to_fill(total(|p| p.indices.len())),
-        face_starts: vec_to_fill(total(|p| p.face_starts.len()) + 1),
+        positions: joined(positions, |_, v| v),
+        colors: joined(colors, |_, v| v),
+        indices: joined(indices, |_, v| v),
+        face_starts: joined(face_starts, |k, end| end + shifts[k]),
         polylines: Vec::new(),
         texture: CornerValues::new("texture coordinates (vt)"),
         normals: CornerValues::new("normals (vn)"),
     };
-    out.face_starts.push(0);
     for piece in pieces {
         let p = piece.parsed;
-        let shift = out.indices.len() as u32;
-        out.positions.extend(p.positions);
-        out.colors.extend(p.colors);
-        out.indices.extend(p.indices);
-        out.face_starts
-            .extend(p.face_starts.iter().map(|s| s + shift));
         out.polylines.extend(p.polylines);
         out.texture.join(p.texture);
         out.normals.join(p.normals);
     }
     Ok(out)
+}
+
+/// `parts` one after the other, each value passed through `map` with its part's number, on
+/// all threads: a large mesh's vertices and corners are megabytes of fresh memory, whose
+/// pages cost more to make than the copy.
+fn joined<T: Copy + Default + Send + Sync>(
+    parts: Vec<&[T]>,
+    map: impl Fn(usize, T) -> T + Sync,
+) -> Vec<T> {
+    let total = parts.iter().map(|part| part.len()).sum();
+    let mut out = vec_to_fill(total);
+    out.par_extend(rayon::iter::repeat_n(T::default(), total));
+    let mut rest = &mut out[..];
+    let mut places = Vec::with_capacity(parts.len());
+    for part in &parts {
+        let (place, after) = rest.split_at_mut(part.len());
+        places.push(place);
+        rest = after;
+    }
+    places
+        .into_par_iter()
+        .zip(parts)
+        .enumerate()
+        .for_each(|(k, (place, part))| {
+            for (to, &from) in place.iter_mut().zip(part) {
+                *to = map(k, from);
+            }
+        });
+    out
 }
 
 #[cfg(test)]
