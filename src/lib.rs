@@ -13,6 +13,7 @@ pub mod io;
 pub mod mapped_bytes;
 pub mod mesh;
 pub mod ops;
+pub mod parallel_concat;
 #[cfg(feature = "vdb")]
 pub mod pipeline;
 pub mod progress;

@@ -9,6 +9,7 @@ use super::Mesh;
 use super::attributes::{AttributeKind, VertexAttribute};
 use crate::error::{Error, Result};
 use crate::huge_pages::vec_to_fill;
+use crate::parallel_concat::{concat, concat_with};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::path::Path;
@@ -557,64 +558,37 @@ fn join_pieces(pieces: Vec<Piece>) -> std::result::Result<Parsed, LineError> {
         (Some(e), None) | (None, Some(e)) => return Err(e),
         (None, None) => {}
     }
-    let positions: Vec<&[DVec3]> = pieces.iter().map(|p| &p.parsed.positions[..]).collect();
-    let colors: Vec<&[Vec3]> = pieces.iter().map(|p| &p.parsed.colors[..]).collect();
-    let indices: Vec<&[u32]> = pieces.iter().map(|p| &p.parsed.indices[..]).collect();
-    // A face's end is where it ends in all the indices: after the pieces before its own.
-    let shifts: Vec<u32> = std::iter::once(0)
-        .chain(indices.iter().scan(0, |before, part| {
-            let at = *before;
-            *before += part.len() as u32;
-            Some(at)
-        }))
-        .collect();
-    let mut face_starts: Vec<&[u32]> = vec![&[0]];
-    face_starts.extend(pieces.iter().map(|p| &p.parsed.face_starts[..]));
+    let (mut positions, mut colors, mut indices) = (Vec::new(), Vec::new(), Vec::new());
+    let mut face_ends = vec![vec![0u32]];
     let mut out = Parsed {
-        positions: joined(positions, |_, v| v),
-        colors: joined(colors, |_, v| v),
-        indices: joined(indices, |_, v| v),
-        face_starts: joined(face_starts, |k, end| end + shifts[k]),
+        positions: Vec::new(),
+        colors: Vec::new(),
+        indices: Vec::new(),
+        face_starts: Vec::new(),
         polylines: Vec::new(),
         texture: CornerValues::new("texture coordinates (vt)"),
         normals: CornerValues::new("normals (vn)"),
     };
+    // A face's end is where it ends in all the indices: after the pieces before its own.
+    let mut shifts = vec![0u32];
+    let mut before = 0;
     for piece in pieces {
         let p = piece.parsed;
+        shifts.push(before);
+        before += p.indices.len() as u32;
+        positions.push(p.positions);
+        colors.push(p.colors);
+        indices.push(p.indices);
+        face_ends.push(p.face_starts);
         out.polylines.extend(p.polylines);
         out.texture.join(p.texture);
         out.normals.join(p.normals);
     }
+    out.positions = concat(positions);
+    out.colors = concat(colors);
+    out.indices = concat(indices);
+    out.face_starts = concat_with(face_ends, |k, end| end + shifts[k]);
     Ok(out)
-}
-
-/// `parts` one after the other, each value passed through `map` with its part's number, on
-/// all threads: a large mesh's vertices and corners are megabytes of fresh memory, whose
-/// pages cost more to make than the copy.
-fn joined<T: Copy + Default + Send + Sync>(
-    parts: Vec<&[T]>,
-    map: impl Fn(usize, T) -> T + Sync,
-) -> Vec<T> {
-    let total = parts.iter().map(|part| part.len()).sum();
-    let mut out = vec_to_fill(total);
-    out.par_extend(rayon::iter::repeat_n(T::default(), total));
-    let mut rest = &mut out[..];
-    let mut places = Vec::with_capacity(parts.len());
-    for part in &parts {
-        let (place, after) = rest.split_at_mut(part.len());
-        places.push(place);
-        rest = after;
-    }
-    places
-        .into_par_iter()
-        .zip(parts)
-        .enumerate()
-        .for_each(|(k, (place, part))| {
-            for (to, &from) in place.iter_mut().zip(part) {
-                *to = map(k, from);
-            }
-        });
-    out
 }
 
 #[cfg(test)]

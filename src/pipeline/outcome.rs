@@ -117,7 +117,8 @@ pub fn check_output_path(path: &Path, inputs: &[&Path]) -> Result<()> {
 impl Outcome {
     /// Ends the outcome with the process, which must end next: its memory is left to the
     /// kernel, sooner than freeing every leaf one by one (a level set at 1024 holds hundreds of
-    /// thousands), and its leaves' arrays are handed back on the job's threads first.
+    /// thousands), and its leaves' arrays are handed back first, on as many threads as the job
+    /// ran on.
     ///
     /// # Safety
     /// No other grid's leaf arrays may be used afterwards either (`release_before_exit`).

@@ -98,7 +98,8 @@ fn inside_blocks(columns: &ColumnCrossings, near: &SparseGrid) -> Vec<NodeMask> 
         .par_iter()
         .with_max_len(1)
         .flat_map_iter(|&(nx, ny)| {
-            // The column's nodes, ascending in z as each block column's spans are.
+            // The column's nodes as their first blocks are found: a few, each found by a
+            // look along them.
             let mut masks: Vec<NodeMask> = Vec::new();
             for x in (first(x0.max(nx))..=x1.min(nx + NODE_DIM - 1)).step_by(8) {
                 for y in (first(y0.max(ny))..=y1.min(ny + NODE_DIM - 1)).step_by(8) {
