@@ -5,7 +5,7 @@
 use std::path::Path;
 
 /// The top-level modules from the bottom up; modules on one rank may not use each other.
-const LAYERS: [&[&str]; 14] = [
+const LAYERS: [&[&str]; 15] = [
     &["error"],
     &[
         "system",
@@ -15,6 +15,7 @@ const LAYERS: [&[&str]; 14] = [
         "random",
         "choice",
     ],
+    &["parallel_concat"],
     &["grid"],
     &["contour"],
     &["ffi"],
