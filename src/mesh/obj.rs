@@ -559,17 +559,12 @@ fn join_pieces(pieces: Vec<Piece>) -> std::result::Result<Parsed, LineError> {
         (None, None) => {}
     }
     let (mut positions, mut colors, mut indices) = (Vec::new(), Vec::new(), Vec::new());
+    let mut polylines = Vec::new();
+    let mut texture = CornerValues::new("texture coordinates (vt)");
+    let mut normals = CornerValues::new("normals (vn)");
+    // The first face starts at 0; a piece's faces end where they end in all the indices,
+    // after the pieces before its own.
     let mut face_ends = vec![vec![0u32]];
-    let mut out = Parsed {
-        positions: Vec::new(),
-        colors: Vec::new(),
-        indices: Vec::new(),
-        face_starts: Vec::new(),
-        polylines: Vec::new(),
-        texture: CornerValues::new("texture coordinates (vt)"),
-        normals: CornerValues::new("normals (vn)"),
-    };
-    // A face's end is where it ends in all the indices: after the pieces before its own.
     let mut shifts = vec![0u32];
     let mut before = 0;
     for piece in pieces {
@@ -580,15 +575,19 @@ fn join_pieces(pieces: Vec<Piece>) -> std::result::Result<Parsed, LineError> {
         colors.push(p.colors);
         indices.push(p.indices);
         face_ends.push(p.face_starts);
-        out.polylines.extend(p.polylines);
-        out.texture.join(p.texture);
-        out.normals.join(p.normals);
+        polylines.extend(p.polylines);
+        texture.join(p.texture);
+        normals.join(p.normals);
     }
-    out.positions = concat(positions);
-    out.colors = concat(colors);
-    out.indices = concat(indices);
-    out.face_starts = concat_with(face_ends, |k, end| end + shifts[k]);
-    Ok(out)
+    Ok(Parsed {
+        positions: concat(positions),
+        colors: concat(colors),
+        indices: concat(indices),
+        face_starts: concat_with(face_ends, |k, end| end + shifts[k]),
+        polylines,
+        texture,
+        normals,
+    })
 }
 
 #[cfg(test)]

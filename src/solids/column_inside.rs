@@ -109,14 +109,12 @@ fn inside_blocks(columns: &ColumnCrossings, near: &SparseGrid) -> Vec<NodeMask> 
                                 continue;
                             }
                             let at = [nx, ny, node(z)];
-                            let mask = match masks.iter().position(|m| m.node() == at) {
-                                Some(k) => &mut masks[k],
-                                None => {
-                                    masks.push(NodeMask::new(at));
-                                    masks.last_mut().expect("just pushed")
-                                }
-                            };
-                            mask.insert([x, y, z]);
+                            let k = masks.iter().position(|m| m.node() == at);
+                            let k = k.unwrap_or_else(|| {
+                                masks.push(NodeMask::new(at));
+                                masks.len() - 1
+                            });
+                            masks[k].insert([x, y, z]);
                         }
                     });
                 }
